@@ -1,0 +1,22 @@
+// Registration of rilbed's subcommands. Each subcommand lives in its own cmd_*.cpp,
+// parses its options with CLI11 and calls into the modules; it holds no logic of its own
+// beyond turning options into configs and results into output.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace rilbed::app {
+
+/// `rilbed patterns`: printable marker files (SVG, PDF, PNG).
+void add_patterns_command(CLI::App& app);
+/// `rilbed detect`: the overhead-camera pipeline over a video, images or a camera.
+void add_detect_command(CLI::App& app);
+/// `rilbed calibrate intrinsics|field`: camera and field calibration.
+void add_calibrate_command(CLI::App& app);
+/// `rilbed synth`: renders footage with ground truth from the synthetic overhead camera.
+void add_synth_command(CLI::App& app);
+
+/// Exit code a subcommand's callback stores for main() to return.
+int& exit_code();
+
+}  // namespace rilbed::app

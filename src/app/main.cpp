@@ -1,0 +1,37 @@
+// rilbed: the command line. Thin subcommands over the modules; see README.md.
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <exception>
+#include <iostream>
+
+#include "app/commands.hpp"
+
+namespace rilbed::app {
+int& exit_code() {
+  static int code = 0;
+  return code;
+}
+}  // namespace rilbed::app
+
+int main(int argc, char** argv) {
+  CLI::App app{"rilbed: a robot-in-the-loop test bed for teams of small mobile robots"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "rilbed 0.1.0");
+  // Logs go to stderr so that CSV written to stdout stays clean.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("rilbed"));
+  spdlog::set_pattern("rilbed: %^%l%$: %v");
+  rilbed::app::add_patterns_command(app);
+  rilbed::app::add_detect_command(app);
+  rilbed::app::add_calibrate_command(app);
+  rilbed::app::add_synth_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  }
+  return rilbed::app::exit_code();
+}

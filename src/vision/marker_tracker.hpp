@@ -1,0 +1,115 @@
+// The overhead-camera pipeline of paper 001 §4.2 for one stream of frames: blob
+// detection, circular cross-covariance decoding, object-to-ID assignment, and a tracker
+// that searches near each marker's last position before any full-frame search.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <optional>
+#include <vector>
+
+#include "vision/blob_detector.hpp"
+#include "vision/decoder.hpp"
+#include "vision/marker_family.hpp"
+
+namespace rilbed::vision {
+
+/// One identified marker in one frame, in image coordinates (u right, v down, pixels,
+/// the centre of the top-left pixel is (0, 0)).
+struct MarkerDetection {
+  int id = 0;
+  double u = 0.0;
+  double v = 0.0;
+  /// Heading of the robot's forward direction (bisector of the key slice), degrees
+  /// counter-clockwise on screen from +u, i.e. atan2(-dv, du), in [0, 360).
+  double heading_deg = 0.0;
+  /// Circular cross-covariance of the sampled signal with the ID's ideal signal, in
+  /// [-1, 1]; 1 is a perfect match.
+  double score = 0.0;
+  /// Diameter of the marker's dark disc scaled to the marker's outer diameter, pixels
+  /// (the geometric mean of the ellipse axes).
+  double diameter_px = 0.0;
+  /// True when this frame found it by the local search around its last position.
+  bool tracked = false;
+};
+
+/// Knobs of the whole pipeline.
+struct TrackerConfig {
+  BlobDetectorConfig blobs;
+  DecoderConfig decoder;
+  /// Smallest similarity at which an object may take an ID. Lower finds markers in
+  /// worse images but lets clutter through more often.
+  double min_assign_score = 0.70;
+  /// Local-search window half-size as a multiple of the marker's diameter, plus the
+  /// distance it moved in the last frame. Larger tolerates faster robots, costs more.
+  double search_window_diameters = 1.5;
+  /// When some expected IDs are missing, a full-frame search runs at most every this
+  /// many frames (1: every frame). Larger makes missing robots cheaper and found later.
+  int full_search_interval_frames = 1;
+  /// A track is dropped after this many frames without a detection.
+  int max_missed_frames = 15;
+  /// Bonus added to the similarity of an object lying inside the search window of the
+  /// track of the same ID. Keeps IDs stable when two codes look alike in a poor frame.
+  double track_bonus = 0.05;
+};
+
+/// Per-frame work counters, for summaries and benchmarks.
+struct FrameStats {
+  bool full_search = false;  ///< a full-frame search ran
+  int blobs = 0;             ///< candidate blobs that passed the shape tests
+  int decoded = 0;           ///< blobs whose signal was decodable
+};
+
+/// Runs the pipeline over a stream of frames of one size. Not thread-safe; one per
+/// camera. The family is copied.
+class MarkerTracker {
+ public:
+  /// `ids` are the IDs that may appear (paper: the "available markers"); each is given
+  /// to at most one object per frame. Throws std::invalid_argument for an ID outside
+  /// the family or an empty list.
+  MarkerTracker(MarkerFamily family, std::vector<int> ids, TrackerConfig config = {});
+
+  /// Processes one frame (8-bit grey or BGR). Returns the identified markers sorted by ID.
+  std::vector<MarkerDetection> process(const cv::Mat& frame);
+
+  /// Processes one frame with a full-frame search only, ignoring and not updating the
+  /// tracks (what a single image gets).
+  std::vector<MarkerDetection> detect_full_frame(const cv::Mat& frame);
+
+  /// Forgets every track (e.g. after a cut in the footage).
+  void reset();
+
+  /// Counters of the last processed frame.
+  const FrameStats& last_stats() const { return stats_; }
+  /// The IDs this tracker assigns.
+  const std::vector<int>& ids() const { return ids_; }
+  const TrackerConfig& config() const { return config_; }
+
+ private:
+  struct Track {
+    int id = 0;
+    double u = 0, v = 0, du = 0, dv = 0;  // position and per-frame motion
+    double diameter_px = 0;
+    int missed = 0;
+  };
+  std::vector<MarkerDetection> assign(const cv::Mat& grey, const std::vector<Blob>& blobs,
+                                      bool use_tracks);
+  cv::Mat to_grey(const cv::Mat& frame);
+
+  MarkerFamily family_;
+  std::vector<int> ids_;
+  TrackerConfig config_;
+  BlobDetector detector_;
+  Decoder decoder_;
+  std::vector<Track> tracks_;
+  FrameStats stats_;
+  int frames_since_full_ = 0;
+  cv::Mat grey_buffer_;
+};
+
+/// Convenience: one full-frame detection of `ids` in one image with default knobs.
+std::vector<MarkerDetection> detect_markers(const cv::Mat& image, const MarkerFamily& family,
+                                            const std::vector<int>& ids,
+                                            const TrackerConfig& config = {});
+
+}  // namespace rilbed::vision
