@@ -1,1 +1,292 @@
-// placeholder: being written
+#include "vision/blob_detector.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "core/geometry.hpp"
+#include "vision/marker_family.hpp"
+
+namespace rilbed::vision {
+
+namespace {
+// Fraction of the marker's outer diameter taken by the dark disc the detector finds.
+constexpr double kDiscFraction = MarkerFamily::black_ring_outer_radius;
+// Pixels are sampled every kStatStep rows and columns for the tile statistics: the
+// thinnest feature they must see (a 24 px marker's black ring) is over 2 px wide.
+constexpr int kStatStep = 2;
+}  // namespace
+
+double Blob::disc_diameter_px() const { return 2.0 * std::sqrt(filled_area_px / kPi); }
+
+// Bookkeeping of one flood fill.
+struct BlobDetector::Fill {
+  int area = 0;
+  int x0 = 0, x1 = 0, y0 = 0, y1 = 0;  // bounding box, inclusive
+  bool touches_border = false;
+  bool too_large = false;
+};
+
+BlobDetector::BlobDetector(BlobDetectorConfig config) : config_(config) {
+  config_.tile_px = std::max(2, config_.tile_px);
+  config_.min_diameter_px = std::max(6.0, config_.min_diameter_px);
+}
+
+void BlobDetector::prepare(const cv::Mat& grey) {
+  if (grey.size() == size_) return;
+  size_ = grey.size();
+  tiles_x_ = (size_.width + config_.tile_px - 1) / config_.tile_px;
+  tiles_y_ = (size_.height + config_.tile_px - 1) / config_.tile_px;
+  tile_col_.resize(size_.width);
+  tile_row_.resize(size_.height);
+  for (int x = 0; x < size_.width; ++x) tile_col_[x] = x / config_.tile_px;
+  for (int y = 0; y < size_.height; ++y) tile_row_[y] = y / config_.tile_px;
+  const std::size_t tiles = static_cast<std::size_t>(tiles_x_) * tiles_y_;
+  tile_min_.assign(tiles, 0);
+  tile_max_.assign(tiles, 0);
+  tile_threshold_.assign(tiles, 0);
+  visited_ = cv::Mat::zeros(size_, CV_8UC1);
+  row_min_x_.assign(size_.height, 0);
+  row_max_x_.assign(size_.height, -1);
+  col_min_y_.assign(size_.width, 0);
+  col_max_y_.assign(size_.width, -1);
+}
+
+void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
+  const int t = config_.tile_px;
+  const int tx0 = std::max(0, roi.x / t - 1), tx1 = std::min(tiles_x_ - 1, (roi.x + roi.width - 1) / t + 1);
+  const int ty0 = std::max(0, roi.y / t - 1), ty1 = std::min(tiles_y_ - 1, (roi.y + roi.height - 1) / t + 1);
+  for (int ty = ty0; ty <= ty1; ++ty) {
+    const int y_end = std::min(size_.height, (ty + 1) * t);
+    for (int tx = tx0; tx <= tx1; ++tx) {
+      const int x_end = std::min(size_.width, (tx + 1) * t);
+      std::uint8_t mn = 255, mx = 0;
+      for (int y = ty * t; y < y_end; y += kStatStep) {
+        const std::uint8_t* row = grey.ptr<std::uint8_t>(y);
+        for (int x = tx * t; x < x_end; x += kStatStep) {
+          mn = std::min(mn, row[x]);
+          mx = std::max(mx, row[x]);
+        }
+      }
+      tile_min_[ty * tiles_x_ + tx] = mn;
+      tile_max_[ty * tiles_x_ + tx] = mx;
+    }
+  }
+  // The threshold of a tile comes from its 3x3 neighbourhood so that a marker larger
+  // than one tile sees one consistent threshold across its dark disc.
+  for (int ty = std::min(ty0 + 1, ty1); ty <= std::max(ty1 - 1, ty0); ++ty) {
+    for (int tx = std::min(tx0 + 1, tx1); tx <= std::max(tx1 - 1, tx0); ++tx) {
+      int mn = 255, mx = 0;
+      for (int ny = std::max(0, ty - 1); ny <= std::min(tiles_y_ - 1, ty + 1); ++ny) {
+        for (int nx = std::max(0, tx - 1); nx <= std::min(tiles_x_ - 1, tx + 1); ++nx) {
+          mn = std::min<int>(mn, tile_min_[ny * tiles_x_ + nx]);
+          mx = std::max<int>(mx, tile_max_[ny * tiles_x_ + nx]);
+        }
+      }
+      tile_threshold_[ty * tiles_x_ + tx] =
+          (mx - mn >= config_.min_local_contrast) ? static_cast<std::uint8_t>((mn + mx + 1) / 2) : 0;
+    }
+  }
+}
+
+bool BlobDetector::flood_fill(const cv::Mat& grey, cv::Rect roi, int seed_x, int seed_y, Fill& fill) {
+  const double max_disc_d = config_.max_diameter_px * kDiscFraction;
+  const int max_area = static_cast<int>(kPi * max_disc_d * max_disc_d / 4.0 * 1.3) + 16;
+  // A region far beyond any marker is still labelled (so it is not seeded again and
+  // again) up to this bound, which keeps the worst case linear in the frame size.
+  const int hard_limit = std::max(max_area * 4, 4096);
+  const int rx0 = roi.x, rx1 = roi.x + roi.width - 1, ry0 = roi.y, ry1 = roi.y + roi.height - 1;
+  fill = Fill{0, seed_x, seed_x, seed_y, seed_y, false, false};
+  auto dark = [&](int x, int y) { return grey.at<std::uint8_t>(y, x) < threshold_at(x, y); };
+
+  stack_.clear();
+  stack_.emplace_back(seed_x, seed_y);
+  while (!stack_.empty()) {
+    auto [sx, y] = stack_.back();
+    stack_.pop_back();
+    std::uint8_t* vis = visited_.ptr<std::uint8_t>(y);
+    if (vis[sx] || !dark(sx, y)) continue;
+    int xl = sx, xr = sx;
+    while (xl > rx0 && !vis[xl - 1] && dark(xl - 1, y)) --xl;
+    while (xr < rx1 && !vis[xr + 1] && dark(xr + 1, y)) ++xr;
+    std::fill(vis + xl, vis + xr + 1, std::uint8_t{1});
+    fill.area += xr - xl + 1;
+    if (xl == rx0 || xr == rx1 || y == ry0 || y == ry1) fill.touches_border = true;
+    fill.x0 = std::min(fill.x0, xl);
+    fill.x1 = std::max(fill.x1, xr);
+    fill.y0 = std::min(fill.y0, y);
+    fill.y1 = std::max(fill.y1, y);
+    if (row_max_x_[y] < row_min_x_[y]) {
+      row_min_x_[y] = xl;
+      row_max_x_[y] = xr;
+    } else {
+      row_min_x_[y] = std::min(row_min_x_[y], xl);
+      row_max_x_[y] = std::max(row_max_x_[y], xr);
+    }
+    for (int x = xl; x <= xr; ++x) {
+      if (col_max_y_[x] < col_min_y_[x]) {
+        col_min_y_[x] = col_max_y_[x] = y;
+      } else {
+        col_min_y_[x] = std::min(col_min_y_[x], y);
+        col_max_y_[x] = std::max(col_max_y_[x], y);
+      }
+    }
+    if (fill.area > max_area) fill.too_large = true;
+    if (fill.area > hard_limit) break;
+    for (int ny : {y - 1, y + 1}) {
+      if (ny < ry0 || ny > ry1) continue;
+      const std::uint8_t* nvis = visited_.ptr<std::uint8_t>(ny);
+      for (int x = xl; x <= xr; ++x) {
+        if (!nvis[x] && dark(x, ny)) {
+          stack_.emplace_back(x, ny);
+          while (x < xr && !nvis[x + 1] && dark(x + 1, ny)) ++x;  // one seed per run
+        }
+      }
+    }
+  }
+  return !fill.too_large && !fill.touches_border;
+}
+
+namespace {
+
+// Position, between pixel centres `outside` and `inside`, where the grey level crosses
+// the threshold (linear interpolation). Returns the offset from `inside` towards
+// `outside` in [0, 1].
+double edge_offset(double outside_level, double inside_level, double threshold) {
+  const double span = outside_level - inside_level;
+  if (span <= 0.0) return 0.5;
+  return std::clamp((threshold - inside_level) / span, 0.0, 1.0);
+}
+
+// Running sums of the moments of a region built from parallel chords.
+struct ChordMoments {
+  double area = 0, along = 0, along2 = 0, cross_along = 0, cross = 0;
+  // A chord [a, b] (along the chord's axis) at position c (across).
+  void add(double a, double b, double c) {
+    const double len = b - a;
+    area += len;
+    along += (b * b - a * a) / 2.0;
+    along2 += (b * b * b - a * a * a) / 3.0;
+    cross_along += c * (b * b - a * a) / 2.0;
+    cross += c * len;
+  }
+};
+
+// Expected length of the chord at offset `d` across an ellipse whose quadratic form
+// is q_along*s^2 + 2*q_mixed*s*d + q_across*d^2 = 1.
+double ellipse_chord(double q_along, double q_mixed, double q_across, double d) {
+  const double disc = q_mixed * q_mixed * d * d - q_along * (q_across * d * d - 1.0);
+  return disc > 0.0 ? 2.0 * std::sqrt(disc) / q_along : 0.0;
+}
+
+}  // namespace
+
+bool BlobDetector::measure(const cv::Mat& grey, const Fill& fill, Blob& blob) const {
+  // Sub-pixel chords along rows (for x moments) and along columns (for y moments).
+  ChordMoments rows, cols;
+  std::vector<std::array<double, 3>> row_chords, col_chords;  // {a, b, position}
+  row_chords.reserve(fill.y1 - fill.y0 + 1);
+  col_chords.reserve(fill.x1 - fill.x0 + 1);
+  for (int y = fill.y0; y <= fill.y1; ++y) {
+    const int xl = row_min_x_[y], xr = row_max_x_[y];
+    if (xr < xl) continue;
+    const std::uint8_t* row = grey.ptr<std::uint8_t>(y);
+    double a = xl - 0.5, b = xr + 0.5;
+    if (xl > 0) a = xl - edge_offset(row[xl - 1], row[xl], threshold_at(xl, y));
+    if (xr + 1 < grey.cols) b = xr + edge_offset(row[xr + 1], row[xr], threshold_at(xr, y));
+    rows.add(a, b, y);
+    row_chords.push_back({a, b, static_cast<double>(y)});
+  }
+  for (int x = fill.x0; x <= fill.x1; ++x) {
+    const int yt = col_min_y_[x], yb = col_max_y_[x];
+    if (yb < yt) continue;
+    double a = yt - 0.5, b = yb + 0.5;
+    if (yt > 0) a = yt - edge_offset(grey.at<std::uint8_t>(yt - 1, x), grey.at<std::uint8_t>(yt, x), threshold_at(x, yt));
+    if (yb + 1 < grey.rows) b = yb + edge_offset(grey.at<std::uint8_t>(yb + 1, x), grey.at<std::uint8_t>(yb, x), threshold_at(x, yb));
+    cols.add(a, b, x);
+    col_chords.push_back({a, b, static_cast<double>(x)});
+  }
+  if (rows.area <= 0.0 || cols.area <= 0.0) return false;
+
+  const double cx = rows.along / rows.area;
+  const double cy = cols.along / cols.area;
+  const double sxx = rows.along2 / rows.area - cx * cx;
+  const double syy = cols.along2 / cols.area - cy * cy;
+  const double sxy = 0.5 * (rows.cross_along / rows.area - cx * rows.cross / rows.area +
+                            cols.cross_along / cols.area - cy * cols.cross / cols.area);
+  const double det = sxx * syy - sxy * sxy;
+  if (sxx <= 0.0 || syy <= 0.0 || det <= 0.0) return false;
+
+  // Axis ratio from the eigenvalues of the covariance.
+  const double mean = 0.5 * (sxx + syy);
+  const double diff = std::sqrt(0.25 * (sxx - syy) * (sxx - syy) + sxy * sxy);
+  const double l_major = mean + diff, l_minor = mean - diff;
+  if (l_minor <= 0.0 || std::sqrt(l_major / l_minor) > config_.max_axis_ratio) return false;
+
+  // A uniform ellipse with covariance S has outline q^T (4S)^-1 q = 1 and area 4*pi*sqrt(det S).
+  const double ellipse_area = 4.0 * kPi * std::sqrt(det);
+  const double area = 0.5 * (rows.area + cols.area);
+  if (std::abs(area - ellipse_area) > config_.max_area_error * ellipse_area) return false;
+
+  const double inv = 1.0 / (4.0 * det);
+  const double qxx = syy * inv, qyy = sxx * inv, qxy = -sxy * inv;
+  auto chord_error = [](const std::vector<std::array<double, 3>>& chords, double q_along, double q_mixed,
+                        double q_across, double centre_along, double centre_across) {
+    double err = 0.0, longest = 0.0;
+    for (const auto& c : chords) {
+      const double model = ellipse_chord(q_along, q_mixed, q_across, c[2] - centre_across);
+      longest = std::max(longest, model);
+      // The chord's midpoint must also sit where the ellipse's does.
+      const double mid_model = centre_along - q_mixed * (c[2] - centre_across) / q_along;
+      err += std::abs((c[1] - c[0]) - model) + std::abs(0.5 * (c[0] + c[1]) - mid_model);
+    }
+    return longest > 0.0 ? err / (chords.size() * longest) : 1.0;
+  };
+  if (chord_error(row_chords, qxx, qxy, qyy, cx, cy) > config_.max_chord_error) return false;
+  if (chord_error(col_chords, qyy, qxy, qxx, cy, cx) > config_.max_chord_error) return false;
+
+  // Symmetric square root of 4S maps the unit circle onto the outline.
+  const double s = std::sqrt(det);
+  const double t = std::sqrt(sxx + syy + 2.0 * s);
+  blob.shape = cv::Matx22d(sxx + s, sxy, sxy, syy + s) * (2.0 / t);
+  blob.u = cx;
+  blob.v = cy;
+  blob.filled_area_px = area;
+  blob.threshold = threshold_at(std::clamp(static_cast<int>(cx), 0, grey.cols - 1),
+                                std::clamp(static_cast<int>(cy), 0, grey.rows - 1));
+  return true;
+}
+
+std::vector<Blob> BlobDetector::detect(const cv::Mat& grey, cv::Rect roi) {
+  CV_Assert(grey.type() == CV_8UC1);
+  prepare(grey);
+  roi &= cv::Rect(0, 0, grey.cols, grey.rows);
+  std::vector<Blob> blobs;
+  if (roi.width < 3 || roi.height < 3) return blobs;
+  compute_thresholds(grey, roi);
+  for (int y = roi.y; y < roi.y + roi.height; ++y) {
+    std::fill_n(visited_.ptr<std::uint8_t>(y) + roi.x, roi.width, std::uint8_t{0});
+  }
+
+  const double min_disc_d = config_.min_diameter_px * kDiscFraction;
+  const double min_area = kPi * min_disc_d * min_disc_d / 4.0 / config_.max_axis_ratio * 0.8;
+  const int step = config_.seed_row_step > 0 ? config_.seed_row_step
+                                             : std::max(1, static_cast<int>(min_disc_d / 4.0));
+  Fill fill;
+  for (int y = roi.y + step / 2; y < roi.y + roi.height; y += step) {
+    const std::uint8_t* row = grey.ptr<std::uint8_t>(y);
+    const std::uint8_t* vis = visited_.ptr<std::uint8_t>(y);
+    for (int x = roi.x; x < roi.x + roi.width; ++x) {
+      if (vis[x] || row[x] >= threshold_at(x, y)) continue;
+      const bool whole = flood_fill(grey, roi, x, y, fill);
+      Blob blob;
+      if (whole && fill.area >= min_area && measure(grey, fill, blob)) blobs.push_back(blob);
+      // Reset the chord bookkeeping of the rows and columns this fill touched.
+      for (int r = fill.y0; r <= fill.y1; ++r) { row_min_x_[r] = 0; row_max_x_[r] = -1; }
+      for (int c = fill.x0; c <= fill.x1; ++c) { col_min_y_[c] = 0; col_max_y_[c] = -1; }
+    }
+  }
+  return blobs;
+}
+
+}  // namespace rilbed::vision

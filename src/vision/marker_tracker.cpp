@@ -1,1 +1,167 @@
-// placeholder: being written
+#include "vision/marker_tracker.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "vision/assignment.hpp"
+
+namespace rilbed::vision {
+
+namespace {
+
+std::vector<int> checked_ids(const MarkerFamily& family, std::vector<int> ids) {
+  if (ids.empty()) throw std::invalid_argument("the tracker needs at least one ID");
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  for (int id : ids) {
+    if (!family.valid_id(id)) {
+      throw std::invalid_argument("ID " + std::to_string(id) + " is not in family " + family.name());
+    }
+  }
+  return ids;
+}
+
+// Two searches can find the same blob; keep one per place.
+void append_unique(std::vector<Blob>& into, const std::vector<Blob>& found) {
+  for (const Blob& b : found) {
+    const double radius = 0.25 * b.disc_diameter_px();
+    const bool seen = std::any_of(into.begin(), into.end(), [&](const Blob& o) {
+      return std::hypot(o.u - b.u, o.v - b.v) < radius;
+    });
+    if (!seen) into.push_back(b);
+  }
+}
+
+}  // namespace
+
+MarkerTracker::MarkerTracker(MarkerFamily family, std::vector<int> ids, TrackerConfig config)
+    : family_(std::move(family)),
+      ids_(checked_ids(family_, std::move(ids))),
+      config_(config),
+      detector_(config.blobs),
+      decoder_(family_, ids_, config.decoder) {}
+
+void MarkerTracker::reset() {
+  tracks_.clear();
+  frames_since_full_ = 0;
+}
+
+cv::Mat MarkerTracker::to_grey(const cv::Mat& frame) {
+  if (frame.empty()) throw std::invalid_argument("empty frame");
+  if (frame.type() == CV_8UC1) return frame;
+  if (frame.type() == CV_8UC3) {
+    cv::cvtColor(frame, grey_buffer_, cv::COLOR_BGR2GRAY);
+  } else if (frame.type() == CV_8UC4) {
+    cv::cvtColor(frame, grey_buffer_, cv::COLOR_BGRA2GRAY);
+  } else if (frame.depth() == CV_16U && frame.channels() == 1) {
+    frame.convertTo(grey_buffer_, CV_8U, 1.0 / 257.0);
+  } else {
+    throw std::invalid_argument("unsupported frame type (expected 8-bit grey, BGR or BGRA)");
+  }
+  return grey_buffer_;
+}
+
+std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const std::vector<Blob>& blobs,
+                                                   bool use_tracks) {
+  std::vector<std::vector<double>> similarity;
+  std::vector<std::vector<CodeMatch>> matches;
+  similarity.reserve(blobs.size());
+  matches.reserve(blobs.size());
+  stats_.blobs = static_cast<int>(blobs.size());
+  stats_.decoded = 0;
+  for (const Blob& blob : blobs) {
+    const SampledSignal signal = decoder_.sample(grey, blob);
+    if (signal.usable) ++stats_.decoded;
+    matches.push_back(decoder_.match_all(signal, blob));
+    std::vector<double> row(ids_.size(), -1.0);
+    for (std::size_t c = 0; c < ids_.size(); ++c) {
+      const double score = matches.back()[c].score;
+      if (score < config_.min_assign_score) continue;
+      row[c] = score;
+      if (!use_tracks) continue;
+      for (const Track& t : tracks_) {
+        if (t.id != ids_[c]) continue;
+        const double ahead = t.missed + 1.0;
+        const double gate = config_.search_window_diameters * t.diameter_px + ahead * std::hypot(t.du, t.dv);
+        if (std::hypot(blob.u - (t.u + t.du * ahead), blob.v - (t.v + t.dv * ahead)) < gate) {
+          row[c] += config_.track_bonus;
+        }
+      }
+    }
+    similarity.push_back(std::move(row));
+  }
+  const std::vector<int> chosen = assign_max_similarity(similarity, config_.min_assign_score);
+  std::vector<MarkerDetection> out;
+  for (std::size_t r = 0; r < blobs.size(); ++r) {
+    if (chosen[r] < 0) continue;
+    const CodeMatch& m = matches[r][chosen[r]];
+    const Blob& b = blobs[r];
+    const double disc_d = 2.0 * std::sqrt(std::abs(cv::determinant(b.shape)));
+    out.push_back({m.id, b.u, b.v, m.heading_deg, m.score, disc_d / MarkerFamily::black_ring_outer_radius, false});
+  }
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
+  return out;
+}
+
+std::vector<MarkerDetection> MarkerTracker::detect_full_frame(const cv::Mat& frame) {
+  const cv::Mat grey = to_grey(frame);
+  stats_ = FrameStats{};
+  stats_.full_search = true;
+  return assign(grey, detector_.detect(grey), false);
+}
+
+std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
+  const cv::Mat grey = to_grey(frame);
+  stats_ = FrameStats{};
+  std::vector<Blob> blobs;
+  for (const Track& t : tracks_) {
+    // A track that missed frames coasts: its window moves on and widens with them.
+    const double ahead = t.missed + 1.0;
+    const double pu = t.u + t.du * ahead, pv = t.v + t.dv * ahead;
+    const double half = (config_.search_window_diameters + 0.5) * t.diameter_px + ahead * std::hypot(t.du, t.dv);
+    const cv::Rect roi(static_cast<int>(std::floor(pu - half)), static_cast<int>(std::floor(pv - half)),
+                       static_cast<int>(std::ceil(2 * half)) + 1, static_cast<int>(std::ceil(2 * half)) + 1);
+    append_unique(blobs, detector_.detect(grey, roi));
+  }
+  std::vector<MarkerDetection> found = assign(grey, blobs, true);
+  for (auto& d : found) d.tracked = true;
+
+  const bool all_found = found.size() == ids_.size();
+  ++frames_since_full_;
+  if (tracks_.empty() || (!all_found && frames_since_full_ >= config_.full_search_interval_frames)) {
+    frames_since_full_ = 0;
+    append_unique(blobs, detector_.detect(grey));
+    found = assign(grey, blobs, true);
+    stats_.full_search = true;
+  }
+
+  // Update the tracks: move the seen ones, coast the others, drop the long-lost.
+  for (Track& t : tracks_) ++t.missed;
+  for (const MarkerDetection& d : found) {
+    auto it = std::find_if(tracks_.begin(), tracks_.end(), [&](const Track& t) { return t.id == d.id; });
+    if (it == tracks_.end()) {
+      tracks_.push_back({d.id, d.u, d.v, 0.0, 0.0, d.diameter_px, 0});
+      continue;
+    }
+    const int frames = it->missed;  // frames since the last sighting, >= 1
+    it->du = (d.u - it->u) / frames;
+    it->dv = (d.v - it->v) / frames;
+    it->u = d.u;
+    it->v = d.v;
+    it->diameter_px = d.diameter_px;
+    it->missed = 0;
+  }
+  std::erase_if(tracks_, [&](const Track& t) { return t.missed > config_.max_missed_frames; });
+  return found;
+}
+
+std::vector<MarkerDetection> detect_markers(const cv::Mat& image, const MarkerFamily& family,
+                                            const std::vector<int>& ids, const TrackerConfig& config) {
+  MarkerTracker tracker(family, ids, config);
+  return tracker.detect_full_frame(image);
+}
+
+}  // namespace rilbed::vision

@@ -1,1 +1,310 @@
-// placeholder: being written
+#include "vision/synthetic_camera.hpp"
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/geometry.hpp"
+
+namespace rilbed::vision {
+
+CameraModel CameraModel::overhead(cv::Size image_size, double vfov_deg, cv::Point2d target_m, double height_m,
+                                  double tilt_deg, double k1, double k2) {
+  CameraModel cam;
+  cam.image_size = image_size;
+  const double f = 0.5 * image_size.height / std::tan(deg_to_rad(vfov_deg) / 2.0);
+  cam.camera_matrix = cv::Matx33d(f, 0, (image_size.width - 1) / 2.0, 0, f, (image_size.height - 1) / 2.0, 0, 0, 1);
+  cam.distortion = {k1, k2, 0, 0, 0};
+  // Looking straight down: camera x = field x, camera y = field -y, camera z = field -z.
+  const cv::Matx33d down(1, 0, 0, 0, -1, 0, 0, 0, -1);
+  const double t = deg_to_rad(tilt_deg);
+  const cv::Matx33d tilt(1, 0, 0, 0, std::cos(t), -std::sin(t), 0, std::sin(t), std::cos(t));
+  const cv::Matx33d r = tilt * down;
+  // Place the camera on its optical axis through the target, at the given height.
+  const cv::Vec3d axis_world = r.t() * cv::Vec3d(0, 0, 1);
+  const double distance = height_m / -axis_world[2];
+  const cv::Vec3d centre = cv::Vec3d(target_m.x, target_m.y, 0.0) - distance * axis_world;
+  cv::Rodrigues(r, cam.rvec);
+  cam.tvec = -(r * centre);
+  return cam;
+}
+
+std::vector<cv::Point2d> CameraModel::project(const std::vector<cv::Point3d>& points_m) const {
+  std::vector<cv::Point2d> out;
+  if (points_m.empty()) return out;
+  cv::projectPoints(points_m, rvec, tvec, camera_matrix, distortion, out);
+  return out;
+}
+
+cv::Matx33d CameraModel::pixel_to_plane_homography(double z_m) const {
+  cv::Matx33d r;
+  cv::Rodrigues(rvec, r);
+  // Plane point (x, y, z_m) -> camera: R (x, y, z_m) + t = x r1 + y r2 + (z_m r3 + t).
+  const cv::Vec3d r1(r(0, 0), r(1, 0), r(2, 0)), r2(r(0, 1), r(1, 1), r(2, 1)), r3(r(0, 2), r(1, 2), r(2, 2));
+  const cv::Vec3d c3 = z_m * r3 + tvec;
+  const cv::Matx33d plane_to_cam(r1[0], r2[0], c3[0], r1[1], r2[1], c3[1], r1[2], r2[2], c3[2]);
+  cv::Matx33d h = (camera_matrix * plane_to_cam).inv();
+  return h * (1.0 / h(2, 2));
+}
+
+namespace {
+
+// Reflectance of clutter at a field point, or -1 where it does not cover the floor.
+double clutter_at(const Clutter& c, double x, double y, double black, double white) {
+  switch (c.kind) {
+    case Clutter::Kind::DarkDisc:
+      return std::hypot(x - c.x_m, y - c.y_m) <= c.size_m / 2 ? black : -1.0;
+    case Clutter::Kind::Ring: {
+      const double r = std::hypot(x - c.x_m, y - c.y_m);
+      return (r <= c.size_m / 2 && r >= 0.3 * c.size_m) ? black : -1.0;
+    }
+    case Clutter::Kind::Tape: {
+      const Vec2 a{c.x_m, c.y_m}, b{c.x2_m, c.y2_m}, p{x, y};
+      const Vec2 ab = b - a;
+      const double t = std::clamp((p - a).dot(ab) / std::max(1e-12, ab.dot(ab)), 0.0, 1.0);
+      return (p - (a + ab * t)).norm() <= c.size_m / 2 ? black + 10.0 : -1.0;
+    }
+    case Clutter::Kind::Chessboard: {
+      const double dx = x - c.x_m, dy = y - c.y_m;
+      const double lx = std::cos(c.angle_rad) * dx + std::sin(c.angle_rad) * dy;
+      const double ly = -std::sin(c.angle_rad) * dx + std::cos(c.angle_rad) * dy;
+      const double gx = lx / c.size_m + c.cols / 2.0, gy = ly / c.size_m + c.rows / 2.0;
+      if (gx < -0.5 || gy < -0.5 || gx > c.cols + 0.5 || gy > c.rows + 0.5) return -1.0;
+      if (gx < 0 || gy < 0 || gx >= c.cols || gy >= c.rows) return white;  // margin
+      return ((static_cast<int>(gx) + static_cast<int>(gy)) % 2) ? white : black;
+    }
+    case Clutter::Kind::Text:
+      return -1.0;  // drawn with putText
+  }
+  return -1.0;
+}
+
+double lighting_gain(double ratio, double direction_rad, double x, double y, double lo, double hi) {
+  const double along = std::cos(direction_rad) * x + std::sin(direction_rad) * y;
+  const double t = std::clamp((along - lo) / std::max(1e-9, hi - lo), 0.0, 1.0);
+  return std::exp(std::log(ratio) * (t - 0.5));
+}
+
+}  // namespace
+
+SyntheticCamera::SyntheticCamera(CameraModel camera, MarkerFamily family, ImagingConditions conditions,
+                                 std::vector<Clutter> clutter)
+    : camera_(std::move(camera)), family_(std::move(family)), conditions_(conditions) {
+  const cv::Size size = camera_.image_size;
+  std::vector<cv::Point2d> pixels;
+  pixels.reserve(static_cast<std::size_t>(size.area()));
+  for (int v = 0; v < size.height; ++v) {
+    for (int u = 0; u < size.width; ++u) pixels.emplace_back(u, v);
+  }
+  std::vector<cv::Point2d> normalised;
+  cv::undistortPoints(pixels, normalised, camera_.camera_matrix, camera_.distortion, cv::noArray(), cv::noArray(),
+                      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 40, 1e-10));
+  cv::Matx33d r;
+  cv::Rodrigues(camera_.rvec, r);
+  const cv::Vec3d centre = -(r.t() * camera_.tvec);
+  field_x_.create(size, CV_64F);
+  field_y_.create(size, CV_64F);
+  for (int v = 0; v < size.height; ++v) {
+    for (int u = 0; u < size.width; ++u) {
+      const cv::Point2d& n = normalised[static_cast<std::size_t>(v) * size.width + u];
+      const cv::Vec3d d = r.t() * cv::Vec3d(n.x, n.y, 1.0);
+      const double s = d[2] < -1e-9 ? -centre[2] / d[2] : 1e6;  // rays above the horizon go far
+      field_x_.at<double>(v, u) = centre[0] + s * d[0];
+      field_y_.at<double>(v, u) = centre[1] + s * d[1];
+    }
+  }
+
+  // Static floor: a slightly uneven grey (low-frequency, fixed pattern), then clutter.
+  cv::Mat blotches(std::max(2, size.height / 64), std::max(2, size.width / 64), CV_32F);
+  cv::RNG floor_rng(7);
+  floor_rng.fill(blotches, cv::RNG::NORMAL, 0.0, 4.0);
+  cv::resize(blotches, floor_, size, 0, 0, cv::INTER_CUBIC);
+  floor_ += conditions_.floor_grey;
+  for (const Clutter& c : clutter) draw_clutter(floor_, c);
+
+  // Lighting varies across the field's extent as seen by this camera.
+  double lo = 1e300, hi = -1e300;
+  for (const auto& corner : {cv::Point(0, 0), cv::Point(size.width - 1, 0), cv::Point(0, size.height - 1),
+                             cv::Point(size.width - 1, size.height - 1)}) {
+    const double along = std::cos(conditions_.light_direction_rad) * field_x_.at<double>(corner) +
+                         std::sin(conditions_.light_direction_rad) * field_y_.at<double>(corner);
+    lo = std::min(lo, along);
+    hi = std::max(hi, along);
+  }
+  light_.create(size, CV_32F);
+  for (int v = 0; v < size.height; ++v) {
+    for (int u = 0; u < size.width; ++u) {
+      light_.at<float>(v, u) = static_cast<float>(lighting_gain(std::max(1.0, conditions_.light_ratio),
+                                                                conditions_.light_direction_rad,
+                                                                field_x_.at<double>(v, u), field_y_.at<double>(v, u), lo, hi));
+    }
+  }
+}
+
+cv::Point2d SyntheticCamera::field_at(double u, double v) const {
+  u = std::clamp(u, 0.0, field_x_.cols - 1.0001);
+  v = std::clamp(v, 0.0, field_x_.rows - 1.0001);
+  const int x = static_cast<int>(u), y = static_cast<int>(v);
+  const double fx = u - x, fy = v - y;
+  auto lerp = [&](const cv::Mat& m) {
+    return (m.at<double>(y, x) * (1 - fx) + m.at<double>(y, x + 1) * fx) * (1 - fy) +
+           (m.at<double>(y + 1, x) * (1 - fx) + m.at<double>(y + 1, x + 1) * fx) * fy;
+  };
+  return {lerp(field_x_), lerp(field_y_)};
+}
+
+namespace {
+
+// Pixel rectangle covering the projection of a field-aligned square (centre, half side).
+cv::Rect projected_box(const CameraModel& cam, double x, double y, double half, cv::Size size) {
+  std::vector<cv::Point3d> corners;
+  for (int i = 0; i < 16; ++i) {  // points around the square's outline bound a distorted image well
+    const double a = 2 * kPi * i / 16;
+    corners.emplace_back(x + 1.42 * half * std::cos(a), y + 1.42 * half * std::sin(a), 0.0);
+  }
+  const auto px = cam.project(corners);
+  double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
+  for (const auto& p : px) {
+    u0 = std::min(u0, p.x); v0 = std::min(v0, p.y);
+    u1 = std::max(u1, p.x); v1 = std::max(v1, p.y);
+  }
+  const cv::Rect box(static_cast<int>(std::floor(u0)) - 2, static_cast<int>(std::floor(v0)) - 2,
+                     static_cast<int>(std::ceil(u1 - u0)) + 5, static_cast<int>(std::ceil(v1 - v0)) + 5);
+  return box & cv::Rect(0, 0, size.width, size.height);
+}
+
+}  // namespace
+
+void SyntheticCamera::draw_marker(cv::Mat& reflectance, const SceneMarker& m) const {
+  const double radius = m.diameter_m / 2.0;
+  const cv::Rect box = projected_box(camera_, m.x_m, m.y_m, radius, reflectance.size());
+  const int s = std::max(1, conditions_.supersample);
+  const double c = std::cos(m.theta_rad), sn = std::sin(m.theta_rad);
+  for (int v = box.y; v < box.y + box.height; ++v) {
+    float* row = reflectance.ptr<float>(v);
+    for (int u = box.x; u < box.x + box.width; ++u) {
+      double acc = 0.0;
+      int covered = 0;
+      for (int j = 0; j < s; ++j) {
+        for (int i = 0; i < s; ++i) {
+          const cv::Point2d f = field_at(u + (i + 0.5) / s - 0.5, v + (j + 0.5) / s - 0.5);
+          const double dx = f.x - m.x_m, dy = f.y - m.y_m;
+          const double lx = c * dx + sn * dy, ly = -sn * dx + c * dy;
+          const double colour = family_.colour_at(m.id, std::hypot(lx, ly) / radius, rad_to_deg(std::atan2(ly, lx)));
+          if (colour < 0.0) continue;
+          acc += conditions_.black_grey + colour * (conditions_.white_grey - conditions_.black_grey);
+          ++covered;
+        }
+      }
+      if (covered == 0) continue;
+      row[u] = static_cast<float>((acc + (s * s - covered) * row[u]) / (s * s));
+    }
+  }
+}
+
+void SyntheticCamera::draw_clutter(cv::Mat& reflectance, const Clutter& c) const {
+  if (c.kind == Clutter::Kind::Text) {
+    const auto px = camera_.project({cv::Point3d(c.x_m, c.y_m, 0), cv::Point3d(c.x_m, c.y_m + c.size_m, 0)});
+    const double height_px = std::abs(px[1].y - px[0].y);
+    cv::putText(reflectance, c.text, px[0], cv::FONT_HERSHEY_SIMPLEX, std::max(0.2, height_px / 22.0),
+                cv::Scalar(conditions_.black_grey), std::max(1, static_cast<int>(height_px / 8)), cv::LINE_AA);
+    return;
+  }
+  double cx = c.x_m, cy = c.y_m, half = c.size_m;
+  if (c.kind == Clutter::Kind::Tape) {
+    cx = (c.x_m + c.x2_m) / 2;
+    cy = (c.y_m + c.y2_m) / 2;
+    half = std::hypot(c.x2_m - c.x_m, c.y2_m - c.y_m) / 2 + c.size_m;
+  } else if (c.kind == Clutter::Kind::Chessboard) {
+    half = c.size_m * (std::max(c.cols, c.rows) / 2.0 + 1.0);
+  }
+  const cv::Rect box = projected_box(camera_, cx, cy, half, reflectance.size());
+  const int s = std::max(1, conditions_.supersample);
+  for (int v = box.y; v < box.y + box.height; ++v) {
+    float* row = reflectance.ptr<float>(v);
+    for (int u = box.x; u < box.x + box.width; ++u) {
+      double acc = 0.0;
+      for (int j = 0; j < s; ++j) {
+        for (int i = 0; i < s; ++i) {
+          const cv::Point2d f = field_at(u + (i + 0.5) / s - 0.5, v + (j + 0.5) / s - 0.5);
+          const double g = clutter_at(c, f.x, f.y, conditions_.black_grey, conditions_.white_grey);
+          acc += g < 0.0 ? row[u] : g;
+        }
+      }
+      row[u] = static_cast<float>(acc / (s * s));
+    }
+  }
+}
+
+cv::Mat SyntheticCamera::render(const std::vector<SceneMarker>& markers, cv::RNG& rng) const {
+  cv::Mat reflectance = floor_.clone();
+  for (const SceneMarker& m : markers) draw_marker(reflectance, m);
+  cv::Mat radiance = reflectance.mul(light_);
+  if (conditions_.blur_sigma_px > 0.0) {
+    cv::GaussianBlur(radiance, radiance, cv::Size(), conditions_.blur_sigma_px);
+  }
+  if (conditions_.noise_sigma > 0.0) {
+    cv::Mat noise(radiance.size(), CV_32F);
+    rng.fill(noise, cv::RNG::NORMAL, 0.0, conditions_.noise_sigma);
+    radiance += noise;
+  }
+  cv::Mat grey, bgr;
+  radiance.convertTo(grey, CV_8U);  // saturates at 0 and 255
+  cv::cvtColor(grey, bgr, cv::COLOR_GRAY2BGR);
+  if (conditions_.jpeg_quality > 0) {
+    std::vector<std::uint8_t> jpeg;
+    cv::imencode(".jpg", bgr, jpeg, {cv::IMWRITE_JPEG_QUALITY, std::clamp(conditions_.jpeg_quality, 1, 100)});
+    bgr = cv::imdecode(jpeg, cv::IMREAD_COLOR);
+  }
+  return bgr;
+}
+
+std::vector<MarkerTruth> SyntheticCamera::truth(const std::vector<SceneMarker>& markers) const {
+  std::vector<MarkerTruth> out;
+  constexpr double kAhead_m = 0.001;
+  for (const SceneMarker& m : markers) {
+    const auto px = camera_.project({cv::Point3d(m.x_m, m.y_m, 0),
+                                     cv::Point3d(m.x_m + kAhead_m * std::cos(m.theta_rad),
+                                                 m.y_m + kAhead_m * std::sin(m.theta_rad), 0)});
+    MarkerTruth t;
+    t.id = m.id;
+    t.u = px[0].x;
+    t.v = px[0].y;
+    t.heading_deg = wrap_deg_360(rad_to_deg(std::atan2(-(px[1].y - px[0].y), px[1].x - px[0].x)));
+    t.x_m = m.x_m;
+    t.y_m = m.y_m;
+    t.theta_deg = wrap_deg_360(rad_to_deg(m.theta_rad));
+    const cv::Rect box = projected_box(camera_, m.x_m, m.y_m, m.diameter_m / 2, cv::Size(1 << 30, 1 << 30));
+    t.visible = box.x > 0 && box.y > 0 && box.x + box.width < camera_.image_size.width &&
+                box.y + box.height < camera_.image_size.height;
+    out.push_back(t);
+  }
+  return out;
+}
+
+cv::Mat render_marker_topdown(const MarkerFamily& family, int id, int size_px, double heading_deg,
+                              double background_grey, int supersample) {
+  cv::Mat out(size_px, size_px, CV_8UC1);
+  const double radius = size_px / 2.0, centre = (size_px - 1) / 2.0;
+  const int s = std::max(1, supersample);
+  for (int v = 0; v < size_px; ++v) {
+    for (int u = 0; u < size_px; ++u) {
+      double acc = 0.0;
+      for (int j = 0; j < s; ++j) {
+        for (int i = 0; i < s; ++i) {
+          const double dx = u + (i + 0.5) / s - 0.5 - centre, dy = -(v + (j + 0.5) / s - 0.5 - centre);
+          const double colour = family.colour_at(id, std::hypot(dx, dy) / radius,
+                                                 rad_to_deg(std::atan2(dy, dx)) - heading_deg);
+          acc += colour < 0.0 ? background_grey : 28.0 + colour * (240.0 - 28.0);
+        }
+      }
+      out.at<std::uint8_t>(v, u) = cv::saturate_cast<std::uint8_t>(acc / (s * s));
+    }
+  }
+  return out;
+}
+
+}  // namespace rilbed::vision

@@ -1,1 +1,64 @@
-// placeholder: being written
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "vision/blob_detector.hpp"
+#include "vision/synthetic_camera.hpp"
+
+using namespace rilbed::vision;
+
+// The centroid is sub-pixel: a marker placed at fractional positions (by rendering it
+// larger and resizing with area averaging) is found within 0.1 px.
+TEST(BlobDetector, SubPixelCentroid) {
+  const auto f = MarkerFamily::six_ucp();
+  BlobDetector detector;
+  for (double offset : {0.0, 0.25, 0.5, 0.75}) {
+    constexpr int kScale = 8;
+    const int size_px = 32;
+    cv::Mat big(100 * kScale, 100 * kScale, CV_8UC1, cv::Scalar(185));
+    const cv::Mat marker = render_marker_topdown(f, 3, size_px * kScale, 30.0, 185.0, 1);
+    const int shift = static_cast<int>(offset * kScale);
+    marker.copyTo(big(cv::Rect(30 * kScale + shift, 40 * kScale + shift, marker.cols, marker.rows)));
+    cv::Mat img;
+    cv::resize(big, img, cv::Size(100, 100), 0, 0, cv::INTER_AREA);
+    const auto blobs = detector.detect(img);
+    ASSERT_EQ(blobs.size(), 1u);
+    // The marker covers big pixels [30k+shift, 30k+shift+32k); its centre in small pixel
+    // coordinates (centres at integers) is 30 + offset + 16 - 0.5.
+    EXPECT_NEAR(blobs[0].u, 30 + offset + size_px / 2.0 - 0.5, 0.1);
+    EXPECT_NEAR(blobs[0].v, 40 + offset + size_px / 2.0 - 0.5, 0.1);
+    EXPECT_NEAR(blobs[0].disc_diameter_px(), 0.8 * size_px, 0.8);
+  }
+}
+
+TEST(BlobDetector, RejectsSquaresAndLines) {
+  cv::Mat img(200, 200, CV_8UC1, cv::Scalar(185));
+  cv::rectangle(img, {20, 20, 30, 30}, cv::Scalar(28), cv::FILLED);       // square
+  cv::line(img, {100, 20}, {180, 60}, cv::Scalar(28), 4);                // tape
+  cv::rectangle(img, {20, 120, 60, 20}, cv::Scalar(28), cv::FILLED);      // bar
+  BlobDetector detector;
+  EXPECT_TRUE(detector.detect(img).empty());
+}
+
+TEST(BlobDetector, FindsTiltedEllipses) {
+  cv::Mat img(200, 200, CV_8UC1, cv::Scalar(185));
+  cv::ellipse(img, {{100.3f, 90.7f}, {40.f, 28.f}, 30.f}, cv::Scalar(28), cv::FILLED, cv::LINE_AA);
+  BlobDetector detector;
+  const auto blobs = detector.detect(img);
+  ASSERT_EQ(blobs.size(), 1u);
+  EXPECT_NEAR(blobs[0].u, 100.3, 0.15);
+  EXPECT_NEAR(blobs[0].v, 90.7, 0.15);
+}
+
+TEST(BlobDetector, RoiSearchFindsOnlyInside) {
+  cv::Mat img(200, 300, CV_8UC1, cv::Scalar(185));
+  cv::circle(img, {50, 50}, 15, cv::Scalar(28), cv::FILLED, cv::LINE_AA);
+  cv::circle(img, {200, 120}, 15, cv::Scalar(28), cv::FILLED, cv::LINE_AA);
+  BlobDetector detector;
+  EXPECT_EQ(detector.detect(img).size(), 2u);
+  const auto inside = detector.detect(img, cv::Rect(150, 70, 100, 100));
+  ASSERT_EQ(inside.size(), 1u);
+  EXPECT_NEAR(inside[0].u, 200, 0.2);
+  // A blob cut by the ROI's border is not reported.
+  EXPECT_TRUE(detector.detect(img, cv::Rect(190, 70, 100, 100)).empty());
+}

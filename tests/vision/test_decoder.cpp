@@ -1,1 +1,85 @@
-// placeholder: being written
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/geometry.hpp"
+#include "vision/blob_detector.hpp"
+#include "vision/decoder.hpp"
+#include "vision/synthetic_camera.hpp"
+
+using namespace rilbed;
+using namespace rilbed::vision;
+
+namespace {
+// One marker top-down in the middle of a light canvas.
+cv::Mat canvas_with_marker(const MarkerFamily& f, int id, int size_px, double heading_deg) {
+  cv::Mat canvas(size_px * 3, size_px * 3, CV_8UC1, cv::Scalar(185));
+  render_marker_topdown(f, id, size_px, heading_deg).copyTo(canvas(cv::Rect(size_px, size_px, size_px, size_px)));
+  return canvas;
+}
+}  // namespace
+
+// Every ID at many headings decodes to itself with the right heading.
+TEST(Decoder, DecodesEveryIdAndHeading) {
+  const auto f = MarkerFamily::six_ucp();
+  std::vector<int> ids{1, 2, 3, 4, 5, 6, 7, 8};
+  Decoder decoder(f, ids);
+  BlobDetector detector;
+  for (int id : ids) {
+    for (double heading = 3.7; heading < 360; heading += 37.1) {
+      const cv::Mat img = canvas_with_marker(f, id, 48, heading);
+      const auto blobs = detector.detect(img);
+      ASSERT_EQ(blobs.size(), 1u) << "id " << id << " heading " << heading;
+      const auto signal = decoder.sample(img, blobs[0]);
+      ASSERT_TRUE(signal.usable);
+      const auto matches = decoder.match_all(signal, blobs[0]);
+      int best = 0;
+      for (int k = 1; k < 8; ++k) if (matches[k].score > matches[best].score) best = k;
+      EXPECT_EQ(matches[best].id, id) << "heading " << heading;
+      EXPECT_GT(matches[best].score, 0.9);
+      EXPECT_NEAR(wrap_deg_180(matches[best].heading_deg - heading), 0.0, 1.0) << "id " << id;
+    }
+  }
+}
+
+TEST(Decoder, LargeFamilyDecodes) {
+  const auto f = MarkerFamily::by_name("9ucp");
+  std::vector<int> ids;
+  for (int id = 1; id <= 64; ++id) ids.push_back(id);
+  Decoder decoder(f, ids);
+  BlobDetector detector;
+  for (int id : {1, 17, 42, 64}) {
+    const cv::Mat img = canvas_with_marker(f, id, 64, 100.0);
+    const auto blobs = detector.detect(img);
+    ASSERT_EQ(blobs.size(), 1u);
+    const auto matches = decoder.match_all(decoder.sample(img, blobs[0]), blobs[0]);
+    const auto best = std::max_element(matches.begin(), matches.end(),
+                                       [](const auto& a, const auto& b) { return a.score < b.score; });
+    EXPECT_EQ(best->id, id);
+    EXPECT_NEAR(wrap_deg_180(best->heading_deg - 100.0), 0.0, 1.5);
+  }
+}
+
+// A uniform dark disc with a light surround has no code and must not decode.
+TEST(Decoder, RejectsUniformDisc) {
+  cv::Mat img(120, 120, CV_8UC1, cv::Scalar(185));
+  cv::circle(img, {60, 60}, 20, cv::Scalar(28), cv::FILLED, cv::LINE_AA);
+  BlobDetector detector;
+  const auto blobs = detector.detect(img);
+  ASSERT_EQ(blobs.size(), 1u);  // it is a round blob...
+  Decoder decoder(MarkerFamily::six_ucp(), {1, 2, 3});
+  EXPECT_FALSE(decoder.sample(img, blobs[0]).usable);  // ...without a code
+}
+
+// Cross-covariance against the ideal signal is 1 for a perfect signal, per eq. 4.
+TEST(Decoder, ScoreIsNormalised) {
+  const auto f = MarkerFamily::six_ucp();
+  Decoder decoder(f, {5});
+  const cv::Mat img = canvas_with_marker(f, 5, 96, 0.0);
+  BlobDetector detector;
+  const auto blobs = detector.detect(img);
+  ASSERT_EQ(blobs.size(), 1u);
+  const auto m = decoder.match_all(decoder.sample(img, blobs[0]), blobs[0]);
+  EXPECT_GT(m[0].score, 0.97);
+  EXPECT_LE(m[0].score, 1.0);
+}

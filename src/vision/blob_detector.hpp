@@ -1,0 +1,92 @@
+// Finds the dark, circular blobs that 6UCP markers make in a grey image: a local
+// threshold (tile min/max, the local form of the paper's contrast stretch), a seeded
+// scanline flood fill, and shape tests on the filled outline. Each blob comes with a
+// sub-pixel centroid and the ellipse that the marker's circle projects to.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace rilbed::vision {
+
+/// Knobs of the blob detector. Sizes are of the whole marker (outer white ring) in
+/// pixels, as they appear in the image.
+struct BlobDetectorConfig {
+  /// Smallest marker diameter looked for. Lower finds smaller markers but lets more
+  /// clutter reach the decoder.
+  double min_diameter_px = 18.0;
+  /// Largest marker diameter looked for. Higher costs nothing per frame by itself, but
+  /// markers much larger than 8 tiles (see tile_px) may lose local contrast inside.
+  double max_diameter_px = 160.0;
+  /// Side of the square tiles over which the local threshold is computed. Smaller adapts
+  /// to steeper lighting changes; larger saves time and keeps big markers intact.
+  int tile_px = 8;
+  /// Least grey-level difference between the darkest and brightest pixel around a tile
+  /// for its pixels to count as dark or bright. Lower accepts fainter markers and more
+  /// noise-made fragments.
+  int min_local_contrast = 24;
+  /// Rows between seed scan lines of a search; 0 picks a quarter of the smallest dark
+  /// disc. Larger is faster and misses markers smaller than about 2 steps.
+  int seed_row_step = 0;
+  /// Largest mean relative deviation of the blob's chord lengths from those of an
+  /// ellipse. A disc scores about 0.02, a square 0.2.
+  double max_chord_error = 0.09;
+  /// Largest ratio of the ellipse's axes (a marker viewed at 60 degrees gives 2).
+  double max_axis_ratio = 1.8;
+  /// Largest relative difference between the filled area and the ellipse's area.
+  double max_area_error = 0.15;
+};
+
+/// One candidate marker: the filled dark disc enclosed by the marker's black ring.
+struct Blob {
+  /// Sub-pixel centroid of the filled disc, pixels (u right, v down).
+  double u = 0.0;
+  double v = 0.0;
+  /// Affine map from the unit circle to the disc's outline: outline = centre + shape·p
+  /// for |p| = 1. Symmetric (the polar decomposition's stretch). Pixels.
+  cv::Matx22d shape = cv::Matx22d::eye();
+  /// Local threshold (grey level) at the centre.
+  double threshold = 0.0;
+  /// Area of the filled disc in pixels.
+  double filled_area_px = 0.0;
+  /// Diameter of a circle of the same area as the disc, pixels.
+  double disc_diameter_px() const;
+};
+
+/// Detects marker blobs in 8-bit grey frames of one size. Keeps its scratch buffers
+/// between calls (not thread-safe; one per camera).
+class BlobDetector {
+ public:
+  explicit BlobDetector(BlobDetectorConfig config = {});
+
+  /// Searches `roi` (clipped to the image) of the 8-bit single-channel image `grey`.
+  /// Blobs touching the ROI's border are dropped (they may be cut).
+  std::vector<Blob> detect(const cv::Mat& grey, cv::Rect roi);
+
+  /// The whole image.
+  std::vector<Blob> detect(const cv::Mat& grey) { return detect(grey, cv::Rect(0, 0, grey.cols, grey.rows)); }
+
+  const BlobDetectorConfig& config() const { return config_; }
+
+ private:
+  struct Fill;
+  void prepare(const cv::Mat& grey);
+  void compute_thresholds(const cv::Mat& grey, cv::Rect roi);
+  bool flood_fill(const cv::Mat& grey, cv::Rect roi, int seed_x, int seed_y, Fill& fill);
+  bool measure(const cv::Mat& grey, const Fill& fill, Blob& blob) const;
+  std::uint8_t threshold_at(int x, int y) const { return tile_threshold_[tile_row_[y] * tiles_x_ + tile_col_[x]]; }
+
+  BlobDetectorConfig config_;
+  cv::Size size_;
+  int tiles_x_ = 0, tiles_y_ = 0;
+  std::vector<int> tile_col_, tile_row_;           // pixel column/row -> tile column/row
+  std::vector<std::uint8_t> tile_min_, tile_max_;  // raw tile statistics
+  std::vector<std::uint8_t> tile_threshold_;       // 0 marks a tile without contrast
+  cv::Mat visited_;                                // 8-bit, nonzero = already filled
+  std::vector<int> row_min_x_, row_max_x_, col_min_y_, col_max_y_;
+  std::vector<std::pair<int, int>> stack_;
+};
+
+}  // namespace rilbed::vision

@@ -1,0 +1,76 @@
+// Decodes a marker blob into an ID and a heading by circular cross-covariance (paper
+// 001, eq. 4-6): the grey levels on circles in the coded annulus are compared with the
+// ideal signal of every available ID at every lag; the best lag gives the heading.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <vector>
+
+#include "vision/blob_detector.hpp"
+#include "vision/marker_family.hpp"
+
+namespace rilbed::vision {
+
+/// Knobs of the decoder.
+struct DecoderConfig {
+  /// Samples around the circle. More resolves narrower slices (kUCP with large k) at a
+  /// linear cost; 120 gives 3 degrees per sample.
+  int samples = 120;
+  /// Least grey-level difference between the marker's white outer ring and its black
+  /// ring. Lower accepts fainter markers and more clutter.
+  double min_ring_contrast = 20.0;
+  /// Least fraction of the white ring's samples that must be brighter than the
+  /// midpoint between black and white. Rejects dark clutter without a white surround.
+  double min_white_ring_fraction = 0.85;
+  /// Least spread of the coded signal (10th to 90th percentile) as a fraction of the
+  /// ring contrast. Rejects uniform discs and rings that carry no code.
+  double min_code_contrast = 0.45;
+};
+
+/// The angular signal sampled from one blob.
+struct SampledSignal {
+  bool usable = false;            ///< false when the contrast tests failed
+  std::vector<double> values;     ///< mean grey level per angle, CCW from the sampling axis
+  double ring_contrast = 0.0;     ///< white ring minus black ring, grey levels
+};
+
+/// The best match of a signal against one ID.
+struct CodeMatch {
+  int id = 0;
+  double score = -1.0;        ///< circular cross-covariance at the best lag, [-1, 1]
+  double heading_deg = 0.0;   ///< on screen, CCW from +u, [0, 360)
+};
+
+/// Decoder for a fixed family and a fixed set of available IDs; precomputes their ideal
+/// signals. Immutable after construction, so one decoder may serve several threads.
+class Decoder {
+ public:
+  /// Throws std::invalid_argument for an ID outside the family.
+  Decoder(const MarkerFamily& family, const std::vector<int>& ids, DecoderConfig config = {});
+
+  /// Samples the coded annulus of `blob` in the 8-bit grey image.
+  SampledSignal sample(const cv::Mat& grey, const Blob& blob) const;
+
+  /// Similarity of the signal to every available ID, in the order of ids() (the paper's
+  /// Table 1 row for one object). Each entry carries the heading for that ID's best lag.
+  std::vector<CodeMatch> match_all(const SampledSignal& signal, const Blob& blob) const;
+
+  const std::vector<int>& ids() const { return ids_; }
+  const DecoderConfig& config() const { return config_; }
+
+ private:
+  struct Ideal {
+    int id = 0;
+    std::vector<double> start;  // segment starts in samples (fractional), ascending
+    std::vector<double> level;  // zero-mean, unit-norm level of each segment
+  };
+  double correlate(const std::vector<double>& cumulative, const Ideal& ideal, double lag) const;
+  double heading_on_screen(const Blob& blob, double lag) const;
+
+  DecoderConfig config_;
+  std::vector<int> ids_;
+  std::vector<Ideal> ideals_;
+};
+
+}  // namespace rilbed::vision
