@@ -15,6 +15,8 @@ void add_detect_command(CLI::App& app);
 void add_calibrate_command(CLI::App& app);
 /// `rilbed synth`: renders footage with ground truth from the synthetic overhead camera.
 void add_synth_command(CLI::App& app);
+/// `rilbed score`: compares detections with ground truth.
+void add_score_command(CLI::App& app);
 
 /// Exit code a subcommand's callback stores for main() to return.
 int& exit_code();

@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   rilbed::app::add_detect_command(app);
   rilbed::app::add_calibrate_command(app);
   rilbed::app::add_synth_command(app);
+  rilbed::app::add_score_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -186,11 +186,22 @@ bool BlobDetector::measure(const cv::Mat& grey, const Fill& fill, Blob& blob) co
   ChordMoments rows, cols;
   std::vector<std::array<double, 3>> row_chords, col_chords;  // {a, b, position}
   row_chords.reserve(fill.y1 - fill.y0 + 1);
+  // A marker's disc is bounded by bright pixels (its white ring, or a light floor). A
+  // region that ends where the local contrast ends instead (a dark floor around a
+  // marker, cut off by tiles without contrast) is not a disc.
+  int bright_edges = 0, edges = 0;
+  auto bright = [&](int x, int y) {
+    const std::uint8_t t = threshold_at(x, y);
+    return t != 0 && grey.at<std::uint8_t>(y, x) >= t ? 1 : 0;
+  };
   col_chords.reserve(fill.x1 - fill.x0 + 1);
   for (int y = fill.y0; y <= fill.y1; ++y) {
     const int xl = row_min_x_[y], xr = row_max_x_[y];
     if (xr < xl) continue;
     const std::uint8_t* row = grey.ptr<std::uint8_t>(y);
+    if (xl > 0) bright_edges += bright(xl - 1, y);
+    if (xr + 1 < grey.cols) bright_edges += bright(xr + 1, y);
+    edges += 2;
     double a = xl - 0.5, b = xr + 0.5;
     if (xl > 0) a = xl - edge_offset(row[xl - 1], row[xl], threshold_at(xl, y));
     if (xr + 1 < grey.cols) b = xr + edge_offset(row[xr + 1], row[xr], threshold_at(xr, y));
@@ -200,6 +211,9 @@ bool BlobDetector::measure(const cv::Mat& grey, const Fill& fill, Blob& blob) co
   for (int x = fill.x0; x <= fill.x1; ++x) {
     const int yt = col_min_y_[x], yb = col_max_y_[x];
     if (yb < yt) continue;
+    if (yt > 0) bright_edges += bright(x, yt - 1);
+    if (yb + 1 < grey.rows) bright_edges += bright(x, yb + 1);
+    edges += 2;
     double a = yt - 0.5, b = yb + 0.5;
     if (yt > 0) a = yt - edge_offset(grey.at<std::uint8_t>(yt - 1, x), grey.at<std::uint8_t>(yt, x), threshold_at(x, yt));
     if (yb + 1 < grey.rows) b = yb + edge_offset(grey.at<std::uint8_t>(yb + 1, x), grey.at<std::uint8_t>(yb, x), threshold_at(x, yb));
@@ -207,6 +221,7 @@ bool BlobDetector::measure(const cv::Mat& grey, const Fill& fill, Blob& blob) co
     col_chords.push_back({a, b, static_cast<double>(x)});
   }
   if (rows.area <= 0.0 || cols.area <= 0.0) return false;
+  if (bright_edges < config_.min_bright_outline * edges) return false;
 
   const double cx = rows.along / rows.area;
   const double cy = cols.along / cols.area;

@@ -35,6 +35,9 @@ struct BlobDetectorConfig {
   double max_chord_error = 0.09;
   /// Largest ratio of the ellipse's axes (a marker viewed at 60 degrees gives 2).
   double max_axis_ratio = 1.8;
+  /// Least fraction of the outline's outside neighbours that must be bright (above a
+  /// valid local threshold). Rejects dark floor around a marker on a dark mat.
+  double min_bright_outline = 0.9;
   /// Largest relative difference between the filled area and the ellipse's area.
   double max_area_error = 0.15;
 };

@@ -24,12 +24,12 @@ std::vector<int> checked_ids(const MarkerFamily& family, std::vector<int> ids) {
   return ids;
 }
 
-// Two searches can find the same blob; keep one per place.
+// Two searches can find the same blob; keep one per place and size.
 void append_unique(std::vector<Blob>& into, const std::vector<Blob>& found) {
   for (const Blob& b : found) {
-    const double radius = 0.25 * b.disc_diameter_px();
+    const double d = b.disc_diameter_px();
     const bool seen = std::any_of(into.begin(), into.end(), [&](const Blob& o) {
-      return std::hypot(o.u - b.u, o.v - b.v) < radius;
+      return std::hypot(o.u - b.u, o.v - b.v) < 0.25 * d && std::abs(o.disc_diameter_px() - d) < 0.25 * d;
     });
     if (!seen) into.push_back(b);
   }

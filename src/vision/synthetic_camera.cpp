@@ -76,6 +76,11 @@ double clutter_at(const Clutter& c, double x, double y, double black, double whi
       if (gx < 0 || gy < 0 || gx >= c.cols || gy >= c.rows) return white;  // margin
       return ((static_cast<int>(gx) + static_cast<int>(gy)) % 2) ? white : black;
     }
+    case Clutter::Kind::Mat:
+      return (x >= std::min(c.x_m, c.x2_m) && x <= std::max(c.x_m, c.x2_m) && y >= std::min(c.y_m, c.y2_m) &&
+              y <= std::max(c.y_m, c.y2_m))
+                 ? c.grey
+                 : -1.0;
     case Clutter::Kind::Text:
       return -1.0;  // drawn with putText
   }
@@ -214,7 +219,7 @@ void SyntheticCamera::draw_clutter(cv::Mat& reflectance, const Clutter& c) const
     return;
   }
   double cx = c.x_m, cy = c.y_m, half = c.size_m;
-  if (c.kind == Clutter::Kind::Tape) {
+  if (c.kind == Clutter::Kind::Tape || c.kind == Clutter::Kind::Mat) {
     cx = (c.x_m + c.x2_m) / 2;
     cy = (c.y_m + c.y2_m) / 2;
     half = std::hypot(c.x2_m - c.x_m, c.y2_m - c.y_m) / 2 + c.size_m;

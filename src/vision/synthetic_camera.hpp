@@ -46,11 +46,12 @@ struct SceneMarker {
 
 /// Things on the floor that are not markers and must never get an ID.
 struct Clutter {
-  enum class Kind { DarkDisc, Ring, Tape, Chessboard, Text };
+  enum class Kind { DarkDisc, Ring, Tape, Chessboard, Text, Mat };
   Kind kind = Kind::DarkDisc;
-  double x_m = 0.0, y_m = 0.0;   ///< centre (tape: start point; text: lower-left)
+  double x_m = 0.0, y_m = 0.0;   ///< centre (tape: start point; text: lower-left; mat: a corner)
   double size_m = 0.05;          ///< disc/ring outer diameter, tape width, chessboard square, text height
-  double x2_m = 0.0, y2_m = 0.0; ///< tape end point
+  double x2_m = 0.0, y2_m = 0.0; ///< tape end point; mat: the opposite corner
+  double grey = 60.0;            ///< mat reflectance, 0..255 (a dark floor region)
   int cols = 5, rows = 4;        ///< chessboard squares
   double angle_rad = 0.0;        ///< chessboard rotation
   std::string text;              ///< for Text

@@ -89,6 +89,11 @@ ScenePreset scene_preset(const std::string& name, cv::Size image_size) {
     p.conditions.jpeg_quality = 60;
     using K = Clutter::Kind;
     add_field_border(p);
+    Clutter mat = make_clutter(K::Mat, 0.02, 0.02, 0.0);  // a dark mat: markers on a dark floor
+    mat.x2_m = 0.55;
+    mat.y2_m = 0.50;
+    mat.grey = 55.0;
+    p.clutter.push_back(mat);
     p.clutter.push_back(tape(0.30, 0.55, 0.70, 0.62, 0.015));          // a stray strip of tape
     p.clutter.push_back(make_clutter(K::DarkDisc, 0.12, 0.12, 0.05));  // a disc the size of a marker
     p.clutter.push_back(make_clutter(K::DarkDisc, 1.40, 1.05, 0.04));

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Runs rilbed's benchmarks and prints their tables (Markdown) on stdout.
+#   tools/bench.sh [BUILD_DIR] [bench_vision options...]
+# `./run bench` calls it with its Release build directory. On its own it uses
+# BUILD_DIR (default: build/ next to this tools/ folder) and builds the bench_vision
+# target there first if it is missing, configuring a Release build if the directory
+# has none. Options after BUILD_DIR go to bench_vision (--quick, --budget S, ...).
+set -euo pipefail
+ROOT="$(cd "$(dirname "$0")/.." && pwd)"
+BUILD_DIR="${1:-$ROOT/build}"
+shift || true
+
+if [[ ! -x "$BUILD_DIR/bench_vision" ]]; then
+  echo "[bench] $BUILD_DIR/bench_vision not built yet; building it (one job)" >&2
+  if [[ ! -f "$BUILD_DIR/CMakeCache.txt" ]]; then
+    cmake -S "$ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >&2
+  fi
+  cmake --build "$BUILD_DIR" -j1 --target bench_vision >&2
+fi
+
+BUILD_TYPE="$(sed -n 's/^CMAKE_BUILD_TYPE:STRING=//p' "$BUILD_DIR/CMakeCache.txt" 2>/dev/null || true)"
+if [[ "$BUILD_TYPE" != Release ]]; then
+  echo "[bench] warning: $BUILD_DIR is a '${BUILD_TYPE:-unknown}' build; timings mean little outside Release" >&2
+fi
+export RILBED_BENCH_BUILD_TYPE="${BUILD_TYPE:-unknown}"
+RILBED_BENCH_APRILTAG_VERSION="$(pkg-config --modversion apriltag 2>/dev/null || echo 3)"
+export RILBED_BENCH_APRILTAG_VERSION
+
+"$BUILD_DIR/bench_vision" "$@"
