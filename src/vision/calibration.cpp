@@ -120,25 +120,12 @@ std::vector<double> to_vector(const cv::Mat& m) {
 
 }  // namespace
 
-IntrinsicsResult calibrate_intrinsics(const std::vector<std::string>& image_paths,
-                                      const ChessboardSpec& board, int min_images) {
-  IntrinsicsResult result;
-  if (auto error = validate_board(board); !error.empty()) {
-    result.error = error;
-    return result;
-  }
-  const cv::Size pattern(board.cols, board.rows);
-  std::vector<BoardView> views;
-  for (const auto& path : image_paths) {
-    result.images.push_back({path, false, {}});
-    if (auto view = find_board(path, pattern, result.images.back())) {
-      view->report_index = result.images.size() - 1;
-      views.push_back(std::move(*view));
-    }
-  }
-  const cv::Size image_size = majority_size(views);
+namespace {
+
+// Keeps the views of the calibration size, marking them usable and the others skipped.
+std::vector<std::vector<cv::Point2f>> select_views(std::vector<BoardView>& views, cv::Size image_size,
+                                                   IntrinsicsResult& result, CameraIntrinsics& intrinsics) {
   std::vector<std::vector<cv::Point2f>> image_points;
-  CameraIntrinsics intrinsics;
   for (auto& view : views) {
     auto& report = result.images[view.report_index];
     if (view.image_size != image_size) {
@@ -150,31 +137,56 @@ IntrinsicsResult calibrate_intrinsics(const std::vector<std::string>& image_path
     image_points.push_back(std::move(view.corners_px));
     intrinsics.images_used.push_back(report.path);
   }
+  return image_points;
+}
+
+// Runs the solver as the sample does; fills the lens and RMS, or returns an error.
+std::string solve(const std::vector<std::vector<cv::Point2f>>& image_points, const ChessboardSpec& board,
+                  CameraIntrinsics& intrinsics) {
+  const std::vector<std::vector<cv::Point3f>> object_points(image_points.size(), board_points(board));
+  cv::Mat camera_matrix = cv::Mat::eye(3, 3, CV_64F);
+  cv::Mat distortion = cv::Mat::zeros(kInitialDistortionCount, 1, CV_64F);
+  std::vector<cv::Mat> rvecs, tvecs;
+  try {
+    intrinsics.rms_px = cv::calibrateCamera(object_points, image_points, intrinsics.image_size, camera_matrix,
+                                            distortion, rvecs, tvecs, kCalibrateFlags);
+  } catch (const cv::Exception& e) {
+    return std::string("calibration failed: ") + e.err;
+  }
+  if (!all_finite(camera_matrix) || !all_finite(distortion)) {
+    return "calibration diverged (non-finite camera matrix or distortion)";
+  }
+  intrinsics.lens.camera_matrix = cv::Matx33d(camera_matrix);
+  intrinsics.lens.distortion = to_vector(distortion);
+  return {};
+}
+
+}  // namespace
+
+IntrinsicsResult calibrate_intrinsics(const std::vector<std::string>& image_paths,
+                                      const ChessboardSpec& board, int min_images) {
+  IntrinsicsResult result;
+  if (result.error = validate_board(board); !result.error.empty()) return result;
+  const cv::Size pattern(board.cols, board.rows);
+  std::vector<BoardView> views;
+  for (const auto& path : image_paths) {
+    result.images.push_back({path, false, {}});
+    if (auto view = find_board(path, pattern, result.images.back())) {
+      view->report_index = result.images.size() - 1;
+      views.push_back(std::move(*view));
+    }
+  }
+  CameraIntrinsics intrinsics;
+  intrinsics.image_size = majority_size(views);
+  intrinsics.board = board;
+  const auto image_points = select_views(views, intrinsics.image_size, result, intrinsics);
   if (static_cast<int>(image_points.size()) < min_images) {
     result.error = "only " + std::to_string(image_points.size()) + " of " +
                    std::to_string(image_paths.size()) + " images are usable, at least " +
                    std::to_string(min_images) + " are needed";
     return result;
   }
-  const std::vector<std::vector<cv::Point3f>> object_points(image_points.size(), board_points(board));
-  cv::Mat camera_matrix = cv::Mat::eye(3, 3, CV_64F);
-  cv::Mat distortion = cv::Mat::zeros(kInitialDistortionCount, 1, CV_64F);
-  std::vector<cv::Mat> rvecs, tvecs;
-  try {
-    intrinsics.rms_px = cv::calibrateCamera(object_points, image_points, image_size, camera_matrix,
-                                            distortion, rvecs, tvecs, kCalibrateFlags);
-  } catch (const cv::Exception& e) {
-    result.error = std::string("calibration failed: ") + e.what();
-    return result;
-  }
-  if (!all_finite(camera_matrix) || !all_finite(distortion)) {
-    result.error = "calibration diverged (non-finite camera matrix or distortion)";
-    return result;
-  }
-  intrinsics.image_size = image_size;
-  intrinsics.lens.camera_matrix = cv::Matx33d(camera_matrix);
-  intrinsics.lens.distortion = to_vector(distortion);
-  intrinsics.board = board;
+  if (result.error = solve(image_points, board, intrinsics); !result.error.empty()) return result;
   result.intrinsics = std::move(intrinsics);
   return result;
 }

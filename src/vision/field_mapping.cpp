@@ -129,47 +129,53 @@ void measure_residuals(const cv::Matx33d& h, const std::vector<cv::Point2d>& und
   result.residual_rms_mm = count > 0 ? std::sqrt(sum_sq_m2 / count) * 1000.0 : 0.0;
 }
 
+std::string check_fit_inputs(std::size_t point_count, double width_m, double height_m, cv::Size image_size,
+                             const std::optional<LensModel>& lens) {
+  if (auto error = validate_size(width_m, height_m, image_size); !error.empty()) return error;
+  if (lens) {
+    if (auto error = validate_lens(*lens); !error.empty()) return "intrinsics: " + error;
+  }
+  if (point_count < 4) return "a homography needs at least 4 points, got " + std::to_string(point_count);
+  return {};
+}
+
+// Exactly 4 points: the exact solution. More: RANSAC, so that one misplaced marker
+// cannot bend the whole mapping; OpenCV then refines on the inliers. `inlier` must hold
+// one entry per point. Empty result and `error` set on failure.
+cv::Mat estimate_homography(const std::vector<cv::Point2d>& undistorted_px, const std::vector<cv::Point2d>& field_m,
+                            double ransac_threshold_m, std::vector<uchar>& inlier, std::string& error) {
+  if (undistorted_px.size() == 4 && (has_three_collinear(undistorted_px) || has_three_collinear(field_m))) {
+    error = "three of the 4 points lie on a line (in the image or on the field)";
+    return {};
+  }
+  cv::Mat h;
+  try {
+    h = undistorted_px.size() == 4
+            ? exact_homography(undistorted_px, field_m)
+            : cv::findHomography(undistorted_px, field_m, cv::RANSAC, ransac_threshold_m, inlier, 2000, 0.999);
+  } catch (const cv::Exception& e) {
+    error = std::string("homography fit failed: ") + e.err;
+    return {};
+  }
+  if (h.empty()) error = "no homography fits the points (are three or more of them on a line?)";
+  return h;
+}
+
 FieldCalibrationResult fit(const std::vector<PointCorrespondence>& points, double width_m, double height_m,
                            cv::Size image_size, const std::optional<LensModel>& lens,
                            double ransac_threshold_m) {
   FieldCalibrationResult result;
-  if (result.error = validate_size(width_m, height_m, image_size); !result.error.empty()) return result;
-  if (lens) {
-    if (auto error = validate_lens(*lens); !error.empty()) {
-      result.error = "intrinsics: " + error;
-      return result;
-    }
-  }
-  if (points.size() < 4) {
-    result.error = "a homography needs at least 4 points, got " + std::to_string(points.size());
-    return result;
-  }
+  result.error = check_fit_inputs(points.size(), width_m, height_m, image_size, lens);
+  if (!result.error.empty()) return result;
   std::vector<cv::Point2d> raw_px, field_m;
   for (const auto& p : points) {
     raw_px.emplace_back(p.image_px.x, p.image_px.y);
     field_m.emplace_back(p.field_m.x, p.field_m.y);
   }
   const auto undistorted_px = undistort_px(lens, raw_px);
-  if (points.size() == 4 && (has_three_collinear(undistorted_px) || has_three_collinear(field_m))) {
-    result.error = "three of the 4 points lie on a line (in the image or on the field)";
-    return result;
-  }
-  // Exactly 4 points: the exact solution. More: RANSAC, so one misplaced marker cannot
-  // bend the whole mapping; OpenCV then refines on the inliers.
   std::vector<uchar> inlier(points.size(), 1);
-  cv::Mat h;
-  try {
-    h = points.size() == 4 ? exact_homography(undistorted_px, field_m)
-                           : cv::findHomography(undistorted_px, field_m, cv::RANSAC, ransac_threshold_m, inlier,
-                                                2000, 0.999);
-  } catch (const cv::Exception& e) {
-    result.error = std::string("homography fit failed: ") + e.err;
-    return result;
-  }
-  if (h.empty()) {
-    result.error = "no homography fits the points (are three or more of them on a line?)";
-    return result;
-  }
+  const cv::Mat h = estimate_homography(undistorted_px, field_m, ransac_threshold_m, inlier, result.error);
+  if (!result.error.empty()) return result;
   FieldCalibration calibration{width_m, height_m, cv::Matx33d(h), image_size, lens};
   if (auto error = validate_field_calibration(calibration); !error.empty()) {
     result.error = "the fitted homography is unusable: " + error;

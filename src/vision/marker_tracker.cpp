@@ -35,6 +35,16 @@ void append_unique(std::vector<Blob>& into, const std::vector<Blob>& found) {
   }
 }
 
+// The IDs the decoder compares with: the whole family when it is small enough, so that
+// a marker of an unlisted ID is recognised as such.
+std::vector<int> decoder_ids(const MarkerFamily& family, const std::vector<int>& listed) {
+  constexpr int kMaxWholeFamily = 64;
+  if (family.max_id() > kMaxWholeFamily) return listed;
+  std::vector<int> all;
+  for (int id = family.min_id(); id <= family.max_id(); ++id) all.push_back(id);
+  return all;
+}
+
 }  // namespace
 
 MarkerTracker::MarkerTracker(MarkerFamily family, std::vector<int> ids, TrackerConfig config)
@@ -42,7 +52,12 @@ MarkerTracker::MarkerTracker(MarkerFamily family, std::vector<int> ids, TrackerC
       ids_(checked_ids(family_, std::move(ids))),
       config_(config),
       detector_(config.blobs),
-      decoder_(family_, ids_, config.decoder) {}
+      decoder_(family_, decoder_ids(family_, ids_), config.decoder) {
+  for (int id : ids_) {
+    const auto& all = decoder_.ids();
+    decoder_index_.push_back(static_cast<int>(std::find(all.begin(), all.end(), id) - all.begin()));
+  }
+}
 
 void MarkerTracker::reset() {
   tracks_.clear();
@@ -76,10 +91,12 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
     const SampledSignal signal = decoder_.sample(grey, blob);
     if (signal.usable) ++stats_.decoded;
     matches.push_back(decoder_.match_all(signal, blob));
+    double family_best = -1.0;
+    for (const CodeMatch& m : matches.back()) family_best = std::max(family_best, m.score);
     std::vector<double> row(ids_.size(), -1.0);
     for (std::size_t c = 0; c < ids_.size(); ++c) {
-      const double score = matches.back()[c].score;
-      if (score < config_.min_assign_score) continue;
+      const double score = matches.back()[decoder_index_[c]].score;
+      if (score < config_.min_assign_score || score < family_best - config_.family_margin) continue;
       row[c] = score;
       if (!use_tracks) continue;
       for (const Track& t : tracks_) {
@@ -97,7 +114,7 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
   std::vector<MarkerDetection> out;
   for (std::size_t r = 0; r < blobs.size(); ++r) {
     if (chosen[r] < 0) continue;
-    const CodeMatch& m = matches[r][chosen[r]];
+    const CodeMatch& m = matches[r][decoder_index_[chosen[r]]];
     const Blob& b = blobs[r];
     const double disc_d = 2.0 * std::sqrt(std::abs(cv::determinant(b.shape)));
     out.push_back({m.id, b.u, b.v, m.heading_deg, m.score, disc_d / MarkerFamily::black_ring_outer_radius, false});
