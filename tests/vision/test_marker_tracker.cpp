@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
+
+#include <opencv2/imgproc.hpp>
 
 #include "core/geometry.hpp"
 #include "vision/marker_tracker.hpp"
@@ -77,4 +80,73 @@ TEST(MarkerTracker, FullFrameMatchesTracked) {
 TEST(MarkerTracker, RejectsBadIds) {
   EXPECT_THROW(MarkerTracker(MarkerFamily::six_ucp(), {}), std::invalid_argument);
   EXPECT_THROW(MarkerTracker(MarkerFamily::six_ucp(), {1, 9}), std::invalid_argument);
+}
+
+// A marker hidden for a few frames (a hand over the robot) comes back with its own ID,
+// and no other marker takes its ID meanwhile.
+TEST(MarkerTracker, OcclusionDoesNotSwapIds) {
+  const auto preset = scene_preset("nominal");
+  SyntheticCamera camera(preset.camera, MarkerFamily::six_ucp(), preset.conditions, preset.clutter);
+  MarkerTracker tracker(MarkerFamily::six_ucp(), {1, 2, 3, 4, 5, 6, 7, 8});
+  cv::RNG rng(4);
+  for (int f = 0; f < 20; ++f) {
+    auto robots = robots_at(f / 15.0, 8, preset, 4);
+    const bool hidden = f >= 5 && f < 9;
+    if (hidden) robots.erase(robots.begin() + 2);  // robot 3 vanishes
+    const auto truth = camera.truth(robots);
+    const auto found = tracker.process(camera.render(robots, rng));
+    EXPECT_EQ(found.size(), hidden ? 7u : 8u) << "frame " << f;
+    for (const auto& d : found) {
+      const auto it = std::find_if(truth.begin(), truth.end(), [&](const auto& t) { return t.id == d.id; });
+      ASSERT_NE(it, truth.end()) << "frame " << f << " reported absent ID " << d.id;
+      EXPECT_LT(std::hypot(d.u - it->u, d.v - it->v), 1.0) << "frame " << f << " ID " << d.id;
+    }
+  }
+}
+
+// Tracked frames search only near the markers: no full-frame search once all are found.
+TEST(MarkerTracker, TrackedFramesSkipTheFullSearch) {
+  const auto preset = scene_preset("nominal");
+  SyntheticCamera camera(preset.camera, MarkerFamily::six_ucp(), preset.conditions, preset.clutter);
+  MarkerTracker tracker(MarkerFamily::six_ucp(), {1, 2, 3, 4, 5, 6, 7, 8});
+  cv::RNG rng(5);
+  for (int f = 0; f < 6; ++f) {
+    const auto found = tracker.process(camera.render(robots_at(f / 15.0, 8, preset, 5), rng));
+    ASSERT_EQ(found.size(), 8u);
+    EXPECT_EQ(tracker.last_stats().full_search, f == 0) << "frame " << f;
+    if (f > 0) {
+      EXPECT_TRUE(std::all_of(found.begin(), found.end(), [](const auto& d) { return d.tracked; }));
+    }
+  }
+}
+
+// Markers about 24 px across under blur and noise still decode with the right heading.
+TEST(MarkerTracker, SmallMarkersUnderBlurAndNoise) {
+  const auto f = MarkerFamily::six_ucp();
+  cv::RNG rng(6);
+  int found = 0;
+  double heading_err2 = 0.0;
+  for (int id = 1; id <= 8; ++id) {
+    for (int k = 0; k < 4; ++k) {
+      const double heading = rng.uniform(0.0, 360.0);
+      constexpr int kScale = 8;
+      cv::Mat big(64 * kScale, 64 * kScale, CV_8UC1, cv::Scalar(185));
+      render_marker_topdown(f, id, 24 * kScale, heading, 185.0, 1).copyTo(big(cv::Rect(150, 170, 24 * kScale, 24 * kScale)));
+      cv::Mat img, noise(64, 64, CV_16SC1);
+      cv::resize(big, img, {64, 64}, 0, 0, cv::INTER_AREA);
+      cv::GaussianBlur(img, img, {}, 0.7);
+      rng.fill(noise, cv::RNG::NORMAL, 0, 3);
+      img.convertTo(img, CV_16S);
+      img += noise;
+      img.convertTo(img, CV_8U);
+      const auto d = detect_markers(img, f, {1, 2, 3, 4, 5, 6, 7, 8});
+      if (d.size() == 1 && d[0].id == id) {
+        ++found;
+        const double err = wrap_deg_180(d[0].heading_deg - heading);
+        heading_err2 += err * err;
+      }
+    }
+  }
+  EXPECT_GE(found, 31);
+  EXPECT_LT(std::sqrt(heading_err2 / std::max(found, 1)), 2.0);
 }
