@@ -439,6 +439,7 @@ struct Row {
   int scored_frames = 0;
   double median() const { return percentile(ms, 0.5); }
   double p90() const { return percentile(ms, 0.9); }
+  double cpu_median() const { return percentile(cpu_ms, 0.5); }
 };
 
 double ms_since(Clock::time_point t0) {
@@ -564,10 +565,11 @@ std::string fmt(const char* f, double x) {
   return buf;
 }
 
-void print_table1(const std::vector<Row>& rows, double rilbed_full_ms) {
+void print_table1(const std::vector<Row>& rows) {
+  const Row& full = rows.front();
   std::printf(
-      "| detector | markers | ms/frame median | ms/frame p90 | recall | false IDs/frame | time ÷ rilbed full-frame "
-      "| CPU ms/frame median | centre RMS px | centre bias u, v px | frames × passes |\n");
+      "| detector | markers | ms/frame median | ms/frame p90 | CPU ms/frame median | recall | false IDs/frame "
+      "| time ÷ rilbed full-frame (wall, CPU) | centre RMS px | centre bias u, v px | frames × passes |\n");
   std::printf("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
   for (const Row& r : rows) {
     std::string det = r.detector;
@@ -575,12 +577,13 @@ void print_table1(const std::vector<Row>& rows, double rilbed_full_ms) {
       det += " (full search in " + std::to_string(r.full_searches) + "/" + std::to_string(r.scored_frames) +
              " frames)";
     }
-    std::printf("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s, %s | %d × %d |\n", det.c_str(),
+    std::printf("| %s | %s | %s | %s | %s | %s | %s | %s, %s | %s | %s, %s | %d × %d |\n", det.c_str(),
                 r.markers.c_str(), fmt("%.3f", r.median()).c_str(), fmt("%.3f", r.p90()).c_str(),
-                fmt("%.3f", r.score.recall()).c_str(), fmt("%.2f", r.score.false_per_frame()).c_str(),
-                fmt("%.2f", r.median() / rilbed_full_ms).c_str(), fmt("%.3f", percentile(r.cpu_ms, 0.5)).c_str(),
-                fmt("%.3f", r.score.centre_rms()).c_str(), fmt("%+.2f", Score::mean(r.score.du)).c_str(),
-                fmt("%+.2f", Score::mean(r.score.dv)).c_str(), r.scored_frames, r.passes);
+                fmt("%.3f", r.cpu_median()).c_str(), fmt("%.3f", r.score.recall()).c_str(),
+                fmt("%.2f", r.score.false_per_frame()).c_str(), fmt("%.2f", r.median() / full.median()).c_str(),
+                fmt("%.2f", r.cpu_median() / full.cpu_median()).c_str(), fmt("%.3f", r.score.centre_rms()).c_str(),
+                fmt("%+.2f", Score::mean(r.score.du)).c_str(), fmt("%+.2f", Score::mean(r.score.dv)).c_str(),
+                r.scored_frames, r.passes);
   }
 }
 
@@ -612,6 +615,7 @@ int main(int argc, char** argv) {
               "not defined",
 #endif
               __VERSION__);
+  std::printf("- sources: %s\n", env_or("RILBED_BENCH_SOURCE", "unknown (run through tools/bench.sh to print it)").c_str());
   std::printf("- OpenCV %s (aruco from opencv_contrib), AprilTag %s; threads: OpenCV setNumThreads(0) and OpenCL "
               "off, AprilTag nthreads = 1, rilbed single-threaded\n\n",
               CV_VERSION, env_or("RILBED_BENCH_APRILTAG_VERSION", "3 (libapriltag)").c_str());
@@ -650,9 +654,9 @@ int main(int argc, char** argv) {
       "- Timing: steady_clock around each detector call on an in-memory 8-bit grey frame (result conversion "
       "included, frame rendering and colour conversion not). One untimed pass first (it also yields recall), then "
       "whole passes over the sequence until %.1f s per row are spent (at least %d, at most %d passes); median and "
-      "90th percentile of the wall time over all timed frames; the ratio column divides wall-time medians. The CPU "
-      "column is the median of the thread's own CPU time (CLOCK_THREAD_CPUTIME_ID) for the same calls: on a shared "
-      "machine it leaves out time stolen by other processes.\n",
+      "90th percentile of the wall time over all timed frames. The CPU column is the median of the thread's own CPU "
+      "time (CLOCK_THREAD_CPUTIME_ID) for the same calls: on a shared machine it leaves out time other processes "
+      "took. The ratio column divides medians, wall and CPU.\n",
       opt.budget_s, opt.min_passes, opt.max_passes);
   std::printf(
       "- Recall: fraction of rendered markers for which a detection with the right ID lies within %.0f px of the "
@@ -747,9 +751,9 @@ int main(int argc, char** argv) {
   std::printf("## Table 1 — speed and recall, %dx%d, markers %.0f px across\n\n", kFrameSize.width,
               kFrameSize.height, size1);
   std::printf("### 8 markers\n\n");
-  print_table1(rows8, rows8[0].median());
+  print_table1(rows8);
   std::printf("\n### 64 markers\n\n");
-  print_table1(rows64, rows64[0].median());
+  print_table1(rows64);
   std::printf("\n");
   std::fflush(stdout);
 
@@ -802,30 +806,35 @@ int main(int argc, char** argv) {
 
   // ---------------------------------------------------------------- targets
   std::printf("## Targets from the issue (printed, not asserted)\n\n");
+  std::printf(
+      "Speed ratios are given on wall-time and on CPU-time medians; the verdict uses CPU time, which other "
+      "processes on a shared machine do not inflate (long calls are preempted more often than short ones, which "
+      "flatters the fast detector's wall-time ratio).\n\n");
   const Row& full8 = rows8[0];
-  const Row& tracked8 = rows8[1];
-  std::printf("- full-frame <= 1.5 ms/frame with 8 markers: %.3f ms median — %s\n", full8.median(),
-              full8.median() <= 1.5 ? "met" : "NOT met");
+  std::printf("- full-frame <= 1.5 ms/frame with 8 markers: %.3f ms wall, %.3f ms CPU (medians) — %s\n",
+              full8.median(), full8.cpu_median(), full8.cpu_median() <= 1.5 ? "met" : "NOT met");
   for (const auto* rows : {&rows8, &rows64}) {
     const Row& full = (*rows)[0];
     const int n = rows == &rows8 ? 8 : 64;
     for (std::size_t i = 2; i < rows->size(); ++i) {
       const Row& peer = (*rows)[i];
-      const double ratio = peer.median() / full.median();
+      const double wall = peer.median() / full.median(), cpu = peer.cpu_median() / full.cpu_median();
       const bool recall_ok = full.score.recall() >= peer.score.recall();
-      std::printf("- >= 20x faster than %s at equal or better recall (%d markers): %.1fx, recall %.3f vs %.3f — %s\n",
-                  peer.detector.c_str(), n, ratio, full.score.recall(), peer.score.recall(),
-                  (ratio >= 20.0 && recall_ok) ? "met" : "NOT met");
+      std::printf(
+          "- >= 20x faster than %s at equal or better recall (%d markers): %.1fx wall, %.1fx CPU; recall %.3f vs "
+          "%.3f — %s\n",
+          peer.detector.c_str(), n, wall, cpu, full.score.recall(), peer.score.recall(),
+          (cpu >= 20.0 && recall_ok) ? "met" : "NOT met");
     }
   }
   for (const auto* rows : {&rows8, &rows64}) {
     const Row& full = (*rows)[0];
     const Row& tracked = (*rows)[1];
-    const double ratio = full.median() / tracked.median();
-    std::printf("- tracked >= 10x faster than full-frame (%d markers): %.1fx (%.3f vs %.3f ms) — %s\n",
-                rows == &rows8 ? 8 : 64, ratio, tracked.median(), full.median(), ratio >= 10.0 ? "met" : "NOT met");
+    const double wall = full.median() / tracked.median(), cpu = full.cpu_median() / tracked.cpu_median();
+    std::printf("- tracked >= 10x faster than full-frame (%d markers): %.1fx wall, %.1fx CPU (%.3f vs %.3f ms CPU) — %s\n",
+                rows == &rows8 ? 8 : 64, wall, cpu, tracked.cpu_median(), full.cpu_median(),
+                cpu >= 10.0 ? "met" : "NOT met");
   }
-  (void)tracked8;
   for (const AccuracyRow& r : acc_rows) {
     std::printf("- accuracy at %d px: centre %.3f px RMS (<= 0.3), heading %.2f deg RMS (<= 1.5) — %s\n", r.size,
                 r.score.centre_rms(), r.score.heading_rms(),

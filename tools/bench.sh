@@ -25,5 +25,11 @@ fi
 export RILBED_BENCH_BUILD_TYPE="${BUILD_TYPE:-unknown}"
 RILBED_BENCH_APRILTAG_VERSION="$(pkg-config --modversion apriltag 2>/dev/null || echo 3)"
 export RILBED_BENCH_APRILTAG_VERSION
+# Which sources were measured: the commit, and any uncommitted change under src/.
+if SOURCE="$(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null)"; then
+  DIRTY="$(git -C "$ROOT" status --porcelain -- src 2>/dev/null | awk '{print $2}' | tr '\n' ' ')"
+  [[ -n "$DIRTY" ]] && SOURCE="$SOURCE, uncommitted changes in: ${DIRTY% }"
+  export RILBED_BENCH_SOURCE="$SOURCE"
+fi
 
 "$BUILD_DIR/bench_vision" "$@"

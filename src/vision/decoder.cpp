@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
+#include <tuple>
 
 #include "core/geometry.hpp"
 
@@ -24,9 +25,10 @@ double bilinear(const cv::Mat& grey, double u, double v) {
 // Image position of the marker-frame point at radius r (fraction of the outer radius)
 // and angle a (radians, CCW on screen). The blob's shape maps the unit circle onto the
 // dark disc, whose radius is black_ring_outer_radius.
-cv::Point2d marker_point(const Blob& blob, double r, double a) {
+// `unit` is (cos a, -sin a) for the angle a counter-clockwise on screen.
+cv::Point2d marker_point(const Blob& blob, double r, cv::Vec2d unit) {
   const double k = r / MarkerFamily::black_ring_outer_radius;
-  const cv::Vec2d p(k * std::cos(a), -k * std::sin(a));
+  const cv::Vec2d p = unit * k;
   const cv::Vec2d q = blob.shape * p;
   return {blob.u + q[0], blob.v + q[1]};
 }
@@ -57,6 +59,15 @@ double cumulative_at(const std::vector<double>& cumulative, double t) {
 Decoder::Decoder(const MarkerFamily& family, const std::vector<int>& ids, DecoderConfig config)
     : config_(config), ids_(ids) {
   config_.samples = std::max(24, config_.samples);
+  // Directions of the sampling angles, computed once: the sampler runs per blob per frame.
+  for (int k = 0; k < config_.samples; ++k) {
+    const double a = 2.0 * kPi * k / config_.samples;
+    sample_directions_.emplace_back(std::cos(a), -std::sin(a));
+  }
+  for (int k = 0; k < kRingSamples; ++k) {
+    const double a = 2.0 * kPi * (k + 0.5) / kRingSamples;
+    ring_directions_.emplace_back(std::cos(a), -std::sin(a));
+  }
   const double n = config_.samples;
   const double deg_per_sample = 360.0 / n;
   for (int id : ids) {
@@ -67,14 +78,13 @@ Decoder::Decoder(const MarkerFamily& family, const std::vector<int>& ids, Decode
     // the correlation sees them.
     std::vector<double> bins(config_.samples, 0.0);
     for (const auto& s : slices) {
-      ideal.start.push_back(s.start_deg / deg_per_sample);
-      ideal.level.push_back(s.white ? 1.0 : 0.0);
+      if (!s.white) continue;
       for (int k = 0; k < config_.samples; ++k) {
         // overlap of bin [k-0.5, k+0.5] (in samples) with the slice, handling wrap
         for (double shift : {-n, 0.0, n}) {
           const double a = std::max(k - 0.5, s.start_deg / deg_per_sample + shift);
           const double b = std::min(k + 0.5, s.end_deg / deg_per_sample + shift);
-          if (b > a && s.white) bins[k] += b - a;
+          if (b > a) bins[k] += b - a;
         }
       }
     }
@@ -82,7 +92,17 @@ Decoder::Decoder(const MarkerFamily& family, const std::vector<int>& ids, Decode
     double norm2 = 0.0;
     for (double b : bins) norm2 += (b - mean) * (b - mean);
     const double norm = std::sqrt(norm2);
-    for (double& l : ideal.level) l = (l - mean) / norm;
+    for (std::size_t i = 0; i < slices.size(); ++i) {
+      const auto& prev = slices[(i + slices.size() - 1) % slices.size()];
+      if (prev.white == slices[i].white) continue;
+      double e = slices[i].start_deg / deg_per_sample;
+      e -= n * std::floor(e / n);
+      ideal.edge.push_back(e);
+      ideal.step.push_back(((prev.white ? 1.0 : 0.0) - (slices[i].white ? 1.0 : 0.0)) / norm);
+      const int index = static_cast<int>(std::floor(e + 0.5));
+      ideal.edge_index.push_back(index % config_.samples);
+      ideal.edge_frac.push_back(e + 0.5 - index);
+    }
     ideals_.push_back(std::move(ideal));
   }
 }
@@ -92,10 +112,9 @@ SampledSignal Decoder::sample(const cv::Mat& grey, const Blob& blob) const {
   const int n = config_.samples;
   out.values.resize(n);
   for (int k = 0; k < n; ++k) {
-    const double a = 2.0 * kPi * k / n;
     double sum = 0.0;
     for (double r : MarkerFamily::sample_radii) {
-      const cv::Point2d p = marker_point(blob, r, a);
+      const cv::Point2d p = marker_point(blob, r, sample_directions_[k]);
       const double g = bilinear(grey, p.x, p.y);
       if (g < 0.0) return out;  // annulus leaves the image
       sum += g;
@@ -103,13 +122,12 @@ SampledSignal Decoder::sample(const cv::Mat& grey, const Blob& blob) const {
     out.values[k] = sum / std::size(MarkerFamily::sample_radii);
   }
   // The rings: black just outside the code, white beyond the dark disc.
-  constexpr int kRingSamples = 24;
   const double black_r = 0.5 * (MarkerFamily::code_outer_radius + MarkerFamily::black_ring_outer_radius);
   const double white_r = 0.5 * (MarkerFamily::black_ring_outer_radius + 1.0);
   std::vector<double> black(kRingSamples), white(kRingSamples);
   for (int k = 0; k < kRingSamples; ++k) {
-    const double a = 2.0 * kPi * (k + 0.5) / kRingSamples;
-    const cv::Point2d pb = marker_point(blob, black_r, a), pw = marker_point(blob, white_r, a);
+    const cv::Vec2d unit = ring_directions_[k];
+    const cv::Point2d pb = marker_point(blob, black_r, unit), pw = marker_point(blob, white_r, unit);
     black[k] = bilinear(grey, pb.x, pb.y);
     white[k] = bilinear(grey, pw.x, pw.y);
     if (black[k] < 0.0 || white[k] < 0.0) return out;
@@ -117,6 +135,8 @@ SampledSignal Decoder::sample(const cv::Mat& grey, const Blob& blob) const {
   const double black_level = percentile(black, 0.5);
   const double white_level = percentile(white, 0.5);
   out.ring_contrast = white_level - black_level;
+  out.black_level = black_level;
+  out.white_level = white_level;
   if (out.ring_contrast < config_.min_ring_contrast) return out;
   const double mid = 0.5 * (black_level + white_level);
   const auto bright = std::count_if(white.begin(), white.end(), [&](double g) { return g > mid; });
@@ -128,16 +148,8 @@ SampledSignal Decoder::sample(const cv::Mat& grey, const Blob& blob) const {
 }
 
 double Decoder::correlate(const std::vector<double>& cumulative, const Ideal& ideal, double lag) const {
-  // sum_k x[k] * y[k - lag]: the ideal is piecewise constant, so each segment
-  // contributes its level times the integral of x over the shifted segment.
-  const double n = config_.samples;
   double acc = 0.0;
-  const std::size_t segments = ideal.start.size();
-  for (std::size_t s = 0; s < segments; ++s) {
-    const double a = ideal.start[s] + lag;
-    const double b = (s + 1 < segments ? ideal.start[s + 1] : ideal.start[0] + n) + lag;
-    acc += ideal.level[s] * (cumulative_at(cumulative, b) - cumulative_at(cumulative, a));
-  }
+  for (std::size_t e = 0; e < ideal.edge.size(); ++e) acc += ideal.step[e] * cumulative_at(cumulative, ideal.edge[e] + lag);
   return acc;
 }
 
@@ -147,55 +159,106 @@ double Decoder::heading_on_screen(const Blob& blob, double lag) const {
   return wrap_deg_360(rad_to_deg(std::atan2(-dir[1], dir[0])));
 }
 
-std::vector<CodeMatch> Decoder::match_all(const SampledSignal& signal, const Blob& blob) const {
-  std::vector<CodeMatch> out;
-  out.reserve(ideals_.size());
-  if (!signal.usable) {
-    for (const auto& ideal : ideals_) out.push_back({ideal.id, -1.0, 0.0});
-    return out;
-  }
+Decoder::Prepared Decoder::prepare(const SampledSignal& signal) const {
   const int n = config_.samples;
+  Prepared p;
   const double mean = std::accumulate(signal.values.begin(), signal.values.end(), 0.0) / n;
   double norm2 = 0.0;
-  std::vector<double> cumulative(n + 1, 0.0);
+  p.cumulative.assign(n + 1, 0.0);
   for (int k = 0; k < n; ++k) {
     const double x = signal.values[k] - mean;
     norm2 += x * x;
-    cumulative[k + 1] = cumulative[k] + x;
+    p.cumulative[k + 1] = p.cumulative[k] + x;
   }
-  const double norm = std::sqrt(norm2);
-  for (const auto& ideal : ideals_) {
-    int best_lag = 0;
-    double best = -1e300;
-    for (int lag = 0; lag < n; ++lag) {
-      const double c = correlate(cumulative, ideal, lag);
-      if (c > best) {
-        best = c;
-        best_lag = lag;
-      }
+  p.norm = std::sqrt(norm2);
+  // The running integral is periodic because the signal is mean-free; doubling it lets
+  // every lag read it without wrapping.
+  p.doubled_cumulative.resize(2 * n);
+  p.doubled_signal.resize(2 * n);
+  for (int k = 0; k < 2 * n; ++k) {
+    p.doubled_cumulative[k] = p.cumulative[k % n];
+    p.doubled_signal[k] = signal.values[k % n] - mean;
+  }
+  return p;
+}
+
+std::pair<int, double> Decoder::coarse_peak(const Prepared& p, const Ideal& ideal, std::vector<double>& scratch) const {
+  const int n = config_.samples;
+  scratch.assign(n, 0.0);
+  // Edge by edge over all lags: contiguous loops the compiler vectorises.
+  for (std::size_t e = 0; e < ideal.edge.size(); ++e) {
+    const double* c = &p.doubled_cumulative[ideal.edge_index[e]];  // + lag < 2n: no modulo
+    const double* x = &p.doubled_signal[ideal.edge_index[e]];
+    const double step = ideal.step[e], frac = ideal.edge_frac[e];
+    for (int lag = 0; lag < n; ++lag) scratch[lag] += step * (c[lag] + frac * x[lag]);
+  }
+  const auto best = std::max_element(scratch.begin(), scratch.end());
+  return {static_cast<int>(best - scratch.begin()), *best};
+}
+
+std::pair<double, double> Decoder::refine_peak(const Prepared& p, const Ideal& ideal, int lag, double value) const {
+  // Golden-section search of the (unimodal near its peak) correlation on
+  // [lag - 1, lag + 1]; 12 steps narrow it to 0.01 samples.
+  double lo = lag - 1.0, hi = lag + 1.0;
+  constexpr double kInvPhi = 0.6180339887498949;
+  double m1 = hi - kInvPhi * (hi - lo), m2 = lo + kInvPhi * (hi - lo);
+  double c1 = correlate(p.cumulative, ideal, m1), c2 = correlate(p.cumulative, ideal, m2);
+  for (int it = 0; it < 12; ++it) {
+    if (c1 < c2) {
+      lo = m1; m1 = m2; c1 = c2;
+      m2 = lo + kInvPhi * (hi - lo);
+      c2 = correlate(p.cumulative, ideal, m2);
+    } else {
+      hi = m2; m2 = m1; c2 = c1;
+      m1 = hi - kInvPhi * (hi - lo);
+      c1 = correlate(p.cumulative, ideal, m1);
     }
-    // Refine the lag below one sample: golden-section search of the (unimodal near its
-    // peak) correlation on [best_lag - 1, best_lag + 1].
-    double lo = best_lag - 1.0, hi = best_lag + 1.0;
-    constexpr double kInvPhi = 0.6180339887498949;
-    double m1 = hi - kInvPhi * (hi - lo), m2 = lo + kInvPhi * (hi - lo);
-    double c1 = correlate(cumulative, ideal, m1), c2 = correlate(cumulative, ideal, m2);
-    for (int it = 0; it < 18; ++it) {
-      if (c1 < c2) {
-        lo = m1; m1 = m2; c1 = c2;
-        m2 = lo + kInvPhi * (hi - lo);
-        c2 = correlate(cumulative, ideal, m2);
-      } else {
-        hi = m2; m2 = m1; c2 = c1;
-        m1 = hi - kInvPhi * (hi - lo);
-        c1 = correlate(cumulative, ideal, m1);
-      }
+  }
+  return {0.5 * (lo + hi), std::max({value, c1, c2})};
+}
+
+std::vector<CodeMatch> Decoder::match_all(const SampledSignal& signal, const Blob& blob) const {
+  std::vector<CodeMatch> out;
+  out.reserve(ideals_.size());
+  if (!signal.usable || signal.values.size() != static_cast<std::size_t>(config_.samples)) {
+    for (const auto& ideal : ideals_) out.push_back({ideal.id, -1.0, 0.0});
+    return out;
+  }
+  const Prepared p = prepare(signal);
+  if (p.norm <= 0.0) {
+    for (const auto& ideal : ideals_) out.push_back({ideal.id, -1.0, 0.0});
+    return out;
+  }
+  // Coarse pass: every ID at every whole-sample lag.
+  std::vector<double> scratch;
+  std::vector<std::pair<int, double>> peaks;
+  double family_best = -1e300;
+  for (const Ideal& ideal : ideals_) {
+    peaks.push_back(coarse_peak(p, ideal, scratch));
+    family_best = std::max(family_best, peaks.back().second);
+  }
+  // Fine pass only for IDs that could win.
+  constexpr double kRefineMargin = 0.1;
+  for (std::size_t i = 0; i < ideals_.size(); ++i) {
+    auto [lag, value] = std::pair<double, double>(peaks[i].first, peaks[i].second);
+    if ((family_best - value) / p.norm < kRefineMargin) {
+      std::tie(lag, value) = refine_peak(p, ideals_[i], peaks[i].first, value);
     }
-    const double lag = 0.5 * (lo + hi);
-    const double peak = std::max({best, c1, c2});
-    out.push_back({ideal.id, norm > 0.0 ? std::clamp(peak / norm, -1.0, 1.0) : -1.0, heading_on_screen(blob, lag)});
+    out.push_back({ideals_[i].id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, lag)});
   }
   return out;
+}
+
+CodeMatch Decoder::match_one(const SampledSignal& signal, const Blob& blob, int id) const {
+  const auto it = std::find_if(ideals_.begin(), ideals_.end(), [&](const Ideal& i) { return i.id == id; });
+  if (it == ideals_.end()) throw std::invalid_argument("ID " + std::to_string(id) + " is not decoded here");
+  if (!signal.usable || signal.values.size() != static_cast<std::size_t>(config_.samples)) return {id, -1.0, 0.0};
+  const Prepared p = prepare(signal);
+  if (p.norm <= 0.0) return {id, -1.0, 0.0};
+  std::vector<double> scratch;
+  const auto [coarse_lag, coarse_value] = coarse_peak(p, *it, scratch);
+  const auto [lag, value] = refine_peak(p, *it, coarse_lag, coarse_value);
+  return {id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, lag)};
 }
 
 }  // namespace rilbed::vision

@@ -5,6 +5,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <utility>
 #include <vector>
 
 #include "vision/blob_detector.hpp"
@@ -33,13 +34,18 @@ struct SampledSignal {
   bool usable = false;            ///< false when the contrast tests failed
   std::vector<double> values;     ///< mean grey level per angle, CCW from the sampling axis
   double ring_contrast = 0.0;     ///< white ring minus black ring, grey levels
+  double black_level = 0.0;       ///< median grey level of the black ring
+  double white_level = 0.0;       ///< median grey level of the white ring
 };
 
 /// The best match of a signal against one ID.
 struct CodeMatch {
   int id = 0;
   double score = -1.0;        ///< circular cross-covariance at the best lag, [-1, 1]
-  double heading_deg = 0.0;   ///< on screen, CCW from +u, [0, 360)
+  /// On screen, CCW from +u, [0, 360). Refined below the sampling step only for IDs
+  /// within 0.1 of the best score (the only ones that can be assigned); others carry
+  /// the whole-sample lag's heading.
+  double heading_deg = 0.0;
 };
 
 /// Decoder for a fixed family and a fixed set of available IDs; precomputes their ideal
@@ -56,19 +62,42 @@ class Decoder {
   /// Table 1 row for one object). Each entry carries the heading for that ID's best lag.
   std::vector<CodeMatch> match_all(const SampledSignal& signal, const Blob& blob) const;
 
+  /// Similarity of the signal to one ID (which must be one of ids()): what a tracked
+  /// marker needs to confirm its ID at a fraction of match_all's cost.
+  CodeMatch match_one(const SampledSignal& signal, const Blob& blob, int id) const;
+
   const std::vector<int>& ids() const { return ids_; }
   const DecoderConfig& config() const { return config_; }
 
  private:
+  // The ideal signal is piecewise constant, so its correlation with x at lag L is
+  // sum over colour edges e of step(e) * P(e + L), where P is the running integral of the
+  // mean-free signal (periodic, since the signal sums to zero). That costs one term per
+  // edge instead of one per sample.
   struct Ideal {
     int id = 0;
-    std::vector<double> start;  // segment starts in samples (fractional), ascending
-    std::vector<double> level;  // zero-mean, unit-norm level of each segment
+    std::vector<double> edge;  // positions of colour changes, in samples, in [0, n)
+    std::vector<double> step;  // normalised level before the edge minus level after it
+    std::vector<int> edge_index;     // floor(edge + 0.5): the bin the edge falls in
+    std::vector<double> edge_frac;   // edge + 0.5 - edge_index
   };
+  // The mean-free signal's running integral, plain (n + 1) and doubled (2n, with the
+  // signal itself doubled beside it), and its norm.
+  struct Prepared {
+    std::vector<double> cumulative, doubled_cumulative, doubled_signal;
+    double norm = 0.0;
+  };
+  Prepared prepare(const SampledSignal& signal) const;
+  // Best whole-sample lag of one ideal and its (unnormalised) correlation.
+  std::pair<int, double> coarse_peak(const Prepared& p, const Ideal& ideal, std::vector<double>& scratch) const;
+  // The lag refined below one sample, with its correlation.
+  std::pair<double, double> refine_peak(const Prepared& p, const Ideal& ideal, int lag, double value) const;
   double correlate(const std::vector<double>& cumulative, const Ideal& ideal, double lag) const;
   double heading_on_screen(const Blob& blob, double lag) const;
 
+  static constexpr int kRingSamples = 24;  // samples on each of the two rings
   DecoderConfig config_;
+  std::vector<cv::Vec2d> sample_directions_, ring_directions_;
   std::vector<int> ids_;
   std::vector<Ideal> ideals_;
 };

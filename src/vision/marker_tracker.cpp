@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include "vision/assignment.hpp"
@@ -80,16 +81,17 @@ cv::Mat MarkerTracker::to_grey(const cv::Mat& frame) {
 }
 
 std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const std::vector<Blob>& blobs,
-                                                   bool use_tracks) {
+                                                   bool use_tracks, const std::vector<int>& taken_ids) {
   std::vector<std::vector<double>> similarity;
   std::vector<std::vector<CodeMatch>> matches;
+  std::vector<double> thresholds;
   similarity.reserve(blobs.size());
   matches.reserve(blobs.size());
-  stats_.blobs = static_cast<int>(blobs.size());
-  stats_.decoded = 0;
+  stats_.blobs += static_cast<int>(blobs.size());
   for (const Blob& blob : blobs) {
     const SampledSignal signal = decoder_.sample(grey, blob);
     if (signal.usable) ++stats_.decoded;
+    thresholds.push_back(0.5 * (signal.black_level + signal.white_level));
     matches.push_back(decoder_.match_all(signal, blob));
     double family_best = -1.0;
     for (const CodeMatch& m : matches.back()) family_best = std::max(family_best, m.score);
@@ -97,6 +99,7 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
     for (std::size_t c = 0; c < ids_.size(); ++c) {
       const double score = matches.back()[decoder_index_[c]].score;
       if (score < config_.min_assign_score || score < family_best - config_.family_margin) continue;
+      if (std::find(taken_ids.begin(), taken_ids.end(), ids_[c]) != taken_ids.end()) continue;
       row[c] = score;
       if (!use_tracks) continue;
       for (const Track& t : tracks_) {
@@ -117,7 +120,8 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
     const CodeMatch& m = matches[r][decoder_index_[chosen[r]]];
     const Blob& b = blobs[r];
     const double disc_d = 2.0 * std::sqrt(std::abs(cv::determinant(b.shape)));
-    out.push_back({m.id, b.u, b.v, m.heading_deg, m.score, disc_d / MarkerFamily::black_ring_outer_radius, false});
+    out.push_back({m.id, b.u, b.v, m.heading_deg, m.score, disc_d / MarkerFamily::black_ring_outer_radius, false,
+                   thresholds[r]});
   }
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
   return out;
@@ -130,10 +134,23 @@ std::vector<MarkerDetection> MarkerTracker::detect_full_frame(const cv::Mat& fra
   return assign(grey, detector_.detect(grey), false);
 }
 
+std::optional<MarkerDetection> MarkerTracker::confirm(const cv::Mat& grey, const Track& track, const Blob& blob) {
+  const SampledSignal signal = decoder_.sample(grey, blob);
+  if (!signal.usable) return std::nullopt;
+  ++stats_.decoded;
+  const CodeMatch m = decoder_.match_one(signal, blob, track.id);
+  if (m.score < config_.min_assign_score || m.score < track.score - config_.confirm_drop) return std::nullopt;
+  const double disc_d = 2.0 * std::sqrt(std::abs(cv::determinant(blob.shape)));
+  return MarkerDetection{m.id, blob.u, blob.v, m.heading_deg, m.score, disc_d / MarkerFamily::black_ring_outer_radius,
+                         true, 0.5 * (signal.black_level + signal.white_level)};
+}
+
 std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
   const cv::Mat grey = to_grey(frame);
   stats_ = FrameStats{};
-  std::vector<Blob> blobs;
+  std::vector<Blob> blobs;  // found but not confirmed: decoded against the family
+  std::vector<MarkerDetection> confirmed;
+  std::vector<int> confirmed_ids;
   for (const Track& t : tracks_) {
     // A track that missed frames coasts: its window moves on and widens with them.
     const double ahead = t.missed + 1.0;
@@ -141,26 +158,50 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     const double half = (config_.search_window_diameters + 0.5) * t.diameter_px + ahead * std::hypot(t.du, t.dv);
     const cv::Rect roi(static_cast<int>(std::floor(pu - half)), static_cast<int>(std::floor(pv - half)),
                        static_cast<int>(std::ceil(2 * half)) + 1, static_cast<int>(std::ceil(2 * half)) + 1);
-    append_unique(blobs, detector_.detect(grey, roi));
+    const std::vector<Blob> near = detector_.detect_near(grey, roi, {pu, pv}, t.threshold_grey);
+    if (near.size() == 1 && t.missed == 0) {
+      ++stats_.blobs;
+      if (auto d = confirm(grey, t, near[0])) {
+        confirmed.push_back(*d);
+        confirmed_ids.push_back(t.id);
+        continue;
+      }
+    }
+    append_unique(blobs, near);
   }
-  std::vector<MarkerDetection> found = assign(grey, blobs, true);
+  // Blobs at a confirmed marker's place are that marker.
+  std::erase_if(blobs, [&](const Blob& b) {
+    return std::any_of(confirmed.begin(), confirmed.end(), [&](const MarkerDetection& d) {
+      return std::hypot(d.u - b.u, d.v - b.v) < 0.25 * d.diameter_px;
+    });
+  });
+  std::vector<MarkerDetection> found = assign(grey, blobs, true, confirmed_ids);
   for (auto& d : found) d.tracked = true;
+  found.insert(found.end(), confirmed.begin(), confirmed.end());
 
   const bool all_found = found.size() == ids_.size();
   ++frames_since_full_;
   if (tracks_.empty() || (!all_found && frames_since_full_ >= config_.full_search_interval_frames)) {
     frames_since_full_ = 0;
-    append_unique(blobs, detector_.detect(grey));
-    found = assign(grey, blobs, true);
+    std::vector<Blob> more = detector_.detect(grey);
+    std::erase_if(more, [&](const Blob& b) {
+      return std::any_of(confirmed.begin(), confirmed.end(), [&](const MarkerDetection& d) {
+        return std::hypot(d.u - b.u, d.v - b.v) < 0.25 * d.diameter_px;
+      });
+    });
+    append_unique(blobs, more);
+    found = assign(grey, blobs, true, confirmed_ids);
+    found.insert(found.end(), confirmed.begin(), confirmed.end());
     stats_.full_search = true;
   }
+  std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
 
   // Update the tracks: move the seen ones, coast the others, drop the long-lost.
   for (Track& t : tracks_) ++t.missed;
   for (const MarkerDetection& d : found) {
     auto it = std::find_if(tracks_.begin(), tracks_.end(), [&](const Track& t) { return t.id == d.id; });
     if (it == tracks_.end()) {
-      tracks_.push_back({d.id, d.u, d.v, 0.0, 0.0, d.diameter_px, 0});
+      tracks_.push_back({d.id, d.u, d.v, 0.0, 0.0, d.diameter_px, d.threshold_grey, d.score, 0});
       continue;
     }
     const int frames = it->missed;  // frames since the last sighting, >= 1
@@ -169,6 +210,10 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     it->u = d.u;
     it->v = d.v;
     it->diameter_px = d.diameter_px;
+    it->threshold_grey = d.threshold_grey;
+    // The reference score is set by a full decode and only lowered slowly by
+    // confirmations, so a drifting code cannot ratchet its own bar down.
+    it->score = d.tracked ? std::max(d.score, it->score - 0.01) : d.score;
     it->missed = 0;
   }
   std::erase_if(tracks_, [&](const Track& t) { return t.missed > config_.max_missed_frames; });

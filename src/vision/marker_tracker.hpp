@@ -31,6 +31,8 @@ struct MarkerDetection {
   double diameter_px = 0.0;
   /// True when this frame found it by the local search around its last position.
   bool tracked = false;
+  /// Grey level midway between the marker's black and white rings in this frame.
+  double threshold_grey = 0.0;
 };
 
 /// Knobs of the whole pipeline.
@@ -48,7 +50,7 @@ struct TrackerConfig {
   double family_margin = 0.03;
   /// Local-search window half-size as a multiple of the marker's diameter, plus the
   /// distance it moved in the last frame. Larger tolerates faster robots, costs more.
-  double search_window_diameters = 1.5;
+  double search_window_diameters = 0.75;
   /// When some expected IDs are missing, a full-frame search runs at most every this
   /// many frames (1: every frame). Larger makes missing robots cheaper and found later.
   int full_search_interval_frames = 1;
@@ -57,6 +59,11 @@ struct TrackerConfig {
   /// Bonus added to the similarity of an object lying inside the search window of the
   /// track of the same ID. Keeps IDs stable when two codes look alike in a poor frame.
   double track_bonus = 0.05;
+  /// A tracked marker found again near its prediction keeps its ID after a check
+  /// against that ID alone, as long as its similarity stays above min_assign_score and
+  /// within this of the score it had when last seen; otherwise it is decoded against
+  /// the whole family again. Larger saves decoding, smaller re-checks more often.
+  double confirm_drop = 0.08;
 };
 
 /// Per-frame work counters, for summaries and benchmarks.
@@ -96,10 +103,13 @@ class MarkerTracker {
     int id = 0;
     double u = 0, v = 0, du = 0, dv = 0;  // position and per-frame motion
     double diameter_px = 0;
+    double threshold_grey = 0;
+    double score = 0;
     int missed = 0;
   };
-  std::vector<MarkerDetection> assign(const cv::Mat& grey, const std::vector<Blob>& blobs,
-                                      bool use_tracks);
+  std::vector<MarkerDetection> assign(const cv::Mat& grey, const std::vector<Blob>& blobs, bool use_tracks,
+                                      const std::vector<int>& taken_ids = {});
+  std::optional<MarkerDetection> confirm(const cv::Mat& grey, const Track& track, const Blob& blob);
   cv::Mat to_grey(const cv::Mat& frame);
 
   MarkerFamily family_;
