@@ -45,6 +45,8 @@ void BlobDetector::prepare(const cv::Mat& grey) {
   tile_min_.assign(tiles, 0);
   tile_max_.assign(tiles, 0);
   tile_threshold_.assign(tiles, 0);
+  row_min_scratch_.assign(tiles, 0);
+  row_max_scratch_.assign(tiles, 0);
   visited_ = cv::Mat::zeros(size_, CV_8UC1);
   row_min_x_.assign(size_.height, 0);
   row_max_x_.assign(size_.height, -1);
@@ -82,19 +84,45 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
       tile_max_[ty * tiles_x_ + tx] = mx;
     }
   }
-  // The threshold of a tile comes from its 3x3 neighbourhood so that a marker larger
-  // than one tile sees one consistent threshold across its dark disc.
-  for (int ty = std::min(ty0 + 1, ty1); ty <= std::max(ty1 - 1, ty0); ++ty) {
-    for (int tx = std::min(tx0 + 1, tx1); tx <= std::max(tx1 - 1, tx0); ++tx) {
-      int mn = 255, mx = 0;
-      for (int ny = std::max(0, ty - 1); ny <= std::min(tiles_y_ - 1, ty + 1); ++ny) {
-        for (int nx = std::max(0, tx - 1); nx <= std::min(tiles_x_ - 1, tx + 1); ++nx) {
-          mn = std::min<int>(mn, tile_min_[ny * tiles_x_ + nx]);
-          mx = std::max<int>(mx, tile_max_[ny * tiles_x_ + nx]);
-        }
+  // Sensor noise alone spans some grey levels in every tile; a tile counts as having
+  // contrast only well above that. The noise floor is the median range of the tiles of
+  // a large search (most of a frame is floor), kept for the small tracked searches.
+  const int computed = (tx1 - tx0 + 1) * (ty1 - ty0 + 1);
+  if (computed * 4 >= tiles_x_ * tiles_y_) {
+    range_scratch_.clear();
+    for (int ty = ty0; ty <= ty1; ++ty) {
+      for (int tx = tx0; tx <= tx1; ++tx) {
+        range_scratch_.push_back(tile_max_[ty * tiles_x_ + tx] - tile_min_[ty * tiles_x_ + tx]);
       }
-      tile_threshold_[ty * tiles_x_ + tx] =
-          (mx - mn >= config_.min_local_contrast) ? static_cast<std::uint8_t>((mn + mx + 1) / 2) : 0;
+    }
+    auto mid = range_scratch_.begin() + range_scratch_.size() / 2;
+    std::nth_element(range_scratch_.begin(), mid, range_scratch_.end());
+    noise_range_ = *mid;
+  }
+  const int min_contrast =
+      std::max(config_.min_local_contrast, static_cast<int>(std::lround(config_.contrast_over_noise * noise_range_)));
+
+  // The threshold of a tile comes from its 3x3 neighbourhood so that a marker larger
+  // than one tile sees one consistent threshold across its dark disc; done as two
+  // separable passes (a row of three, then a column of three).
+  const int ax = std::min(tx0 + 1, tx1), bx = std::max(tx1 - 1, tx0);
+  const int ay = std::min(ty0 + 1, ty1), by = std::max(ty1 - 1, ty0);
+  for (int ty = ty0; ty <= ty1; ++ty) {
+    const std::size_t row = static_cast<std::size_t>(ty) * tiles_x_;
+    for (int tx = ax; tx <= bx; ++tx) {
+      const int l = std::max(0, tx - 1), r = std::min(tiles_x_ - 1, tx + 1);
+      row_min_scratch_[row + tx] = std::min({tile_min_[row + l], tile_min_[row + tx], tile_min_[row + r]});
+      row_max_scratch_[row + tx] = std::max({tile_max_[row + l], tile_max_[row + tx], tile_max_[row + r]});
+    }
+  }
+  for (int ty = ay; ty <= by; ++ty) {
+    const std::size_t up = static_cast<std::size_t>(std::max(0, ty - 1)) * tiles_x_;
+    const std::size_t row = static_cast<std::size_t>(ty) * tiles_x_;
+    const std::size_t down = static_cast<std::size_t>(std::min(tiles_y_ - 1, ty + 1)) * tiles_x_;
+    for (int tx = ax; tx <= bx; ++tx) {
+      const int mn = std::min({row_min_scratch_[up + tx], row_min_scratch_[row + tx], row_min_scratch_[down + tx]});
+      const int mx = std::max({row_max_scratch_[up + tx], row_max_scratch_[row + tx], row_max_scratch_[down + tx]});
+      tile_threshold_[row + tx] = (mx - mn >= min_contrast) ? static_cast<std::uint8_t>((mn + mx + 1) / 2) : 0;
     }
   }
 }
@@ -330,17 +358,17 @@ std::vector<Blob> BlobDetector::scan(const cv::Mat& grey, cv::Rect roi) {
     const std::uint8_t* vis = visited_.ptr<std::uint8_t>(y);
     const std::uint8_t* tile_thresholds = &tile_threshold_[static_cast<std::size_t>(tile_row_[y]) * tiles_x_];
     const int x_end = roi.x + roi.width;
-    for (int x = roi.x; x < x_end; ++x) {
-      const std::uint8_t t = tile_thresholds[tile_col_[x]];
-      if (t == 0) {
-        // A tile without contrast holds no dark pixel: skip to the next tile. Most of a
-        // plain floor is such tiles, so this is most of the scan's saving.
-        x = std::min(x_end, (tile_col_[x] + 1) * config_.tile_px) - 1;
-        continue;
+    // Tile by tile: a tile without contrast holds no dark pixel, and most of a plain
+    // floor is such tiles, so whole tiles are skipped.
+    for (int tx = roi.x / config_.tile_px; tx * config_.tile_px < x_end; ++tx) {
+      const std::uint8_t t = tile_thresholds[tx];
+      if (t == 0) continue;
+      const int xa = std::max(roi.x, tx * config_.tile_px), xb = std::min(x_end, (tx + 1) * config_.tile_px);
+      for (int x = xa; x < xb; ++x) {
+        if (vis[x] || row[x] >= t) continue;
+        Blob blob;
+        if (try_seed(grey, roi, x, y, blob)) blobs.push_back(blob);
       }
-      if (vis[x] || row[x] >= t) continue;
-      Blob blob;
-      if (try_seed(grey, roi, x, y, blob)) blobs.push_back(blob);
     }
   }
   return blobs;

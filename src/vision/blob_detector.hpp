@@ -28,6 +28,11 @@ struct BlobDetectorConfig {
   /// for its pixels to count as dark or bright. Lower accepts fainter markers and more
   /// noise-made fragments.
   int min_local_contrast = 24;
+  /// The least local contrast is also at least this many times the frame's noise floor
+  /// (the median grey-level range of a tile, measured on each full-frame search). Keeps
+  /// a noisy floor from counting as contrast, which would flood the search with specks;
+  /// higher rejects more noise and loses faint markers sooner.
+  double contrast_over_noise = 2.0;
   /// Rows between seed scan lines of a search; 0 picks a quarter of the smallest dark
   /// disc. Larger is faster and misses markers smaller than about 2 steps.
   int seed_row_step = 0;
@@ -103,6 +108,9 @@ class BlobDetector {
   std::vector<int> tile_col_, tile_row_;           // pixel column/row -> tile column/row
   std::vector<std::uint8_t> tile_min_, tile_max_;  // raw tile statistics
   std::vector<std::uint8_t> tile_threshold_;       // 0 marks a tile without contrast
+  std::vector<std::uint8_t> row_min_scratch_, row_max_scratch_;  // first pass of the 3x3 spread
+  std::vector<int> range_scratch_;
+  int noise_range_ = 0;                             // median tile range of the last large search
   cv::Mat visited_;                                // 8-bit, nonzero = already filled
   std::vector<int> row_min_x_, row_max_x_, col_min_y_, col_max_y_;
   std::vector<std::pair<int, int>> stack_;
