@@ -105,6 +105,34 @@ Decoder::Decoder(const MarkerFamily& family, const std::vector<int>& ids, Decode
     }
     ideals_.push_back(std::move(ideal));
   }
+  index_of_id_.assign(family.max_id() + 1, -1);
+  for (std::size_t i = 0; i < ids.size(); ++i) index_of_id_[ids[i]] = static_cast<int>(i);
+  if (static_cast<int>(ids.size()) > kExhaustiveIds) build_key_template(family);
+}
+
+void Decoder::build_key_template(const MarkerFamily& family) {
+  // The slices every ID shares: the white key (+1) between two black guards (-1); the
+  // code slices weigh nothing. Its correlation peak is the heading whatever the code.
+  const double deg_per_sample = 360.0 / config_.samples;
+  const auto slices = family.slices(family.min_id());
+  const int k = static_cast<int>(slices.size());
+  std::vector<double> level(k, 0.0);
+  level[0] = 1.0;
+  level[1] = level[k - 1] = -1.0;
+  key_ = Ideal{};
+  for (int i = 0; i < k; ++i) {
+    const double step = level[(i + k - 1) % k] - level[i];
+    if (step == 0.0) continue;
+    double e = slices[i].start_deg / deg_per_sample;
+    e -= config_.samples * std::floor(e / config_.samples);
+    const int index = static_cast<int>(std::floor(e + 0.5));
+    key_.edge.push_back(e);
+    key_.step.push_back(step);
+    key_.edge_index.push_back(index % config_.samples);
+    key_.edge_frac.push_back(e + 0.5 - index);
+  }
+  slice_bounds_.clear();
+  for (const auto& s : slices) slice_bounds_.emplace_back(s.start_deg / deg_per_sample, s.end_deg / deg_per_sample);
 }
 
 SampledSignal Decoder::sample(const cv::Mat& grey, const Blob& blob) const {
@@ -229,6 +257,7 @@ std::vector<CodeMatch> Decoder::match_all(const SampledSignal& signal, const Blo
     for (const auto& ideal : ideals_) out.push_back({ideal.id, -1.0, 0.0});
     return out;
   }
+  if (!slice_bounds_.empty()) return match_by_key(p, blob);
   // Coarse pass: every ID at every whole-sample lag.
   std::vector<double> scratch;
   std::vector<std::pair<int, double>> peaks;
@@ -245,6 +274,41 @@ std::vector<CodeMatch> Decoder::match_all(const SampledSignal& signal, const Blo
       std::tie(lag, value) = refine_peak(p, ideals_[i], peaks[i].first, value);
     }
     out.push_back({ideals_[i].id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, lag)});
+  }
+  return out;
+}
+
+std::vector<CodeMatch> Decoder::match_by_key(const Prepared& p, const Blob& blob) const {
+  // Heading first, from the key and guards alone; then the code bits read at that
+  // heading; then the exact cross-covariance for the code read and for every code one
+  // bit away (the only IDs a misread bit can hide). The cost no longer grows with the
+  // number of IDs.
+  std::vector<CodeMatch> out;
+  out.reserve(ideals_.size());
+  for (const auto& ideal : ideals_) out.push_back({ideal.id, -1.0, 0.0});
+  std::vector<double> scratch;
+  const auto [key_lag, key_value] = coarse_peak(p, key_, scratch);
+  const double lag = refine_peak(p, key_, key_lag, key_value).first;
+  auto mean_over = [&](std::size_t slice) {
+    const auto [a, b] = slice_bounds_[slice];
+    return (cumulative_at(p.cumulative, b + lag) - cumulative_at(p.cumulative, a + lag)) / (b - a);
+  };
+  const std::size_t k = slice_bounds_.size();
+  const double white = mean_over(0), black = 0.5 * (mean_over(1) + mean_over(k - 1));
+  const double mid = 0.5 * (white + black);
+  int code = 0;
+  for (std::size_t i = 2; i + 1 < k; ++i) {
+    if (mean_over(i) > mid) code |= 1 << (i - 2);
+  }
+  std::vector<int> candidates{code};
+  for (std::size_t bit = 0; bit + 3 < k; ++bit) candidates.push_back(code ^ (1 << bit));
+  for (int c : candidates) {
+    const int id = c + 1;
+    if (id >= static_cast<int>(index_of_id_.size()) || index_of_id_[id] < 0) continue;
+    const Ideal& ideal = ideals_[index_of_id_[id]];
+    const auto [coarse_lag, coarse_value] = coarse_peak(p, ideal, scratch);
+    const auto [fine_lag, value] = refine_peak(p, ideal, coarse_lag, coarse_value);
+    out[index_of_id_[id]] = {id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, fine_lag)};
   }
   return out;
 }

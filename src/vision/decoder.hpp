@@ -60,6 +60,9 @@ class Decoder {
 
   /// Similarity of the signal to every available ID, in the order of ids() (the paper's
   /// Table 1 row for one object). Each entry carries the heading for that ID's best lag.
+  /// For more than 16 IDs the decoder first finds the heading from the slices all IDs
+  /// share, reads the code bits there, and scores only that code and the codes one bit
+  /// away; the others get -1 (they cannot be the best match unless two bits misread).
   std::vector<CodeMatch> match_all(const SampledSignal& signal, const Blob& blob) const;
 
   /// Similarity of the signal to one ID (which must be one of ids()): what a tracked
@@ -96,6 +99,12 @@ class Decoder {
   double heading_on_screen(const Blob& blob, double lag) const;
 
   static constexpr int kRingSamples = 24;  // samples on each of the two rings
+  static constexpr int kExhaustiveIds = 16;  // above this many IDs, decode by key and bits
+  void build_key_template(const MarkerFamily& family);
+  std::vector<CodeMatch> match_by_key(const Prepared& p, const Blob& blob) const;
+  Ideal key_;                                            // key and guards only
+  std::vector<std::pair<double, double>> slice_bounds_;  // slices at lag 0, in samples; empty: exhaustive
+  std::vector<int> index_of_id_;                         // ID -> index in ideals_, -1 if absent
   DecoderConfig config_;
   std::vector<cv::Vec2d> sample_directions_, ring_directions_;
   std::vector<int> ids_;

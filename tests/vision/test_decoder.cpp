@@ -83,3 +83,26 @@ TEST(Decoder, ScoreIsNormalised) {
   EXPECT_GT(m[0].score, 0.97);
   EXPECT_LE(m[0].score, 1.0);
 }
+
+// Hundreds of IDs: decoding by key and bits finds each ID without scoring all 512.
+TEST(Decoder, TwelveSliceFamilyDecodesByKeyAndBits) {
+  const auto f = MarkerFamily::by_name("12ucp");
+  std::vector<int> ids;
+  for (int id = 1; id <= f.max_id(); ++id) ids.push_back(id);
+  Decoder decoder(f, ids);
+  BlobDetector detector;
+  for (int id : {1, 2, 100, 255, 256, 377, 511, 512}) {
+    const cv::Mat img = canvas_with_marker(f, id, 72, 33.0 + id);
+    const auto blobs = detector.detect(img);
+    ASSERT_EQ(blobs.size(), 1u);
+    const auto matches = decoder.match_all(decoder.sample(img, blobs[0]), blobs[0]);
+    const auto best = std::max_element(matches.begin(), matches.end(),
+                                       [](const auto& a, const auto& b) { return a.score < b.score; });
+    EXPECT_EQ(best->id, id);
+    EXPECT_GT(best->score, 0.9);
+    EXPECT_NEAR(wrap_deg_180(best->heading_deg - (33.0 + id)), 0.0, 1.5) << "id " << id;
+    // Only the code read and its one-bit neighbours are scored.
+    const auto scored = std::count_if(matches.begin(), matches.end(), [](const auto& m) { return m.score > -1.0; });
+    EXPECT_LE(scored, 10);
+  }
+}
