@@ -32,7 +32,7 @@ struct BlobDetectorConfig {
   /// (the median grey-level range of a tile, measured on each full-frame search). Keeps
   /// a noisy floor from counting as contrast, which would flood the search with specks;
   /// higher rejects more noise and loses faint markers sooner.
-  double contrast_over_noise = 2.0;
+  double contrast_over_noise = 2.5;
   /// Rows between seed scan lines of a search; 0 picks a quarter of the smallest dark
   /// disc. Larger is faster and misses markers smaller than about 2 steps.
   int seed_row_step = 0;
