@@ -179,14 +179,6 @@ bool BlobDetector::flood_fill(const cv::Mat& grey, cv::Rect roi, int seed_x, int
       row_min_x_[y] = std::min(row_min_x_[y], xl);
       row_max_x_[y] = std::max(row_max_x_[y], xr);
     }
-    for (int x = xl; x <= xr; ++x) {
-      if (col_max_y_[x] < col_min_y_[x]) {
-        col_min_y_[x] = col_max_y_[x] = y;
-      } else {
-        col_min_y_[x] = std::min(col_min_y_[x], y);
-        col_max_y_[x] = std::max(col_max_y_[x], y);
-      }
-    }
     if (fill.area > max_area) fill.too_large = true;
     if (fill.area > hard_limit) break;
     for (int ny : {y - 1, y + 1}) {
@@ -353,7 +345,18 @@ bool BlobDetector::try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blo
   const double min_area = kPi * min_disc_d * min_disc_d / 4.0 / config_.max_axis_ratio * 0.8;
   Fill fill;
   const bool whole = flood_fill(grey, roi, x, y, fill);
-  const bool ok = whole && fill.area >= min_area && measure(grey, fill, blob);
+  const bool candidate = whole && fill.area >= min_area;
+  if (candidate) {
+    // Column extents of the filled outline, from its row spans: only candidates pay
+    // for them (a long strip of tape is filled, but never measured).
+    for (int r = fill.y0; r <= fill.y1; ++r) {
+      for (int c = row_min_x_[r]; c <= row_max_x_[r]; ++c) {
+        if (col_max_y_[c] < col_min_y_[c]) col_min_y_[c] = r;
+        col_max_y_[c] = r;
+      }
+    }
+  }
+  const bool ok = candidate && measure(grey, fill, blob);
   // Reset the chord bookkeeping of the rows and columns this fill touched.
   for (int r = fill.y0; r <= fill.y1; ++r) {
     row_min_x_[r] = 0;

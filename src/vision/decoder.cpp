@@ -1,6 +1,7 @@
 #include "vision/decoder.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
@@ -11,27 +12,6 @@
 namespace rilbed::vision {
 
 namespace {
-
-// Bilinear grey level at a sub-pixel position; positions outside give -1.
-double bilinear(const cv::Mat& grey, double u, double v) {
-  if (u < 0.0 || v < 0.0 || u > grey.cols - 1.001 || v > grey.rows - 1.001) return -1.0;
-  const int x = static_cast<int>(u), y = static_cast<int>(v);
-  const double fx = u - x, fy = v - y;
-  const std::uint8_t* r0 = grey.ptr<std::uint8_t>(y);
-  const std::uint8_t* r1 = grey.ptr<std::uint8_t>(y + 1);
-  return (r0[x] * (1 - fx) + r0[x + 1] * fx) * (1 - fy) + (r1[x] * (1 - fx) + r1[x + 1] * fx) * fy;
-}
-
-// Image position of the marker-frame point at radius r (fraction of the outer radius)
-// and angle a (radians, CCW on screen). The blob's shape maps the unit circle onto the
-// dark disc, whose radius is black_ring_outer_radius.
-// `unit` is (cos a, -sin a) for the angle a counter-clockwise on screen.
-cv::Point2d marker_point(const Blob& blob, double r, cv::Vec2d unit) {
-  const double k = r / MarkerFamily::black_ring_outer_radius;
-  const cv::Vec2d p = unit * k;
-  const cv::Vec2d q = blob.shape * p;
-  return {blob.u + q[0], blob.v + q[1]};
-}
 
 double percentile(std::vector<double> v, double p) {
   const auto k = static_cast<std::size_t>(p * (v.size() - 1));
@@ -138,36 +118,57 @@ void Decoder::build_key_template(const MarkerFamily& family) {
 SampledSignal Decoder::sample(const cv::Mat& grey, const Blob& blob) const {
   SampledSignal out;
   const int n = config_.samples;
+  // The whole marker must lie inside the image; then no sample needs a bounds check.
+  const double reach = 1.0 / MarkerFamily::black_ring_outer_radius;
+  const double half_u = reach * (std::abs(blob.shape(0, 0)) + std::abs(blob.shape(0, 1)));
+  const double half_v = reach * (std::abs(blob.shape(1, 0)) + std::abs(blob.shape(1, 1)));
+  if (blob.u - half_u < 0.0 || blob.v - half_v < 0.0 || blob.u + half_u > grey.cols - 1.001 ||
+      blob.v + half_v > grey.rows - 1.001) {
+    return out;
+  }
+  const std::uint8_t* data = grey.ptr<std::uint8_t>(0);
+  const std::size_t stride = grey.step[0];
+  // Unchecked bilinear read at (u, v), inside the image by the test above.
+  auto read = [&](double u, double v) {
+    const int x = static_cast<int>(u), y = static_cast<int>(v);
+    const double fx = u - x, fy = v - y;
+    const std::uint8_t* r0 = data + y * stride + x;
+    const std::uint8_t* r1 = r0 + stride;
+    return (r0[0] + (r0[1] - r0[0]) * fx) * (1 - fy) + (r1[0] + (r1[1] - r1[0]) * fx) * fy;
+  };
+  // shape maps the unit circle to the dark disc; scale it to the marker's radius units.
+  const double a = blob.shape(0, 0) * reach, b = blob.shape(0, 1) * reach;
+  const double c = blob.shape(1, 0) * reach, d = blob.shape(1, 1) * reach;
   out.values.resize(n);
+  constexpr std::size_t kRadii = std::size(MarkerFamily::sample_radii);
   for (int k = 0; k < n; ++k) {
+    const double du = a * sample_directions_[k][0] + b * sample_directions_[k][1];
+    const double dv = c * sample_directions_[k][0] + d * sample_directions_[k][1];
     double sum = 0.0;
-    for (double r : MarkerFamily::sample_radii) {
-      const cv::Point2d p = marker_point(blob, r, sample_directions_[k]);
-      const double g = bilinear(grey, p.x, p.y);
-      if (g < 0.0) return out;  // annulus leaves the image
-      sum += g;
-    }
-    out.values[k] = sum / std::size(MarkerFamily::sample_radii);
+    for (double r : MarkerFamily::sample_radii) sum += read(blob.u + r * du, blob.v + r * dv);
+    out.values[k] = sum / kRadii;
   }
   // The rings: black just outside the code, white beyond the dark disc.
   const double black_r = 0.5 * (MarkerFamily::code_outer_radius + MarkerFamily::black_ring_outer_radius);
   const double white_r = 0.5 * (MarkerFamily::black_ring_outer_radius + 1.0);
-  std::vector<double> black(kRingSamples), white(kRingSamples);
+  std::array<double, kRingSamples> black{}, white{};
   for (int k = 0; k < kRingSamples; ++k) {
-    const cv::Vec2d unit = ring_directions_[k];
-    const cv::Point2d pb = marker_point(blob, black_r, unit), pw = marker_point(blob, white_r, unit);
-    black[k] = bilinear(grey, pb.x, pb.y);
-    white[k] = bilinear(grey, pw.x, pw.y);
-    if (black[k] < 0.0 || white[k] < 0.0) return out;
+    const double du = a * ring_directions_[k][0] + b * ring_directions_[k][1];
+    const double dv = c * ring_directions_[k][0] + d * ring_directions_[k][1];
+    black[k] = read(blob.u + black_r * du, blob.v + black_r * dv);
+    white[k] = read(blob.u + white_r * du, blob.v + white_r * dv);
   }
-  const double black_level = percentile(black, 0.5);
-  const double white_level = percentile(white, 0.5);
+  const std::array<double, kRingSamples> white_copy = white;
+  std::nth_element(black.begin(), black.begin() + kRingSamples / 2, black.end());
+  std::nth_element(white.begin(), white.begin() + kRingSamples / 2, white.end());
+  const double black_level = black[kRingSamples / 2];
+  const double white_level = white[kRingSamples / 2];
   out.ring_contrast = white_level - black_level;
   out.black_level = black_level;
   out.white_level = white_level;
   if (out.ring_contrast < config_.min_ring_contrast) return out;
   const double mid = 0.5 * (black_level + white_level);
-  const auto bright = std::count_if(white.begin(), white.end(), [&](double g) { return g > mid; });
+  const auto bright = std::count_if(white_copy.begin(), white_copy.end(), [&](double g) { return g > mid; });
   if (bright < config_.min_white_ring_fraction * kRingSamples) return out;
   const double spread = percentile(out.values, 0.9) - percentile(out.values, 0.1);
   if (spread < config_.min_code_contrast * out.ring_contrast) return out;
