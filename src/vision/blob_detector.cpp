@@ -146,6 +146,18 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
 }
 
 bool BlobDetector::flood_fill(const cv::Mat& grey, cv::Rect roi, int seed_x, int seed_y, Fill& fill) {
+  // One threshold over the whole ROI (a tracked search) needs no per-pixel tile lookup.
+  if (uniform_threshold_ > 0) {
+    const std::uint8_t t = uniform_threshold_;
+    return fill_region(grey, roi, seed_x, seed_y, fill, [&](int x, int y) { return grey.ptr<std::uint8_t>(y)[x] < t; });
+  }
+  return fill_region(grey, roi, seed_x, seed_y, fill,
+                     [&](int x, int y) { return grey.ptr<std::uint8_t>(y)[x] < threshold_at(x, y); });
+}
+
+template <class DarkFn>
+bool BlobDetector::fill_region(const cv::Mat& grey, cv::Rect roi, int seed_x, int seed_y, Fill& fill, DarkFn dark) {
+  (void)grey;
   const double max_disc_d = config_.max_diameter_px * kDiscFraction;
   const int max_area = static_cast<int>(kPi * max_disc_d * max_disc_d / 4.0 * 1.3) + 16;
   // A region far beyond any marker is still labelled (so it is not seeded again and
@@ -153,7 +165,6 @@ bool BlobDetector::flood_fill(const cv::Mat& grey, cv::Rect roi, int seed_x, int
   const int hard_limit = std::max(max_area * 4, 4096);
   const int rx0 = roi.x, rx1 = roi.x + roi.width - 1, ry0 = roi.y, ry1 = roi.y + roi.height - 1;
   fill = Fill{0, seed_x, seed_x, seed_y, seed_y, false, false};
-  auto dark = [&](int x, int y) { return grey.at<std::uint8_t>(y, x) < threshold_at(x, y); };
 
   stack_.clear();
   stack_.emplace_back(seed_x, seed_y);
@@ -325,8 +336,10 @@ bool BlobDetector::begin_search(const cv::Mat& grey, cv::Rect& roi, std::optiona
   prepare(grey);
   roi &= cv::Rect(0, 0, grey.cols, grey.rows);
   if (roi.width < 3 || roi.height < 3) return false;
+  uniform_threshold_ = 0;
   if (fixed_threshold) {
     const auto t = static_cast<std::uint8_t>(std::clamp(*fixed_threshold, 1.0, 255.0));
+    uniform_threshold_ = t;
     const int t_px = config_.tile_px;
     for (int ty = roi.y / t_px; ty <= (roi.y + roi.height - 1) / t_px; ++ty) {
       for (int tx = roi.x / t_px; tx <= (roi.x + roi.width - 1) / t_px; ++tx) tile_threshold_[ty * tiles_x_ + tx] = t;

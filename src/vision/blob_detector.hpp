@@ -99,6 +99,8 @@ class BlobDetector {
   bool try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blob& blob);
   void compute_thresholds(const cv::Mat& grey, cv::Rect roi);
   bool flood_fill(const cv::Mat& grey, cv::Rect roi, int seed_x, int seed_y, Fill& fill);
+  template <class DarkFn>
+  bool fill_region(const cv::Mat& grey, cv::Rect roi, int seed_x, int seed_y, Fill& fill, DarkFn dark);
   bool measure(const cv::Mat& grey, const Fill& fill, Blob& blob) const;
   std::uint8_t threshold_at(int x, int y) const { return tile_threshold_[tile_row_[y] * tiles_x_ + tile_col_[x]]; }
 
@@ -110,7 +112,8 @@ class BlobDetector {
   std::vector<std::uint8_t> tile_threshold_;       // 0 marks a tile without contrast
   std::vector<std::uint8_t> row_min_scratch_, row_max_scratch_;  // first pass of the 3x3 spread
   std::vector<int> range_scratch_;
-  int noise_range_ = 0;                             // median tile range of the last large search
+  int noise_range_ = 0;
+  std::uint8_t uniform_threshold_ = 0;              // nonzero: the current search uses this one threshold                             // median tile range of the last large search
   cv::Mat visited_;                                // 8-bit, nonzero = already filled
   std::vector<int> row_min_x_, row_max_x_, col_min_y_, col_max_y_;
   std::vector<std::pair<int, int>> stack_;
