@@ -111,7 +111,6 @@ class BlobDetector {
   std::vector<std::uint8_t> tile_min_, tile_max_;  // raw tile statistics
   std::vector<std::uint8_t> tile_threshold_;       // 0 marks a tile without contrast
   std::vector<std::uint8_t> row_min_scratch_, row_max_scratch_;  // first pass of the 3x3 spread
-  std::vector<int> range_scratch_;
   int noise_range_ = 0;
   std::uint8_t uniform_threshold_ = 0;              // nonzero: the current search uses this one threshold                             // median tile range of the last large search
   cv::Mat visited_;                                // 8-bit, nonzero = already filled
