@@ -218,7 +218,7 @@ void add_detect_command(CLI::App& app) {
   cmd->add_flag("--no-track", opt->no_track, "Search the whole frame every frame (no tracking)");
   cmd->add_option("--max-frames", opt->max_frames, "Stop after N frames");
   cmd->add_option("--min-diameter-px", opt->min_diameter_px, "Smallest marker diameter in pixels (default 18)");
-  cmd->add_option("--max-diameter-px", opt->max_diameter_px, "Largest marker diameter in pixels (default 160)");
+  cmd->add_option("--max-diameter-px", opt->max_diameter_px, "Largest marker diameter in pixels (default 480)");
   cmd->add_option("--min-score", opt->min_score, "Least similarity for an ID (default 0.75)");
   cmd->add_flag("-q,--quiet", opt->quiet, "No progress bar");
   cmd->callback([opt, cmd] {

@@ -20,7 +20,7 @@ struct BlobDetectorConfig {
   double min_diameter_px = 18.0;
   /// Largest marker diameter looked for. Higher costs nothing per frame by itself, but
   /// markers much larger than 8 tiles (see tile_px) may lose local contrast inside.
-  double max_diameter_px = 160.0;
+  double max_diameter_px = 480.0;
   /// Side of the square tiles over which the local threshold is computed. Smaller adapts
   /// to steeper lighting changes; larger saves time and keeps big markers intact.
   int tile_px = 8;

@@ -150,3 +150,20 @@ TEST(MarkerTracker, SmallMarkersUnderBlurAndNoise) {
   EXPECT_GE(found, 31);
   EXPECT_LT(std::sqrt(heading_err2 / std::max(found, 1)), 2.0);
 }
+
+// A camera close to the field sees markers hundreds of pixels across.
+TEST(MarkerTracker, LargeMarkers) {
+  const auto f = MarkerFamily::six_ucp();
+  for (int size : {100, 250, 400}) {
+    for (int id : {1, 6, 8}) {
+      cv::Mat img(size * 3, size * 3, CV_8UC1, cv::Scalar(185));
+      render_marker_topdown(f, id, size, 40.0).copyTo(img(cv::Rect(size, size, size, size)));
+      cv::GaussianBlur(img, img, {}, 1.0);
+      const auto d = detect_markers(img, f, {1, 2, 3, 4, 5, 6, 7, 8});
+      ASSERT_EQ(d.size(), 1u) << "size " << size << " id " << id;
+      EXPECT_EQ(d[0].id, id);
+      EXPECT_NEAR(d[0].u, 1.5 * size - 0.5, 0.2);
+      EXPECT_NEAR(wrap_deg_180(d[0].heading_deg - 40.0), 0.0, 0.5);
+    }
+  }
+}
