@@ -171,6 +171,8 @@ bool BlobDetector::fill_region(const cv::Mat& grey, cv::Rect roi, int seed_x, in
   // A region far beyond any marker is still labelled (so it is not seeded again and
   // again) up to this bound, which keeps the worst case linear in the frame size.
   const int hard_limit = std::max(max_area * 4, 4096);
+  // No marker's disc is wider or taller than this (tilt only shrinks one axis).
+  const int max_extent = static_cast<int>(max_disc_d * 1.2) + 2;
   const int rx0 = roi.x, rx1 = roi.x + roi.width - 1, ry0 = roi.y, ry1 = roi.y + roi.height - 1;
   fill = Fill{0, seed_x, seed_x, seed_y, seed_y, false, false};
 
@@ -198,7 +200,7 @@ bool BlobDetector::fill_region(const cv::Mat& grey, cv::Rect roi, int seed_x, in
       row_min_x_[y] = std::min(row_min_x_[y], xl);
       row_max_x_[y] = std::max(row_max_x_[y], xr);
     }
-    if (fill.area > max_area) fill.too_large = true;
+    if (fill.area > max_area || fill.x1 - fill.x0 > max_extent || fill.y1 - fill.y0 > max_extent) fill.too_large = true;
     if (fill.area > hard_limit) break;
     for (int ny : {y - 1, y + 1}) {
       if (ny < ry0 || ny > ry1) continue;
