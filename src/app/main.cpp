@@ -1,7 +1,9 @@
 // rilbed: the command line. Thin subcommands over the modules; see README.md.
+#include <opencv2/core/utils/logger.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <cstdlib>
 #include <exception>
 #include <iostream>
 
@@ -21,6 +23,11 @@ int main(int argc, char** argv) {
   // Logs go to stderr so that CSV written to stdout stays clean.
   spdlog::set_default_logger(spdlog::stderr_color_mt("rilbed"));
   spdlog::set_pattern("rilbed: %^%l%$: %v");
+  // rilbed reports unreadable inputs itself, naming them; OpenCV's backend warnings
+  // (GStreamer, V4L2, FFmpeg) would only repeat that. RILBED_OPENCV_LOG=1 shows them.
+  if (std::getenv("RILBED_OPENCV_LOG") == nullptr) {
+    cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
+  }
   rilbed::app::add_patterns_command(app);
   rilbed::app::add_detect_command(app);
   rilbed::app::add_calibrate_command(app);

@@ -192,6 +192,13 @@ TEST(DetectCli, ClutterNeverGetsAnId) {
   fs::remove_all(out);
 }
 
+TEST(DetectCli, MissingCameraFailsClearly) {
+  const auto r = run_rilbed("detect --camera 57 -q");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("camera 57"), std::string::npos) << r.err;
+  EXPECT_NE(run_rilbed("detect --camera 0 somefile.avi").exit_code, 0);  // one input only
+}
+
 TEST(ScoreCli, ReportsRecallAndErrors) {
   const auto truth = (kDatasets / "nominal" / "ground_truth.csv").string();
   const auto r = run_rilbed("score --truth '" + truth + "' --detections '" + truth + "'");
