@@ -50,6 +50,7 @@ void BlobDetector::prepare(const cv::Mat& grey) {
   tile_max_.assign(tiles, 0);
   tile_threshold_.assign(tiles, 0);
   row_min_scratch_.assign(tiles, 0);
+  tile_range_.assign(tiles, 0);
   row_max_scratch_.assign(tiles, 0);
   visited_ = cv::Mat::zeros(size_, CV_8UC1);
   row_min_x_.assign(size_.height, 0);
@@ -102,32 +103,6 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
       tile_max_[ty * tiles_x_ + tx] = mx;
     }
   }
-  // Sensor noise alone spans some grey levels in every tile; a tile counts as having
-  // contrast only well above that. The noise floor is the median range of the tiles of
-  // a large search (most of a frame is floor), kept for the small tracked searches.
-  const int computed = (tx1 - tx0 + 1) * (ty1 - ty0 + 1);
-  if (computed * 4 >= tiles_x_ * tiles_y_) {
-    // Median by counting (ranges are 0..255): cheaper than selecting among 14,400 tiles.
-    std::array<int, 256> histogram{};
-    int count = 0;
-    for (int ty = ty0; ty <= ty1; ++ty) {
-      for (int tx = tx0; tx <= tx1; ++tx) {
-        ++histogram[tile_max_[ty * tiles_x_ + tx] - tile_min_[ty * tiles_x_ + tx]];
-        ++count;
-      }
-    }
-    int seen = 0;
-    for (int range = 0; range < 256; ++range) {
-      seen += histogram[range];
-      if (2 * seen > count) {
-        noise_range_ = range;
-        break;
-      }
-    }
-  }
-  const int min_contrast =
-      std::max(config_.min_local_contrast, static_cast<int>(std::lround(config_.contrast_over_noise * noise_range_)));
-
   // The threshold of a tile comes from its 3x3 neighbourhood so that a marker larger
   // than one tile sees one consistent threshold across its dark disc; done as two
   // separable passes (a row of three, then a column of three).
@@ -148,7 +123,38 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
     for (int tx = ax; tx <= bx; ++tx) {
       const int mn = std::min({row_min_scratch_[up + tx], row_min_scratch_[row + tx], row_min_scratch_[down + tx]});
       const int mx = std::max({row_max_scratch_[up + tx], row_max_scratch_[row + tx], row_max_scratch_[down + tx]});
-      tile_threshold_[row + tx] = (mx - mn >= min_contrast) ? static_cast<std::uint8_t>((mn + mx + 1) / 2) : 0;
+      tile_range_[row + tx] = static_cast<std::uint8_t>(mx - mn);
+      tile_threshold_[row + tx] = static_cast<std::uint8_t>((mn + mx + 1) / 2);
+    }
+  }
+  // Sensor noise alone spans some grey levels around every tile; a tile counts as
+  // having contrast only well above that. The floor's contrast is the lower quartile of
+  // these very ranges over a large search (a quarter of any frame is floor), kept for
+  // the small tracked searches; a cap keeps a frame crowded with markers from raising
+  // it to the markers' own contrast.
+  if ((bx - ax + 1) * (by - ay + 1) * 4 >= tiles_x_ * tiles_y_) {
+    std::array<int, 256> histogram{};
+    int count = 0;
+    for (int ty = ay; ty <= by; ++ty) {
+      for (int tx = ax; tx <= bx; ++tx) ++histogram[tile_range_[static_cast<std::size_t>(ty) * tiles_x_ + tx]];
+      count += bx - ax + 1;
+    }
+    int seen = 0;
+    for (int range = 0; range < 256; ++range) {  // quartile by counting
+      seen += histogram[range];
+      if (4 * seen > count) {
+        floor_range_ = range;
+        break;
+      }
+    }
+  }
+  const int min_contrast = std::max(
+      config_.min_local_contrast,
+      std::min(config_.max_noise_contrast, static_cast<int>(std::lround(config_.contrast_over_noise * floor_range_))));
+  for (int ty = ay; ty <= by; ++ty) {
+    const std::size_t row = static_cast<std::size_t>(ty) * tiles_x_;
+    for (int tx = ax; tx <= bx; ++tx) {
+      if (tile_range_[row + tx] < min_contrast) tile_threshold_[row + tx] = 0;
     }
   }
 }
@@ -354,11 +360,22 @@ bool BlobDetector::begin_search(const cv::Mat& grey, cv::Rect& roi, std::optiona
     for (int ty = roi.y / t_px; ty <= (roi.y + roi.height - 1) / t_px; ++ty) {
       for (int tx = roi.x / t_px; tx <= (roi.x + roi.width - 1) / t_px; ++tx) tile_threshold_[ty * tiles_x_ + tx] = t;
     }
-  } else {
-    compute_thresholds(grey, roi);
+    for (int y = roi.y; y < roi.y + roi.height; ++y) {
+      std::fill_n(visited_.ptr<std::uint8_t>(y) + roi.x, roi.width, std::uint8_t{0});
+    }
+    return true;
   }
-  for (int y = roi.y; y < roi.y + roi.height; ++y) {
-    std::fill_n(visited_.ptr<std::uint8_t>(y) + roi.x, roi.width, std::uint8_t{0});
+  compute_thresholds(grey, roi);
+  // Only pixels of tiles with contrast can be dark, so only those tiles are filled and
+  // need their marks cleared; a stale mark elsewhere reads like a bright pixel anyway.
+  const int t_px = config_.tile_px;
+  for (int ty = roi.y / t_px; ty <= (roi.y + roi.height - 1) / t_px; ++ty) {
+    const int y0 = std::max(roi.y, ty * t_px), y1 = std::min(roi.y + roi.height, (ty + 1) * t_px);
+    for (int tx = roi.x / t_px; tx <= (roi.x + roi.width - 1) / t_px; ++tx) {
+      if (tile_threshold_[ty * tiles_x_ + tx] == 0) continue;
+      const int x0 = std::max(roi.x, tx * t_px), x1 = std::min(roi.x + roi.width, (tx + 1) * t_px);
+      for (int y = y0; y < y1; ++y) std::fill(visited_.ptr<std::uint8_t>(y) + x0, visited_.ptr<std::uint8_t>(y) + x1, 0);
+    }
   }
   return true;
 }
@@ -367,6 +384,7 @@ bool BlobDetector::try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blo
   const double min_disc_d = config_.min_diameter_px * kDiscFraction;
   const double min_area = kPi * min_disc_d * min_disc_d / 4.0 / config_.max_axis_ratio * 0.8;
   Fill fill;
+  ++fill_count_;
   const bool whole = flood_fill(grey, roi, x, y, fill);
   const bool candidate = whole && fill.area >= min_area;
   if (candidate) {

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace rilbed::vision {
@@ -28,11 +29,14 @@ struct BlobDetectorConfig {
   /// for its pixels to count as dark or bright. Lower accepts fainter markers and more
   /// noise-made fragments.
   int min_local_contrast = 24;
-  /// The least local contrast is also at least this many times the frame's noise floor
-  /// (the median grey-level range of a tile, measured on each full-frame search). Keeps
-  /// a noisy floor from counting as contrast, which would flood the search with specks;
-  /// higher rejects more noise and loses faint markers sooner.
-  double contrast_over_noise = 2.5;
+  /// The least local contrast is also at least this many times the floor's own
+  /// contrast (the lower quartile of the local grey-level ranges, measured on each
+  /// full-frame search), so that sensor noise does not count as contrast and flood the
+  /// search with specks. Higher rejects more noise and loses faint markers sooner.
+  double contrast_over_noise = 1.8;
+  /// ...but never more than this many grey levels: a frame crowded with markers must
+  /// not raise the bar to the markers' own contrast.
+  int max_noise_contrast = 64;
   /// Rows between seed scan lines of a search; 0 picks a quarter of the smallest dark
   /// disc. Larger is faster and misses markers smaller than about 2 steps.
   int seed_row_step = 0;
@@ -89,6 +93,8 @@ class BlobDetector {
   std::vector<Blob> detect(const cv::Mat& grey) { return detect(grey, cv::Rect(0, 0, grey.cols, grey.rows)); }
 
   const BlobDetectorConfig& config() const { return config_; }
+  /// Flood fills started since the last call of this function (work done, for stats).
+  int take_fill_count() { return std::exchange(fill_count_, 0); }
 
  private:
   struct Fill;
@@ -111,7 +117,9 @@ class BlobDetector {
   std::vector<std::uint8_t> tile_min_, tile_max_;  // raw tile statistics
   std::vector<std::uint8_t> tile_threshold_;       // 0 marks a tile without contrast
   std::vector<std::uint8_t> row_min_scratch_, row_max_scratch_;  // first pass of the 3x3 spread
-  int noise_range_ = 0;
+  std::vector<std::uint8_t> tile_range_;            // max - min over each tile's 3x3 neighbourhood
+  int fill_count_ = 0;
+  int floor_range_ = 0;  // the floor's local contrast found by the last large search, grey levels
   std::uint8_t uniform_threshold_ = 0;              // nonzero: the current search uses this one threshold                             // median tile range of the last large search
   cv::Mat visited_;                                // 8-bit, nonzero = already filled
   std::vector<int> row_min_x_, row_max_x_, col_min_y_, col_max_y_;

@@ -131,7 +131,9 @@ std::vector<MarkerDetection> MarkerTracker::detect_full_frame(const cv::Mat& fra
   const cv::Mat grey = to_grey(frame);
   stats_ = FrameStats{};
   stats_.full_search = true;
-  return assign(grey, detector_.detect(grey), false);
+  auto found = assign(grey, detector_.detect(grey), false);
+  stats_.fills = detector_.take_fill_count();
+  return found;
 }
 
 std::optional<MarkerDetection> MarkerTracker::confirm(const cv::Mat& grey, const Track& track, const Blob& blob) {
@@ -195,6 +197,7 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     stats_.full_search = true;
   }
   std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
+  stats_.fills = detector_.take_fill_count();
 
   // Update the tracks: move the seen ones, coast the others, drop the long-lost.
   for (Track& t : tracks_) ++t.missed;

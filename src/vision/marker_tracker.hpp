@@ -71,6 +71,7 @@ struct FrameStats {
   bool full_search = false;  ///< a full-frame search ran
   int blobs = 0;             ///< candidate blobs that passed the shape tests
   int decoded = 0;           ///< blobs whose signal was decodable
+  int fills = 0;             ///< dark regions filled (the detector's main work)
 };
 
 /// Runs the pipeline over a stream of frames of one size. Not thread-safe; one per

@@ -167,3 +167,20 @@ TEST(MarkerTracker, LargeMarkers) {
     }
   }
 }
+
+// A noisy sensor must not turn the floor into contrast: the search stays with the
+// markers (few candidate blobs) and finds them all.
+TEST(MarkerTracker, NoisyFloorDoesNotFloodTheSearch) {
+  auto preset = scene_preset("nominal");
+  preset.conditions.noise_sigma = 7.0;
+  preset.conditions.jpeg_quality = 90;
+  SyntheticCamera camera(preset.camera, MarkerFamily::six_ucp(), preset.conditions, preset.clutter);
+  MarkerTracker tracker(MarkerFamily::six_ucp(), {1, 2, 3, 4, 5, 6, 7, 8});
+  cv::RNG rng(8);
+  const auto found = tracker.detect_full_frame(camera.render(robots_at(0.0, 8, preset, 8), rng));
+  EXPECT_EQ(found.size(), 8u);
+  EXPECT_LE(tracker.last_stats().blobs, 16);
+  // Markers, the border tape and a few noise specks; without the noise floor it is
+  // thousands of specks.
+  EXPECT_LT(tracker.last_stats().fills, 400);
+}
