@@ -108,23 +108,40 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
   // separable passes (a row of three, then a column of three).
   const int ax = std::min(tx0 + 1, tx1), bx = std::max(tx1 - 1, tx0);
   const int ay = std::min(ty0 + 1, ty1), by = std::max(ty1 - 1, ty0);
+  const bool interior = ax >= 1 && bx <= tiles_x_ - 2;  // neighbours exist: no clamping, so it vectorises
   for (int ty = ty0; ty <= ty1; ++ty) {
     const std::size_t row = static_cast<std::size_t>(ty) * tiles_x_;
+    const std::uint8_t* mins = &tile_min_[row];
+    const std::uint8_t* maxs = &tile_max_[row];
+    std::uint8_t* out_min = &row_min_scratch_[row];
+    std::uint8_t* out_max = &row_max_scratch_[row];
+    if (interior) {
+      for (int tx = ax; tx <= bx; ++tx) {
+        out_min[tx] = std::min(std::min(mins[tx - 1], mins[tx]), mins[tx + 1]);
+        out_max[tx] = std::max(std::max(maxs[tx - 1], maxs[tx]), maxs[tx + 1]);
+      }
+      continue;
+    }
     for (int tx = ax; tx <= bx; ++tx) {
       const int l = std::max(0, tx - 1), r = std::min(tiles_x_ - 1, tx + 1);
-      row_min_scratch_[row + tx] = std::min({tile_min_[row + l], tile_min_[row + tx], tile_min_[row + r]});
-      row_max_scratch_[row + tx] = std::max({tile_max_[row + l], tile_max_[row + tx], tile_max_[row + r]});
+      out_min[tx] = std::min({mins[l], mins[tx], mins[r]});
+      out_max[tx] = std::max({maxs[l], maxs[tx], maxs[r]});
     }
   }
   for (int ty = ay; ty <= by; ++ty) {
     const std::size_t up = static_cast<std::size_t>(std::max(0, ty - 1)) * tiles_x_;
     const std::size_t row = static_cast<std::size_t>(ty) * tiles_x_;
     const std::size_t down = static_cast<std::size_t>(std::min(tiles_y_ - 1, ty + 1)) * tiles_x_;
+    const std::uint8_t *min_up = &row_min_scratch_[up], *min_row = &row_min_scratch_[row], *min_down = &row_min_scratch_[down];
+    const std::uint8_t *max_up = &row_max_scratch_[up], *max_row = &row_max_scratch_[row], *max_down = &row_max_scratch_[down];
+    std::uint8_t* range = &tile_range_[row];
+    std::uint8_t* threshold = &tile_threshold_[row];
     for (int tx = ax; tx <= bx; ++tx) {
-      const int mn = std::min({row_min_scratch_[up + tx], row_min_scratch_[row + tx], row_min_scratch_[down + tx]});
-      const int mx = std::max({row_max_scratch_[up + tx], row_max_scratch_[row + tx], row_max_scratch_[down + tx]});
-      tile_range_[row + tx] = static_cast<std::uint8_t>(mx - mn);
-      tile_threshold_[row + tx] = static_cast<std::uint8_t>((mn + mx + 1) / 2);
+      const std::uint8_t mn = std::min(std::min(min_up[tx], min_row[tx]), min_down[tx]);
+      const std::uint8_t mx = std::max(std::max(max_up[tx], max_row[tx]), max_down[tx]);
+      range[tx] = static_cast<std::uint8_t>(mx - mn);
+      // (mn + mx + 1) / 2 without overflow: the rounded-up average of two bytes.
+      threshold[tx] = static_cast<std::uint8_t>((mn | mx) - ((mn ^ mx) >> 1));
     }
   }
   // Sensor noise alone spans some grey levels around every tile; a tile counts as
@@ -151,11 +168,12 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
   const int min_contrast = std::max(
       config_.min_local_contrast,
       std::min(config_.max_noise_contrast, static_cast<int>(std::lround(config_.contrast_over_noise * floor_range_))));
+  const auto floor_cut = static_cast<std::uint8_t>(std::clamp(min_contrast, 0, 255));
   for (int ty = ay; ty <= by; ++ty) {
     const std::size_t row = static_cast<std::size_t>(ty) * tiles_x_;
-    for (int tx = ax; tx <= bx; ++tx) {
-      if (tile_range_[row + tx] < min_contrast) tile_threshold_[row + tx] = 0;
-    }
+    const std::uint8_t* range = &tile_range_[row];
+    std::uint8_t* threshold = &tile_threshold_[row];
+    for (int tx = ax; tx <= bx; ++tx) threshold[tx] = range[tx] < floor_cut ? 0 : threshold[tx];
   }
 }
 
@@ -369,10 +387,13 @@ bool BlobDetector::begin_search(const cv::Mat& grey, cv::Rect& roi, std::optiona
   // Only pixels of tiles with contrast can be dark, so only those tiles are filled and
   // need their marks cleared; a stale mark elsewhere reads like a bright pixel anyway.
   const int t_px = config_.tile_px;
-  for (int ty = roi.y / t_px; ty <= (roi.y + roi.height - 1) / t_px; ++ty) {
+  const int tx_first = roi.x / t_px, tx_last = (roi.x + roi.width - 1) / t_px;
+  const int ty_first = roi.y / t_px, ty_last = (roi.y + roi.height - 1) / t_px;
+  for (int ty = ty_first; ty <= ty_last; ++ty) {
     const int y0 = std::max(roi.y, ty * t_px), y1 = std::min(roi.y + roi.height, (ty + 1) * t_px);
-    for (int tx = roi.x / t_px; tx <= (roi.x + roi.width - 1) / t_px; ++tx) {
-      if (tile_threshold_[ty * tiles_x_ + tx] == 0) continue;
+    const std::uint8_t* thresholds = &tile_threshold_[static_cast<std::size_t>(ty) * tiles_x_];
+    for (int tx = tx_first; tx <= tx_last; ++tx) {
+      if (thresholds[tx] == 0) continue;
       const int x0 = std::max(roi.x, tx * t_px), x1 = std::min(roi.x + roi.width, (tx + 1) * t_px);
       for (int y = y0; y < y1; ++y) std::fill(visited_.ptr<std::uint8_t>(y) + x0, visited_.ptr<std::uint8_t>(y) + x1, 0);
     }
