@@ -106,23 +106,24 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
   // The threshold of a tile comes from its 3x3 neighbourhood so that a marker larger
   // than one tile sees one consistent threshold across its dark disc; done as two
   // separable passes (a row of three, then a column of three).
-  const int ax = std::min(tx0 + 1, tx1), bx = std::max(tx1 - 1, tx0);
-  const int ay = std::min(ty0 + 1, ty1), by = std::max(ty1 - 1, ty0);
-  const bool interior = ax >= 1 && bx <= tiles_x_ - 2;  // neighbours exist: no clamping, so it vectorises
+  // The ROI's own tiles; their neighbours (tx0..tx1, ty0..ty1) only lend statistics.
+  const int ax = roi.x / t, bx = (roi.x + roi.width - 1) / t;
+  const int ay = roi.y / t, by = (roi.y + roi.height - 1) / t;
+  // Interior tiles have both neighbours: no clamping, so the loop vectorises; the
+  // frame's edge tiles (if in the ROI) take a clamped neighbourhood.
+  const int ix0 = std::max(ax, 1), ix1 = std::min(bx, tiles_x_ - 2);
   for (int ty = ty0; ty <= ty1; ++ty) {
     const std::size_t row = static_cast<std::size_t>(ty) * tiles_x_;
     const std::uint8_t* mins = &tile_min_[row];
     const std::uint8_t* maxs = &tile_max_[row];
     std::uint8_t* out_min = &row_min_scratch_[row];
     std::uint8_t* out_max = &row_max_scratch_[row];
-    if (interior) {
-      for (int tx = ax; tx <= bx; ++tx) {
-        out_min[tx] = std::min(std::min(mins[tx - 1], mins[tx]), mins[tx + 1]);
-        out_max[tx] = std::max(std::max(maxs[tx - 1], maxs[tx]), maxs[tx + 1]);
-      }
-      continue;
+    for (int tx = ix0; tx <= ix1; ++tx) {
+      out_min[tx] = std::min(std::min(mins[tx - 1], mins[tx]), mins[tx + 1]);
+      out_max[tx] = std::max(std::max(maxs[tx - 1], maxs[tx]), maxs[tx + 1]);
     }
-    for (int tx = ax; tx <= bx; ++tx) {
+    for (int tx : {ax, bx}) {
+      if (tx >= ix0 && tx <= ix1) continue;
       const int l = std::max(0, tx - 1), r = std::min(tiles_x_ - 1, tx + 1);
       out_min[tx] = std::min({mins[l], mins[tx], mins[r]});
       out_max[tx] = std::max({maxs[l], maxs[tx], maxs[r]});

@@ -184,3 +184,16 @@ TEST(MarkerTracker, NoisyFloorDoesNotFloodTheSearch) {
   // thousands of specks.
   EXPECT_LT(tracker.last_stats().fills, 400);
 }
+
+// A marker right at the frame's edge: the edge tiles get thresholds too.
+TEST(MarkerTracker, MarkerAtTheFrameEdge) {
+  const auto f = MarkerFamily::six_ucp();
+  cv::Mat img(120, 160, CV_8UC1, cv::Scalar(185));
+  render_marker_topdown(f, 5, 32, 10.0).copyTo(img(cv::Rect(1, 1, 32, 32)));
+  render_marker_topdown(f, 2, 32, 200.0).copyTo(img(cv::Rect(160 - 33, 120 - 33, 32, 32)));
+  const auto d = detect_markers(img, f, {1, 2, 3, 4, 5, 6, 7, 8});
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_EQ(d[0].id, 2);
+  EXPECT_EQ(d[1].id, 5);
+  EXPECT_NEAR(d[1].u, 16.5, 0.2);
+}
