@@ -51,6 +51,8 @@ void BlobDetector::prepare(const cv::Mat& grey) {
   tile_threshold_.assign(tiles, 0);
   row_min_scratch_.assign(tiles, 0);
   tile_range_.assign(tiles, 0);
+  contrast_tiles_.assign(tiles, 0);
+  contrast_tile_count_.assign(tiles_y_, 0);
   row_max_scratch_.assign(tiles, 0);
   visited_ = cv::Mat::zeros(size_, CV_8UC1);
   row_min_x_.assign(size_.height, 0);
@@ -114,10 +116,10 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
   const int ix0 = std::max(ax, 1), ix1 = std::min(bx, tiles_x_ - 2);
   for (int ty = ty0; ty <= ty1; ++ty) {
     const std::size_t row = static_cast<std::size_t>(ty) * tiles_x_;
-    const std::uint8_t* mins = &tile_min_[row];
-    const std::uint8_t* maxs = &tile_max_[row];
-    std::uint8_t* out_min = &row_min_scratch_[row];
-    std::uint8_t* out_max = &row_max_scratch_[row];
+    const std::uint8_t* __restrict__ mins = &tile_min_[row];
+    const std::uint8_t* __restrict__ maxs = &tile_max_[row];
+    std::uint8_t* __restrict__ out_min = &row_min_scratch_[row];
+    std::uint8_t* __restrict__ out_max = &row_max_scratch_[row];
     for (int tx = ix0; tx <= ix1; ++tx) {
       out_min[tx] = std::min(std::min(mins[tx - 1], mins[tx]), mins[tx + 1]);
       out_max[tx] = std::max(std::max(maxs[tx - 1], maxs[tx]), maxs[tx + 1]);
@@ -133,10 +135,15 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
     const std::size_t up = static_cast<std::size_t>(std::max(0, ty - 1)) * tiles_x_;
     const std::size_t row = static_cast<std::size_t>(ty) * tiles_x_;
     const std::size_t down = static_cast<std::size_t>(std::min(tiles_y_ - 1, ty + 1)) * tiles_x_;
-    const std::uint8_t *min_up = &row_min_scratch_[up], *min_row = &row_min_scratch_[row], *min_down = &row_min_scratch_[down];
-    const std::uint8_t *max_up = &row_max_scratch_[up], *max_row = &row_max_scratch_[row], *max_down = &row_max_scratch_[down];
-    std::uint8_t* range = &tile_range_[row];
-    std::uint8_t* threshold = &tile_threshold_[row];
+    // __restrict__: the arrays are distinct, which lets the loop vectorise.
+    const std::uint8_t* __restrict__ min_up = &row_min_scratch_[up];
+    const std::uint8_t* __restrict__ min_row = &row_min_scratch_[row];
+    const std::uint8_t* __restrict__ min_down = &row_min_scratch_[down];
+    const std::uint8_t* __restrict__ max_up = &row_max_scratch_[up];
+    const std::uint8_t* __restrict__ max_row = &row_max_scratch_[row];
+    const std::uint8_t* __restrict__ max_down = &row_max_scratch_[down];
+    std::uint8_t* __restrict__ range = &tile_range_[row];
+    std::uint8_t* __restrict__ threshold = &tile_threshold_[row];
     for (int tx = ax; tx <= bx; ++tx) {
       const std::uint8_t mn = std::min(std::min(min_up[tx], min_row[tx]), min_down[tx]);
       const std::uint8_t mx = std::max(std::max(max_up[tx], max_row[tx]), max_down[tx]);
@@ -153,9 +160,11 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
   if ((bx - ax + 1) * (by - ay + 1) * 4 >= tiles_x_ * tiles_y_) {
     std::array<int, 256> histogram{};
     int count = 0;
-    for (int ty = ay; ty <= by; ++ty) {
-      for (int tx = ax; tx <= bx; ++tx) ++histogram[tile_range_[static_cast<std::size_t>(ty) * tiles_x_ + tx]];
-      count += bx - ax + 1;
+    // Every other tile of every other row is plenty for a quartile of thousands.
+    for (int ty = ay; ty <= by; ty += 2) {
+      const std::uint8_t* range = &tile_range_[static_cast<std::size_t>(ty) * tiles_x_];
+      for (int tx = ax; tx <= bx; tx += 2) ++histogram[range[tx]];
+      count += (bx - ax) / 2 + 1;
     }
     int seen = 0;
     for (int range = 0; range < 256; ++range) {  // quartile by counting
@@ -172,9 +181,17 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
   const auto floor_cut = static_cast<std::uint8_t>(std::clamp(min_contrast, 0, 255));
   for (int ty = ay; ty <= by; ++ty) {
     const std::size_t row = static_cast<std::size_t>(ty) * tiles_x_;
-    const std::uint8_t* range = &tile_range_[row];
-    std::uint8_t* threshold = &tile_threshold_[row];
+    const std::uint8_t* __restrict__ range = &tile_range_[row];
+    std::uint8_t* __restrict__ threshold = &tile_threshold_[row];
     for (int tx = ax; tx <= bx; ++tx) threshold[tx] = range[tx] < floor_cut ? 0 : threshold[tx];
+    // The tiles with contrast, listed per tile row: the seed scan visits only these.
+    std::int16_t* list = &contrast_tiles_[row];
+    int n = 0;
+    for (int tx = ax; tx <= bx; ++tx) {
+      list[n] = static_cast<std::int16_t>(tx);
+      n += threshold[tx] != 0;
+    }
+    contrast_tile_count_[ty] = n;
   }
 }
 
@@ -278,7 +295,10 @@ double ellipse_chord(double q_along, double q_mixed, double q_across, double d) 
 bool BlobDetector::measure(const cv::Mat& grey, const Fill& fill, Blob& blob) const {
   // Sub-pixel chords along rows (for x moments) and along columns (for y moments).
   ChordMoments rows, cols;
-  std::vector<std::array<double, 3>> row_chords, col_chords;  // {a, b, position}
+  std::vector<std::array<double, 3>>& row_chords = row_chords_;  // {a, b, position}
+  std::vector<std::array<double, 3>>& col_chords = col_chords_;
+  row_chords.clear();
+  col_chords.clear();
   row_chords.reserve(fill.y1 - fill.y0 + 1);
   // A marker's disc is bounded by bright pixels (its white ring, or a light floor). A
   // region that ends where the local contrast ends instead (a dark floor around a
@@ -440,13 +460,16 @@ std::vector<Blob> BlobDetector::scan(const cv::Mat& grey, cv::Rect roi) {
   for (int y = roi.y + step / 2; y < roi.y + roi.height; y += step) {
     const std::uint8_t* row = grey.ptr<std::uint8_t>(y);
     const std::uint8_t* vis = visited_.ptr<std::uint8_t>(y);
-    const std::uint8_t* tile_thresholds = &tile_threshold_[static_cast<std::size_t>(tile_row_[y]) * tiles_x_];
+    const std::size_t tile_row = static_cast<std::size_t>(tile_row_[y]) * tiles_x_;
+    const std::uint8_t* tile_thresholds = &tile_threshold_[tile_row];
     const int x_end = roi.x + roi.width;
-    // Tile by tile: a tile without contrast holds no dark pixel, and most of a plain
-    // floor is such tiles, so whole tiles are skipped.
-    for (int tx = roi.x / config_.tile_px; tx * config_.tile_px < x_end; ++tx) {
+    // Only the tiles with contrast (listed when their thresholds were set): a tile
+    // without contrast holds no dark pixel, and most of a plain floor is such tiles.
+    const std::int16_t* list = &contrast_tiles_[tile_row];
+    const int listed = contrast_tile_count_[tile_row_[y]];
+    for (int i = 0; i < listed; ++i) {
+      const int tx = list[i];
       const std::uint8_t t = tile_thresholds[tx];
-      if (t == 0) continue;
       const int xa = std::max(roi.x, tx * config_.tile_px), xb = std::min(x_end, (tx + 1) * config_.tile_px);
       for (int x = xa; x < xb; ++x) {
         if (vis[x] || row[x] >= t) continue;

@@ -6,6 +6,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <utility>
@@ -118,6 +119,9 @@ class BlobDetector {
   std::vector<std::uint8_t> tile_threshold_;       // 0 marks a tile without contrast
   std::vector<std::uint8_t> row_min_scratch_, row_max_scratch_;  // first pass of the 3x3 spread
   std::vector<std::uint8_t> tile_range_;            // max - min over each tile's 3x3 neighbourhood
+  std::vector<std::int16_t> contrast_tiles_;        // per tile row: columns of tiles with contrast
+  std::vector<int> contrast_tile_count_;            // per tile row: how many are listed
+  mutable std::vector<std::array<double, 3>> row_chords_, col_chords_;  // measure()'s scratch
   int fill_count_ = 0;
   int floor_range_ = 0;  // the floor's local contrast found by the last large search, grey levels
   std::uint8_t uniform_threshold_ = 0;              // nonzero: the current search uses this one threshold                             // median tile range of the last large search
