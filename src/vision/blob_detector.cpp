@@ -196,18 +196,25 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
 }
 
 bool BlobDetector::flood_fill(const cv::Mat& grey, cv::Rect roi, int seed_x, int seed_y, Fill& fill) {
-  // One threshold over the whole ROI (a tracked search) needs no per-pixel tile lookup.
+  // The darkness test is bound to a row once per span, not looked up per pixel; one
+  // threshold over the whole ROI (a tracked search) needs no tile lookup at all.
   if (uniform_threshold_ > 0) {
     const std::uint8_t t = uniform_threshold_;
-    return fill_region(grey, roi, seed_x, seed_y, fill, [&](int x, int y) { return grey.ptr<std::uint8_t>(y)[x] < t; });
+    return fill_region(roi, seed_x, seed_y, fill, [&](int y) {
+      const std::uint8_t* row = grey.ptr<std::uint8_t>(y);
+      return [row, t](int x) { return row[x] < t; };
+    });
   }
-  return fill_region(grey, roi, seed_x, seed_y, fill,
-                     [&](int x, int y) { return grey.ptr<std::uint8_t>(y)[x] < threshold_at(x, y); });
+  return fill_region(roi, seed_x, seed_y, fill, [&](int y) {
+    const std::uint8_t* row = grey.ptr<std::uint8_t>(y);
+    const std::uint8_t* thresholds = &tile_threshold_[static_cast<std::size_t>(tile_row_[y]) * tiles_x_];
+    const int* cols = tile_col_.data();
+    return [row, thresholds, cols](int x) { return row[x] < thresholds[cols[x]]; };
+  });
 }
 
-template <class DarkFn>
-bool BlobDetector::fill_region(const cv::Mat& grey, cv::Rect roi, int seed_x, int seed_y, Fill& fill, DarkFn dark) {
-  (void)grey;
+template <class RowDarkFn>
+bool BlobDetector::fill_region(cv::Rect roi, int seed_x, int seed_y, Fill& fill, RowDarkFn row_dark) {
   const double max_disc_d = config_.max_diameter_px * kDiscFraction;
   const int max_area = static_cast<int>(kPi * max_disc_d * max_disc_d / 4.0 * 1.3) + 16;
   // A region far beyond any marker is still labelled (so it is not seeded again and
@@ -224,10 +231,11 @@ bool BlobDetector::fill_region(const cv::Mat& grey, cv::Rect roi, int seed_x, in
     auto [sx, y] = stack_.back();
     stack_.pop_back();
     std::uint8_t* vis = visited_.ptr<std::uint8_t>(y);
-    if (vis[sx] || !dark(sx, y)) continue;
+    const auto dark = row_dark(y);
+    if (vis[sx] || !dark(sx)) continue;
     int xl = sx, xr = sx;
-    while (xl > rx0 && !vis[xl - 1] && dark(xl - 1, y)) --xl;
-    while (xr < rx1 && !vis[xr + 1] && dark(xr + 1, y)) ++xr;
+    while (xl > rx0 && !vis[xl - 1] && dark(xl - 1)) --xl;
+    while (xr < rx1 && !vis[xr + 1] && dark(xr + 1)) ++xr;
     std::fill(vis + xl, vis + xr + 1, std::uint8_t{1});
     fill.area += xr - xl + 1;
     if (xl == rx0 || xr == rx1 || y == ry0 || y == ry1) fill.touches_border = true;
@@ -247,10 +255,11 @@ bool BlobDetector::fill_region(const cv::Mat& grey, cv::Rect roi, int seed_x, in
     for (int ny : {y - 1, y + 1}) {
       if (ny < ry0 || ny > ry1) continue;
       const std::uint8_t* nvis = visited_.ptr<std::uint8_t>(ny);
+      const auto ndark = row_dark(ny);
       for (int x = xl; x <= xr; ++x) {
-        if (!nvis[x] && dark(x, ny)) {
+        if (!nvis[x] && ndark(x)) {
           stack_.emplace_back(x, ny);
-          while (x < xr && !nvis[x + 1] && dark(x + 1, ny)) ++x;  // one seed per run
+          while (x < xr && !nvis[x + 1] && ndark(x + 1)) ++x;  // one seed per run
         }
       }
     }

@@ -106,8 +106,8 @@ class BlobDetector {
   bool try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blob& blob);
   void compute_thresholds(const cv::Mat& grey, cv::Rect roi);
   bool flood_fill(const cv::Mat& grey, cv::Rect roi, int seed_x, int seed_y, Fill& fill);
-  template <class DarkFn>
-  bool fill_region(const cv::Mat& grey, cv::Rect roi, int seed_x, int seed_y, Fill& fill, DarkFn dark);
+  template <class RowDarkFn>
+  bool fill_region(cv::Rect roi, int seed_x, int seed_y, Fill& fill, RowDarkFn row_dark);
   bool measure(const cv::Mat& grey, const Fill& fill, Blob& blob) const;
   std::uint8_t threshold_at(int x, int y) const { return tile_threshold_[tile_row_[y] * tiles_x_ + tile_col_[x]]; }
 
