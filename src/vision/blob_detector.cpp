@@ -120,7 +120,17 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
     const std::uint8_t* __restrict__ maxs = &tile_max_[row];
     std::uint8_t* __restrict__ out_min = &row_min_scratch_[row];
     std::uint8_t* __restrict__ out_max = &row_max_scratch_[row];
-    for (int tx = ix0; tx <= ix1; ++tx) {
+    int tx = ix0;
+#if defined(__SSE2__)
+    for (; tx + 16 <= ix1 + 1; tx += 16) {  // sixteen tiles per step
+      auto load = [](const std::uint8_t* p) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); };
+      const __m128i lo = _mm_min_epu8(_mm_min_epu8(load(mins + tx - 1), load(mins + tx)), load(mins + tx + 1));
+      const __m128i hi = _mm_max_epu8(_mm_max_epu8(load(maxs + tx - 1), load(maxs + tx)), load(maxs + tx + 1));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(out_min + tx), lo);
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(out_max + tx), hi);
+    }
+#endif
+    for (; tx <= ix1; ++tx) {
       out_min[tx] = std::min(std::min(mins[tx - 1], mins[tx]), mins[tx + 1]);
       out_max[tx] = std::max(std::max(maxs[tx - 1], maxs[tx]), maxs[tx + 1]);
     }
@@ -144,7 +154,17 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
     const std::uint8_t* __restrict__ max_down = &row_max_scratch_[down];
     std::uint8_t* __restrict__ range = &tile_range_[row];
     std::uint8_t* __restrict__ threshold = &tile_threshold_[row];
-    for (int tx = ax; tx <= bx; ++tx) {
+    int tx = ax;
+#if defined(__SSE2__)
+    for (; tx + 16 <= bx + 1; tx += 16) {  // sixteen tiles per step; avg_epu8 is (a + b + 1) / 2
+      auto load = [](const std::uint8_t* p) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); };
+      const __m128i mn = _mm_min_epu8(_mm_min_epu8(load(min_up + tx), load(min_row + tx)), load(min_down + tx));
+      const __m128i mx = _mm_max_epu8(_mm_max_epu8(load(max_up + tx), load(max_row + tx)), load(max_down + tx));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(range + tx), _mm_sub_epi8(mx, mn));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(threshold + tx), _mm_avg_epu8(mn, mx));
+    }
+#endif
+    for (; tx <= bx; ++tx) {
       const std::uint8_t mn = std::min(std::min(min_up[tx], min_row[tx]), min_down[tx]);
       const std::uint8_t mx = std::max(std::max(max_up[tx], max_row[tx]), max_down[tx]);
       range[tx] = static_cast<std::uint8_t>(mx - mn);
@@ -183,7 +203,17 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
     const std::size_t row = static_cast<std::size_t>(ty) * tiles_x_;
     const std::uint8_t* __restrict__ range = &tile_range_[row];
     std::uint8_t* __restrict__ threshold = &tile_threshold_[row];
-    for (int tx = ax; tx <= bx; ++tx) threshold[tx] = range[tx] < floor_cut ? 0 : threshold[tx];
+    int tx = ax;
+#if defined(__SSE2__)
+    const __m128i cut = _mm_set1_epi8(static_cast<char>(floor_cut));
+    for (; tx + 16 <= bx + 1; tx += 16) {  // keep where range >= cut, i.e. max(range, cut) == range
+      const __m128i r = _mm_loadu_si128(reinterpret_cast<const __m128i*>(range + tx));
+      const __m128i keep = _mm_cmpeq_epi8(_mm_max_epu8(r, cut), r);
+      const __m128i t = _mm_loadu_si128(reinterpret_cast<const __m128i*>(threshold + tx));
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(threshold + tx), _mm_and_si128(keep, t));
+    }
+#endif
+    for (; tx <= bx; ++tx) threshold[tx] = range[tx] < floor_cut ? 0 : threshold[tx];
     // The tiles with contrast, listed per tile row: the seed scan visits only these.
     std::int16_t* list = &contrast_tiles_[row];
     int n = 0;
