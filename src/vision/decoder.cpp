@@ -233,6 +233,21 @@ std::pair<int, double> Decoder::coarse_peak(const Prepared& p, const Ideal& idea
   return {static_cast<int>(best - scratch.begin()), *best};
 }
 
+std::pair<int, double> Decoder::local_peak(const Prepared& p, const Ideal& ideal, int centre_lag, int reach) const {
+  const int n = config_.samples;
+  std::pair<int, double> best{centre_lag, -1e300};
+  for (int d = -reach; d <= reach; ++d) {
+    const int lag = ((centre_lag + d) % n + n) % n;
+    double c = 0.0;
+    for (std::size_t e = 0; e < ideal.edge.size(); ++e) {
+      const int k = ideal.edge_index[e] + lag;
+      c += ideal.step[e] * (p.doubled_cumulative[k] + ideal.edge_frac[e] * p.doubled_signal[k]);
+    }
+    if (c > best.second) best = {lag, c};
+  }
+  return best;
+}
+
 std::pair<double, double> Decoder::refine_peak(const Prepared& p, const Ideal& ideal, int lag, double value) const {
   // Golden-section search of the (unimodal near its peak) correlation on
   // [lag - 1, lag + 1]; 10 steps narrow it to 0.02 samples (0.06 degrees at 120).
@@ -317,7 +332,7 @@ std::vector<CodeMatch> Decoder::match_by_key(const Prepared& p, const Blob& blob
   for (int c : candidates) {
     const int id = c + 1;
     if (id >= static_cast<int>(index_of_id_.size()) || index_of_id_[id] < 0) continue;
-    coarse.emplace_back(index_of_id_[id], coarse_peak(p, ideals_[index_of_id_[id]], scratch));
+    coarse.emplace_back(index_of_id_[id], local_peak(p, ideals_[index_of_id_[id]], key_lag, kKeyLagReach));
     best = std::max(best, coarse.back().second.second);
   }
   constexpr double kRefineMargin = 0.1;

@@ -62,7 +62,8 @@ class Decoder {
   /// Table 1 row for one object). Each entry carries the heading for that ID's best lag.
   /// For more than 16 IDs the decoder first finds the heading from the slices all IDs
   /// share, reads the code bits there, and scores only that code and the codes one bit
-  /// away; the others get -1 (they cannot be the best match unless two bits misread).
+  /// away, at lags within 3 samples of the key's (they share the key, so their peaks lie
+  /// there); the others get -1 (they cannot be the best match unless two bits misread).
   std::vector<CodeMatch> match_all(const SampledSignal& signal, const Blob& blob) const;
 
   /// Similarity of the signal to one ID (which must be one of ids()): what a tracked
@@ -93,6 +94,8 @@ class Decoder {
   Prepared prepare(const SampledSignal& signal) const;
   // Best whole-sample lag of one ideal and its (unnormalised) correlation.
   std::pair<int, double> coarse_peak(const Prepared& p, const Ideal& ideal, std::vector<double>& scratch) const;
+  // Best whole-sample lag within `reach` samples of `centre_lag`.
+  std::pair<int, double> local_peak(const Prepared& p, const Ideal& ideal, int centre_lag, int reach) const;
   // The lag refined below one sample, with its correlation.
   std::pair<double, double> refine_peak(const Prepared& p, const Ideal& ideal, int lag, double value) const;
   double correlate(const std::vector<double>& cumulative, const Ideal& ideal, double lag) const;
@@ -100,6 +103,8 @@ class Decoder {
 
   static constexpr int kRingSamples = 24;  // samples on each of the two rings
   static constexpr int kExhaustiveIds = 16;  // above this many IDs, decode by key and bits
+  // Candidates share the key, so their peak lies within a few samples of the key's.
+  static constexpr int kKeyLagReach = 3;
   void build_key_template(const MarkerFamily& family);
   std::vector<CodeMatch> match_by_key(const Prepared& p, const Blob& blob) const;
   Ideal key_;                                            // key and guards only
