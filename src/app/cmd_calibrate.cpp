@@ -44,8 +44,6 @@ using vision::FieldCalibrationResult;
 using vision::LensModel;
 using vision::PointCorrespondence;
 
-constexpr int kExitFailure = 1;
-constexpr int kExitUsage = 2;
 
 /// A value parsed from an option, or a message naming the option and what is wrong.
 template <typename T>

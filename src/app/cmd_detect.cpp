@@ -76,7 +76,7 @@ int run_detect(const DetectOptions& opt) {
     family = vision::MarkerFamily::by_name(opt.family);
   } catch (const std::invalid_argument& e) {
     spdlog::error("--family: {}", e.what());
-    return 2;
+    return kExitUsage;
   }
   std::vector<int> ids;
   if (opt.ids.empty()) {
@@ -85,7 +85,7 @@ int run_detect(const DetectOptions& opt) {
     const auto parsed = parse_id_list(opt.ids, family->min_id(), family->max_id());
     if (!parsed.ok()) {
       spdlog::error("--ids: {}", parsed.error);
-      return 2;
+      return kExitUsage;
     }
     ids = parsed.ids;
   }
@@ -95,7 +95,7 @@ int run_detect(const DetectOptions& opt) {
     auto loaded = vision::load_field_calibration(opt.calib);
     if (!loaded.ok()) {
       spdlog::error("--calib: {}", loaded.error);
-      return 2;
+      return kExitUsage;
     }
     calib = loaded.calibration;
   }
@@ -103,7 +103,7 @@ int run_detect(const DetectOptions& opt) {
   vision::OpenResult opened = opt.camera >= 0 ? vision::open_camera(opt.camera) : vision::open_frame_source(opt.input);
   if (!opened.ok()) {
     spdlog::error("{}", opened.error);
-    return 1;
+    return kExitFailure;
   }
   vision::FrameSource& source = *opened.source;
   spdlog::info("reading {}", source.describe());
@@ -114,7 +114,7 @@ int run_detect(const DetectOptions& opt) {
     csv_file.open(opt.csv);
     if (!csv_file) {
       spdlog::error("--csv: cannot write '{}'", opt.csv);
-      return 1;
+      return kExitFailure;
     }
     csv = &csv_file;
   }
@@ -197,7 +197,7 @@ int run_detect(const DetectOptions& opt) {
                frames ? 1000.0 * pipeline_s / frames : 0.0);
   if (frames == 0) {
     spdlog::error("no frame could be read from {}", opt.camera >= 0 ? "camera " + std::to_string(opt.camera) : opt.input);
-    return 1;
+    return kExitFailure;
   }
   return 0;
 }

@@ -28,8 +28,6 @@ using vision::MarkerFamily;
 using vision::PatternFormat;
 using vision::PatternResult;
 
-constexpr int kExitIo = 1;
-constexpr int kExitUsage = 2;
 
 /// The options as typed on the command line.
 struct PatternsOptions {
@@ -122,13 +120,13 @@ PatternResult write_one(const PatternsJob& job, int id, const fs::path& path) {
 int write_all(const PatternsJob& job) {
   if (const auto error = prepare_out_dir(job.out_dir)) {
     std::cerr << "rilbed patterns: " << *error << "\n";
-    return kExitIo;
+    return kExitFailure;
   }
   for (int id : job.ids) {
     const fs::path path = job.out_dir / vision::marker_file_name(job.family, id, job.format);
     if (const PatternResult r = write_one(job, id, path); !r.ok()) {
       std::cerr << "rilbed patterns: " << r.error << "\n";
-      return kExitIo;
+      return kExitFailure;
     }
     std::cout << path.string() << "\n";
   }
@@ -136,7 +134,7 @@ int write_all(const PatternsJob& job) {
     const fs::path path = job.out_dir / vision::sheet_file_name(job.family);
     if (const PatternResult r = vision::write_marker_sheet_pdf(job.family, job.ids, job.diameter_mm, path); !r.ok()) {
       std::cerr << "rilbed patterns: " << r.error << "\n";
-      return kExitIo;
+      return kExitFailure;
     }
     std::cout << path.string() << "\n";
   }

@@ -25,7 +25,7 @@ void add_score_command(CLI::App& app) {
     for (const auto* r : {&truth, &det}) {
       if (!r->ok()) {
         spdlog::error("{}", r->error);
-        exit_code() = 1;
+        exit_code() = kExitFailure;
         return;
       }
     }

@@ -32,13 +32,13 @@ int run_synth(const SynthOptions& opt) {
     preset = vision::scene_preset(opt.preset, {opt.width, opt.height});
   } catch (const std::invalid_argument& e) {
     spdlog::error("--preset: {}", e.what());
-    return 2;
+    return kExitUsage;
   }
   std::error_code ec;
   std::filesystem::create_directories(opt.out, ec);
   if (ec) {
     spdlog::error("--out: cannot create '{}': {}", opt.out, ec.message());
-    return 1;
+    return kExitFailure;
   }
   const std::filesystem::path dir(opt.out);
   // The MJPG writer does the compression, once, at the preset's quality: exactly what a
@@ -55,14 +55,14 @@ int run_synth(const SynthOptions& opt) {
                preset.camera.image_size);
     if (!video.isOpened()) {
       spdlog::error("cannot write '{}'", path);
-      return 1;
+      return kExitFailure;
     }
     video.set(cv::VIDEOWRITER_PROP_QUALITY, quality);
   } else {
     std::filesystem::create_directories(dir / "frames", ec);
     if (ec) {
       spdlog::error("cannot create '{}': {}", (dir / "frames").string(), ec.message());
-      return 1;
+      return kExitFailure;
     }
   }
   std::ofstream truth(dir / "ground_truth.csv");
@@ -77,7 +77,7 @@ int run_synth(const SynthOptions& opt) {
       std::snprintf(line, sizeof line, "frame_%04d.%s", f, opt.format.c_str());
       if (!cv::imwrite((dir / "frames" / line).string(), frame, {cv::IMWRITE_JPEG_QUALITY, quality})) {
         spdlog::error("cannot write '{}'", (dir / "frames" / line).string());
-        return 1;
+        return kExitFailure;
       }
     } else {
       video.write(frame);
@@ -101,7 +101,7 @@ int run_synth(const SynthOptions& opt) {
   calib.lens = lens;
   if (const std::string err = vision::save_field_calibration(calib, (dir / "calibration.yaml").string()); !err.empty()) {
     spdlog::error("{}", err);
-    return 1;
+    return kExitFailure;
   }
   std::ofstream about(dir / "scene.txt");
   about << "rendered by: rilbed synth --preset " << opt.preset << " --frames " << opt.frames << " --fps " << opt.fps

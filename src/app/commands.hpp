@@ -21,4 +21,9 @@ void add_score_command(CLI::App& app);
 /// Exit code a subcommand's callback stores for main() to return.
 int& exit_code();
 
+/// Exit status for input that could not be used or output that could not be written.
+inline constexpr int kExitFailure = 1;
+/// Exit status for a malformed option value (a usage error).
+inline constexpr int kExitUsage = 2;
+
 }  // namespace rilbed::app

@@ -21,6 +21,13 @@ constexpr double kDiscFraction = MarkerFamily::black_ring_outer_radius;
 constexpr int kStatStep = 2;
 }  // namespace
 
+#if defined(__SSE2__)
+namespace {
+// Sixteen bytes from any address.
+__m128i load16(const std::uint8_t* p) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); }
+}  // namespace
+#endif
+
 double Blob::disc_diameter_px() const { return 2.0 * std::sqrt(filled_area_px / kPi); }
 
 // Bookkeeping of one flood fill.
@@ -75,7 +82,7 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
       for (; tx + 1 <= tx1 && (tx + 2) * 8 <= size_.width; tx += 2) {
         __m128i mn = _mm_set1_epi8(static_cast<char>(0xFF)), mx = _mm_setzero_si128();
         for (int y = ty * t; y < y_end; y += kStatStep) {
-          const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(grey.ptr<std::uint8_t>(y) + tx * 8));
+          const __m128i v = load16(grey.ptr<std::uint8_t>(y) + tx * 8);
           mn = _mm_min_epu8(mn, v);
           mx = _mm_max_epu8(mx, v);
         }
@@ -123,9 +130,8 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
     int tx = ix0;
 #if defined(__SSE2__)
     for (; tx + 16 <= ix1 + 1; tx += 16) {  // sixteen tiles per step
-      auto load = [](const std::uint8_t* p) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); };
-      const __m128i lo = _mm_min_epu8(_mm_min_epu8(load(mins + tx - 1), load(mins + tx)), load(mins + tx + 1));
-      const __m128i hi = _mm_max_epu8(_mm_max_epu8(load(maxs + tx - 1), load(maxs + tx)), load(maxs + tx + 1));
+      const __m128i lo = _mm_min_epu8(_mm_min_epu8(load16(mins + tx - 1), load16(mins + tx)), load16(mins + tx + 1));
+      const __m128i hi = _mm_max_epu8(_mm_max_epu8(load16(maxs + tx - 1), load16(maxs + tx)), load16(maxs + tx + 1));
       _mm_storeu_si128(reinterpret_cast<__m128i*>(out_min + tx), lo);
       _mm_storeu_si128(reinterpret_cast<__m128i*>(out_max + tx), hi);
     }
@@ -157,9 +163,8 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
     int tx = ax;
 #if defined(__SSE2__)
     for (; tx + 16 <= bx + 1; tx += 16) {  // sixteen tiles per step; avg_epu8 is (a + b + 1) / 2
-      auto load = [](const std::uint8_t* p) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); };
-      const __m128i mn = _mm_min_epu8(_mm_min_epu8(load(min_up + tx), load(min_row + tx)), load(min_down + tx));
-      const __m128i mx = _mm_max_epu8(_mm_max_epu8(load(max_up + tx), load(max_row + tx)), load(max_down + tx));
+      const __m128i mn = _mm_min_epu8(_mm_min_epu8(load16(min_up + tx), load16(min_row + tx)), load16(min_down + tx));
+      const __m128i mx = _mm_max_epu8(_mm_max_epu8(load16(max_up + tx), load16(max_row + tx)), load16(max_down + tx));
       _mm_storeu_si128(reinterpret_cast<__m128i*>(range + tx), _mm_sub_epi8(mx, mn));
       _mm_storeu_si128(reinterpret_cast<__m128i*>(threshold + tx), _mm_avg_epu8(mn, mx));
     }
@@ -207,9 +212,9 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
 #if defined(__SSE2__)
     const __m128i cut = _mm_set1_epi8(static_cast<char>(floor_cut));
     for (; tx + 16 <= bx + 1; tx += 16) {  // keep where range >= cut, i.e. max(range, cut) == range
-      const __m128i r = _mm_loadu_si128(reinterpret_cast<const __m128i*>(range + tx));
+      const __m128i r = load16(range + tx);
       const __m128i keep = _mm_cmpeq_epi8(_mm_max_epu8(r, cut), r);
-      const __m128i t = _mm_loadu_si128(reinterpret_cast<const __m128i*>(threshold + tx));
+      const __m128i t = load16(threshold + tx);
       _mm_storeu_si128(reinterpret_cast<__m128i*>(threshold + tx), _mm_and_si128(keep, t));
     }
 #endif

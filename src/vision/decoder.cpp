@@ -238,11 +238,7 @@ std::pair<int, double> Decoder::local_peak(const Prepared& p, const Ideal& ideal
   std::pair<int, double> best{centre_lag, -1e300};
   for (int d = -reach; d <= reach; ++d) {
     const int lag = ((centre_lag + d) % n + n) % n;
-    double c = 0.0;
-    for (std::size_t e = 0; e < ideal.edge.size(); ++e) {
-      const int k = ideal.edge_index[e] + lag;
-      c += ideal.step[e] * (p.doubled_cumulative[k] + ideal.edge_frac[e] * p.doubled_signal[k]);
-    }
+    const double c = correlate(p.cumulative, ideal, lag);
     if (c > best.second) best = {lag, c};
   }
   return best;

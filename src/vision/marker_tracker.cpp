@@ -46,6 +46,22 @@ std::vector<int> decoder_ids(const MarkerFamily& family, const std::vector<int>&
   return all;
 }
 
+// A detection of `blob` as `match`; the blob's disc scaled to the marker's outer size.
+MarkerDetection make_detection(const Blob& blob, const CodeMatch& match, bool tracked, double threshold_grey) {
+  const double disc_d = 2.0 * std::sqrt(std::abs(cv::determinant(blob.shape)));
+  return {match.id, blob.u,  blob.v, match.heading_deg, match.score, disc_d / MarkerFamily::black_ring_outer_radius,
+          tracked,  threshold_grey};
+}
+
+// Blobs at a confirmed marker's place are that marker: drop them.
+void drop_confirmed(std::vector<Blob>& blobs, const std::vector<MarkerDetection>& confirmed) {
+  std::erase_if(blobs, [&](const Blob& b) {
+    return std::any_of(confirmed.begin(), confirmed.end(), [&](const MarkerDetection& d) {
+      return std::hypot(d.u - b.u, d.v - b.v) < 0.25 * d.diameter_px;
+    });
+  });
+}
+
 }  // namespace
 
 MarkerTracker::MarkerTracker(MarkerFamily family, std::vector<int> ids, TrackerConfig config)
@@ -104,11 +120,9 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
       if (!use_tracks) continue;
       for (const Track& t : tracks_) {
         if (t.id != ids_[c]) continue;
-        const double ahead = t.missed + 1.0;
-        const double gate = config_.search_window_diameters * t.diameter_px + ahead * std::hypot(t.du, t.dv);
-        if (std::hypot(blob.u - (t.u + t.du * ahead), blob.v - (t.v + t.dv * ahead)) < gate) {
-          row[c] += config_.track_bonus;
-        }
+        const cv::Point2d p = t.predicted();
+        const double gate = config_.search_window_diameters * t.diameter_px + t.predicted_travel();
+        if (std::hypot(blob.u - p.x, blob.v - p.y) < gate) row[c] += config_.track_bonus;
       }
     }
     similarity.push_back(std::move(row));
@@ -117,11 +131,7 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
   std::vector<MarkerDetection> out;
   for (std::size_t r = 0; r < blobs.size(); ++r) {
     if (chosen[r] < 0) continue;
-    const CodeMatch& m = matches[r][decoder_index_[chosen[r]]];
-    const Blob& b = blobs[r];
-    const double disc_d = 2.0 * std::sqrt(std::abs(cv::determinant(b.shape)));
-    out.push_back({m.id, b.u, b.v, m.heading_deg, m.score, disc_d / MarkerFamily::black_ring_outer_radius, false,
-                   thresholds[r]});
+    out.push_back(make_detection(blobs[r], matches[r][decoder_index_[chosen[r]]], false, thresholds[r]));
   }
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
   return out;
@@ -142,9 +152,7 @@ std::optional<MarkerDetection> MarkerTracker::confirm(const cv::Mat& grey, const
   ++stats_.decoded;
   const CodeMatch m = decoder_.match_one(signal, blob, track.id);
   if (m.score < config_.min_assign_score || m.score < track.score - config_.confirm_drop) return std::nullopt;
-  const double disc_d = 2.0 * std::sqrt(std::abs(cv::determinant(blob.shape)));
-  return MarkerDetection{m.id, blob.u, blob.v, m.heading_deg, m.score, disc_d / MarkerFamily::black_ring_outer_radius,
-                         true, 0.5 * (signal.black_level + signal.white_level)};
+  return make_detection(blob, m, true, 0.5 * (signal.black_level + signal.white_level));
 }
 
 std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
@@ -155,12 +163,11 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
   std::vector<int> confirmed_ids;
   for (const Track& t : tracks_) {
     // A track that missed frames coasts: its window moves on and widens with them.
-    const double ahead = t.missed + 1.0;
-    const double pu = t.u + t.du * ahead, pv = t.v + t.dv * ahead;
-    const double half = (config_.search_window_diameters + 0.5) * t.diameter_px + ahead * std::hypot(t.du, t.dv);
-    const cv::Rect roi(static_cast<int>(std::floor(pu - half)), static_cast<int>(std::floor(pv - half)),
+    const cv::Point2d p = t.predicted();
+    const double half = (config_.search_window_diameters + 0.5) * t.diameter_px + t.predicted_travel();
+    const cv::Rect roi(static_cast<int>(std::floor(p.x - half)), static_cast<int>(std::floor(p.y - half)),
                        static_cast<int>(std::ceil(2 * half)) + 1, static_cast<int>(std::ceil(2 * half)) + 1);
-    const std::vector<Blob> near = detector_.detect_near(grey, roi, {pu, pv}, t.threshold_grey);
+    const std::vector<Blob> near = detector_.detect_near(grey, roi, p, t.threshold_grey);
     if (near.size() == 1 && t.missed == 0) {
       ++stats_.blobs;
       if (auto d = confirm(grey, t, near[0])) {
@@ -171,12 +178,7 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     }
     append_unique(blobs, near);
   }
-  // Blobs at a confirmed marker's place are that marker.
-  std::erase_if(blobs, [&](const Blob& b) {
-    return std::any_of(confirmed.begin(), confirmed.end(), [&](const MarkerDetection& d) {
-      return std::hypot(d.u - b.u, d.v - b.v) < 0.25 * d.diameter_px;
-    });
-  });
+  drop_confirmed(blobs, confirmed);
   std::vector<MarkerDetection> found = assign(grey, blobs, true, confirmed_ids);
   for (auto& d : found) d.tracked = true;
   found.insert(found.end(), confirmed.begin(), confirmed.end());
@@ -186,11 +188,7 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
   if (tracks_.empty() || (!all_found && frames_since_full_ >= config_.full_search_interval_frames)) {
     frames_since_full_ = 0;
     std::vector<Blob> more = detector_.detect(grey);
-    std::erase_if(more, [&](const Blob& b) {
-      return std::any_of(confirmed.begin(), confirmed.end(), [&](const MarkerDetection& d) {
-        return std::hypot(d.u - b.u, d.v - b.v) < 0.25 * d.diameter_px;
-      });
-    });
+    drop_confirmed(more, confirmed);
     append_unique(blobs, more);
     found = assign(grey, blobs, true, confirmed_ids);
     found.insert(found.end(), confirmed.begin(), confirmed.end());

@@ -5,6 +5,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <cmath>
 #include <optional>
 #include <vector>
 
@@ -107,6 +108,10 @@ class MarkerTracker {
     double threshold_grey = 0;
     double score = 0;
     int missed = 0;
+    /// Where it should be in the coming frame (constant motion, coasting over misses).
+    cv::Point2d predicted() const { return {u + du * (missed + 1.0), v + dv * (missed + 1.0)}; }
+    /// How far it moves by then, pixels.
+    double predicted_travel() const { return (missed + 1.0) * std::hypot(du, dv); }
   };
   std::vector<MarkerDetection> assign(const cv::Mat& grey, const std::vector<Blob>& blobs, bool use_tracks,
                                       const std::vector<int>& taken_ids = {});

@@ -2,6 +2,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
+
 #include "core/geometry.hpp"
 #include "vision/blob_detector.hpp"
 #include "vision/decoder.hpp"
@@ -16,6 +18,12 @@ cv::Mat canvas_with_marker(const MarkerFamily& f, int id, int size_px, double he
   cv::Mat canvas(size_px * 3, size_px * 3, CV_8UC1, cv::Scalar(185));
   render_marker_topdown(f, id, size_px, heading_deg).copyTo(canvas(cv::Rect(size_px, size_px, size_px, size_px)));
   return canvas;
+}
+
+// The best-scoring entry of a row of matches.
+const CodeMatch& best_match(const std::vector<CodeMatch>& matches) {
+  return *std::max_element(matches.begin(), matches.end(),
+                           [](const auto& a, const auto& b) { return a.score < b.score; });
 }
 }  // namespace
 
@@ -33,11 +41,10 @@ TEST(Decoder, DecodesEveryIdAndHeading) {
       const auto signal = decoder.sample(img, blobs[0]);
       ASSERT_TRUE(signal.usable);
       const auto matches = decoder.match_all(signal, blobs[0]);
-      int best = 0;
-      for (int k = 1; k < 8; ++k) if (matches[k].score > matches[best].score) best = k;
-      EXPECT_EQ(matches[best].id, id) << "heading " << heading;
-      EXPECT_GT(matches[best].score, 0.9);
-      EXPECT_NEAR(wrap_deg_180(matches[best].heading_deg - heading), 0.0, 1.0) << "id " << id;
+      const CodeMatch& best = best_match(matches);
+      EXPECT_EQ(best.id, id) << "heading " << heading;
+      EXPECT_GT(best.score, 0.9);
+      EXPECT_NEAR(wrap_deg_180(best.heading_deg - heading), 0.0, 1.0) << "id " << id;
     }
   }
 }
@@ -53,8 +60,7 @@ TEST(Decoder, LargeFamilyDecodes) {
     const auto blobs = detector.detect(img);
     ASSERT_EQ(blobs.size(), 1u);
     const auto matches = decoder.match_all(decoder.sample(img, blobs[0]), blobs[0]);
-    const auto best = std::max_element(matches.begin(), matches.end(),
-                                       [](const auto& a, const auto& b) { return a.score < b.score; });
+    const auto* best = &best_match(matches);
     EXPECT_EQ(best->id, id);
     EXPECT_NEAR(wrap_deg_180(best->heading_deg - 100.0), 0.0, 1.5);
   }
@@ -96,8 +102,7 @@ TEST(Decoder, TwelveSliceFamilyDecodesByKeyAndBits) {
     const auto blobs = detector.detect(img);
     ASSERT_EQ(blobs.size(), 1u);
     const auto matches = decoder.match_all(decoder.sample(img, blobs[0]), blobs[0]);
-    const auto best = std::max_element(matches.begin(), matches.end(),
-                                       [](const auto& a, const auto& b) { return a.score < b.score; });
+    const auto* best = &best_match(matches);
     EXPECT_EQ(best->id, id);
     EXPECT_GT(best->score, 0.9);
     EXPECT_NEAR(wrap_deg_180(best->heading_deg - (33.0 + id)), 0.0, 1.5) << "id " << id;
