@@ -13,18 +13,21 @@ namespace rilbed::vision {
 
 namespace {
 
-// The p-quantile of grey levels (0..255) by counting: no copy, no sort, no branches
-// that depend on the data's order.
-double percentile(const std::vector<double>& v, double p) {
+// The spread between the lo- and hi-quantiles of grey levels (0..255), by counting
+// into one histogram: no copy, no sort, no branches that depend on the data's order.
+double quantile_spread(const std::vector<double>& v, double lo, double hi) {
   std::array<std::uint16_t, 256> histogram{};
   for (double g : v) ++histogram[static_cast<std::size_t>(std::clamp(g, 0.0, 255.0))];
-  const auto rank = static_cast<std::size_t>(p * (v.size() - 1));
+  const auto rank_lo = static_cast<std::size_t>(lo * (v.size() - 1));
+  const auto rank_hi = static_cast<std::size_t>(hi * (v.size() - 1));
   std::size_t seen = 0;
-  for (std::size_t level = 0; level < histogram.size(); ++level) {
+  int level_lo = -1;
+  for (int level = 0; level < 256; ++level) {
     seen += histogram[level];
-    if (seen > rank) return static_cast<double>(level);
+    if (level_lo < 0 && seen > rank_lo) level_lo = level;
+    if (seen > rank_hi) return level - level_lo;
   }
-  return 255.0;
+  return 255.0 - std::max(level_lo, 0);
 }
 
 // Value at fractional index t of the cumulative integral of a piecewise-constant
@@ -125,6 +128,14 @@ void Decoder::build_key_template(const MarkerFamily& family) {
 
 SampledSignal Decoder::sample(const cv::Mat& grey, const Blob& blob) const {
   SampledSignal out;
+  sample(grey, blob, out);
+  return out;
+}
+
+void Decoder::sample(const cv::Mat& grey, const Blob& blob, SampledSignal& out) const {
+  out.usable = false;
+  out.ring_contrast = out.black_level = out.white_level = 0.0;
+  out.values.clear();
   const int n = config_.samples;
   // The whole marker must lie inside the image; then no sample needs a bounds check.
   const double reach = 1.0 / MarkerFamily::black_ring_outer_radius;
@@ -132,7 +143,7 @@ SampledSignal Decoder::sample(const cv::Mat& grey, const Blob& blob) const {
   const double half_v = reach * (std::abs(blob.shape(1, 0)) + std::abs(blob.shape(1, 1)));
   if (blob.u - half_u < 0.0 || blob.v - half_v < 0.0 || blob.u + half_u > grey.cols - 1.001 ||
       blob.v + half_v > grey.rows - 1.001) {
-    return out;
+    return;
   }
   const std::uint8_t* data = grey.ptr<std::uint8_t>(0);
   const std::size_t stride = grey.step[0];
@@ -174,14 +185,14 @@ SampledSignal Decoder::sample(const cv::Mat& grey, const Blob& blob) const {
   out.ring_contrast = white_level - black_level;
   out.black_level = black_level;
   out.white_level = white_level;
-  if (out.ring_contrast < config_.min_ring_contrast) return out;
+  if (out.ring_contrast < config_.min_ring_contrast) return;
   const double mid = 0.5 * (black_level + white_level);
   const auto bright = std::count_if(white_copy.begin(), white_copy.end(), [&](double g) { return g > mid; });
-  if (bright < config_.min_white_ring_fraction * kRingSamples) return out;
-  const double spread = percentile(out.values, 0.9) - percentile(out.values, 0.1);
-  if (spread < config_.min_code_contrast * out.ring_contrast) return out;
+  if (bright < config_.min_white_ring_fraction * kRingSamples) return;
+  const double spread = quantile_spread(out.values, 0.1, 0.9);
+  if (spread < config_.min_code_contrast * out.ring_contrast) return;
   out.usable = true;
-  return out;
+  return;
 }
 
 double Decoder::correlate(const std::vector<double>& cumulative, const Ideal& ideal, double lag) const {
@@ -196,9 +207,8 @@ double Decoder::heading_on_screen(const Blob& blob, double lag) const {
   return wrap_deg_360(rad_to_deg(std::atan2(-dir[1], dir[0])));
 }
 
-Decoder::Prepared Decoder::prepare(const SampledSignal& signal) const {
+void Decoder::prepare(const SampledSignal& signal, Prepared& p) const {
   const int n = config_.samples;
-  Prepared p;
   const double mean = std::accumulate(signal.values.begin(), signal.values.end(), 0.0) / n;
   double norm2 = 0.0;
   p.cumulative.assign(n + 1, 0.0);
@@ -216,7 +226,13 @@ Decoder::Prepared Decoder::prepare(const SampledSignal& signal) const {
     p.doubled_cumulative[k] = p.cumulative[k % n];
     p.doubled_signal[k] = signal.values[k % n] - mean;
   }
-  return p;
+}
+
+double Decoder::lag_of_heading(const Blob& blob, double heading_deg) const {
+  const double h = deg_to_rad(heading_deg);
+  const cv::Vec2d dir = blob.shape.inv() * cv::Vec2d(std::cos(h), -std::sin(h));
+  const double lag = std::atan2(-dir[1], dir[0]) * config_.samples / (2.0 * kPi);
+  return lag < 0.0 ? lag + config_.samples : lag;
 }
 
 std::pair<int, double> Decoder::coarse_peak(const Prepared& p, const Ideal& ideal, std::vector<double>& scratch) const {
@@ -272,15 +288,19 @@ std::vector<CodeMatch> Decoder::match_all(const SampledSignal& signal, const Blo
     for (const auto& ideal : ideals_) out.push_back({ideal.id, -1.0, 0.0});
     return out;
   }
-  const Prepared p = prepare(signal);
+  // Per-thread scratch: the decoder is shared and immutable, and a frame decodes many
+  // blobs, so the buffers are reused instead of allocated per blob.
+  thread_local Prepared p;
+  prepare(signal, p);
   if (p.norm <= 0.0) {
     for (const auto& ideal : ideals_) out.push_back({ideal.id, -1.0, 0.0});
     return out;
   }
   if (!slice_bounds_.empty()) return match_by_key(p, blob);
   // Coarse pass: every ID at every whole-sample lag.
-  std::vector<double> scratch;
-  std::vector<std::pair<int, double>> peaks;
+  thread_local std::vector<double> scratch;
+  thread_local std::vector<std::pair<int, double>> peaks;
+  peaks.clear();
   double family_best = -1e300;
   for (const Ideal& ideal : ideals_) {
     peaks.push_back(coarse_peak(p, ideal, scratch));
@@ -306,7 +326,7 @@ std::vector<CodeMatch> Decoder::match_by_key(const Prepared& p, const Blob& blob
   std::vector<CodeMatch> out;
   out.reserve(ideals_.size());
   for (const auto& ideal : ideals_) out.push_back({ideal.id, -1.0, 0.0});
-  std::vector<double> scratch;
+  thread_local std::vector<double> scratch;
   const auto [key_lag, key_value] = coarse_peak(p, key_, scratch);
   const double lag = refine_peak(p, key_, key_lag, key_value).first;
   auto mean_over = [&](std::size_t slice) {
@@ -340,15 +360,28 @@ std::vector<CodeMatch> Decoder::match_by_key(const Prepared& p, const Blob& blob
   return out;
 }
 
-CodeMatch Decoder::match_one(const SampledSignal& signal, const Blob& blob, int id) const {
-  const auto it = std::find_if(ideals_.begin(), ideals_.end(), [&](const Ideal& i) { return i.id == id; });
-  if (it == ideals_.end()) throw std::invalid_argument("ID " + std::to_string(id) + " is not decoded here");
+CodeMatch Decoder::match_one(const SampledSignal& signal, const Blob& blob, int id,
+                             std::optional<double> expected_heading_deg) const {
+  const int index = id >= 0 && id < static_cast<int>(index_of_id_.size()) ? index_of_id_[id] : -1;
+  if (index < 0) throw std::invalid_argument("ID " + std::to_string(id) + " is not decoded here");
+  const Ideal& ideal = ideals_[index];
   if (!signal.usable || signal.values.size() != static_cast<std::size_t>(config_.samples)) return {id, -1.0, 0.0};
-  const Prepared p = prepare(signal);
+  thread_local Prepared p;
+  prepare(signal, p);
   if (p.norm <= 0.0) return {id, -1.0, 0.0};
-  std::vector<double> scratch;
-  const auto [coarse_lag, coarse_value] = coarse_peak(p, *it, scratch);
-  const auto [lag, value] = refine_peak(p, *it, coarse_lag, coarse_value);
+  std::pair<int, double> peak{-1, 0.0};
+  if (expected_heading_deg) {
+    const int centre = static_cast<int>(std::lround(lag_of_heading(blob, *expected_heading_deg))) % config_.samples;
+    peak = local_peak(p, ideal, centre, kTrackLagReach);
+    const int offset = ((peak.first - centre) % config_.samples + config_.samples + config_.samples / 2) %
+                           config_.samples - config_.samples / 2;
+    if (std::abs(offset) >= kTrackLagReach) peak.first = -1;  // on the edge: it may lie beyond
+  }
+  if (peak.first < 0) {
+    thread_local std::vector<double> scratch;
+    peak = coarse_peak(p, ideal, scratch);
+  }
+  const auto [lag, value] = refine_peak(p, ideal, peak.first, peak.second);
   return {id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, lag)};
 }
 

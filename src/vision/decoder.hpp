@@ -5,6 +5,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -57,6 +58,9 @@ class Decoder {
 
   /// Samples the coded annulus of `blob` in the 8-bit grey image.
   SampledSignal sample(const cv::Mat& grey, const Blob& blob) const;
+  /// The same into `out`, reusing its storage (no allocation once it has grown): what a
+  /// per-frame loop over many blobs uses.
+  void sample(const cv::Mat& grey, const Blob& blob, SampledSignal& out) const;
 
   /// Similarity of the signal to every available ID, in the order of ids() (the paper's
   /// Table 1 row for one object). Each entry carries the heading for that ID's best lag.
@@ -68,7 +72,11 @@ class Decoder {
 
   /// Similarity of the signal to one ID (which must be one of ids()): what a tracked
   /// marker needs to confirm its ID at a fraction of match_all's cost.
-  CodeMatch match_one(const SampledSignal& signal, const Blob& blob, int id) const;
+  /// With `expected_heading_deg` (the heading last seen, on screen) only lags within a
+  /// few samples of it are searched; if the best of them lies on the window's edge (the
+  /// marker turned further), every lag is searched as without it.
+  CodeMatch match_one(const SampledSignal& signal, const Blob& blob, int id,
+                      std::optional<double> expected_heading_deg = std::nullopt) const;
 
   const std::vector<int>& ids() const { return ids_; }
   const DecoderConfig& config() const { return config_; }
@@ -91,7 +99,11 @@ class Decoder {
     std::vector<double> cumulative, doubled_cumulative, doubled_signal;
     double norm = 0.0;
   };
-  Prepared prepare(const SampledSignal& signal) const;
+  // Fills `p` (reusing its storage) from the signal.
+  void prepare(const SampledSignal& signal, Prepared& p) const;
+  // Lag (samples, on the sampling axis) at which the key's bisector points along the
+  // on-screen heading for this blob's ellipse: heading_on_screen's inverse.
+  double lag_of_heading(const Blob& blob, double heading_deg) const;
   // Best whole-sample lag of one ideal and its (unnormalised) correlation.
   std::pair<int, double> coarse_peak(const Prepared& p, const Ideal& ideal, std::vector<double>& scratch) const;
   // Best whole-sample lag within `reach` samples of `centre_lag`.
@@ -105,6 +117,9 @@ class Decoder {
   static constexpr int kExhaustiveIds = 16;  // above this many IDs, decode by key and bits
   // Candidates share the key, so their peak lies within a few samples of the key's.
   static constexpr int kKeyLagReach = 3;
+  // A tracked marker turns at most this many samples (3 degrees each at 120) between
+  // frames before its confirmation falls back to the search over every lag.
+  static constexpr int kTrackLagReach = 5;
   void build_key_template(const MarkerFamily& family);
   std::vector<CodeMatch> match_by_key(const Prepared& p, const Blob& blob) const;
   Ideal key_;                                            // key and guards only

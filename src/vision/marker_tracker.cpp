@@ -105,10 +105,10 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
   matches.reserve(blobs.size());
   stats_.blobs += static_cast<int>(blobs.size());
   for (const Blob& blob : blobs) {
-    const SampledSignal signal = decoder_.sample(grey, blob);
-    if (signal.usable) ++stats_.decoded;
-    thresholds.push_back(0.5 * (signal.black_level + signal.white_level));
-    matches.push_back(decoder_.match_all(signal, blob));
+    decoder_.sample(grey, blob, signal_);
+    if (signal_.usable) ++stats_.decoded;
+    thresholds.push_back(0.5 * (signal_.black_level + signal_.white_level));
+    matches.push_back(decoder_.match_all(signal_, blob));
     double family_best = -1.0;
     for (const CodeMatch& m : matches.back()) family_best = std::max(family_best, m.score);
     std::vector<double> row(ids_.size(), -1.0);
@@ -147,12 +147,12 @@ std::vector<MarkerDetection> MarkerTracker::detect_full_frame(const cv::Mat& fra
 }
 
 std::optional<MarkerDetection> MarkerTracker::confirm(const cv::Mat& grey, const Track& track, const Blob& blob) {
-  const SampledSignal signal = decoder_.sample(grey, blob);
-  if (!signal.usable) return std::nullopt;
+  decoder_.sample(grey, blob, signal_);
+  if (!signal_.usable) return std::nullopt;
   ++stats_.decoded;
-  const CodeMatch m = decoder_.match_one(signal, blob, track.id);
+  const CodeMatch m = decoder_.match_one(signal_, blob, track.id, track.heading_deg);
   if (m.score < config_.min_assign_score || m.score < track.score - config_.confirm_drop) return std::nullopt;
-  return make_detection(blob, m, true, 0.5 * (signal.black_level + signal.white_level));
+  return make_detection(blob, m, true, 0.5 * (signal_.black_level + signal_.white_level));
 }
 
 std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
@@ -202,7 +202,7 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
   for (const MarkerDetection& d : found) {
     auto it = std::find_if(tracks_.begin(), tracks_.end(), [&](const Track& t) { return t.id == d.id; });
     if (it == tracks_.end()) {
-      tracks_.push_back({d.id, d.u, d.v, 0.0, 0.0, d.diameter_px, d.threshold_grey, d.score, 0});
+      tracks_.push_back({d.id, d.u, d.v, 0.0, 0.0, d.diameter_px, d.threshold_grey, d.score, d.heading_deg, 0});
       continue;
     }
     const int frames = it->missed;  // frames since the last sighting, >= 1
@@ -211,6 +211,7 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     it->u = d.u;
     it->v = d.v;
     it->diameter_px = d.diameter_px;
+    it->heading_deg = d.heading_deg;
     it->threshold_grey = d.threshold_grey;
     // The reference score is set by a full decode and only lowered slowly by
     // confirmations, so a drifting code cannot ratchet its own bar down.

@@ -107,6 +107,7 @@ class MarkerTracker {
     double diameter_px = 0;
     double threshold_grey = 0;
     double score = 0;
+    double heading_deg = 0;  // on screen, as last seen
     int missed = 0;
     /// Where it should be in the coming frame (constant motion, coasting over misses).
     cv::Point2d predicted() const { return {u + du * (missed + 1.0), v + dv * (missed + 1.0)}; }
@@ -128,6 +129,7 @@ class MarkerTracker {
   FrameStats stats_;
   int frames_since_full_ = 0;
   cv::Mat grey_buffer_;
+  SampledSignal signal_;  // reused for every blob: no allocation per blob
 };
 
 /// Convenience: one full-frame detection of `ids` in one image with default knobs.
