@@ -1,0 +1,63 @@
+// Runs a C controller written against rilbed_controller.h (peek/poke on a register map)
+// as a rilbed Controller: fills the robot's registers from its ControlInput before each
+// call and reads the motor registers back after.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "agents/controller.hpp"
+#include "agents/rilbed_controller.h"
+
+namespace rilbed::agents {
+
+/// One robot's register map (RILBED_REG_COUNT 32-bit words).
+class RegisterMap {
+ public:
+  RegisterMap();
+  /// The value at `address`, 0 outside the map.
+  std::int32_t peek(std::uint32_t address) const;
+  /// Controller write: ignored (and counted) for read-only or unknown addresses.
+  void poke(std::uint32_t address, std::int32_t value);
+  /// rilbed's own write of a sensor register (any address inside the map).
+  void set(std::uint32_t address, std::int32_t value);
+  /// Writes the controller attempted where it may not write.
+  int rejected_writes() const { return rejected_writes_; }
+
+ private:
+  std::vector<std::int32_t> words_;
+  int rejected_writes_ = 0;
+};
+
+/// The C controllers built into rilbed, by name (`braitenberg`). nullptr if unknown.
+const rilbed_c_controller* find_c_controller(std::string_view name);
+/// Names of the built-in C controllers.
+std::vector<std::string> c_controller_names();
+
+/// Adapter from a C controller to the Controller interface; one per robot. The C
+/// controller's functions are called with this robot's register map current (per
+/// thread), so several robots may share one C controller.
+class CControllerAdapter final : public Controller {
+ public:
+  /// `controller` must outlive the adapter (the built-ins are static). Throws
+  /// std::invalid_argument if it has no step function.
+  explicit CControllerAdapter(const rilbed_c_controller& controller);
+  ~CControllerAdapter() override;
+  ControlOutput step(const ControlInput& input) override;
+  /// Calls cleanup once (also done by the destructor if the run did not).
+  void finish() override;
+  const RegisterMap& registers() const { return registers_; }
+
+ private:
+  void load_inputs(const ControlInput& input);
+  const rilbed_c_controller& controller_;
+  RegisterMap registers_;
+  bool initialised_ = false;
+  bool finished_ = false;
+  std::optional<TimeUs> last_t_us_;
+};
+
+}  // namespace rilbed::agents

@@ -1,0 +1,83 @@
+// The controller API: what a robot's controller sees (sensor readings, its pose as the
+// test bed knows it, team messages) and what it commands (wheel speeds). A controller
+// never learns whether its body is virtual or a real Khepera (ARGoS's rule).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "core/geometry.hpp"
+#include "core/time.hpp"
+#include "environment/sensor_readings.hpp"
+
+namespace rilbed::agents {
+
+/// Khepera wheel speed units: pulses per 10 ms; 1 unit = 8 mm/s; the firmware takes ±127.
+inline constexpr double kMetresPerSecondPerUnit = 0.008;
+/// Largest wheel speed the Khepera's `D` command accepts, in its units.
+inline constexpr int kMaxWheelUnits = 127;
+/// Distance between the Khepera's wheels, metres.
+inline constexpr double kWheelBase_m = 0.053;
+
+/// Wheel speeds in Khepera units (pulses per 10 ms, ±127), as the `D` command sends them.
+struct WheelCommand {
+  int left = 0;
+  int right = 0;
+  bool operator==(const WheelCommand&) const = default;
+};
+
+/// Forward speed (m/s) and turn rate (rad/s, counter-clockwise) to wheel units, rounded
+/// and clamped to ±127. When a wheel would exceed the limit both are scaled down together,
+/// so the curvature is kept.
+inline WheelCommand wheels_from_twist(double speed_mps, double turn_rate_radps) {
+  double left = (speed_mps - 0.5 * turn_rate_radps * kWheelBase_m) / kMetresPerSecondPerUnit;
+  double right = (speed_mps + 0.5 * turn_rate_radps * kWheelBase_m) / kMetresPerSecondPerUnit;
+  const double biggest = std::max(std::abs(left), std::abs(right));
+  if (biggest > kMaxWheelUnits) {
+    left *= kMaxWheelUnits / biggest;
+    right *= kMaxWheelUnits / biggest;
+  }
+  return {static_cast<int>(std::lround(left)), static_cast<int>(std::lround(right))};
+}
+
+/// What a robot of the team tells the others (broadcast over the team channel): who, where
+/// and what it is doing. In distributed mode it is an agent's only knowledge of the others.
+struct TeamMessage {
+  int id = 0;
+  Pose2 pose;                  ///< field frame
+  std::string_view behaviour;  ///< its active behaviour ("follow", ...); points to a static string
+  TimeUs t_us = 0;             ///< when the pose was true
+};
+
+/// Everything a controller gets at one control step.
+struct ControlInput {
+  TimeUs t_us = 0;                          ///< simulated time of this step
+  int robot_id = 0;                         ///< the robot being controlled
+  environment::SensorReadings sensors;      ///< its sensors (virtual, real or combined)
+  std::optional<Pose2> pose;                ///< its pose from localisation (world or camera); nullopt if unknown
+  std::vector<TeamMessage> team;            ///< the latest message of every other team member
+};
+
+/// What a controller decides at one control step.
+struct ControlOutput {
+  WheelCommand wheels;
+  /// The active behaviour, part of the agent's visible state (written to the trajectories);
+  /// must point to a string that lives as long as the program (a literal).
+  std::string_view behaviour = "idle";
+};
+
+/// A robot controller: called once per control period with the latest input.
+/// Implementations keep their own state between calls; one instance per robot.
+class Controller {
+ public:
+  virtual ~Controller() = default;
+  /// One control step.
+  virtual ControlOutput step(const ControlInput& input) = 0;
+  /// Called once when the run ends (normally or not), after the last step.
+  virtual void finish() {}
+};
+
+}  // namespace rilbed::agents
