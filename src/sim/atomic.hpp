@@ -1,0 +1,60 @@
+// Atomic DEVS models (Parallel DEVS): explicit state, time advance, transitions, output.
+#pragma once
+
+#include <string>
+#include <utility>
+
+#include "sim/component.hpp"
+#include "sim/time.hpp"
+
+namespace rilbed::sim {
+
+/// An atomic Parallel DEVS model. The coordinator calls, at each instant t where the
+/// model is imminent (its time advance has run out) or receives input:
+///  - output() first, for imminent models only, before any transition at t;
+///  - then exactly one of internal_transition() (imminent, no input),
+///    external_transition(elapsed_us) (input, not imminent) or
+///    confluent_transition(elapsed_us) (both);
+///  - then time_advance() for the next event.
+/// Typical use: declare ports as reference members initialised with
+/// add_input<T>("name") / add_output<T>("name") in the constructor.
+/// Models know no absolute time: only durations. Not thread-safe (the coordinator's
+/// thread calls everything).
+class Atomic : public Component {
+ public:
+  using Component::Component;
+
+  /// Time from the last transition to the next internal event, in microseconds;
+  /// >= 0, or kInfinity when passive. A negative value is a model error.
+  virtual TimeUs time_advance() const = 0;
+  /// The internal transition (δint), when the time advance has run out.
+  virtual void internal_transition() = 0;
+  /// The external transition (δext): reads the bags of the input ports; `elapsed_us`
+  /// is the time since the last transition (0 <= elapsed_us <= time_advance()).
+  virtual void external_transition(TimeUs elapsed_us) = 0;
+  /// The confluent transition (δcon), when input arrives exactly as the time advance
+  /// runs out; `elapsed_us` equals the time advance. Default: internal_transition()
+  /// then external_transition(0).
+  virtual void confluent_transition(TimeUs elapsed_us);
+  /// The output function (λ), called just before an internal or confluent transition:
+  /// writes messages to the output ports and must not change the state.
+  virtual void output() = 0;
+};
+
+/// An atomic model whose whole state is one value of type State, so that tests,
+/// recorders and displays can read it (state()) without knowing the model.
+template <class State>
+class AtomicModel : public Atomic {
+ public:
+  AtomicModel(std::string id, State initial_state)
+      : Atomic(std::move(id)), state_(std::move(initial_state)) {}
+
+  /// The current state (read-only; valid until the next transition).
+  const State& state() const { return state_; }
+
+ protected:
+  /// The state, changed only by the transitions of the derived model.
+  State state_;
+};
+
+}  // namespace rilbed::sim
