@@ -1,0 +1,330 @@
+#include "environment/collision_resolver.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace rilbed::environment {
+
+namespace {
+
+// Unit normal of segment [a, b] pointing to the side `from` is on.
+Vec2 normal_towards(Vec2 a, Vec2 b, Vec2 from) {
+  const Vec2 ab = b - a;
+  const double len = ab.norm();
+  Vec2 n{-ab.y / len, ab.x / len};
+  if (ab.cross(from - a) < 0.0) n = n * -1.0;
+  return n;
+}
+
+Box path_box(Vec2 from, Vec2 to, double margin) {
+  return {{std::min(from.x, to.x) - margin, std::min(from.y, to.y) - margin},
+          {std::max(from.x, to.x) + margin, std::max(from.y, to.y) + margin}};
+}
+
+Contact mover_segment_contact(const MovingObstacle& m, Vec2 a, Vec2 b) {
+  if (m.shape() == MovingShape::Disc) return disc_segment_contact(m.position_m(), m.bounding_radius_m(), a, b);
+  return convex_polygon_segment_contact(m.world_vertices_m(), a, b);
+}
+
+// Contact of a robot's disc with a moving obstacle; the normal points towards the robot.
+Contact body_mover_contact(const Body& b, const MovingObstacle& m) {
+  if (m.shape() == MovingShape::Disc)
+    return disc_disc_contact(b.position_m, b.radius_m, m.position_m(), m.bounding_radius_m());
+  return disc_convex_polygon_contact(b.position_m, b.radius_m, m.world_vertices_m());
+}
+
+BodyRef robot_ref(const CollisionScene& s, std::size_t i) { return {BodyKind::Robot, s.body_ids[i]}; }
+
+}  // namespace
+
+CollisionResolver::CollisionResolver(CollisionConfig config) : config_(config) {}
+
+void CollisionResolver::begin_step() { contacts_.clear(); }
+
+void CollisionResolver::record(BodyRef a, BodyRef b) { contacts_.push_back({a, b, now_us_}); }
+
+void CollisionResolver::mark_moved(std::size_t body) {
+  if (moved_[body]) return;
+  moved_[body] = 1;
+  moved_list_.push_back(static_cast<int>(body));
+}
+
+void CollisionResolver::resolve(CollisionScene& s, TimeUs t_us) {
+  now_us_ = t_us;
+  const std::size_t n = s.bodies.size();
+  is_active_.assign(n, 0);
+  moved_.assign(n, 0);
+  active_.clear();
+  all_active_ = true;
+  s.grid.rebuild(n, [&](std::size_t i) { return s.bodies[i].position_m; });
+
+  for (int pass = 0; pass < config_.max_passes; ++pass) {
+    moved_list_.clear();
+    // Statics last, so that a robot pushed by another towards a wall ends the pass
+    // outside the wall; the next pass settles what that push-back disturbed.
+    bool corrected = movers_vs_statics(s);
+    corrected |= robots_vs_robots(s);
+    corrected |= robots_vs_movers(s);
+    corrected |= robots_vs_statics(s);
+    for (const int i : moved_list_) s.grid.move(static_cast<std::size_t>(i), s.bodies[static_cast<std::size_t>(i)].position_m);
+    if (!corrected) return;
+    // Only the bodies moved in this pass can be in new overlaps with each other, with
+    // unmoved bodies or with statics; pairs of unmoved bodies were checked already.
+    for (const int i : active_) is_active_[static_cast<std::size_t>(i)] = 0;
+    for (const int i : moved_list_) {
+      is_active_[static_cast<std::size_t>(i)] = 1;
+      moved_[static_cast<std::size_t>(i)] = 0;
+    }
+    active_.swap(moved_list_);
+    all_active_ = false;
+  }
+  fall_back(s);
+}
+
+bool CollisionResolver::robots_vs_robots(CollisionScene& s) {
+  bool corrected = false;
+  const double margin = config_.contact_margin_m, tol = config_.tolerance_m;
+  auto visit = [&](std::size_t i) {
+    Body& bi = s.bodies[i];
+    if (!bi.pushable) return;  // real robots start nothing; their virtual partners do
+    const double reach = bi.radius_m + s.max_body_radius_m + margin;
+    s.grid.for_each_in_box(box_around(bi.position_m, reach), [&](int jj) {
+      const auto j = static_cast<std::size_t>(jj);
+      if (j == i) return;
+      Body& bj = s.bodies[j];
+      // A pair of virtual robots both visited in this pass is handled by the lower slot.
+      if (bj.pushable && j < i && (all_active_ || is_active_[j])) return;
+      const Vec2 d = bi.position_m - bj.position_m;
+      const double dist_sq = d.dot(d);
+      const double sum = bi.radius_m + bj.radius_m;
+      if (dist_sq >= (sum + margin) * (sum + margin)) return;
+      if (bi.pushable && bj.pushable) {
+        const int a = s.body_ids[i], b = s.body_ids[j];
+        record({BodyKind::Robot, std::min(a, b)}, {BodyKind::Robot, std::max(a, b)});
+      } else {
+        record(robot_ref(s, i), robot_ref(s, j));
+      }
+      if (dist_sq >= (sum - tol) * (sum - tol)) return;
+      const double dist = std::sqrt(dist_sq);
+      Vec2 normal{1.0, 0.0};  // from j towards i
+      if (dist > 1e-12) {
+        normal = d / dist;
+      } else {
+        // Coincident centres: separate along where they came from.
+        const Vec2 back = bi.previous_m - bj.previous_m;
+        const double len = back.norm();
+        if (len > 0.0) normal = back / len;
+      }
+      const double overlap = sum - dist;
+      if (bj.pushable) {
+        bi.position_m = bi.position_m + normal * (0.5 * overlap);
+        bj.position_m = bj.position_m - normal * (0.5 * overlap);
+        mark_moved(j);
+      } else {
+        bi.position_m = bi.position_m + normal * overlap;
+      }
+      mark_moved(i);
+      corrected = true;
+    });
+  };
+  if (all_active_) {
+    for (std::size_t i = 0; i < s.bodies.size(); ++i) visit(i);
+  } else {
+    for (const int i : active_) visit(static_cast<std::size_t>(i));
+  }
+  return corrected;
+}
+
+bool CollisionResolver::robots_vs_movers(CollisionScene& s) {
+  bool corrected = false;
+  const double margin = config_.contact_margin_m, tol = config_.tolerance_m;
+  for (std::size_t m = 0; m < s.movers.size(); ++m) {
+    MovingObstacle& mover = s.movers[m];
+    const double reach = mover.bounding_radius_m() + s.max_body_radius_m + margin;
+    s.grid.for_each_in_box(box_around(mover.position_m(), reach), [&](int jj) {
+      const auto j = static_cast<std::size_t>(jj);
+      Body& b = s.bodies[j];
+      const Contact c = body_mover_contact(b, mover);
+      if (c.separation_m >= margin) return;
+      record(robot_ref(s, j), {BodyKind::MovingObstacle, static_cast<int>(m)});
+      if (c.separation_m >= -tol) return;
+      const double depth = -c.separation_m;
+      if (b.pushable) {
+        b.position_m = b.position_m + c.normal * depth;
+        mark_moved(j);
+      } else {
+        mover.translate(c.normal * -depth);
+        mover.reflect_off(c.normal * -1.0);
+      }
+      corrected = true;
+    });
+  }
+  return corrected;
+}
+
+bool CollisionResolver::robots_vs_statics(CollisionScene& s) {
+  bool corrected = false;
+  const double margin = config_.contact_margin_m, tol = config_.tolerance_m;
+  auto visit = [&](std::size_t i) {
+    Body& b = s.bodies[i];
+    const Box box = path_box(b.pushable ? b.previous_m : b.position_m, b.position_m, b.radius_m + margin);
+    s.statics.for_each_in_box(box, [&](const IndexedSegment& seg) {
+      if (b.pushable && path_crosses_segment(b.previous_m, b.position_m, seg.a_m, seg.b_m)) {
+        // The centre went through the segment (a fast robot, or a push): put it back on
+        // the side it came from, touching.
+        const Vec2 n = normal_towards(seg.a_m, seg.b_m, b.previous_m);
+        const double signed_dist = (b.position_m - seg.a_m).dot(n);
+        b.position_m = b.position_m + n * (b.radius_m - signed_dist);
+        record(robot_ref(s, i), seg.owner);
+        mark_moved(i);
+        corrected = true;
+        return;
+      }
+      const Contact c = disc_segment_contact(b.position_m, b.radius_m, seg.a_m, seg.b_m);
+      if (c.separation_m >= margin) return;
+      record(robot_ref(s, i), seg.owner);
+      if (!b.pushable || c.separation_m >= -tol) return;
+      b.position_m = b.position_m + c.normal * -c.separation_m;
+      mark_moved(i);
+      corrected = true;
+    });
+  };
+  if (all_active_) {
+    for (std::size_t i = 0; i < s.bodies.size(); ++i) visit(i);
+  } else {
+    for (const int i : active_) visit(static_cast<std::size_t>(i));
+  }
+  return corrected;
+}
+
+bool CollisionResolver::movers_vs_statics(CollisionScene& s) {
+  bool corrected = false;
+  const double margin = config_.contact_margin_m, tol = config_.tolerance_m;
+  for (std::size_t m = 0; m < s.movers.size(); ++m) {
+    MovingObstacle& mover = s.movers[m];
+    const BodyRef self{BodyKind::MovingObstacle, static_cast<int>(m)};
+    const Box box = path_box(mover.previous_m(), mover.position_m(), mover.bounding_radius_m() + margin);
+    s.statics.for_each_in_box(box, [&](const IndexedSegment& seg) {
+      if (path_crosses_segment(mover.previous_m(), mover.position_m(), seg.a_m, seg.b_m)) {
+        // Went through: mirror the reference point back across the segment's line.
+        const Vec2 n = normal_towards(seg.a_m, seg.b_m, mover.previous_m());
+        const double signed_dist = (mover.position_m() - seg.a_m).dot(n);
+        mover.translate(n * (-2.0 * signed_dist));
+        mover.reflect_off(n);
+        record(self, seg.owner);
+        corrected = true;
+        return;
+      }
+      const Contact c = mover_segment_contact(mover, seg.a_m, seg.b_m);
+      if (c.separation_m >= margin) return;
+      record(self, seg.owner);
+      if (c.separation_m >= -tol) return;
+      const double depth = -c.separation_m;
+      // An elastic bounce: the overshoot into the wall is mirrored out of it.
+      const bool bounced = mover.reflect_off(c.normal);
+      mover.translate(c.normal * (bounced ? 2.0 * depth : depth));
+      corrected = true;
+    });
+  }
+  return corrected;
+}
+
+bool CollisionResolver::body_overlaps(const CollisionScene& s, std::size_t i) const {
+  const Body& b = s.bodies[i];
+  const double tol = config_.tolerance_m;
+  bool overlaps = false;
+  s.grid.for_each_in_box(box_around(b.position_m, b.radius_m + s.max_body_radius_m), [&](int jj) {
+    const auto j = static_cast<std::size_t>(jj);
+    if (j == i || overlaps) return;
+    const double sum = b.radius_m + s.bodies[j].radius_m - tol;
+    if (distance_sq(b.position_m, s.bodies[j].position_m) < sum * sum) overlaps = true;
+  });
+  for (const MovingObstacle& m : s.movers)
+    if (!overlaps && body_mover_contact(b, m).separation_m < -tol) overlaps = true;
+  s.statics.for_each_in_box(box_around(b.position_m, b.radius_m), [&](const IndexedSegment& seg) {
+    if (!overlaps && disc_segment_contact(b.position_m, b.radius_m, seg.a_m, seg.b_m).separation_m < -tol)
+      overlaps = true;
+  });
+  return overlaps;
+}
+
+bool CollisionResolver::mover_overlaps(const CollisionScene& s, std::size_t m) const {
+  const MovingObstacle& mover = s.movers[m];
+  const double tol = config_.tolerance_m;
+  bool overlaps = false;
+  s.grid.for_each_in_box(box_around(mover.position_m(), mover.bounding_radius_m() + s.max_body_radius_m), [&](int j) {
+    if (!overlaps && body_mover_contact(s.bodies[static_cast<std::size_t>(j)], mover).separation_m < -tol)
+      overlaps = true;
+  });
+  s.statics.for_each_in_box(box_around(mover.position_m(), mover.bounding_radius_m()), [&](const IndexedSegment& seg) {
+    if (!overlaps && mover_segment_contact(mover, seg.a_m, seg.b_m).separation_m < -tol) overlaps = true;
+  });
+  return overlaps;
+}
+
+void CollisionResolver::fall_back(CollisionScene& s) {
+  // Everything was free at the start of the substep, so putting overlapping bodies back
+  // there converges. Only bodies moved in the last pass can still overlap (pairs of
+  // unmoved bodies were checked in earlier passes), so the search starts from them and
+  // spreads to the neighbours of each body put back, which it may now overlap.
+  const std::size_t n = s.bodies.size();
+  reverted_.assign(n + s.movers.size(), 0);
+  std::vector<int>& queue = moved_list_;  // free at this point; reused to avoid allocating
+  queue.assign(active_.begin(), active_.end());
+  auto enqueue_neighbours = [&](Vec2 p, double reach) {
+    s.grid.for_each_in_box(box_around(p, reach + s.max_body_radius_m), [&](int j) {
+      if (!reverted_[static_cast<std::size_t>(j)]) queue.push_back(j);
+    });
+  };
+  for (;;) {
+    while (!queue.empty()) {
+      const auto i = static_cast<std::size_t>(queue.back());
+      queue.pop_back();
+      Body& b = s.bodies[i];
+      if (!b.pushable || reverted_[i] || !body_overlaps(s, i)) continue;
+      b.position_m = b.previous_m;
+      s.grid.move(i, b.position_m);
+      reverted_[i] = 1;
+      enqueue_neighbours(b.position_m, b.radius_m);
+    }
+    bool mover_reverted = false;
+    for (std::size_t m = 0; m < s.movers.size(); ++m) {
+      if (reverted_[n + m] || !mover_overlaps(s, m)) continue;
+      MovingObstacle& mover = s.movers[m];
+      mover.revert();
+      mover.set_velocity(mover.velocity_mps() * -1.0);  // blocked: it bounces back the way it came
+      reverted_[n + m] = 1;
+      mover_reverted = true;
+      enqueue_neighbours(mover.position_m(), mover.bounding_radius_m());
+    }
+    if (!mover_reverted && queue.empty()) break;
+  }
+  queue.clear();
+}
+
+std::span<const CollisionEvent> CollisionResolver::end_step() {
+  std::sort(contacts_.begin(), contacts_.end(), [](const ContactRecord& a, const ContactRecord& b) {
+    if (a.first != b.first) return a.first < b.first;
+    if (a.second != b.second) return a.second < b.second;
+    return a.t_us < b.t_us;
+  });
+  current_pairs_.clear();
+  events_.clear();
+  for (std::size_t k = 0; k < contacts_.size(); ++k) {
+    const ContactRecord& c = contacts_[k];
+    if (k > 0 && contacts_[k - 1].first == c.first && contacts_[k - 1].second == c.second) continue;
+    const Pair pair{c.first, c.second};
+    current_pairs_.push_back(pair);
+    if (!std::binary_search(previous_pairs_.begin(), previous_pairs_.end(), pair))
+      events_.push_back({c.t_us, c.first, c.second});
+  }
+  previous_pairs_.swap(current_pairs_);
+  std::sort(events_.begin(), events_.end(), [](const CollisionEvent& a, const CollisionEvent& b) {
+    if (a.t_us != b.t_us) return a.t_us < b.t_us;
+    if (a.first != b.first) return a.first < b.first;
+    return a.second < b.second;
+  });
+  return events_;
+}
+
+}  // namespace rilbed::environment

@@ -1,0 +1,114 @@
+// The collision server (paper 000 §6.2): after every substep of motion it removes every
+// overlap between robots, static geometry and moving obstacles by positional correction,
+// and it turns contacts into per-episode collision events.
+//
+// Rules:
+// - A virtual robot and a wall or static obstacle: the robot is pushed out along the
+//   contact normal until it touches. If its centre crossed a segment during the substep
+//   (a fast robot, or a push), it is put back on the side it came from.
+// - Two virtual robots: each moves half the overlap, apart along the line of centres.
+// - A virtual and a real robot: the virtual one moves the whole overlap; nothing virtual
+//   ever moves a real robot. Two real robots are left alone (the real world decides).
+// - A moving obstacle and a virtual robot: the robot is pushed out. A moving obstacle
+//   and a real robot: the obstacle is pushed back and its velocity reflected.
+// - A moving obstacle and a wall or static obstacle: pushed out and its velocity
+//   reflected (elastic bounce: the overshoot is mirrored).
+// The rules are applied in passes (Gauss–Seidel: each correction sees the previous ones)
+// until a pass finds nothing to correct; each later pass only revisits bodies moved in
+// the pass before. If max_passes is reached with overlaps left (a robot pinned in a
+// crowd), every body still overlapping is put back where its substep started (a free
+// place), repeatedly, until none overlaps: a virtual robot is never left overlapping
+// another robot, an obstacle or a wall, except when real robots or a real robot and a
+// wall squeeze it (the real world does not know about it).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "environment/body.hpp"
+#include "environment/collision_event.hpp"
+#include "environment/moving_obstacle.hpp"
+#include "environment/segment_index.hpp"
+#include "environment/spatial_grid.hpp"
+
+namespace rilbed::environment {
+
+/// Knobs of the resolver.
+struct CollisionConfig {
+  /// Most correction passes per substep before the fallback. A pass after the first
+  /// only revisits the bodies moved in the pass before, so extra passes are cheap; a
+  /// robot squeezed between a wall and another robot halves its overlap per pass, so
+  /// reaching the tolerance from a centimetre takes about 25.
+  int max_passes = 32;
+  /// Surfaces closer than this count as touching for the contact episodes (so that a
+  /// robot resting against a wall stays in one episode). Metres.
+  double contact_margin_m = 1e-4;
+  /// Overlaps up to this are left alone (floating-point slack). Metres.
+  double tolerance_m = 1e-9;
+};
+
+/// What the resolver works on, by reference: the World's arrays.
+struct CollisionScene {
+  std::span<Body> bodies;          ///< robots, by slot
+  std::span<const int> body_ids;   ///< robot id of each slot, for the events
+  SpatialGrid& grid;               ///< bodies hashed by cell; kept current by the resolver
+  const SegmentIndex& statics;     ///< walls and obstacle edges
+  std::span<MovingObstacle> movers;  ///< by index
+  double max_body_radius_m = 0.0;
+};
+
+/// Resolves overlaps and records contact episodes. Keeps scratch buffers between calls
+/// (no allocation per step once they have grown). Not thread-safe.
+class CollisionResolver {
+ public:
+  explicit CollisionResolver(CollisionConfig config = {});
+
+  /// The knobs it was made with.
+  const CollisionConfig& config() const { return config_; }
+
+  /// Starts a step: forgets the contacts of the previous step's substeps.
+  void begin_step();
+  /// Resolves the overlaps after one substep of motion that ended at t_us. Bodies'
+  /// previous_m (and movers' previous_m) must hold their positions at the substep's start.
+  void resolve(CollisionScene& scene, TimeUs t_us);
+  /// Ends the step: the pairs in contact during this step that were not in contact
+  /// during the previous step become events, sorted by time, then parties.
+  std::span<const CollisionEvent> end_step();
+  /// The events of the last ended step.
+  std::span<const CollisionEvent> events() const { return events_; }
+
+ private:
+  struct ContactRecord {
+    BodyRef first;
+    BodyRef second;
+    TimeUs t_us;
+  };
+  using Pair = std::pair<BodyRef, BodyRef>;
+
+  void record(BodyRef a, BodyRef b);
+  bool robots_vs_robots(CollisionScene& s);
+  bool robots_vs_movers(CollisionScene& s);
+  bool robots_vs_statics(CollisionScene& s);
+  bool movers_vs_statics(CollisionScene& s);
+  void mark_moved(std::size_t body);
+  bool body_overlaps(const CollisionScene& s, std::size_t i) const;
+  bool mover_overlaps(const CollisionScene& s, std::size_t m) const;
+  void fall_back(CollisionScene& s);
+
+  CollisionConfig config_;
+  TimeUs now_us_ = 0;
+  std::vector<ContactRecord> contacts_;
+  std::vector<Pair> previous_pairs_;
+  std::vector<Pair> current_pairs_;
+  std::vector<CollisionEvent> events_;
+  // Active-set bookkeeping: bodies to visit in this pass, bodies moved in this pass.
+  std::vector<int> active_;
+  std::vector<int> moved_list_;
+  std::vector<std::uint8_t> is_active_;
+  std::vector<std::uint8_t> moved_;
+  std::vector<std::uint8_t> reverted_;
+  bool all_active_ = true;
+};
+
+}  // namespace rilbed::environment

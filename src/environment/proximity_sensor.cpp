@@ -1,0 +1,65 @@
+#include "environment/proximity_sensor.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "environment/random.hpp"
+
+namespace rilbed::environment {
+
+ProximitySensor::ProximitySensor(ProximityConfig config, const std::string& what) : config_(config) {
+  auto fail = [&](const std::string& why) { throw std::invalid_argument(what + ": proximity: " + why); };
+  if (!std::isfinite(config_.range_m) || config_.range_m <= 0.0) fail("range_m must be a positive number");
+  if (!std::isfinite(config_.falloff_m) || config_.falloff_m <= 0.0) fail("falloff_m must be a positive number");
+  if (!(config_.half_angle_rad > 0.0 && config_.half_angle_rad < 0.5 * kPi))
+    fail("half_angle_rad must be in (0, pi/2)");
+  if (!std::isfinite(config_.noise_sd) || config_.noise_sd < 0.0) fail("noise_sd must be >= 0");
+  for (int i = 0; i < kProximityCount; ++i) {
+    const double a = config_.mount_angles_rad[static_cast<std::size_t>(i)];
+    if (!std::isfinite(a)) fail("mount angle " + std::to_string(i) + " is not finite");
+    directions_[static_cast<std::size_t>(i)] = {std::cos(a), std::sin(a)};
+  }
+  cos_half_ = std::cos(config_.half_angle_rad);
+  sin_half_ = std::sin(config_.half_angle_rad);
+  floor_ = std::exp(-config_.range_m / config_.falloff_m);
+}
+
+double ProximitySensor::response(double distance_m) const {
+  if (!(distance_m < config_.range_m)) return 0.0;
+  const double d = std::max(0.0, distance_m);
+  return kProximityMax * (std::exp(-d / config_.falloff_m) - floor_) / (1.0 - floor_);
+}
+
+void ProximitySensor::nearest_distances(const Scene& scene, int body, Vec2 heading,
+                                        std::array<double, kProximityCount>& distances_m) const {
+  const Body& self = scene.bodies[static_cast<std::size_t>(body)];
+  std::array<Wedge, kProximityCount> wedges;
+  for (std::size_t i = 0; i < wedges.size(); ++i) {
+    const Vec2 d = directions_[i];
+    const Vec2 axis{heading.x * d.x - heading.y * d.y, heading.y * d.x + heading.x * d.y};
+    wedges[i] = make_wedge(self.position_m + axis * self.radius_m, axis, cos_half_, sin_half_);
+  }
+  scene.nearest_in_wedges(self.position_m, self.radius_m + config_.range_m, body, wedges, distances_m);
+}
+
+void ProximitySensor::sense(const Scene& scene, int body, Vec2 heading, std::mt19937_64& rng,
+                            ProximityValues& out) const {
+  std::array<double, kProximityCount> distances;
+  nearest_distances(scene, body, heading, distances);
+  std::array<double, kProximityCount> noise{};
+  if (config_.noise_sd > 0.0) {
+    for (std::size_t i = 0; i < noise.size(); i += 2) {
+      const auto [a, b] = standard_normal_pair(rng);
+      noise[i] = a * config_.noise_sd;
+      if (i + 1 < noise.size()) noise[i + 1] = b * config_.noise_sd;
+    }
+  }
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    // Clamp, then round half up (cheaper than std::round, a library call, in this loop).
+    const double v = std::clamp(response(distances[i]) + noise[i], 0.0, static_cast<double>(kProximityMax));
+    out[i] = static_cast<int>(v + 0.5);
+  }
+}
+
+}  // namespace rilbed::environment

@@ -1,0 +1,55 @@
+// One robot as the world knows it: identity, kind, pose, body, wheel commands, wheel
+// counters and the sensors it carries.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "core/time.hpp"
+#include "environment/kinematics.hpp"
+#include "environment/sensor_suite.hpp"
+
+namespace rilbed::environment {
+
+/// Virtual robots live only in the world: the world drives them from their wheel
+/// commands. Real robots are driven by the real world: the world takes their pose from
+/// outside (the camera) and never moves them.
+enum class RobotKind { Virtual, Real };
+
+/// "virtual" or "real".
+std::string_view to_string(RobotKind kind);
+
+/// A robot to add to the world.
+struct RobotConfig {
+  int id = 0;                           ///< unique within the world
+  RobotKind kind = RobotKind::Virtual;  ///< virtual (driven here) or real (observed)
+  Pose2 pose;                           ///< initial pose, field frame
+  double radius_m = kKheperaRadius_m;   ///< the body is a disc of this radius
+  double wheel_base_m = kKheperaWheelBase_m;
+  WheelNoiseConfig noise;               ///< virtual robots only
+  SensorSuiteConfig sensors;            ///< virtual sensors (fed by the world for either kind)
+};
+
+/// The world's record of one robot. Values; the World owns them.
+struct RobotState {
+  int id = 0;                          ///< as configured
+  RobotKind kind = RobotKind::Virtual; ///< as configured
+  Pose2 pose;                        ///< current pose, heading in [-pi, pi)
+  TimeUs pose_t_us = 0;              ///< when pose was last set (step end or observation)
+  double radius_m = kKheperaRadius_m;        ///< body disc
+  double wheel_base_m = kKheperaWheelBase_m;  ///< between the wheels
+  int left_speed_units = 0;          ///< commanded, pulses per 10 ms, in [-127, 127]
+  int right_speed_units = 0;
+  /// Wheel travel counted by the encoders since the counters were last set, metres
+  /// (kept in metres so that fractions of a pulse are not lost between steps).
+  double left_wheel_travel_m = 0.0;
+  double right_wheel_travel_m = 0.0;
+  WheelNoiseConfig noise;     ///< as configured
+  SensorSuiteConfig sensors;  ///< as configured
+
+  /// The wheel counters, as the Khepera's `H` command would report them: whole pulses of
+  /// 0.08 mm, rounded towards minus infinity.
+  OdometryReading odometer() const;
+};
+
+}  // namespace rilbed::environment

@@ -1,0 +1,56 @@
+// The set of virtual sensors one robot carries, configured per robot, and the code that
+// reads all of them at once into a SensorReadings.
+#pragma once
+
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "environment/beacon_finder.hpp"
+#include "environment/proximity_sensor.hpp"
+#include "environment/range_finder.hpp"
+#include "environment/track_sensor.hpp"
+
+namespace rilbed::environment {
+
+/// Which sensors a robot carries and how each is set. The default is a stock Khepera II:
+/// the eight IR proximity sensors and the wheel counters.
+struct SensorSuiteConfig {
+  std::optional<ProximityConfig> proximity = ProximityConfig{};  ///< nullopt: no IR ring
+  std::vector<RangeFinderConfig> range_finders;                  ///< ultrasonic, in reading order
+  std::optional<BeaconFinderConfig> beacon_finder;               ///< nullopt: none
+  std::vector<TrackSensorConfig> track_sensors;                  ///< elements, in reading order
+  bool odometer = true;                                          ///< report the wheel counters
+};
+
+/// A robot's sensors, validated and precomputed (footprints, directions).
+class SensorSuite {
+ public:
+  /// Validates every sensor's configuration; throws std::invalid_argument prefixed with
+  /// `what` (e.g. "robot 3").
+  SensorSuite(const SensorSuiteConfig& config, const std::string& what);
+
+  /// Reads every sensor of the robot in slot `body` at `pose` into `out` (fields of
+  /// sensors it does not carry are emptied; vectors keep their capacity). `odometry` is
+  /// reported when the suite has an odometer and it is given. Noise draws come from `rng`
+  /// in a fixed order: proximity, range finders, beacons, track sensors.
+  void sense(const Scene& scene, int body, Pose2 pose, std::optional<OdometryReading> odometry, TimeUs t_us,
+             std::mt19937_64& rng, SensorReadings& out) const;
+
+  /// The IR ring, if carried.
+  const std::optional<ProximitySensor>& proximity() const { return proximity_; }
+  /// The range finders (possibly none).
+  const RangeFinders& range_finders() const { return range_finders_; }
+  /// The track sensor elements (possibly none), with their footprints.
+  const std::vector<TrackSensor>& track_sensors() const { return track_sensors_; }
+
+ private:
+  std::optional<ProximitySensor> proximity_;
+  RangeFinders range_finders_;
+  std::optional<BeaconFinderConfig> beacon_finder_;
+  std::vector<TrackSensor> track_sensors_;
+  bool odometer_ = true;
+};
+
+}  // namespace rilbed::environment

@@ -1,0 +1,389 @@
+#include "environment/world.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "environment/random.hpp"
+
+namespace rilbed::environment {
+
+namespace {
+
+constexpr double kDefaultCell_m = 0.1;
+
+bool finite(Vec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); }
+
+void validate_config(const WorldConfig& c) {
+  if (!std::isfinite(c.cell_size_m) || c.cell_size_m < 0.0) throw std::invalid_argument("world: cell_size_m must be >= 0");
+  if (c.max_grid_cells < 1) throw std::invalid_argument("world: max_grid_cells must be >= 1");
+  if (!std::isfinite(c.max_substep_travel_m) || c.max_substep_travel_m < 0.0)
+    throw std::invalid_argument("world: max_substep_travel_m must be >= 0");
+  if (c.collision.max_passes < 1) throw std::invalid_argument("world: collision.max_passes must be >= 1");
+  if (!std::isfinite(c.collision.contact_margin_m) || c.collision.contact_margin_m < 0.0)
+    throw std::invalid_argument("world: collision.contact_margin_m must be >= 0");
+  if (!std::isfinite(c.collision.tolerance_m) || c.collision.tolerance_m < 0.0)
+    throw std::invalid_argument("world: collision.tolerance_m must be >= 0");
+}
+
+GridGeometry make_grid(const StaticMap& map, const WorldConfig& config) {
+  const double cell = config.cell_size_m > 0.0 ? config.cell_size_m : kDefaultCell_m;
+  Box box = map.extent();
+  // One spare cell around everything, so that bodies just outside still hash apart.
+  box.lo_m = box.lo_m - Vec2{cell, cell};
+  box.hi_m = box.hi_m + Vec2{cell, cell};
+  return GridGeometry::covering(box, cell, config.max_grid_cells);
+}
+
+std::vector<IndexedSegment> static_segments(const StaticMap& map) {
+  std::vector<IndexedSegment> segments;
+  if (map.field().boundary_walls) {
+    const auto walls = map.wall_segments();
+    for (int k = 0; k < 4; ++k) segments.push_back({walls[k][0], walls[k][1], {BodyKind::Wall, k}, 0.0});
+  }
+  for (std::size_t i = 0; i < map.obstacles().size(); ++i) {
+    const auto& v = map.obstacles()[i].vertices_m;
+    for (std::size_t k = 0; k < v.size(); ++k)
+      segments.push_back({v[k], v[(k + 1) % v.size()], {BodyKind::Obstacle, static_cast<int>(i)}, 0.0});
+  }
+  return segments;
+}
+
+std::vector<IndexedSegment> track_segments(const StaticMap& map) {
+  std::vector<IndexedSegment> segments;
+  for (std::size_t i = 0; i < map.tracks().size(); ++i) {
+    const TrackConfig& t = map.tracks()[i];
+    const BodyRef owner{BodyKind::Obstacle, static_cast<int>(i)};
+    for (std::size_t k = 0; k + 1 < t.points_m.size(); ++k)
+      segments.push_back({t.points_m[k], t.points_m[k + 1], owner, 0.5 * t.width_m});
+    if (t.closed) segments.push_back({t.points_m.back(), t.points_m.front(), owner, 0.5 * t.width_m});
+  }
+  return segments;
+}
+
+}  // namespace
+
+World::World(StaticMapConfig map, WorldConfig config)
+    : config_((validate_config(config), config)),
+      map_(std::move(map)),
+      grid_geometry_(make_grid(map_, config_)),
+      statics_(grid_geometry_, static_segments(map_)),
+      tracks_(grid_geometry_, track_segments(map_)),
+      grid_(grid_geometry_),
+      resolver_(config_.collision),
+      t_us_(config_.start_t_us) {}
+
+std::size_t World::slot(int id) const {
+  const auto it = slot_of_.find(id);
+  if (it == slot_of_.end()) throw std::invalid_argument("no robot with id " + std::to_string(id));
+  return it->second;
+}
+
+const RobotState& World::robot(int id) const { return robots_[slot(id)]; }
+
+Scene World::scene() const {
+  return Scene{statics_, tracks_, bodies_, grid_, movers_, map_.beacons(), max_radius_m_};
+}
+
+void World::check_placement_free(const std::string& what, Vec2 p, double r, int exclude_slot) const {
+  const double tol = config_.collision.tolerance_m;
+  if (map_.field().boundary_walls) {
+    const FieldConfig& f = map_.field();
+    const char* wall = nullptr;
+    if (p.x - r < -tol) wall = "the left wall";
+    else if (p.x + r > f.width_m + tol) wall = "the right wall";
+    else if (p.y - r < -tol) wall = "the bottom wall";
+    else if (p.y + r > f.height_m + tol) wall = "the top wall";
+    if (wall) throw std::invalid_argument(what + ": placed overlapping " + wall);
+  }
+  if (const int inside = map_.obstacle_containing(p); inside >= 0)
+    throw std::invalid_argument(what + ": placed inside obstacle " + std::to_string(inside));
+  statics_.for_each_in_box(box_around(p, r), [&](const IndexedSegment& seg) {
+    if (disc_segment_contact(p, r, seg.a_m, seg.b_m).separation_m < -tol)
+      throw std::invalid_argument(what + ": placed overlapping " + to_string(seg.owner));
+  });
+  grid_.for_each_in_box(box_around(p, r + max_radius_m_), [&](int j) {
+    if (j == exclude_slot) return;
+    const Body& b = bodies_[static_cast<std::size_t>(j)];
+    const double sum = r + b.radius_m - tol;
+    if (distance_sq(p, b.position_m) < sum * sum)
+      throw std::invalid_argument(what + ": placed overlapping robot " + std::to_string(ids_[static_cast<std::size_t>(j)]));
+  });
+  for (std::size_t m = 0; m < movers_.size(); ++m) {
+    const MovingObstacle& mover = movers_[m];
+    const Contact c = mover.shape() == MovingShape::Disc
+                          ? disc_disc_contact(p, r, mover.position_m(), mover.bounding_radius_m())
+                          : disc_convex_polygon_contact(p, r, mover.world_vertices_m());
+    if (c.separation_m < -tol)
+      throw std::invalid_argument(what + ": placed overlapping moving obstacle " + std::to_string(m));
+  }
+}
+
+void World::add_robot(const RobotConfig& c) {
+  const std::string what = label(c.id);
+  if (slot_of_.contains(c.id)) throw std::invalid_argument(what + ": another robot has this id");
+  if (!finite(c.pose.position_m) || !std::isfinite(c.pose.heading_rad)) throw std::invalid_argument(what + ": pose is not finite");
+  if (!std::isfinite(c.radius_m) || c.radius_m <= 0.0) throw std::invalid_argument(what + ": radius_m must be a positive number");
+  if (!std::isfinite(c.wheel_base_m) || c.wheel_base_m <= 0.0)
+    throw std::invalid_argument(what + ": wheel_base_m must be a positive number");
+  const WheelNoiseConfig& n = c.noise;
+  if (!std::isfinite(n.slip_sd) || n.slip_sd < 0.0) throw std::invalid_argument(what + ": noise.slip_sd must be >= 0");
+  if (!std::isfinite(n.left_bias) || !std::isfinite(n.right_bias) || n.left_bias <= -1.0 || n.right_bias <= -1.0)
+    throw std::invalid_argument(what + ": noise biases must be finite and above -1");
+  SensorSuite suite(c.sensors, what);  // validates the sensors
+  if (c.kind == RobotKind::Virtual) check_placement_free(what, c.pose.position_m, c.radius_m, -1);
+
+  RobotState state;
+  state.id = c.id;
+  state.kind = c.kind;
+  state.pose = {c.pose.position_m, wrap_rad_pi(c.pose.heading_rad)};
+  state.pose_t_us = t_us_;
+  state.radius_m = c.radius_m;
+  state.wheel_base_m = c.wheel_base_m;
+  state.noise = c.noise;
+  state.sensors = c.sensors;
+  // Grow everything first (geometrically, so that adding n robots costs O(n)) so that a
+  // failed allocation leaves the parallel arrays in step.
+  const std::size_t s = robots_.size();
+  if (s == robots_.capacity()) {
+    const std::size_t want = std::max<std::size_t>(16, 2 * s);
+    robots_.reserve(want), bodies_.reserve(want), ids_.reserve(want), suites_.reserve(want), motion_.reserve(want);
+  }
+  slot_of_.reserve(s + 1);
+  robots_.push_back(std::move(state));
+  bodies_.push_back({c.pose.position_m, c.pose.position_m, c.radius_m, c.kind == RobotKind::Virtual});
+  ids_.push_back(c.id);
+  suites_.push_back(std::move(suite));
+  motion_.emplace_back();
+  slot_of_.emplace(c.id, s);
+  grid_.push_back(c.pose.position_m);
+  refresh_max_radius();
+}
+
+void World::remove_robot(int id) {
+  const std::size_t s = slot(id);
+  const std::size_t last = robots_.size() - 1;
+  if (s != last) {
+    robots_[s] = std::move(robots_[last]);
+    bodies_[s] = bodies_[last];
+    ids_[s] = ids_[last];
+    suites_[s] = std::move(suites_[last]);
+    motion_[s] = motion_[last];
+    slot_of_[ids_[s]] = s;
+  }
+  robots_.pop_back(), bodies_.pop_back(), ids_.pop_back(), suites_.pop_back(), motion_.pop_back();
+  slot_of_.erase(id);
+  grid_.rebuild(bodies_.size(), [&](std::size_t i) { return bodies_[i].position_m; });
+  refresh_max_radius();
+}
+
+void World::refresh_max_radius() {
+  max_radius_m_ = 0.0;
+  min_radius_m_ = bodies_.empty() ? 0.0 : bodies_[0].radius_m;
+  for (const Body& b : bodies_) {
+    max_radius_m_ = std::max(max_radius_m_, b.radius_m);
+    min_radius_m_ = std::min(min_radius_m_, b.radius_m);
+  }
+}
+
+void World::set_wheel_speeds(int id, int left_units, int right_units) {
+  RobotState& r = robots_[slot(id)];
+  r.left_speed_units = clamp_speed_units(left_units);
+  r.right_speed_units = clamp_speed_units(right_units);
+}
+
+void World::set_observed_pose(int id, Pose2 pose, TimeUs t_us) {
+  const std::size_t s = slot(id);
+  RobotState& r = robots_[s];
+  if (r.kind != RobotKind::Real) throw std::invalid_argument(label(id) + ": set_observed_pose is for real robots");
+  if (!finite(pose.position_m) || !std::isfinite(pose.heading_rad))
+    throw std::invalid_argument(label(id) + ": observed pose is not finite");
+  r.pose = {pose.position_m, wrap_rad_pi(pose.heading_rad)};
+  r.pose_t_us = t_us;
+  bodies_[s].position_m = bodies_[s].previous_m = pose.position_m;
+  grid_.move(s, pose.position_m);
+}
+
+void World::set_odometer(int id, OdometryReading counters) {
+  RobotState& r = robots_[slot(id)];
+  r.left_wheel_travel_m = static_cast<double>(counters.left_pulses) * kKheperaPulse_m;
+  r.right_wheel_travel_m = static_cast<double>(counters.right_pulses) * kKheperaPulse_m;
+}
+
+int World::add_moving_obstacle(const MovingObstacleConfig& config) {
+  const std::string what = "moving obstacle " + std::to_string(movers_.size());
+  MovingObstacle mover(config, what);
+  const double tol = config_.collision.tolerance_m;
+  auto overlaps_segment = [&](Vec2 a, Vec2 b) {
+    const Contact c = mover.shape() == MovingShape::Disc
+                          ? disc_segment_contact(mover.position_m(), mover.bounding_radius_m(), a, b)
+                          : convex_polygon_segment_contact(mover.world_vertices_m(), a, b);
+    return c.separation_m < -tol;
+  };
+  statics_.for_each_in_box(box_around(mover.position_m(), mover.bounding_radius_m()), [&](const IndexedSegment& seg) {
+    if (overlaps_segment(seg.a_m, seg.b_m))
+      throw std::invalid_argument(what + ": placed overlapping " + to_string(seg.owner));
+  });
+  if (const int inside = map_.obstacle_containing(mover.position_m()); inside >= 0)
+    throw std::invalid_argument(what + ": placed inside obstacle " + std::to_string(inside));
+  if (map_.field().boundary_walls) {
+    const Vec2 p = mover.position_m();
+    if (p.x < 0.0 || p.y < 0.0 || p.x > map_.field().width_m || p.y > map_.field().height_m)
+      throw std::invalid_argument(what + ": placed outside the walled field");
+  }
+  for (std::size_t j = 0; j < bodies_.size(); ++j) {
+    const Body& b = bodies_[j];
+    const Contact c = mover.shape() == MovingShape::Disc
+                          ? disc_disc_contact(b.position_m, b.radius_m, mover.position_m(), mover.bounding_radius_m())
+                          : disc_convex_polygon_contact(b.position_m, b.radius_m, mover.world_vertices_m());
+    if (c.separation_m < -tol) throw std::invalid_argument(what + ": placed overlapping " + label(ids_[j]));
+  }
+  movers_.push_back(std::move(mover));
+  return static_cast<int>(movers_.size() - 1);
+}
+
+double World::substep_limit_m() const {
+  if (config_.max_substep_travel_m > 0.0) return config_.max_substep_travel_m;
+  return min_radius_m_ > 0.0 ? min_radius_m_ : kKheperaRadius_m;
+}
+
+std::span<const CollisionEvent> World::step(TimeUs dt_us, std::mt19937_64& rng) {
+  if (dt_us < 0) throw std::invalid_argument("world: step dt_us must be >= 0");
+  if (dt_us == 0) return {};
+  const double dt_s = us_to_seconds(dt_us);
+
+  // Wheel speeds for the whole step (commands are constant over a step), the counters,
+  // and the longest distance anything travels.
+  double max_travel_m = 0.0;
+  struct Speeds {
+    double left_mps, right_mps;
+  };
+  for (std::size_t i = 0; i < robots_.size(); ++i) {
+    RobotState& r = robots_[i];
+    if (r.kind != RobotKind::Virtual) continue;
+    const double left_cmd = speed_units_to_mps(r.left_speed_units);
+    const double right_cmd = speed_units_to_mps(r.right_speed_units);
+    double left_gain = 1.0 + r.noise.left_bias, right_gain = 1.0 + r.noise.right_bias;
+    if (r.noise.slip_sd > 0.0) {
+      const auto [a, b] = standard_normal_pair(rng);
+      left_gain += r.noise.slip_sd * a;
+      right_gain += r.noise.slip_sd * b;
+    }
+    const Speeds actual{left_cmd * left_gain, right_cmd * right_gain};
+    if (r.noise.odometer_counts_slip) {
+      r.left_wheel_travel_m += actual.left_mps * dt_s;
+      r.right_wheel_travel_m += actual.right_mps * dt_s;
+    } else {
+      r.left_wheel_travel_m += left_cmd * dt_s;
+      r.right_wheel_travel_m += right_cmd * dt_s;
+    }
+    max_travel_m = std::max(max_travel_m, std::abs(0.5 * (actual.left_mps + actual.right_mps)) * dt_s);
+    // Stash the speeds in the motion record; the substep arc needs the substep count.
+    motion_[i].local_step_m = {actual.left_mps, actual.right_mps};
+  }
+  for (const MovingObstacle& m : movers_) max_travel_m = std::max(max_travel_m, m.velocity_mps().norm() * dt_s);
+
+  constexpr double kMaxSubsteps = 100000.0;
+  const int substeps = static_cast<int>(std::clamp(std::ceil(max_travel_m / substep_limit_m()), 1.0, kMaxSubsteps));
+  const double h_s = dt_s / substeps;
+  for (std::size_t i = 0; i < robots_.size(); ++i) {
+    const RobotState& r = robots_[i];
+    if (r.kind != RobotKind::Virtual) continue;
+    Motion& m = motion_[i];
+    const ArcStep arc = diff_drive_arc(m.local_step_m.x, m.local_step_m.y, r.wheel_base_m, h_s);
+    m.local_step_m = arc.local_displacement_m;
+    m.cos_turn = arc.cos_heading_change;
+    m.sin_turn = arc.sin_heading_change;
+    m.heading = {std::cos(r.pose.heading_rad), std::sin(r.pose.heading_rad)};
+    m.end_heading_rad = r.pose.heading_rad + arc.heading_change_rad * substeps;
+  }
+
+  CollisionScene cs{bodies_, ids_, grid_, statics_, movers_, max_radius_m_};
+  resolver_.begin_step();
+  for (int k = 0; k < substeps; ++k) {
+    for (MovingObstacle& m : movers_) {
+      m.begin_substep();
+      m.translate(m.velocity_mps() * h_s);
+    }
+    for (std::size_t i = 0; i < bodies_.size(); ++i) {
+      Body& b = bodies_[i];
+      b.previous_m = b.position_m;
+      if (!b.pushable) continue;
+      Motion& m = motion_[i];
+      const Vec2 d = m.local_step_m;
+      b.position_m = b.position_m + Vec2{m.heading.x * d.x - m.heading.y * d.y, m.heading.y * d.x + m.heading.x * d.y};
+      m.heading = {m.heading.x * m.cos_turn - m.heading.y * m.sin_turn, m.heading.y * m.cos_turn + m.heading.x * m.sin_turn};
+    }
+    resolver_.resolve(cs, t_us_ + dt_us * (k + 1) / substeps);
+  }
+
+  t_us_ += dt_us;
+  for (std::size_t i = 0; i < robots_.size(); ++i) {
+    RobotState& r = robots_[i];
+    if (r.kind != RobotKind::Virtual) continue;
+    r.pose = {bodies_[i].position_m, wrap_rad_pi(motion_[i].end_heading_rad)};
+    r.pose_t_us = t_us_;
+  }
+  return resolver_.end_step();
+}
+
+SensorReadings World::sense(int id, TimeUs t_us, std::mt19937_64& rng) const {
+  const std::size_t s = slot(id);
+  const RobotState& r = robots_[s];
+  SensorReadings out;
+  std::optional<OdometryReading> odometry;
+  if (r.kind == RobotKind::Virtual) odometry = r.odometer();
+  suites_[s].sense(scene(), static_cast<int>(s), r.pose, odometry, t_us, rng, out);
+  return out;
+}
+
+void World::sense_all(TimeUs t_us, std::mt19937_64& rng, std::vector<SensorReadings>& out) const {
+  out.resize(robots_.size());
+  const Scene sc = scene();
+  for (std::size_t s = 0; s < robots_.size(); ++s) {
+    const RobotState& r = robots_[s];
+    std::optional<OdometryReading> odometry;
+    if (r.kind == RobotKind::Virtual) odometry = r.odometer();
+    suites_[s].sense(sc, static_cast<int>(s), r.pose, odometry, t_us, rng, out[s]);
+  }
+}
+
+WorldSnapshot World::snapshot() const {
+  WorldSnapshot snap;
+  snap.t_us = t_us_;
+  snap.robots.reserve(robots_.size());
+  for (const RobotState& r : robots_)
+    snap.robots.push_back({r.id, r.kind, r.pose, r.radius_m, r.left_speed_units, r.right_speed_units});
+  for (const MovingObstacle& m : movers_)
+    snap.moving_obstacles.push_back({m.shape(), m.position_m(), m.velocity_mps(), m.bounding_radius_m(), m.world_vertices_m()});
+  const auto events = resolver_.events();
+  snap.collisions.assign(events.begin(), events.end());
+  return snap;
+}
+
+double World::max_overlap_m() const {
+  double worst = 0.0;
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    const Body& b = bodies_[i];
+    if (!b.pushable) continue;
+    grid_.for_each_in_box(box_around(b.position_m, b.radius_m + max_radius_m_), [&](int jj) {
+      const auto j = static_cast<std::size_t>(jj);
+      if (j == i) return;
+      const double gap = std::sqrt(distance_sq(b.position_m, bodies_[j].position_m)) - b.radius_m - bodies_[j].radius_m;
+      worst = std::max(worst, -gap);
+    });
+    statics_.for_each_in_box(box_around(b.position_m, b.radius_m), [&](const IndexedSegment& seg) {
+      worst = std::max(worst, -disc_segment_contact(b.position_m, b.radius_m, seg.a_m, seg.b_m).separation_m);
+    });
+    if (map_.obstacle_containing(b.position_m) >= 0) worst = std::max(worst, b.radius_m);
+    for (const MovingObstacle& m : movers_) {
+      const Contact c = m.shape() == MovingShape::Disc
+                            ? disc_disc_contact(b.position_m, b.radius_m, m.position_m(), m.bounding_radius_m())
+                            : disc_convex_polygon_contact(b.position_m, b.radius_m, m.world_vertices_m());
+      worst = std::max(worst, -c.separation_m);
+    }
+  }
+  return worst;
+}
+
+}  // namespace rilbed::environment

@@ -1,0 +1,163 @@
+// The world model (paper 000 §6.1, world server and collision server together): the
+// static map, the robots (virtual ones driven by their wheel commands, real ones placed
+// from outside), moving obstacles, collisions, and every robot's virtual sensors.
+//
+// A step moves virtual robots along exact arcs and moving obstacles in straight lines,
+// in as many equal substeps as the fastest body needs to travel at most
+// max_substep_travel_m per substep, and resolves collisions after each substep
+// (CollisionResolver). Robots and static segments are hashed in uniform grids, so a
+// step costs about linearly in the number of robots at constant density.
+#pragma once
+
+#include <cstddef>
+#include <random>
+#include <span>
+#include <unordered_map>
+#include <vector>
+
+#include "core/time.hpp"
+#include "environment/collision_resolver.hpp"
+#include "environment/robot_state.hpp"
+#include "environment/scene.hpp"
+#include "environment/sensor_readings.hpp"
+#include "environment/static_map.hpp"
+#include "environment/world_snapshot.hpp"
+
+namespace rilbed::environment {
+
+/// Knobs of the world.
+struct WorldConfig {
+  /// Side of the grid cells that hash robots and static segments, metres; 0 picks 0.1 m
+  /// (a Khepera's diameter plus its IR range). Smaller cells mean fewer candidates per
+  /// query but more cells to visit; far from a Khepera's scale, set it to about the
+  /// largest robot diameter plus the longest proximity range.
+  double cell_size_m = 0.0;
+  /// Upper bound on the cell count; cells grow beyond cell_size_m on huge fields.
+  std::size_t max_grid_cells = std::size_t{1} << 22;
+  /// Largest distance a body may travel in one substep, metres; 0 means the smallest
+  /// robot radius, which keeps two robots from passing through each other. Smaller is
+  /// finer and slower (the number of substeps per step grows as 1 / this).
+  double max_substep_travel_m = 0.0;
+  /// Collision resolution (passes, contact margin for events, tolerance).
+  CollisionConfig collision;
+  /// The world's clock at construction.
+  TimeUs start_t_us = 0;
+};
+
+/// The world. Owns everything in it. Not thread-safe for changes: one thread adds,
+/// removes, sets and steps. The const members (sense, sense_all, snapshot, robot, ...)
+/// keep no scratch state, so several threads may call them at once between steps, each
+/// with its own random generator.
+class World {
+ public:
+  /// Builds the world around a validated static map. Throws std::invalid_argument for a
+  /// bad map (see StaticMap) or bad config values.
+  explicit World(StaticMapConfig map, WorldConfig config = {});
+
+  /// The static map (send it to displays once).
+  const StaticMap& map() const { return map_; }
+  /// The knobs the world was made with.
+  const WorldConfig& config() const { return config_; }
+  /// The world's clock, microseconds.
+  TimeUs time_us() const { return t_us_; }
+
+  /// Adds a robot. Throws std::invalid_argument naming it ("robot 3: ...") for a
+  /// duplicate id, non-finite pose, non-positive radius or wheel base, bad noise or
+  /// sensor settings, and, for a virtual robot, a placement overlapping a boundary wall,
+  /// a static obstacle, a moving obstacle or another robot. A real robot may be placed
+  /// anywhere (the camera saw it there); virtual robots make way for it.
+  void add_robot(const RobotConfig& config);
+  /// Removes a robot. Throws std::invalid_argument for an unknown id.
+  void remove_robot(int id);
+  /// Whether a robot with this id is in the world.
+  bool has_robot(int id) const { return slot_of_.contains(id); }
+  /// The robot with this id. Throws std::invalid_argument for an unknown id. The
+  /// reference stays valid until a robot is added or removed.
+  const RobotState& robot(int id) const;
+  /// All robots, in the order they were added (removal moves the last into the gap).
+  std::span<const RobotState> robots() const { return robots_; }
+
+  /// Sets a robot's wheel commands, pulses per 10 ms, clamped to [-127, 127] as the
+  /// Khepera firmware does. Used by the next step (virtual robots); kept for display for
+  /// real ones.
+  void set_wheel_speeds(int id, int left_units, int right_units);
+  /// Sets a real robot's pose as observed (by the camera) at t_us. Throws
+  /// std::invalid_argument for a virtual robot or a non-finite pose.
+  void set_observed_pose(int id, Pose2 pose, TimeUs t_us);
+  /// Sets a robot's wheel counters (the Khepera's `G` command).
+  void set_odometer(int id, OdometryReading counters);
+
+  /// Adds a moving obstacle and returns its index (used in collision events). Throws
+  /// std::invalid_argument for a bad configuration or a placement overlapping a wall, a
+  /// static obstacle or a robot.
+  int add_moving_obstacle(const MovingObstacleConfig& config);
+  /// The moving obstacles, by index.
+  std::span<const MovingObstacle> moving_obstacles() const { return movers_; }
+
+  /// Advances the world by dt_us >= 0: virtual robots drive (wheel noise drawn from
+  /// `rng`, in robot order), moving obstacles drift, collisions are resolved, the clock
+  /// advances. Returns the collision events that began during this step (valid until
+  /// the next step). dt_us == 0 does nothing. Same seed and same calls give the same
+  /// world, on any standard library.
+  std::span<const CollisionEvent> step(TimeUs dt_us, std::mt19937_64& rng);
+  /// The events returned by the last step.
+  std::span<const CollisionEvent> last_collisions() const { return resolver_.events(); }
+
+  /// Reads every virtual sensor robot `id` carries, stamped t_us (noise from `rng`).
+  /// Works for real robots too: their virtual sensors see virtual and real robots,
+  /// walls and obstacles. The odometer is filled for virtual robots only (a real robot's
+  /// counters come from its link). Throws std::invalid_argument for an unknown id.
+  SensorReadings sense(int id, TimeUs t_us, std::mt19937_64& rng) const;
+  /// Reads every robot's sensors into out[i] for robots()[i] (out is resized; its
+  /// elements' buffers are reused, so a caller that keeps `out` allocates nothing).
+  void sense_all(TimeUs t_us, std::mt19937_64& rng, std::vector<SensorReadings>& out) const;
+
+  /// A copy of the moving state, with the last step's events.
+  WorldSnapshot snapshot() const;
+
+  /// Largest overlap, metres, between a virtual robot and anything (another robot, a
+  /// wall or static obstacle, a moving obstacle); 0 when none. A check for tests and
+  /// benchmarks: O(robots).
+  double max_overlap_m() const;
+
+  /// The read-only view sensors use (valid until the world changes).
+  Scene scene() const;
+
+ private:
+  // Per-step motion of one virtual robot: its substep displacement in its own frame and
+  // the rotation per substep (exact arc, applied by rotating a unit heading vector, so
+  // that a substep costs no trigonometry).
+  struct Motion {
+    Vec2 local_step_m;
+    double cos_turn = 1.0, sin_turn = 0.0;
+    Vec2 heading;  // unit, current substep
+    double end_heading_rad = 0.0;
+  };
+
+  std::size_t slot(int id) const;
+  std::string label(int id) const { return "robot " + std::to_string(id); }
+  void check_placement_free(const std::string& what, Vec2 position_m, double radius_m, int exclude_slot) const;
+  void refresh_max_radius();
+  double substep_limit_m() const;
+
+  WorldConfig config_;
+  StaticMap map_;
+  GridGeometry grid_geometry_;
+  SegmentIndex statics_;
+  SegmentIndex tracks_;
+  SpatialGrid grid_;
+  // Robots, in parallel arrays by slot.
+  std::vector<RobotState> robots_;
+  std::vector<Body> bodies_;
+  std::vector<int> ids_;
+  std::vector<SensorSuite> suites_;
+  std::vector<Motion> motion_;
+  std::unordered_map<int, std::size_t> slot_of_;
+  double max_radius_m_ = 0.0;
+  double min_radius_m_ = 0.0;
+  std::vector<MovingObstacle> movers_;
+  CollisionResolver resolver_;
+  TimeUs t_us_ = 0;
+};
+
+}  // namespace rilbed::environment

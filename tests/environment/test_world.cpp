@@ -1,0 +1,297 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "environment/random.hpp"
+#include "environment/world.hpp"
+#include "world_fixtures.hpp"
+
+using namespace rilbed;
+using namespace rilbed::environment;
+using namespace rilbed::environment::testing;
+
+namespace {
+constexpr double kR = kKheperaRadius_m;
+constexpr TimeUs kTick = 100'000;
+
+// Expects `f` to throw std::invalid_argument whose message contains `needle`.
+template <class F>
+void expect_invalid(F&& f, const std::string& needle) {
+  try {
+    f();
+    ADD_FAILURE() << "no exception; expected one mentioning '" << needle << "'";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+// The lab's field with a non-convex obstacle, a box and a moving disc.
+StaticMapConfig cluttered_field() {
+  StaticMapConfig map = empty_field(1.5, 1.2);
+  map.obstacles.push_back({{{0.3, 0.3}, {0.5, 0.3}, {0.5, 0.35}, {0.35, 0.35}, {0.35, 0.5}, {0.3, 0.5}}, "ell"});
+  map.obstacles.push_back(rectangle(1.0, 0.7, 1.1, 0.9));
+  return map;
+}
+
+// Places up to `count` virtual robots on free lattice points of the world.
+void populate(World& world, int count, std::mt19937_64& rng, double spacing = 0.075) {
+  const FieldConfig& f = world.map().field();
+  int id = 0;
+  for (double y = 0.04; y < f.height_m - 0.04 && id < count; y += spacing) {
+    for (double x = 0.04; x < f.width_m - 0.04 && id < count; x += spacing) {
+      RobotConfig c;
+      c.id = id;
+      c.pose = {{x, y}, 2 * kPi * uniform01(rng)};
+      c.noise.slip_sd = 0.05;
+      try {
+        world.add_robot(c);
+        ++id;
+      } catch (const std::invalid_argument&) {
+        // on an obstacle: skip this lattice point
+      }
+    }
+  }
+}
+
+// Largest overlap among all robots and with walls and obstacles, by brute force.
+double brute_force_overlap(const World& world) {
+  double worst = 0.0;
+  const auto robots = world.robots();
+  const FieldConfig& f = world.map().field();
+  for (std::size_t a = 0; a < robots.size(); ++a) {
+    const Vec2 p = robots[a].pose.position_m;
+    const double r = robots[a].radius_m;
+    worst = std::max({worst, r - p.x, r - p.y, p.x + r - f.width_m, p.y + r - f.height_m});
+    for (const ObstacleConfig& o : world.map().obstacles()) {
+      worst = std::max(worst, r - distance_to_polygon(p, o.vertices_m));
+      if (point_in_polygon(p, o.vertices_m)) worst = std::max(worst, r);
+    }
+    for (std::size_t b = a + 1; b < robots.size(); ++b)
+      worst = std::max(worst, r + robots[b].radius_m - (robots[b].pose.position_m - p).norm());
+    for (const MovingObstacle& m : world.moving_obstacles())
+      worst = std::max(worst, r + m.bounding_radius_m() - (m.position_m() - p).norm());
+  }
+  return worst;
+}
+}  // namespace
+
+TEST(WorldValidation, BadMapsAreRejectedNamingTheItem) {
+  expect_invalid([] { World w(empty_field(-1, 1)); }, "field: width_m");
+  expect_invalid([] { World w(empty_field(1, NAN)); }, "field: height_m");
+  StaticMapConfig map = empty_field(1, 1);
+  map.obstacles.push_back(rectangle(0.1, 0.1, 0.2, 0.2));
+  map.obstacles.push_back({{{0.5, 0.5}, {0.6, NAN}, {0.6, 0.6}}, "pillar"});
+  expect_invalid([&] { World w(map); }, "obstacle 1 (pillar): vertex 1 is not finite");
+  map.obstacles[1] = {{{0, 0}, {2, 2}, {2, 0}, {0, 1}}, "bow"};
+  expect_invalid([&] { World w(map); }, "obstacle 1 (bow): has crossing edges");
+  map.obstacles[1] = {{{0, 0}, {1, 1}}, ""};
+  expect_invalid([&] { World w(map); }, "obstacle 1: needs at least three");
+  map.obstacles.pop_back();
+  map.tracks.push_back({{{0, 0}, {1, 1}}, -0.01, false, ""});
+  expect_invalid([&] { World w(map); }, "track 0: width_m");
+  map.tracks.clear();
+  map.beacons.push_back({3, {0.5, 0.5}, 0.0, 0.0, 1.0});
+  expect_invalid([&] { World w(map); }, "beacon 0 (id 3): aperture_rad");
+  map.beacons[0].aperture_rad = 1.0;
+  map.beacons.push_back({3, {0.2, 0.5}, 0.0, 1.0, 1.0});
+  expect_invalid([&] { World w(map); }, "beacon 1 (id 3): another beacon has the same id");
+  // A repeated closing vertex is fine.
+  StaticMapConfig closed = empty_field(1, 1);
+  closed.obstacles.push_back({{{0.1, 0.1}, {0.2, 0.1}, {0.2, 0.2}, {0.1, 0.1}}, ""});
+  const World ok(closed);
+  EXPECT_EQ(ok.map().obstacles()[0].vertices_m.size(), 3u);
+  WorldConfig bad;
+  bad.collision.max_passes = 0;
+  expect_invalid([&] { World w(empty_field(1, 1), bad); }, "max_passes");
+}
+
+TEST(WorldValidation, BadRobotsAreRejectedNamingTheRobot) {
+  StaticMapConfig map = empty_field(1, 1);
+  map.obstacles.push_back(rectangle(0.6, 0.6, 0.8, 0.8));
+  World world(map);
+  expect_invalid([&] { world.add_robot(quiet_robot(3, 0.01, 0.5, 0.0)); }, "robot 3: placed overlapping the left wall");
+  expect_invalid([&] { world.add_robot(quiet_robot(3, 0.5, 0.99, 0.0)); }, "robot 3: placed overlapping the top wall");
+  expect_invalid([&] { world.add_robot(quiet_robot(3, 0.7, 0.7, 0.0)); }, "robot 3: placed inside obstacle 0");
+  expect_invalid([&] { world.add_robot(quiet_robot(3, 0.58, 0.7, 0.0)); }, "robot 3: placed overlapping obstacle 0");
+  expect_invalid([&] { world.add_robot(quiet_robot(3, NAN, 0.5, 0.0)); }, "robot 3: pose is not finite");
+  RobotConfig c = quiet_robot(3, 0.3, 0.3, 0.0);
+  c.radius_m = 0.0;
+  expect_invalid([&] { world.add_robot(c); }, "robot 3: radius_m");
+  c = quiet_robot(3, 0.3, 0.3, 0.0);
+  c.noise.slip_sd = -1;
+  expect_invalid([&] { world.add_robot(c); }, "robot 3: noise.slip_sd");
+  c = quiet_robot(3, 0.3, 0.3, 0.0);
+  c.sensors.proximity->half_angle_rad = 2.0;
+  expect_invalid([&] { world.add_robot(c); }, "robot 3: proximity: half_angle_rad");
+  world.add_robot(quiet_robot(3, 0.3, 0.3, 0.0));
+  expect_invalid([&] { world.add_robot(quiet_robot(3, 0.1, 0.1, 0.0)); }, "robot 3: another robot has this id");
+  expect_invalid([&] { world.add_robot(quiet_robot(4, 0.33, 0.3, 0.0)); }, "robot 4: placed overlapping robot 3");
+  expect_invalid([&] { world.robot(99); }, "no robot with id 99");
+  expect_invalid([&] { world.set_observed_pose(3, {{0.5, 0.5}, 0.0}, 0); }, "robot 3: set_observed_pose is for real robots");
+  std::mt19937_64 rng(1);
+  expect_invalid([&] { world.step(-1, rng); }, "dt_us");
+  // A real robot may be seen anywhere, even overlapping a virtual one.
+  RobotConfig real = quiet_robot(5, 0.32, 0.3, 0.0);
+  real.kind = RobotKind::Real;
+  world.add_robot(real);
+  expect_invalid([&] { world.set_observed_pose(5, {{INFINITY, 0.5}, 0.0}, 0); }, "robot 5: observed pose is not finite");
+  EXPECT_EQ(world.robots().size(), 2u);
+}
+
+TEST(WorldValidation, BadMovingObstaclesAreRejected) {
+  World world(empty_field(1, 1));
+  MovingObstacleConfig m;
+  m.radius_m = -1;
+  expect_invalid([&] { world.add_moving_obstacle(m); }, "moving obstacle 0: radius_m");
+  m.radius_m = 0.1;
+  m.position_m = {0.05, 0.5};
+  expect_invalid([&] { world.add_moving_obstacle(m); }, "moving obstacle 0: placed overlapping wall 3 (left)");
+  MovingObstacleConfig ell;
+  ell.shape = MovingShape::Polygon;
+  ell.position_m = {0.5, 0.5};
+  ell.vertices_m = {{-0.1, -0.1}, {0.1, -0.1}, {0.1, 0.0}, {0.0, 0.0}, {0.0, 0.1}, {-0.1, 0.1}};
+  expect_invalid([&] { world.add_moving_obstacle(ell); }, "must be convex");
+  EXPECT_TRUE(world.moving_obstacles().empty());
+}
+
+TEST(World, AddRemoveAndLookUpRobots) {
+  World world(empty_field(1, 1));
+  world.add_robot(quiet_robot(10, 0.2, 0.2, 0.0));
+  world.add_robot(quiet_robot(20, 0.4, 0.2, 7.0));  // heading wrapped
+  world.add_robot(quiet_robot(30, 0.6, 0.2, 0.0));
+  EXPECT_NEAR(world.robot(20).pose.heading_rad, 7.0 - 2 * kPi, 1e-12);
+  world.remove_robot(10);
+  EXPECT_FALSE(world.has_robot(10));
+  ASSERT_EQ(world.robots().size(), 2u);
+  EXPECT_EQ(world.robot(30).pose.position_m, (Vec2{0.6, 0.2}));
+  EXPECT_EQ(world.robot(20).pose.position_m, (Vec2{0.4, 0.2}));
+  // The freed place can be taken again, and the grid still sees the moved robot.
+  world.add_robot(quiet_robot(10, 0.2, 0.2, 0.0));
+  expect_invalid([&] { world.add_robot(quiet_robot(11, 0.62, 0.21, 0.0)); }, "overlapping robot 30");
+  expect_invalid([&] { world.remove_robot(99); }, "no robot with id 99");
+}
+
+TEST(World, SnapshotCopiesTheMovingState) {
+  World world(empty_field(1, 1));
+  world.add_robot(quiet_robot(1, 0.95, 0.5, 0.0));
+  world.set_wheel_speeds(1, 40, 40);  // 32 mm per tick: reaches the wall
+  MovingObstacleConfig m;
+  m.radius_m = 0.05;
+  m.position_m = {0.2, 0.2};
+  m.velocity_mps = {0.1, 0.0};
+  world.add_moving_obstacle(m);
+  std::mt19937_64 rng(1);
+  world.step(kTick, rng);
+  const WorldSnapshot s = world.snapshot();
+  EXPECT_EQ(s.t_us, kTick);
+  ASSERT_EQ(s.robots.size(), 1u);
+  EXPECT_EQ(s.robots[0].id, 1);
+  EXPECT_EQ(s.robots[0].left_speed_units, 40);
+  EXPECT_NEAR(s.robots[0].pose.position_m.x, 1.0 - kR, 1e-12);
+  ASSERT_EQ(s.moving_obstacles.size(), 1u);
+  EXPECT_NEAR(s.moving_obstacles[0].position_m.x, 0.21, 1e-12);
+  ASSERT_EQ(s.collisions.size(), 1u);
+  EXPECT_EQ(to_string(s.collisions[0].second), "wall 1 (right)");
+}
+
+TEST(World, SameSeedSameWorldDifferentSeedDifferentWorld) {
+  auto run_world = [](std::uint64_t seed) {
+    World world(cluttered_field());
+    std::mt19937_64 rng(seed);
+    populate(world, 60, rng);
+    std::vector<SensorReadings> readings;
+    std::vector<int> proximity_sums;
+    for (int step = 0; step < 100; ++step) {
+      if (step % 10 == 0)
+        for (const RobotState& r : world.robots())
+          world.set_wheel_speeds(r.id, static_cast<int>(uniform01(rng) * 120) - 40, static_cast<int>(uniform01(rng) * 120) - 40);
+      world.step(kTick, rng);
+      world.sense_all(world.time_us(), rng, readings);
+      int sum = 0;
+      for (const SensorReadings& s : readings) for (const int v : *s.proximity) sum += v;
+      proximity_sums.push_back(sum);
+    }
+    std::vector<Pose2> poses;
+    for (const RobotState& r : world.robots()) poses.push_back(r.pose);
+    return std::pair{poses, proximity_sums};
+  };
+  const auto a = run_world(42), b = run_world(42), c = run_world(43);
+  ASSERT_EQ(a.first.size(), b.first.size());
+  for (std::size_t i = 0; i < a.first.size(); ++i) {
+    EXPECT_EQ(a.first[i].position_m, b.first[i].position_m);
+    EXPECT_EQ(a.first[i].heading_rad, b.first[i].heading_rad);
+  }
+  EXPECT_EQ(a.second, b.second);
+  EXPECT_NE(a.second, c.second);
+  bool any_different = false;
+  for (std::size_t i = 0; i < std::min(a.first.size(), c.first.size()); ++i)
+    any_different = any_different || !(a.first[i].position_m == c.first[i].position_m);
+  EXPECT_TRUE(any_different);
+}
+
+TEST(World, SenseAllMatchesSenseOneByOne) {
+  World world(cluttered_field());
+  std::mt19937_64 rng(5);
+  populate(world, 40, rng, 0.06);
+  std::vector<SensorReadings> all;
+  std::mt19937_64 rng_all(9), rng_one(9);
+  world.sense_all(123, rng_all, all);
+  ASSERT_EQ(all.size(), world.robots().size());
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const SensorReadings one = world.sense(world.robots()[i].id, 123, rng_one);
+    EXPECT_EQ(one.t_us, 123);
+    EXPECT_EQ(*one.proximity, *all[i].proximity);
+    EXPECT_EQ(one.odometry->left_pulses, all[i].odometry->left_pulses);
+  }
+}
+
+TEST(World, RealRobotsGetVirtualSensorsButNoVirtualOdometry) {
+  World world(empty_field(1, 1));
+  RobotConfig real = quiet_robot(1, 0.5, 0.5, 0.0);
+  real.kind = RobotKind::Real;
+  world.add_robot(real);
+  world.set_observed_pose(1, {{1.0 - kR - 0.01, 0.5}, 0.0}, 5);
+  EXPECT_EQ(world.robot(1).pose_t_us, 5);
+  std::mt19937_64 rng(1);
+  const SensorReadings s = world.sense(1, 5, rng);
+  EXPECT_GT((*s.proximity)[2], 400);  // the virtual wall, 10 mm ahead
+  EXPECT_FALSE(s.odometry.has_value());
+  // Stepping leaves a real robot where it was seen, whatever its wheel commands.
+  world.set_wheel_speeds(1, 100, 100);
+  world.step(kTick, rng);
+  EXPECT_EQ(world.robot(1).pose.position_m, (Vec2{1.0 - kR - 0.01, 0.5}));
+}
+
+TEST(World, LongRandomRunOf200RobotsNeverOverlaps) {
+  World world(cluttered_field());
+  MovingObstacleConfig disc;
+  disc.radius_m = 0.06;
+  disc.position_m = {0.75, 1.1};
+  disc.velocity_mps = {0.23, -0.17};
+  std::mt19937_64 rng(2024);
+  world.add_moving_obstacle(disc);
+  populate(world, 200, rng);
+  ASSERT_EQ(world.robots().size(), 200u);
+  std::vector<SensorReadings> readings;
+  double worst = 0.0;
+  int collisions = 0;
+  for (int step = 0; step < 600; ++step) {
+    if (step % 5 == 0) {
+      for (const RobotState& r : world.robots()) {
+        // Mostly forward and fast, so that they crowd and shove.
+        const int base = static_cast<int>(uniform01(rng) * 160) - 30;
+        world.set_wheel_speeds(r.id, base + static_cast<int>(uniform01(rng) * 40) - 20,
+                               base + static_cast<int>(uniform01(rng) * 40) - 20);
+      }
+    }
+    collisions += static_cast<int>(world.step(kTick, rng).size());
+    world.sense_all(world.time_us(), rng, readings);
+    const double overlap = brute_force_overlap(world);
+    worst = std::max(worst, overlap);
+    ASSERT_LE(overlap, 1e-6) << "at step " << step;
+    ASSERT_NEAR(world.max_overlap_m(), std::max(0.0, overlap), 1e-12) << "the grid-based check disagrees";
+  }
+  EXPECT_GT(collisions, 200) << "the run should be crowded enough to collide a lot";
+  RecordProperty("worst_overlap_m", std::to_string(worst));
+}
