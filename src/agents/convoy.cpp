@@ -14,12 +14,10 @@ ConvoyAgent::ConvoyAgent(int rank, ConvoyConfig config) : rank_(rank), config_(c
 
 BehaviourInputs ConvoyAgent::inputs(const ConvoyPerception& p) const {
   BehaviourInputs in{};
-  if (p.proximity) {
-    in[static_cast<std::size_t>(Behaviour::kAvoid)] = obstacle_level(*p.proximity, config_.avoid_low, config_.avoid_high);
-  }
   if (rank_ == 1 || !p.leader || !p.self) {
     // The head waits for the team to gather behind it; an agent that cannot place
-    // itself or its leader has nothing better to do than stand still.
+    // itself or its leader has nothing better to do than stand still. Standing still,
+    // neither needs to avoid: the robots gathering around it keep their own distance.
     in[static_cast<std::size_t>(Behaviour::kWait)] = 1.0;
     return in;
   }
@@ -28,6 +26,13 @@ BehaviourInputs ConvoyAgent::inputs(const ConvoyPerception& p) const {
   const double far = std::clamp((distance - config_.engage_m) / config_.engage_ramp_m + 0.5, 0.0, 1.0);
   in[static_cast<std::size_t>(Behaviour::kSearch)] = far;
   in[static_cast<std::size_t>(Behaviour::kFollow)] = 1.0 - far;
+  // Avoidance matters only while driving on: a follower holding its standoff in a tight
+  // convoy sees its neighbours all the time, and turning away from them would only break
+  // the convoy up.
+  const bool driving_on = distance > config_.standoff_m + config_.hold_tolerance_m;
+  if (p.proximity && driving_on) {
+    in[static_cast<std::size_t>(Behaviour::kAvoid)] = obstacle_level(*p.proximity, config_.avoid_low, config_.avoid_high);
+  }
   return in;
 }
 

@@ -34,6 +34,8 @@ struct ConvoyConfig {
   double engage_m = 0.22;
   /// Width of the ramp between search and follow around engage_m, metres.
   double engage_ramp_m = 0.04;
+  /// A follower within this of its standoff holds its place and does not avoid, metres.
+  double hold_tolerance_m = 0.015;
   /// Proximity level (fraction of full scale) at which avoidance starts, and at which it
   /// is fully called for.
   double avoid_low = 0.35;

@@ -17,6 +17,10 @@ void add_calibrate_command(CLI::App& app);
 void add_synth_command(CLI::App& app);
 /// `rilbed score`: compares detections with ground truth.
 void add_score_command(CLI::App& app);
+/// `rilbed run`: runs a scenario once or over a batch of seeds.
+void add_run_command(CLI::App& app);
+/// `rilbed sim-bench`: times the simulation with many virtual robots.
+void add_sim_bench_command(CLI::App& app);
 
 /// Exit code a subcommand's callback stores for main() to return.
 int& exit_code();

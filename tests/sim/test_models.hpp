@@ -17,7 +17,10 @@ using EventLog = std::vector<std::string>;
 
 inline std::string join(const std::vector<int>& values) {
   std::string text = "[";
-  for (std::size_t i = 0; i < values.size(); ++i) text += (i ? "," : "") + std::to_string(values[i]);
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (i) text += ',';
+    text += std::to_string(values[i]);
+  }
   return text + "]";
 }
 

@@ -1,0 +1,112 @@
+// The DEVS models of a run (src/sim): an agent per robot that runs its controller every
+// control period against its body; a team broadcaster that tells every agent where the
+// others are (distributed mode); and the central convoy coordinator that commands every
+// agent (central mode). The world model and the run's monitor live in simulation.hpp.
+//
+// Same-instant order: the coordinator runs imminent models in the order they were added
+// (its flat order), so a run adds the world first: it has moved to time t before any
+// agent senses at t.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "agents/body.hpp"
+#include "agents/controller.hpp"
+#include "agents/convoy.hpp"
+#include "sim/atomic.hpp"
+#include "sim/time.hpp"
+
+namespace rilbed::agents {
+
+/// A wheel command for one agent, from a central coordinator.
+struct AgentCommand {
+  int id = 0;
+  ControlOutput output;
+};
+
+/// State of an agent model.
+struct AgentState {
+  TimeUs t_us = 0;                 ///< simulated time of the last transition
+  TimeUs sigma_us = 0;             ///< time left to the next control step
+  std::vector<TeamMessage> team;   ///< the latest broadcast, as received
+  ControlOutput last;              ///< the last command applied to the body
+};
+
+/// One robot's agent: every control period it senses through its body, runs its
+/// controller and drives its body. Without a controller it is commanded: it applies the
+/// commands that arrive on its `command` port (central mode).
+/// Inputs: "team" (std::vector<TeamMessage>), "command" (AgentCommand).
+class AgentModel final : public sim::AtomicModel<AgentState> {
+ public:
+  /// `body` must outlive the model. `controller` may be null (commanded agent).
+  /// The first control step is at `first_step_us`, then every `period_us` (> 0).
+  AgentModel(Body& body, std::unique_ptr<Controller> controller, TimeUs period_us, TimeUs first_step_us = 0);
+
+  TimeUs time_advance() const override;
+  void internal_transition() override;
+  void external_transition(TimeUs elapsed_us) override;
+  void output() override {}
+
+  Body& body() const { return body_; }
+  /// The active behaviour (a static string), "idle" before the first step.
+  std::string_view behaviour() const { return state_.last.behaviour; }
+  const WheelCommand& wheels() const { return state_.last.wheels; }
+  /// Tells the controller the run ended (Controller::finish) and stops the body.
+  void finish();
+
+ private:
+  Body& body_;
+  std::unique_ptr<Controller> controller_;
+  TimeUs period_us_;
+  sim::Port<std::vector<TeamMessage>>& team_in_;
+  sim::Port<AgentCommand>& command_in_;
+};
+
+/// Broadcasts every agent's pose and behaviour to the team every period.
+/// Output: "team" (std::vector<TeamMessage>), one message per broadcast.
+class TeamBroadcaster final : public sim::AtomicModel<TimeUs> {  // state: time to the next broadcast
+ public:
+  /// `agents` must outlive the model. First broadcast at `first_us`.
+  TeamBroadcaster(std::vector<const AgentModel*> agents, TimeUs period_us, TimeUs first_us = 0);
+  TimeUs time_advance() const override { return state_; }
+  void internal_transition() override { state_ = period_us_; }
+  void external_transition(TimeUs elapsed_us) override { state_ -= elapsed_us; }
+  void output() override;
+
+ private:
+  std::vector<const AgentModel*> agents_;
+  TimeUs period_us_;
+  TimeUs t_us_ = 0;  // simulated time, advanced with each broadcast
+  sim::Port<std::vector<TeamMessage>>& team_out_;
+};
+
+/// State of the central coordinator: when it next decides, and the commands it is about
+/// to send (decided at time t, sent at the same t).
+struct CentralState {
+  TimeUs t_us = 0;
+  TimeUs sigma_us = 0;
+  std::vector<AgentCommand> pending;
+};
+
+/// Central mode (paper 001 §5): one coordinator that knows every agent's pose and sensors
+/// and sends each its command. Output: "commands" (AgentCommand, one per agent).
+class CentralConvoyModel final : public sim::AtomicModel<CentralState> {
+ public:
+  /// `bodies` must outlive the model. Decides every `period_us` from `first_us`.
+  CentralConvoyModel(std::vector<Body*> bodies, ConvoyConfig config, TimeUs period_us, TimeUs first_us = 0);
+  TimeUs time_advance() const override { return state_.sigma_us; }
+  void internal_transition() override;
+  void external_transition(TimeUs elapsed_us) override;
+  void output() override;
+
+ private:
+  std::vector<Body*> bodies_;
+  CentralConvoy convoy_;
+  TimeUs period_us_;
+  sim::Port<AgentCommand>& commands_out_;
+};
+
+}  // namespace rilbed::agents

@@ -1,0 +1,377 @@
+#include "agents/simulation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "agents/basic_controllers.hpp"
+#include "agents/c_controller.hpp"
+#include "agents/convoy.hpp"
+#include "agents/run_models.hpp"
+#include "sim/clock.hpp"
+#include "sim/coordinator.hpp"
+#include "sim/coupled.hpp"
+
+namespace rilbed::agents {
+
+namespace {
+
+// A virtual robot's body: the world's robot, its virtual sensors and its wheels.
+class VirtualBody final : public Body {
+ public:
+  VirtualBody(environment::World& world, int id, std::mt19937_64& rng) : world_(world), id_(id), rng_(rng) {}
+  int id() const override { return id_; }
+  environment::SensorReadings sense(TimeUs t_us) override { return world_.sense(id_, t_us, rng_); }
+  std::optional<Pose2> pose() const override { return world_.robot(id_).pose; }
+  void drive(const WheelCommand& w) override {
+    world_.set_wheel_speeds(id_, std::clamp(w.left, -kMaxWheelUnits, kMaxWheelUnits),
+                            std::clamp(w.right, -kMaxWheelUnits, kMaxWheelUnits));
+  }
+
+ private:
+  environment::World& world_;
+  int id_;
+  std::mt19937_64& rng_;
+};
+
+// The world as a DEVS model: one integration step every physics step. Collisions are
+// kept for the monitor, which drains them.
+class WorldModel final : public sim::AtomicModel<TimeUs> {  // state: time to the next step
+ public:
+  WorldModel(environment::World& world, TimeUs step_us, std::mt19937_64& rng)
+      : sim::AtomicModel<TimeUs>("world", step_us), world_(world), step_us_(step_us), rng_(rng) {}
+  TimeUs time_advance() const override { return state_; }
+  void internal_transition() override {
+    for (const auto& e : world_.step(step_us_, rng_)) collisions_.push_back(e);
+    state_ = step_us_;
+  }
+  void external_transition(TimeUs elapsed_us) override { state_ -= elapsed_us; }
+  void output() override {}
+  std::vector<environment::CollisionEvent> drain() { return std::exchange(collisions_, {}); }
+
+ private:
+  environment::World& world_;
+  TimeUs step_us_;
+  std::mt19937_64& rng_;
+  std::vector<environment::CollisionEvent> collisions_;
+};
+
+int party_code(const environment::BodyRef& b) {
+  switch (b.kind) {
+    case environment::BodyKind::Robot: return b.id;
+    case environment::BodyKind::Wall: return -1;
+    case environment::BodyKind::Obstacle: return -2;
+    case environment::BodyKind::MovingObstacle: return -3;
+  }
+  return 0;
+}
+
+// Watches the run after each control step: records, counts collisions, checks the
+// convoy's formation, prints the status, and ends the run when it should.
+class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to the next sample
+ public:
+  struct Setup {
+    environment::World* world = nullptr;
+    WorldModel* world_model = nullptr;
+    std::vector<AgentModel*> agents;         // by ID order
+    std::vector<int> convoy_ids;             // 1..N, empty when there is no convoy
+    RunRecorder* recorder = nullptr;
+    const RunOptions* options = nullptr;
+    sim::Coordinator** coordinator = nullptr;  // set once built
+    RunResult* result = nullptr;
+    TimeUs period_us = 100'000;
+  };
+  explicit MonitorModel(Setup setup)
+      : sim::AtomicModel<TimeUs>("monitor", 1), s_(std::move(setup)),
+        formation_(std::max<int>(1, static_cast<int>(s_.convoy_ids.size()))) {
+    last_behaviour_.assign(s_.agents.size(), {});
+  }
+  TimeUs time_advance() const override { return state_; }
+  void external_transition(TimeUs elapsed_us) override { state_ -= elapsed_us; }
+  void output() override {}
+  void internal_transition() override {
+    t_us_ += state_;
+    state_ = s_.period_us;
+    const TimeUs t = t_us_ - 1;  // the control step just taken
+    sample(t);
+    if (s_.options->interrupt && s_.options->interrupt->load()) end("interrupt");
+  }
+  bool formed() const { return formation_.formed(); }
+  std::optional<TimeUs> formation_time_us() const { return formation_.formation_time_us(); }
+
+ private:
+  void end(const char* why) {
+    if (s_.result->ended_by.empty()) s_.result->ended_by = why;
+    (*s_.coordinator)->stop();
+  }
+
+  void sample(TimeUs t) {
+    RunResult& r = *s_.result;
+    for (const auto& e : s_.world_model->drain()) {
+      ++r.collisions;
+      if (e.second.kind == environment::BodyKind::Robot) ++r.robot_collisions;
+      if (s_.recorder) {
+        s_.recorder->add_event({e.t_us, "collision", party_code(e.first), party_code(e.second),
+                                to_string(e.first) + " touched " + to_string(e.second)});
+      }
+    }
+    r.max_overlap_m = std::max(r.max_overlap_m, s_.world->max_overlap_m());
+    samples_.clear();
+    for (std::size_t i = 0; i < s_.agents.size(); ++i) {
+      const AgentModel& a = *s_.agents[i];
+      const auto pose = a.body().pose();
+      const std::string_view behaviour = a.behaviour();
+      if (pose) samples_.push_back({t, a.body().id(), *pose, behaviour});
+      if (behaviour != last_behaviour_[i]) {
+        if (s_.recorder && !last_behaviour_[i].empty()) {
+          s_.recorder->add_event({t, "behaviour", a.body().id(), 0,
+                                  std::string(last_behaviour_[i]) + " -> " + std::string(behaviour)});
+        }
+        last_behaviour_[i] = behaviour;
+      }
+    }
+    if (s_.recorder) s_.recorder->add_samples(samples_);
+    if (s_.options->keep_in_memory) r.trajectory.insert(r.trajectory.end(), samples_.begin(), samples_.end());
+    if (!s_.convoy_ids.empty()) check_formation(t);
+    if (s_.options->on_status && t >= next_status_us_) {
+      next_status_us_ = t + 1'000'000;
+      std::ostringstream line;
+      line << "t=" << std::fixed;
+      line.precision(1);
+      line << us_to_seconds(t) << "s";
+      for (const AgentModel* a : s_.agents) line << "  " << a->body().id() << ":" << a->behaviour();
+      if (formation_.formed()) line << "  [formed]";
+      s_.options->on_status(line.str());
+    }
+  }
+
+  void check_formation(TimeUs t) {
+    std::vector<FormationMonitor::Sample> team;
+    for (const TrajectorySample& s : samples_) {
+      if (s.id >= 1 && s.id <= static_cast<int>(s_.convoy_ids.size())) team.push_back({s.id, s.pose, s.behaviour});
+    }
+    const bool was_holding = formation_.holding();
+    if (formation_.update(t, team) && s_.recorder) {
+      s_.recorder->add_event({t, "formed", 0, 0,
+                              "convoy formed; the hold began at " + std::to_string(us_to_seconds(*formation_.formation_time_us())) + " s"});
+    }
+    if (was_holding && !formation_.holding() && formation_.formed() && s_.recorder) {
+      s_.recorder->add_event({t, "broken", 0, 0, "the formed convoy broke"});
+    }
+    if (s_.options->stop_when_formed && formation_.formed() &&
+        t >= *formation_.formed_at_us() + seconds_to_us(s_.options->after_formed_s)) {
+      end("formed");
+    }
+  }
+
+  Setup s_;
+  FormationMonitor formation_;
+  TimeUs t_us_ = 0;
+  TimeUs next_status_us_ = 0;
+  std::vector<TrajectorySample> samples_;
+  std::vector<std::string_view> last_behaviour_;
+};
+
+double param(const RobotSpec& spec, const std::string& key, double fallback, std::set<std::string>& used) {
+  used.insert(key);
+  const auto it = spec.controller.params.find(key);
+  return it == spec.controller.params.end() ? fallback : it->second;
+}
+
+}  // namespace
+
+nlohmann::json RunResult::summary() const {
+  nlohmann::json j;
+  j["seed"] = seed;
+  j["formed"] = formed;
+  j["formation_time_s"] = formation_time_s ? nlohmann::json(*formation_time_s) : nlohmann::json(nullptr);
+  j["collisions"] = collisions;
+  j["robot_collisions"] = robot_collisions;
+  j["max_overlap_m"] = max_overlap_m;
+  j["simulated_s"] = simulated_s;
+  j["wall_s"] = wall_s;
+  j["run_wall_s"] = run_wall_s;
+  j["ended_by"] = ended_by;
+  return j;
+}
+
+std::unique_ptr<Controller> make_controller(const Scenario& scenario, const RobotSpec& spec) {
+  const std::string& name = spec.controller.name;
+  const std::string where = scenario.source.string() + ":" + std::to_string(spec.line) + ": robot " + std::to_string(spec.id);
+  std::set<std::string> used;
+  std::unique_ptr<Controller> controller;
+  if (name == "convoy") {
+    if (scenario.mode == ConvoyMode::kDistributed) controller = std::make_unique<ConvoyController>(spec.id, scenario.convoy);
+  } else if (name == "wander") {
+    WanderConfig c;
+    c.speed_mps = param(spec, "speed_mps", c.speed_mps, used);
+    controller = std::make_unique<WanderController>(c);
+  } else if (name == "track_follow") {
+    TrackFollowConfig c;
+    c.speed_mps = param(spec, "speed_mps", c.speed_mps, used);
+    if (!spec.sensors.track_sensors.empty()) c.max_value = spec.sensors.track_sensors.front().max_value;
+    c.max_value = static_cast<int>(param(spec, "max_value", c.max_value, used));
+    if (spec.sensors.track_sensors.empty()) throw ScenarioError(where + ": track_follow needs `sensors: track:` elements");
+    controller = std::make_unique<TrackFollowController>(c);
+  } else if (name == "beacon_homing") {
+    BeaconHomingConfig c;
+    if (spec.controller.params.contains("beacon_id")) c.beacon_id = static_cast<int>(param(spec, "beacon_id", 0, used));
+    c.speed_mps = param(spec, "speed_mps", c.speed_mps, used);
+    if (!spec.sensors.beacon_finder) throw ScenarioError(where + ": beacon_homing needs `sensors: beacon_finder:`");
+    controller = std::make_unique<BeaconHomingController>(c);
+  } else if (name.rfind("c:", 0) == 0) {
+    const rilbed_c_controller* c = find_c_controller(name.substr(2));
+    if (!c) {
+      std::string known;
+      for (const auto& n : c_controller_names()) known += " c:" + n;
+      throw ScenarioError(where + ": unknown C controller '" + name + "' (built in:" + known + ")");
+    }
+    controller = std::make_unique<CControllerAdapter>(*c);
+  } else if (name != "none") {
+    throw ScenarioError(where + ": unknown controller '" + name +
+                        "' (convoy, wander, track_follow, beacon_homing, c:<name>, none)");
+  }
+  for (const auto& [key, value] : spec.controller.params) {
+    if (!used.contains(key)) throw ScenarioError(where + ": controller " + name + " has no parameter '" + key + "'");
+  }
+  return controller;
+}
+
+RunResult run_scenario(const Scenario& scenario, const RunOptions& options, const RealBodyFactory& real_bodies) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  RunResult result;
+  result.seed = options.seed;
+  // Separate streams for the initial poses and for the run's noise, both from the seed,
+  // so that changing a sensor's noise does not move the starting poses.
+  std::seed_seq pose_seed{options.seed, std::uint64_t{0x706f736573}};
+  std::seed_seq noise_seed{options.seed, std::uint64_t{0x6e6f697365}};
+  std::mt19937_64 pose_rng(pose_seed), noise_rng(noise_seed);
+
+  // The convoy: robots with the convoy controller, numbered 1..N.
+  std::vector<int> convoy_ids;
+  for (const RobotSpec& r : scenario.robots) {
+    if (r.controller.name == "convoy") convoy_ids.push_back(r.id);
+  }
+  for (std::size_t k = 0; k < convoy_ids.size(); ++k) {
+    if (convoy_ids[k] != static_cast<int>(k) + 1) {
+      throw ScenarioError(scenario.source.string() + ": convoy robots must have IDs 1..N (agent k follows agent k-1); found " +
+                          std::to_string(convoy_ids[k]) + " where " + std::to_string(k + 1) + " was expected");
+    }
+  }
+
+  environment::World world(scenario.map);
+  for (const auto& m : scenario.moving_obstacles) world.add_moving_obstacle(m);
+  const std::vector<Pose2> poses = draw_initial_poses(scenario, pose_rng);
+  std::vector<std::unique_ptr<Body>> bodies;
+  for (std::size_t i = 0; i < scenario.robots.size(); ++i) {
+    const RobotSpec& spec = scenario.robots[i];
+    environment::RobotConfig rc;
+    rc.id = spec.id;
+    rc.kind = spec.kind;
+    rc.pose = poses[i];
+    rc.noise = spec.noise;
+    rc.sensors = spec.sensors;
+    try {
+      world.add_robot(rc);
+    } catch (const std::invalid_argument& e) {
+      throw ScenarioError(scenario.source.string() + ":" + std::to_string(spec.line) + ": " + e.what());
+    }
+    if (spec.kind == environment::RobotKind::Real) {
+      std::unique_ptr<Body> body = real_bodies ? real_bodies(spec, world) : nullptr;
+      if (!body) {
+        throw ScenarioError(scenario.source.string() + ":" + std::to_string(spec.line) + ": robot " + std::to_string(spec.id) +
+                            " is real, and this run has no serial links for real robots");
+      }
+      bodies.push_back(std::move(body));
+    } else {
+      bodies.push_back(std::make_unique<VirtualBody>(world, spec.id, noise_rng));
+    }
+  }
+
+  // The coupled model, in the order that breaks ties (see the header).
+  auto root = std::make_shared<sim::Coupled>("run");
+  auto& world_model = root->emplace<WorldModel>(world, scenario.physics_step_us, noise_rng);
+  std::vector<AgentModel*> agents;
+  for (std::size_t i = 0; i < scenario.robots.size(); ++i) {
+    auto controller = make_controller(scenario, scenario.robots[i]);
+    agents.push_back(&root->emplace<AgentModel>(*bodies[i], std::move(controller), scenario.control_period_us));
+  }
+  if (scenario.mode == ConvoyMode::kCentral && !convoy_ids.empty()) {
+    std::vector<Body*> convoy_bodies;
+    for (std::size_t i = 0; i < convoy_ids.size(); ++i) convoy_bodies.push_back(bodies[i].get());
+    auto& central = root->emplace<CentralConvoyModel>(convoy_bodies, scenario.convoy, scenario.control_period_us);
+    for (std::size_t i = 0; i < convoy_ids.size(); ++i) {
+      root->couple(*central.find_output("commands"), *agents[i]->find_input("command"));
+    }
+  } else if (agents.size() > 1) {
+    auto& broadcaster = root->emplace<TeamBroadcaster>(std::vector<const AgentModel*>(agents.begin(), agents.end()),
+                                                       scenario.broadcast_period_us);
+    for (AgentModel* a : agents) root->couple(*broadcaster.find_output("team"), *a->find_input("team"));
+  }
+  std::unique_ptr<RunRecorder> recorder;
+  if (options.out_dir) {
+    FieldDrawing drawing{scenario.map.field.width_m, scenario.map.field.height_m, {}, {}, {}};
+    for (const auto& o : scenario.map.obstacles) drawing.obstacles.push_back(o.vertices_m);
+    for (const auto& t : scenario.map.tracks) {
+      auto points = t.points_m;
+      if (t.closed && !points.empty()) points.push_back(points.front());
+      drawing.tracks.emplace_back(points, t.width_m);
+    }
+    for (const auto& b : scenario.map.beacons) drawing.beacons.push_back(b.position_m);
+    recorder = std::make_unique<RunRecorder>(*options.out_dir, drawing);
+  }
+  const double duration_s = options.duration_s.value_or(scenario.duration_s);
+  const TimeUs end_us = seconds_to_us(duration_s);
+  sim::Coordinator* coordinator_ptr = nullptr;
+  MonitorModel::Setup setup;
+  setup.world = &world;
+  setup.world_model = &world_model;
+  setup.agents = agents;
+  setup.convoy_ids = convoy_ids;
+  setup.recorder = recorder.get();
+  setup.options = &options;
+  setup.coordinator = &coordinator_ptr;
+  setup.result = &result;
+  setup.period_us = scenario.control_period_us;
+  auto& monitor = root->emplace<MonitorModel>(setup);
+
+  sim::FastClock fast_clock;
+  sim::RealTimeClock real_clock(options.rt_factor);
+  sim::Clock& clock = options.realtime ? static_cast<sim::Clock&>(real_clock) : static_cast<sim::Clock&>(fast_clock);
+  sim::Coordinator coordinator(root, clock);
+  coordinator_ptr = &coordinator;
+  std::exception_ptr failure;
+  const auto run_start = std::chrono::steady_clock::now();
+  try {
+    coordinator.run_until(end_us);
+  } catch (const std::exception& e) {
+    failure = std::current_exception();
+    result.ended_by = std::string("error: ") + e.what();
+  }
+  result.run_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
+  // Every body is stopped whatever happened (a real robot must not drive on).
+  for (AgentModel* a : agents) a->finish();
+  if (result.ended_by.empty()) result.ended_by = "duration";
+  result.simulated_s = us_to_seconds(std::min(coordinator.now_us(), end_us));
+  result.formed = monitor.formed();
+  if (const auto t = monitor.formation_time_us()) result.formation_time_s = us_to_seconds(*t);
+  result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  if (recorder) {
+    nlohmann::json summary = result.summary();
+    summary["scenario"] = scenario.name;
+    summary["mode"] = scenario.mode == ConvoyMode::kCentral ? "central" : "distributed";
+    summary["robots"] = scenario.robots.size();
+    summary["convoy_size"] = convoy_ids.size();
+    summary["realtime"] = options.realtime;
+    if (options.realtime) summary["rt_factor"] = options.rt_factor;
+    if (!result.formed && !convoy_ids.empty()) recorder->add_event({coordinator.now_us(), "note", 0, 0, "the convoy did not form"});
+    recorder->finish(summary);
+  }
+  if (failure) std::rethrow_exception(failure);
+  return result;
+}
+
+}  // namespace rilbed::agents

@@ -1,0 +1,76 @@
+// One run of a scenario: builds the world and the robots' bodies, couples the DEVS
+// models (world, agents, team broadcast or central coordinator, monitor), and runs them
+// as fast as possible or paced to the wall clock, recording the run's folder.
+//
+// Model order (the coordinator's tie-break at equal times): the world first, so it has
+// moved to time t before any agent senses at t; then the agents; then the team
+// broadcaster or the central coordinator; the monitor samples 1 µs after each control
+// step, when every decision of that step has been applied.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "agents/body.hpp"
+#include "agents/controller.hpp"
+#include "agents/run_recorder.hpp"
+#include "agents/scenario.hpp"
+#include "environment/world.hpp"
+
+namespace rilbed::agents {
+
+/// How to run.
+struct RunOptions {
+  std::uint64_t seed = 1;            ///< initial poses, wheel slip and sensor noise derive from it
+  std::optional<double> duration_s;  ///< simulated seconds; default: the scenario's duration_s
+  bool realtime = false;             ///< pace to the wall clock (else as fast as possible)
+  double rt_factor = 1.0;            ///< simulated seconds per wall second when realtime
+  bool stop_when_formed = false;     ///< end after_formed_s after the convoy formed
+  double after_formed_s = 5.0;
+  std::optional<std::filesystem::path> out_dir;  ///< write the run folder here
+  /// Set from another thread or a signal handler (it is only read) to end the run early.
+  const std::atomic<bool>* interrupt = nullptr;
+  /// Called once per simulated second with a one-line status (each robot's behaviour).
+  std::function<void(const std::string&)> on_status;
+  /// Record trajectories and events even without an out_dir (kept in memory, for tests).
+  bool keep_in_memory = false;
+};
+
+/// What a run came to.
+struct RunResult {
+  std::uint64_t seed = 0;
+  bool formed = false;                      ///< the convoy formed (see FormationMonitor)
+  std::optional<double> formation_time_s;   ///< when the hold that formed it began
+  int collisions = 0;                       ///< contact episodes (robot–anything)
+  int robot_collisions = 0;                 ///< of those, robot–robot
+  double max_overlap_m = 0.0;               ///< largest overlap seen at any control step
+  double simulated_s = 0.0;
+  double wall_s = 0.0;                      ///< the whole call, building the world included
+  double run_wall_s = 0.0;                  ///< the DEVS run alone (what sim-bench reports)
+  std::string ended_by;                     ///< "duration", "formed" or "interrupt"
+  std::vector<TrajectorySample> trajectory; ///< with keep_in_memory only
+  /// summary.json's content.
+  nlohmann::json summary() const;
+};
+
+/// Makes the body of a real robot (the links module supplies it); nullptr if it cannot.
+using RealBodyFactory = std::function<std::unique_ptr<Body>(const RobotSpec&, environment::World&)>;
+
+/// Makes the controller named in `spec` (nullptr for a commanded convoy agent in central
+/// mode, or "none"). Throws ScenarioError for an unknown name or parameter.
+std::unique_ptr<Controller> make_controller(const Scenario& scenario, const RobotSpec& spec);
+
+/// Runs `scenario` once with `options`. Throws ScenarioError for a scenario the run cannot
+/// use (e.g. convoy IDs not 1..N, real robots without a factory) and std::runtime_error
+/// for an output folder it cannot write.
+RunResult run_scenario(const Scenario& scenario, const RunOptions& options, const RealBodyFactory& real_bodies = {});
+
+}  // namespace rilbed::agents

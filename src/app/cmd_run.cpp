@@ -1,0 +1,206 @@
+// `rilbed run SCENARIO.yaml`: one run, or a batch of runs over seeds, of a scenario.
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "agents/scenario.hpp"
+#include "agents/simulation.hpp"
+#include "app/commands.hpp"
+
+namespace rilbed::app {
+
+namespace {
+
+// Set by SIGINT/SIGTERM; the run polls it after every control step and ends cleanly
+// (every robot stopped, the run folder written).
+std::atomic<bool> interrupted{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler needs a lock-free flag");
+
+extern "C" void on_signal(int) { interrupted.store(true); }
+
+struct RunArgs {
+  std::string scenario;
+  bool fast = false;
+  bool realtime = false;
+  double rt_factor = 1.0;
+  std::optional<double> duration_s;
+  bool stop_when_formed = false;
+  std::uint64_t seed = 1;
+  int seeds = 0;
+  std::string out;
+  int jobs = 0;
+  bool quiet = false;
+};
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double rank = p * (v.size() - 1);
+  const auto lo = static_cast<std::size_t>(rank);
+  const auto hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (rank - lo) * (v[hi] - v[lo]);
+}
+
+void print_result(const agents::RunResult& r) {
+  char formed[64] = "not formed";
+  if (r.formation_time_s) std::snprintf(formed, sizeof formed, "formed at %.1f s", *r.formation_time_s);
+  std::printf("seed %llu: %s; %d collisions (%d robot-robot), max overlap %.2g m; %.1f s simulated in %.2f s (ended by %s)\n",
+              static_cast<unsigned long long>(r.seed), formed, r.collisions, r.robot_collisions, r.max_overlap_m,
+              r.simulated_s, r.wall_s, r.ended_by.c_str());
+}
+
+int run_batch(const agents::Scenario& scenario, const RunArgs& args, agents::RunOptions base) {
+  const int n = args.seeds;
+  std::vector<agents::RunResult> results(n);
+  std::vector<std::string> errors(n);
+  std::atomic<int> next{0};
+  std::mutex print_mutex;
+  const auto wall_start = std::chrono::steady_clock::now();
+  auto worker = [&] {
+    for (int i = next++; i < n && !interrupted.load(); i = next++) {
+      agents::RunOptions o = base;
+      o.seed = args.seed + static_cast<std::uint64_t>(i);
+      if (!args.out.empty()) o.out_dir = std::filesystem::path(args.out) / ("seed_" + std::to_string(o.seed));
+      try {
+        results[i] = agents::run_scenario(scenario, o);
+      } catch (const std::exception& e) {
+        errors[i] = e.what();
+        results[i].seed = o.seed;
+        results[i].ended_by = "error";
+      }
+      std::lock_guard lock(print_mutex);
+      if (!args.quiet) print_result(results[i]);
+    }
+  };
+  const int jobs = std::max(1, args.jobs > 0 ? args.jobs : static_cast<int>(std::thread::hardware_concurrency()));
+  std::vector<std::thread> threads;
+  for (int j = 0; j < std::min(jobs, n); ++j) threads.emplace_back(worker);
+  for (auto& t : threads) t.join();
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+
+  int formed = 0, collisions = 0, robot_collisions = 0, failed = 0, done = 0;
+  double max_overlap = 0.0;
+  std::vector<double> times;
+  nlohmann::json runs = nlohmann::json::array();
+  for (int i = 0; i < n; ++i) {
+    const auto& r = results[i];
+    if (r.ended_by.empty()) continue;  // not run (interrupted)
+    ++done;
+    if (!errors[i].empty()) {
+      ++failed;
+      spdlog::error("seed {}: {}", r.seed, errors[i]);
+    }
+    formed += r.formed;
+    if (r.formation_time_s) times.push_back(*r.formation_time_s);
+    collisions += r.collisions;
+    robot_collisions += r.robot_collisions;
+    max_overlap = std::max(max_overlap, r.max_overlap_m);
+    nlohmann::json j = r.summary();
+    if (!errors[i].empty()) j["error"] = errors[i];
+    runs.push_back(j);
+  }
+  nlohmann::json batch;
+  batch["scenario"] = scenario.name;
+  batch["mode"] = scenario.mode == agents::ConvoyMode::kCentral ? "central" : "distributed";
+  batch["runs"] = done;
+  batch["formed"] = formed;
+  batch["failed"] = failed;
+  batch["formation_time_median_s"] = times.empty() ? nlohmann::json(nullptr) : nlohmann::json(percentile(times, 0.5));
+  batch["formation_time_p95_s"] = times.empty() ? nlohmann::json(nullptr) : nlohmann::json(percentile(times, 0.95));
+  batch["collisions"] = collisions;
+  batch["robot_collisions"] = robot_collisions;
+  batch["max_overlap_m"] = max_overlap;
+  batch["wall_s"] = wall_s;
+  batch["jobs"] = jobs;
+  batch["per_run"] = runs;
+  if (!args.out.empty()) {
+    std::filesystem::create_directories(args.out);
+    std::ofstream(std::filesystem::path(args.out) / "batch.json") << batch.dump(2) << '\n';
+  }
+  std::printf("\n| scenario | mode | runs | formed | formation time median s | formation time p95 s | collisions (robot-robot) | max overlap m | wall s (%d jobs) |\n",
+              jobs);
+  std::printf("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+  char median[32] = "-", p95[32] = "-";
+  if (!times.empty()) {
+    std::snprintf(median, sizeof median, "%.1f", percentile(times, 0.5));
+    std::snprintf(p95, sizeof p95, "%.1f", percentile(times, 0.95));
+  }
+  std::printf("| %s | %s | %d | %d | %s | %s | %d (%d) | %.2g | %.1f |\n", scenario.name.c_str(),
+              batch["mode"].get<std::string>().c_str(), done, formed, median, p95, collisions, robot_collisions,
+              max_overlap, wall_s);
+  return failed > 0 || done == 0 ? kExitFailure : 0;
+}
+
+int run_command(const RunArgs& args) {
+  agents::Scenario scenario;
+  try {
+    scenario = agents::load_scenario(args.scenario);
+  } catch (const agents::ScenarioError& e) {
+    spdlog::error("{}", e.what());
+    return kExitFailure;
+  }
+  agents::RunOptions options;
+  options.realtime = args.realtime;
+  options.rt_factor = args.rt_factor;
+  options.duration_s = args.duration_s;
+  options.stop_when_formed = args.stop_when_formed;
+  options.seed = args.seed;
+  options.interrupt = &interrupted;
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  if (args.seeds > 0) return run_batch(scenario, args, options);
+  if (!args.out.empty()) options.out_dir = args.out;
+  if (args.realtime && !args.quiet) {
+    options.on_status = [](const std::string& line) {
+      std::printf("%s\n", line.c_str());
+      std::fflush(stdout);
+    };
+  }
+  try {
+    const agents::RunResult r = agents::run_scenario(scenario, options);
+    print_result(r);
+    if (!args.out.empty()) std::printf("run folder: %s\n", args.out.c_str());
+  } catch (const agents::ScenarioError& e) {
+    spdlog::error("{}", e.what());
+    return kExitFailure;
+  } catch (const std::exception& e) {
+    spdlog::error("run failed: {}", e.what());
+    return kExitFailure;
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_run_command(CLI::App& app) {
+  auto args = std::make_shared<RunArgs>();
+  CLI::App* cmd = app.add_subcommand("run", "Run a scenario (simulation; robot-in-the-loop when it has real robots)");
+  cmd->add_option("scenario", args->scenario, "Scenario file (YAML, see scenarios/README.md)")->required()->check(CLI::ExistingFile);
+  auto* fast = cmd->add_flag("--fast", args->fast, "As fast as the CPU allows (the default)");
+  auto* realtime = cmd->add_flag("--realtime", args->realtime, "Paced to the wall clock");
+  fast->excludes(realtime);
+  cmd->add_option("--rt-factor", args->rt_factor, "With --realtime: simulated seconds per wall second")
+      ->check(CLI::PositiveNumber)->needs(realtime);
+  cmd->add_option("--duration", args->duration_s, "Simulated seconds to run (default: the scenario's duration_s)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_flag("--stop-when-formed", args->stop_when_formed, "End 5 s after the convoy formed");
+  cmd->add_option("--seed", args->seed, "Seed of the initial poses and the noise (first seed of a batch)")->default_val(1);
+  cmd->add_option("--seeds", args->seeds, "Run a batch of N seeds (seed, seed+1, ...) and print its table")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--out", args->out, "Write the run folder here (a batch: one folder per seed and batch.json)");
+  cmd->add_option("--jobs", args->jobs, "Runs of a batch at once (default: one per core)")->check(CLI::PositiveNumber);
+  cmd->add_flag("--quiet", args->quiet, "No per-second status (realtime) or per-run lines (batch)");
+  cmd->callback([args] { exit_code() = run_command(*args); });
+}
+
+}  // namespace rilbed::app

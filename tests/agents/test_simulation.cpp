@@ -1,0 +1,214 @@
+// Scenario tests: whole runs of the shipped scenarios, checked on their outcome.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <fstream>
+#include <sstream>
+
+#include "agents/simulation.hpp"
+
+namespace rilbed::agents {
+namespace {
+
+Scenario shipped(const std::string& name) {
+  return load_scenario(std::filesystem::path(RILBED_SOURCE_DIR) / "scenarios" / (name + ".yaml"));
+}
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The acceptance: convoy_sim forms in at least 95 of 100 seeds in each mode, and
+// no two robots ever overlap.
+void expect_convoy_forms(ConvoyMode mode) {
+  Scenario s = shipped("convoy_sim");
+  s.mode = mode;
+  int formed = 0;
+  double worst_overlap = 0.0;
+  for (std::uint64_t seed = 1; seed <= 100; ++seed) {
+    RunOptions o;
+    o.seed = seed;
+    o.stop_when_formed = true;
+    const RunResult r = run_scenario(s, o);
+    formed += r.formed;
+    worst_overlap = std::max(worst_overlap, r.max_overlap_m);
+    if (r.formed) {
+      EXPECT_EQ(r.ended_by, "formed");
+      ASSERT_TRUE(r.formation_time_s.has_value());
+      EXPECT_NEAR(r.simulated_s, *r.formation_time_s + 5.0 + 5.0, 0.11);  // the hold, then 5 s more
+    }
+  }
+  EXPECT_GE(formed, 95);
+  EXPECT_LT(worst_overlap, 1e-6);
+}
+
+TEST(ConvoyScenario, FormsDistributed) { expect_convoy_forms(ConvoyMode::kDistributed); }
+TEST(ConvoyScenario, FormsCentral) { expect_convoy_forms(ConvoyMode::kCentral); }
+
+TEST(ConvoyScenario, FinalPosesAreAChain) {
+  RunOptions o;
+  o.seed = 3;
+  o.stop_when_formed = true;
+  o.keep_in_memory = true;
+  const RunResult r = run_scenario(shipped("convoy_sim"), o);
+  ASSERT_TRUE(r.formed);
+  // The last control step's poses: every agent k > 1 following, 0.06..0.30 m behind k-1.
+  std::map<int, TrajectorySample> last;
+  for (const auto& s : r.trajectory) last[s.id] = s;
+  ASSERT_EQ(last.size(), 8u);
+  for (int k = 2; k <= 8; ++k) {
+    EXPECT_EQ(last[k].behaviour, "follow") << k;
+    const double gap = (last[k].pose.position_m - last[k - 1].pose.position_m).norm();
+    EXPECT_GE(gap, 0.06) << k;
+    EXPECT_LE(gap, 0.30) << k;
+  }
+}
+
+TEST(Simulation, SameSeedSameRunByteForByte) {
+  const auto dir = std::filesystem::temp_directory_path() / ("rilbed_determinism_" + std::to_string(::getpid()));
+  const Scenario s = shipped("convoy_sim");
+  for (const char* run : {"a", "b"}) {
+    RunOptions o;
+    o.seed = 11;
+    o.duration_s = 20.0;
+    o.out_dir = dir / run;
+    run_scenario(s, o);
+  }
+  for (const char* file : {"trajectories.csv", "events.csv", "trajectories.svg"}) {
+    const std::string a = slurp(dir / "a" / file), b = slurp(dir / "b" / file);
+    EXPECT_GT(a.size(), 100u) << file;
+    EXPECT_EQ(a, b) << file;
+  }
+  RunOptions other;
+  other.seed = 12;
+  other.duration_s = 20.0;
+  other.out_dir = dir / "c";
+  run_scenario(s, other);
+  EXPECT_NE(slurp(dir / "a" / "trajectories.csv"), slurp(dir / "c" / "trajectories.csv"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Simulation, RunFolderHasItsFilesAndHeaders) {
+  const auto dir = std::filesystem::temp_directory_path() / ("rilbed_folder_" + std::to_string(::getpid()));
+  RunOptions o;
+  o.seed = 2;
+  o.stop_when_formed = true;
+  o.out_dir = dir;
+  const RunResult r = run_scenario(shipped("convoy_sim"), o);
+  const std::string traj = slurp(dir / "trajectories.csv");
+  EXPECT_EQ(traj.substr(0, traj.find('\n')), "t_s,id,x_m,y_m,theta_deg,behaviour");
+  // Every robot at every control step: 8 rows per 0.1 s.
+  const auto rows = std::count(traj.begin(), traj.end(), '\n') - 1;
+  EXPECT_EQ(rows, 8 * (static_cast<long>(std::lround(r.simulated_s / 0.1)) + 1));
+  const std::string events = slurp(dir / "events.csv");
+  EXPECT_EQ(events.substr(0, events.find('\n')), "t_s,kind,id,other,detail");
+  EXPECT_NE(events.find(",behaviour,2,0,wait -> "), std::string::npos);
+  EXPECT_NE(events.find(",formed,"), std::string::npos);
+  const auto summary = nlohmann::json::parse(slurp(dir / "summary.json"));
+  EXPECT_EQ(summary["formed"], r.formed);
+  EXPECT_EQ(summary["collisions"], r.collisions);
+  EXPECT_TRUE(summary.contains("formation_time_s"));
+  EXPECT_NE(slurp(dir / "trajectories.svg").find("<svg"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Simulation, WanderersNeverOverlapAndTheCControllerMoves) {
+  RunOptions o;
+  o.seed = 4;
+  o.keep_in_memory = true;
+  const RunResult r = run_scenario(shipped("wander"), o);
+  EXPECT_LT(r.max_overlap_m, 1e-6);
+  EXPECT_DOUBLE_EQ(r.simulated_s, 60.0);
+  // Robot 6 runs the C Braitenberg controller: it travels and reports its codes.
+  double travelled = 0.0;
+  std::optional<Vec2> previous;
+  bool saw_code = false;
+  for (const auto& s : r.trajectory) {
+    if (s.id != 6) continue;
+    if (previous) travelled += (s.pose.position_m - *previous).norm();
+    previous = s.pose.position_m;
+    saw_code |= s.behaviour == "c0";
+  }
+  EXPECT_GT(travelled, 2.0);  // 60 s at 80 mm/s, less the turns
+  EXPECT_TRUE(saw_code);
+}
+
+TEST(Simulation, TrackFollowersStayOnTheTape) {
+  RunOptions o;
+  o.seed = 1;
+  o.keep_in_memory = true;
+  const RunResult r = run_scenario(shipped("track_following"), o);
+  // After the first 20 s, each robot is in follow most of the time.
+  for (int id : {1, 2}) {
+    int follow = 0, total = 0;
+    for (const auto& s : r.trajectory) {
+      if (s.id != id || s.t_us < seconds_to_us(20.0)) continue;
+      ++total;
+      follow += s.behaviour == "follow";
+    }
+    EXPECT_GT(follow, total * 0.6) << "robot " << id << ": " << follow << " of " << total;
+  }
+}
+
+TEST(Simulation, BeaconHomersReachTheBeacon) {
+  RunOptions o;
+  o.seed = 1;
+  o.keep_in_memory = true;
+  const RunResult r = run_scenario(shipped("beacon"), o);
+  std::map<int, TrajectorySample> last;
+  for (const auto& s : r.trajectory) last[s.id] = s;
+  int arrived = 0;
+  for (const auto& [id, s] : last) arrived += (s.pose.position_m - Vec2{1.45, 0.60}).norm() < 0.35;
+  EXPECT_GE(arrived, 3) << "robots within 0.35 m of beacon 2 at the end";
+}
+
+TEST(Simulation, RealTimeRunsAtTheRequestedPace) {
+  RunOptions o;
+  o.realtime = true;
+  o.rt_factor = 10.0;
+  o.duration_s = 2.0;
+  const auto start = std::chrono::steady_clock::now();
+  const RunResult r = run_scenario(shipped("convoy_sim"), o);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_GE(wall, 0.19);  // 2 s at 10x: at least 0.2 s of wall time (a lower bound only)
+  EXPECT_LT(wall, 10.0);
+  EXPECT_DOUBLE_EQ(r.simulated_s, 2.0);
+}
+
+TEST(Simulation, InterruptEndsTheRunCleanly) {
+  std::atomic<bool> stop{true};
+  RunOptions o;
+  o.interrupt = &stop;
+  const RunResult r = run_scenario(shipped("convoy_sim"), o);
+  EXPECT_EQ(r.ended_by, "interrupt");
+  EXPECT_LT(r.simulated_s, 0.2);
+}
+
+TEST(Simulation, ConvoyIdsMustBeOneToN) {
+  Scenario s = shipped("convoy_sim");
+  s.robots.erase(s.robots.begin() + 2);  // no robot 3
+  EXPECT_THROW(run_scenario(s, RunOptions{}), ScenarioError);
+  Scenario real = shipped("convoy_sim");
+  real.robots[3].kind = environment::RobotKind::Real;
+  EXPECT_THROW(run_scenario(real, RunOptions{}), ScenarioError);
+}
+
+TEST(Simulation, UnknownControllerOrParameterIsNamed) {
+  Scenario s = shipped("wander");
+  s.robots[0].controller.params["sped_mps"] = 0.1;
+  try {
+    run_scenario(s, RunOptions{});
+    FAIL() << "expected an error";
+  } catch (const ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("no parameter 'sped_mps'"), std::string::npos) << e.what();
+  }
+  s = shipped("wander");
+  s.robots[0].controller.name = "c:nonesuch";
+  EXPECT_THROW(run_scenario(s, RunOptions{}), ScenarioError);
+}
+
+}  // namespace
+}  // namespace rilbed::agents

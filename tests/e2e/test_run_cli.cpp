@@ -1,0 +1,111 @@
+// End-to-end tests of `rilbed run` and `rilbed sim-bench`: the real binary, real files.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <csignal>
+#include <fstream>
+#include <filesystem>
+#include <string>
+#include <thread>
+
+#include "run_command.hpp"
+
+namespace rilbed::e2e {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The shipped scenario's path, quoted for the shell (appended piece by piece: a leading
+// `"'" + std::string` trips GCC 12's false -Wrestrict, PR 105329).
+std::string scenario(const std::string& name) {
+  std::string quoted = "'";
+  quoted += (fs::path(RILBED_SOURCE_DIR) / "scenarios" / (name + ".yaml")).string();
+  quoted += "'";
+  return quoted;
+}
+
+TEST(RunCli, OneRunWritesItsFolder) {
+  const fs::path dir = scratch_dir("run_one");
+  const CommandResult r = run_rilbed("run " + scenario("convoy_sim") + " --fast --stop-when-formed --seed 5 --out '" +
+                                     (dir / "run").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("seed 5: formed at"), std::string::npos) << r.out;
+  for (const char* f : {"trajectories.csv", "events.csv", "summary.json", "trajectories.svg"}) {
+    EXPECT_TRUE(fs::exists(dir / "run" / f)) << f;
+  }
+  const auto summary = nlohmann::json::parse(read_file(dir / "run" / "summary.json"));
+  EXPECT_EQ(summary["formed"], true);
+  EXPECT_TRUE(summary["formation_time_s"].is_number());
+  EXPECT_TRUE(summary["collisions"].is_number_integer());
+  fs::remove_all(dir);
+}
+
+TEST(RunCli, ABatchWritesOneFolderPerSeedAndATable) {
+  const fs::path dir = scratch_dir("run_batch");
+  const CommandResult r = run_rilbed("run " + scenario("convoy_sim") + " --fast --stop-when-formed --seed 10 --seeds 4 --out '" +
+                                     dir.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (int seed = 10; seed < 14; ++seed) EXPECT_TRUE(fs::exists(dir / ("seed_" + std::to_string(seed)) / "summary.json"));
+  const auto batch = nlohmann::json::parse(read_file(dir / "batch.json"));
+  EXPECT_EQ(batch["runs"], 4);
+  EXPECT_EQ(batch["per_run"].size(), 4u);
+  EXPECT_NE(r.out.find("| scenario | mode | runs | formed | formation time median s |"), std::string::npos) << r.out;
+  fs::remove_all(dir);
+}
+
+TEST(RunCli, SameSeedTwiceGivesIdenticalFiles) {
+  const fs::path dir = scratch_dir("run_twice");
+  for (const char* run : {"a", "b"}) {
+    const CommandResult r = run_rilbed("run " + scenario("wander") + " --duration 10 --seed 3 --out '" + (dir / run).string() + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  EXPECT_EQ(read_file(dir / "a" / "trajectories.csv"), read_file(dir / "b" / "trajectories.csv"));
+  EXPECT_EQ(read_file(dir / "a" / "events.csv"), read_file(dir / "b" / "events.csv"));
+  fs::remove_all(dir);
+}
+
+TEST(RunCli, ABadScenarioNamesFileLineAndKey) {
+  const fs::path dir = scratch_dir("run_bad");
+  const fs::path bad = dir / "bad.yaml";
+  std::ofstream(bad) << "field:\n  width_m: 1.5\n  heigth_m: 1.2\nrobots:\n  - ids: 1-3\n";
+  const CommandResult r = run_rilbed("run '" + bad.string() + "' --fast");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("bad.yaml:3: field.heigth_m: unknown key"), std::string::npos) << r.err;
+  const CommandResult missing = run_rilbed("run /nonexistent.yaml");
+  EXPECT_NE(missing.exit_code, 0);
+  fs::remove_all(dir);
+}
+
+TEST(RunCli, RealTimeRunPrintsBehavioursAndStopsOnSigint) {
+  const fs::path dir = scratch_dir("run_sigint");
+  // The binary in the background; SIGINT after 1.5 s of wall time. --duration bounds the
+  // run should the signal be missed.
+  const std::string out = (dir / "out.txt").string();
+  const fs::path script = dir / "interrupt.sh";
+  std::ofstream(script) << "'" << RILBED_BINARY << "' run " << scenario("convoy_sim") << " --realtime --duration 20 --out '"
+                        << (dir / "run").string() << "' >'" << out << "' 2>&1 &\n"
+                        << "pid=$!\nsleep 1.5\nkill -INT $pid\nwait $pid\n";
+  const int status = std::system(("/bin/sh '" + script.string() + "'").c_str());
+  EXPECT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  const std::string printed = read_file(out);
+  EXPECT_NE(printed.find("t=0.0s  1:wait  2:"), std::string::npos) << printed;
+  EXPECT_NE(printed.find("t=1.0s"), std::string::npos) << printed;
+  const auto summary = nlohmann::json::parse(read_file(dir / "run" / "summary.json"));
+  EXPECT_EQ(summary["ended_by"], "interrupt");
+  EXPECT_GT(read_file(dir / "run" / "trajectories.csv").size(), 500u);
+  fs::remove_all(dir);
+}
+
+TEST(SimBenchCli, PrintsItsTable) {
+  const CommandResult r = run_rilbed("sim-bench --robots 50,100 --seconds 2");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("| robots | field m | simulated s | wall s | wall ms per simulated s | real-time factor |"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("| 100 |"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace rilbed::e2e
