@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <optional>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -58,7 +60,9 @@ struct ControlInput {
   int robot_id = 0;                         ///< the robot being controlled
   environment::SensorReadings sensors;      ///< its sensors (virtual, real or combined)
   std::optional<Pose2> pose;                ///< its pose from localisation (world or camera); nullopt if unknown
-  std::vector<TeamMessage> team;            ///< the latest message of every other team member
+  /// The latest team broadcast (every member, possibly this robot too); empty unless the
+  /// controller wants_team(). Valid only during the step() call it is passed to.
+  std::span<const TeamMessage> team;
 };
 
 /// What a controller decides at one control step.
@@ -78,6 +82,9 @@ class Controller {
   virtual ControlOutput step(const ControlInput& input) = 0;
   /// Called once when the run ends (normally or not), after the last step.
   virtual void finish() {}
+  /// Whether it reads ControlInput::team. Only such agents are sent the team broadcast,
+  /// which costs a copy of every member's message per agent.
+  virtual bool wants_team() const { return false; }
 };
 
 }  // namespace rilbed::agents

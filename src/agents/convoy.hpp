@@ -87,6 +87,7 @@ class ConvoyController final : public Controller {
  public:
   ConvoyController(int rank, ConvoyConfig config = {});
   ControlOutput step(const ControlInput& input) override;
+  bool wants_team() const override { return true; }
 
  private:
   ConvoyAgent agent_;

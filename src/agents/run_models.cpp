@@ -9,7 +9,7 @@ AgentModel::AgentModel(Body& body, std::unique_ptr<Controller> controller, TimeU
       body_(body),
       controller_(std::move(controller)),
       period_us_(period_us),
-      team_in_(add_input<std::vector<TeamMessage>>("team")),
+      team_in_(add_input<TeamBroadcast>("team")),
       command_in_(add_input<AgentCommand>("command")) {
   if (period_us <= 0) throw std::invalid_argument("agent " + std::to_string(body.id()) + ": control period must be > 0");
   state_.sigma_us = controller_ ? first_step_us : sim::kInfinity;
@@ -24,7 +24,7 @@ void AgentModel::internal_transition() {
   input.robot_id = body_.id();
   input.sensors = body_.sense(state_.t_us);
   input.pose = body_.pose();
-  input.team = state_.team;
+  if (state_.team) input.team = *state_.team;
   state_.last = controller_->step(input);
   body_.drive(state_.last.wheels);
   state_.sigma_us = period_us_;
@@ -52,17 +52,17 @@ TeamBroadcaster::TeamBroadcaster(std::vector<const AgentModel*> agents, TimeUs p
       agents_(std::move(agents)),
       period_us_(period_us),
       t_us_(first_us),
-      team_out_(add_output<std::vector<TeamMessage>>("team")) {
+      team_out_(add_output<TeamBroadcast>("team")) {
   if (period_us <= 0) throw std::invalid_argument("team broadcast: period must be > 0");
 }
 
 void TeamBroadcaster::output() {
   // output() runs at the instant of the internal transition that follows; t_us_ is
   // that instant (first_us, then every period).
-  std::vector<TeamMessage> team;
-  team.reserve(agents_.size());
+  auto team = std::make_shared<std::vector<TeamMessage>>();
+  team->reserve(agents_.size());
   for (const AgentModel* a : agents_) {
-    if (const auto pose = a->body().pose()) team.push_back({a->body().id(), *pose, a->behaviour(), t_us_});
+    if (const auto pose = a->body().pose()) team->push_back({a->body().id(), *pose, a->behaviour(), t_us_});
   }
   team_out_.add(std::move(team));
   t_us_ += period_us_;

@@ -21,6 +21,10 @@
 
 namespace rilbed::agents {
 
+/// One team broadcast: every member's message, shared by all receivers (a broadcast to N
+/// agents must not cost N copies of N messages).
+using TeamBroadcast = std::shared_ptr<const std::vector<TeamMessage>>;
+
 /// A wheel command for one agent, from a central coordinator.
 struct AgentCommand {
   int id = 0;
@@ -31,14 +35,14 @@ struct AgentCommand {
 struct AgentState {
   TimeUs t_us = 0;                 ///< simulated time of the last transition
   TimeUs sigma_us = 0;             ///< time left to the next control step
-  std::vector<TeamMessage> team;   ///< the latest broadcast, as received
+  std::shared_ptr<const std::vector<TeamMessage>> team;  ///< the latest broadcast, as received (shared, not copied)
   ControlOutput last;              ///< the last command applied to the body
 };
 
 /// One robot's agent: every control period it senses through its body, runs its
 /// controller and drives its body. Without a controller it is commanded: it applies the
 /// commands that arrive on its `command` port (central mode).
-/// Inputs: "team" (std::vector<TeamMessage>), "command" (AgentCommand).
+/// Inputs: "team" (TeamBroadcast), "command" (AgentCommand).
 class AgentModel final : public sim::AtomicModel<AgentState> {
  public:
   /// `body` must outlive the model. `controller` may be null (commanded agent).
@@ -51,6 +55,8 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   void output() override {}
 
   Body& body() const { return body_; }
+  /// Whether its controller reads the team broadcast.
+  bool wants_team() const { return controller_ && controller_->wants_team(); }
   /// The active behaviour (a static string), "idle" before the first step.
   std::string_view behaviour() const { return state_.last.behaviour; }
   const WheelCommand& wheels() const { return state_.last.wheels; }
@@ -61,12 +67,12 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   Body& body_;
   std::unique_ptr<Controller> controller_;
   TimeUs period_us_;
-  sim::Port<std::vector<TeamMessage>>& team_in_;
+  sim::Port<TeamBroadcast>& team_in_;
   sim::Port<AgentCommand>& command_in_;
 };
 
 /// Broadcasts every agent's pose and behaviour to the team every period.
-/// Output: "team" (std::vector<TeamMessage>), one message per broadcast.
+/// Output: "team" (TeamBroadcast), one message per broadcast, shared by every receiver.
 class TeamBroadcaster final : public sim::AtomicModel<TimeUs> {  // state: time to the next broadcast
  public:
   /// `agents` must outlive the model. First broadcast at `first_us`.
@@ -80,7 +86,7 @@ class TeamBroadcaster final : public sim::AtomicModel<TimeUs> {  // state: time 
   std::vector<const AgentModel*> agents_;
   TimeUs period_us_;
   TimeUs t_us_ = 0;  // simulated time, advanced with each broadcast
-  sim::Port<std::vector<TeamMessage>>& team_out_;
+  sim::Port<TeamBroadcast>& team_out_;
 };
 
 /// State of the central coordinator: when it next decides, and the commands it is about

@@ -306,10 +306,14 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
     for (std::size_t i = 0; i < convoy_ids.size(); ++i) {
       root->couple(*central.find_output("commands"), *agents[i]->find_input("command"));
     }
-  } else if (agents.size() > 1) {
+  } else if (std::any_of(agents.begin(), agents.end(), [](const AgentModel* a) { return a->wants_team(); })) {
+    // Every robot is in the broadcast (a convoy agent avoids wanderers too); only the
+    // agents that read it receive it.
     auto& broadcaster = root->emplace<TeamBroadcaster>(std::vector<const AgentModel*>(agents.begin(), agents.end()),
                                                        scenario.broadcast_period_us);
-    for (AgentModel* a : agents) root->couple(*broadcaster.find_output("team"), *a->find_input("team"));
+    for (AgentModel* a : agents) {
+      if (a->wants_team()) root->couple(*broadcaster.find_output("team"), *a->find_input("team"));
+    }
   }
   std::unique_ptr<RunRecorder> recorder;
   if (options.out_dir) {

@@ -63,7 +63,9 @@ TEST(ConvoyController, TakesItsLeaderFromTheTeamMessages) {
   in.robot_id = 3;
   in.pose = Pose2{{0.2, 0.2}, 0.0};
   in.sensors.proximity = environment::ProximityValues{};
-  in.team = {{1, {{0.2, 1.0}, 0.0}, "wait", 0}, {2, {{1.0, 0.2}, 0.0}, "search", 0}};
+  const std::vector<TeamMessage> team = {{1, {{0.2, 1.0}, 0.0}, "wait", 0}, {2, {{1.0, 0.2}, 0.0}, "search", 0}};
+  in.team = team;
+  EXPECT_TRUE(c.wants_team());
   ControlOutput out;
   for (int i = 0; i < 10; ++i) {
     in.t_us += 100000;
