@@ -33,3 +33,19 @@ if SOURCE="$(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null)"; then
 fi
 
 "$BUILD_DIR/bench_vision" "$@"
+
+# The simulation: sim-bench's table, then the convoy batch in both modes
+# (wall time of the whole command, as a user sees it).
+echo
+"$BUILD_DIR/rilbed" sim-bench --robots 100,1000,10000 --seconds 10
+echo
+echo "## Convoy batch: 100 seeds of scenarios/convoy_sim.yaml, --fast --stop-when-formed"
+echo
+echo "Each row is one \`rilbed run --seeds 100\` with its wall time (all cores, one run per core)."
+for mode in distributed central; do
+  start=$(date +%s.%N)
+  "$BUILD_DIR/rilbed" run "$ROOT/scenarios/convoy_sim.yaml" --fast --stop-when-formed --seeds 100 --quiet --mode "$mode" \
+    | { if [[ $mode == distributed ]]; then tail -3; else tail -1; fi; }
+  end=$(date +%s.%N)
+  echo "  (whole command: $(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.1f", b - a }') s)"
+done

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <map>
 #include <set>
@@ -174,6 +175,13 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   std::vector<TrajectorySample> samples_;
   std::vector<std::string_view> last_behaviour_;
 };
+
+// CPU time of the calling thread, seconds: what a run costs, whatever else the machine does.
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
 
 double param(const RobotSpec& spec, const std::string& key, double fallback, std::set<std::string>& used) {
   used.insert(key);
@@ -349,6 +357,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   coordinator_ptr = &coordinator;
   std::exception_ptr failure;
   const auto run_start = std::chrono::steady_clock::now();
+  const double cpu_start = thread_cpu_seconds();
   try {
     coordinator.run_until(end_us);
   } catch (const std::exception& e) {
@@ -356,6 +365,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
     result.ended_by = std::string("error: ") + e.what();
   }
   result.run_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
+  result.run_cpu_s = thread_cpu_seconds() - cpu_start;
   // Every body is stopped whatever happened (a real robot must not drive on).
   for (AgentModel* a : agents) a->finish();
   if (result.ended_by.empty()) result.ended_by = "duration";

@@ -55,6 +55,7 @@ struct RunResult {
   double simulated_s = 0.0;
   double wall_s = 0.0;                      ///< the whole call, building the world included
   double run_wall_s = 0.0;                  ///< the DEVS run alone (what sim-bench reports)
+  double run_cpu_s = 0.0;                   ///< the calling thread's CPU time in the DEVS run
   std::string ended_by;                     ///< "duration", "formed" or "interrupt"
   std::vector<TrajectorySample> trajectory; ///< with keep_in_memory only
   /// summary.json's content.

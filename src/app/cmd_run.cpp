@@ -40,6 +40,7 @@ struct RunArgs {
   std::string out;
   int jobs = 0;
   bool quiet = false;
+  std::string mode;  // overrides the scenario's
 };
 
 double percentile(std::vector<double> v, double p) {
@@ -149,6 +150,8 @@ int run_command(const RunArgs& args) {
     spdlog::error("{}", e.what());
     return kExitFailure;
   }
+  if (args.mode == "central") scenario.mode = agents::ConvoyMode::kCentral;
+  if (args.mode == "distributed") scenario.mode = agents::ConvoyMode::kDistributed;
   agents::RunOptions options;
   options.realtime = args.realtime;
   options.rt_factor = args.rt_factor;
@@ -199,6 +202,8 @@ void add_run_command(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--out", args->out, "Write the run folder here (a batch: one folder per seed and batch.json)");
   cmd->add_option("--jobs", args->jobs, "Runs of a batch at once (default: one per core)")->check(CLI::PositiveNumber);
+  cmd->add_option("--mode", args->mode, "Override the scenario's convoy mode")
+      ->check(CLI::IsMember({"central", "distributed"}));
   cmd->add_flag("--quiet", args->quiet, "No per-second status (realtime) or per-run lines (batch)");
   cmd->callback([args] { exit_code() = run_command(*args); });
 }

@@ -233,8 +233,9 @@ void Coordinator::do_step(TimeUs t_us) {
     for (const Route& output : slots_[active_[i]].outputs) output.source->clear();
   for (const auto& port : root_->outputs()) port->clear();
 
-  // Influenced atomics were appended after the imminent ones: restore flat order.
-  std::sort(active_.begin(), active_.end());
+  // Influenced atomics were appended after the imminent ones: restore flat order (the
+  // imminent ones are sorted already, so with no message in flight there is nothing to do).
+  if (active_.size() > imminent_count) std::sort(active_.begin(), active_.end());
   transitioned_.clear();
   for (const std::size_t index : active_) {
     Slot& slot = slots_[index];
