@@ -101,7 +101,7 @@ TEST(RunCli, RealTimeRunPrintsBehavioursAndStopsOnSigint) {
 TEST(SimBenchCli, PrintsItsTable) {
   const CommandResult r = run_rilbed("sim-bench --robots 50,100 --seconds 2");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("| robots | field m | simulated s | wall s | wall ms per simulated s | real-time factor |"),
+  EXPECT_NE(r.out.find("| robots | field m | simulated s | wall s (median of 3) | CPU s (median) | wall ms per simulated s |"),
             std::string::npos)
       << r.out;
   EXPECT_NE(r.out.find("| 100 |"), std::string::npos) << r.out;
