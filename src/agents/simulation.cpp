@@ -154,6 +154,7 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     for (const TrajectorySample& s : samples_) {
       if (s.id >= 1 && s.id <= static_cast<int>(s_.convoy_ids.size())) team.push_back({s.id, s.pose, s.behaviour});
     }
+    record_subteams(t, team);
     const bool was_holding = formation_.holding();
     if (formation_.update(t, team) && s_.recorder) {
       s_.recorder->add_event({t, "formed", 0, 0,
@@ -168,7 +169,34 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     }
   }
 
+  // Sub-teams (paper 001 §5): maximal runs l..m of agents where each k in (l, m] follows
+  // k-1 within the formed gap. Recorded whenever the set changes, as "1-3 5-6".
+  void record_subteams(TimeUs t, const std::vector<FormationMonitor::Sample>& team) {
+    const int n = static_cast<int>(s_.convoy_ids.size());
+    std::vector<const FormationMonitor::Sample*> by_rank(n + 1, nullptr);
+    for (const auto& m : team) by_rank[m.id] = &m;
+    auto linked = [&](int k) {
+      if (!by_rank[k] || !by_rank[k - 1] || by_rank[k]->behaviour != "follow") return false;
+      const double gap = (by_rank[k]->pose.position_m - by_rank[k - 1]->pose.position_m).norm();
+      return gap >= 0.06 && gap <= 0.30;
+    };
+    std::string text;
+    for (int k = 2, start = 1; k <= n + 1; ++k) {
+      if (k <= n && linked(k)) continue;
+      if (k - 1 > start) {
+        if (!text.empty()) text += ' ';
+        text += std::to_string(start);
+        text += '-';
+        text += std::to_string(k - 1);
+      }
+      start = k;
+    }
+    if (text != subteams_ && s_.recorder) s_.recorder->add_event({t, "subteams", 0, 0, text.empty() ? "none" : text});
+    subteams_ = text;
+  }
+
   Setup s_;
+  std::string subteams_;
   FormationMonitor formation_;
   TimeUs t_us_ = 0;
   TimeUs next_status_us_ = 0;

@@ -107,6 +107,7 @@ TEST(Simulation, RunFolderHasItsFilesAndHeaders) {
   EXPECT_EQ(events.substr(0, events.find('\n')), "t_s,kind,id,other,detail");
   EXPECT_NE(events.find(",behaviour,2,0,wait -> "), std::string::npos);
   EXPECT_NE(events.find(",formed,"), std::string::npos);
+  EXPECT_NE(events.find(",subteams,0,0,1-8\n"), std::string::npos);  // the whole convoy is one sub-team at the end
   const auto summary = nlohmann::json::parse(slurp(dir / "summary.json"));
   EXPECT_EQ(summary["formed"], r.formed);
   EXPECT_EQ(summary["collisions"], r.collisions);
