@@ -222,6 +222,7 @@ double param(const RobotSpec& spec, const std::string& key, double fallback, std
 nlohmann::json RunResult::summary() const {
   nlohmann::json j;
   j["seed"] = seed;
+  j["convoy_size"] = convoy_size;
   j["formed"] = formed;
   j["formation_time_s"] = formation_time_s ? nlohmann::json(*formation_time_s) : nlohmann::json(nullptr);
   j["collisions"] = collisions;
@@ -298,6 +299,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
     }
   }
 
+  result.convoy_size = static_cast<int>(convoy_ids.size());
   environment::World world(scenario.map);
   for (const auto& m : scenario.moving_obstacles) world.add_moving_obstacle(m);
   const std::vector<Pose2> poses = draw_initial_poses(scenario, pose_rng);
@@ -406,7 +408,6 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
     summary["scenario"] = scenario.name;
     summary["mode"] = scenario.mode == ConvoyMode::kCentral ? "central" : "distributed";
     summary["robots"] = scenario.robots.size();
-    summary["convoy_size"] = convoy_ids.size();
     summary["realtime"] = options.realtime;
     if (options.realtime) summary["rt_factor"] = options.rt_factor;
     if (!result.formed && !convoy_ids.empty()) recorder->add_event({coordinator.now_us(), "note", 0, 0, "the convoy did not form"});

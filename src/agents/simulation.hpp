@@ -47,6 +47,7 @@ struct RunOptions {
 /// What a run came to.
 struct RunResult {
   std::uint64_t seed = 0;
+  int convoy_size = 0;                      ///< robots with the convoy controller (0: no convoy)
   bool formed = false;                      ///< the convoy formed (see FormationMonitor)
   std::optional<double> formation_time_s;   ///< when the hold that formed it began
   int collisions = 0;                       ///< contact episodes (robot–anything)

@@ -53,7 +53,8 @@ double percentile(std::vector<double> v, double p) {
 }
 
 void print_result(const agents::RunResult& r) {
-  char formed[64] = "not formed";
+  char formed[64] = "no convoy";
+  if (r.convoy_size > 0) std::snprintf(formed, sizeof formed, "convoy not formed");
   if (r.formation_time_s) std::snprintf(formed, sizeof formed, "formed at %.1f s", *r.formation_time_s);
   std::printf("seed %llu: %s; %d collisions (%d robot-robot), max overlap %.2g m; %.1f s simulated in %.2f s (ended by %s)\n",
               static_cast<unsigned long long>(r.seed), formed, r.collisions, r.robot_collisions, r.max_overlap_m,
