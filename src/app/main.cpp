@@ -35,6 +35,8 @@ int main(int argc, char** argv) {
   rilbed::app::add_score_command(app);
   rilbed::app::add_run_command(app);
   rilbed::app::add_sim_bench_command(app);
+  rilbed::app::add_khepera_command(app);
+  rilbed::app::add_khepera_emu_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
