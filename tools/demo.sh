@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# The main demo (`./run demo`): convoy_sim in real time. Eight virtual Kheperas start at
-# random poses in the lab's 1.5 x 1.2 m field and form a convoy; rilbed prints every
-# robot's behaviour once a second, ends 5 s after the convoy formed (or on Ctrl-C), and
-# writes the run folder to out/demo/convoy_sim.
-#   tools/demo.sh RILBED [vision | extra `rilbed run` options...]
-# `vision` runs the overhead-camera demo instead (tools/demo_vision.sh).
+# The main demo (`./run demo`): convoy_mixed in real time, as in paper 001 Fig. 5. Six
+# virtual Kheperas and two real ones (emulated Kheperas on pseudo-terminals, driven over
+# the real serial link and seen by an emulated overhead camera through the real detector)
+# start at random poses in the lab's 1.5 x 1.2 m field and form one convoy; rilbed prints
+# every robot's behaviour once a second, ends 5 s after the convoy formed (or on Ctrl-C),
+# stops the real robots, and writes the run folder to out/demo/convoy_mixed.
+#   tools/demo.sh RILBED [sim | vision | extra `rilbed run` options...]
+# `sim` runs convoy_sim (all virtual); `vision` the camera demo (tools/demo_vision.sh).
 set -euo pipefail
 RILBED="$1"; shift || true
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
@@ -12,9 +14,16 @@ if [[ "${1:-}" == vision ]]; then
   shift
   exec "$ROOT/tools/demo_vision.sh" "$RILBED" "$@"
 fi
-OUT="${RILBED_DEMO_OUT:-$ROOT/out/demo}/convoy_sim"
+SCENARIO=convoy_mixed
+WHAT="6 virtual and 2 real (emulated) Kheperas"
+if [[ "${1:-}" == sim ]]; then
+  shift
+  SCENARIO=convoy_sim
+  WHAT="8 virtual Kheperas"
+fi
+OUT="${RILBED_DEMO_OUT:-$ROOT/out/demo}/$SCENARIO"
 rm -rf "$OUT"
-echo "== rilbed demo: convoy_sim in real time (8 virtual Kheperas; Ctrl-C ends it) =="
-"$RILBED" run "$ROOT/scenarios/convoy_sim.yaml" --realtime --stop-when-formed --seed "${RILBED_DEMO_SEED:-1}" \
+echo "== rilbed demo: $SCENARIO in real time ($WHAT; Ctrl-C ends it) =="
+"$RILBED" run "$ROOT/scenarios/$SCENARIO.yaml" --realtime --stop-when-formed --seed "${RILBED_DEMO_SEED:-1}" \
   --out "$OUT" "$@"
 echo "== wrote $OUT: trajectories.csv, events.csv, summary.json, trajectories.svg =="

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <optional>
+#include <string_view>
 
 #include "agents/controller.hpp"
 #include "core/geometry.hpp"
@@ -29,6 +30,10 @@ class Body {
   virtual void drive(const WheelCommand& wheels) = 0;
   /// Stops it: wheel speeds 0.
   virtual void stop() { drive({}); }
+  /// What keeps it from obeying, or "ok": a real robot reports "unseen" (the camera lost
+  /// it), "geofence", "link lost", "link unresponsive". A static string; the run records
+  /// every change as an event.
+  virtual std::string_view health() const { return "ok"; }
 };
 
 }  // namespace rilbed::agents

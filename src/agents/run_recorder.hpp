@@ -28,7 +28,8 @@ struct TrajectorySample {
 };
 
 /// Something that happened during a run. `kind` is one of "collision",
-/// "behaviour", "subteams", "formed", "broken", "lost", "note"; `id` and `other` are robot IDs (0: none,
+/// "behaviour", "subteams", "formed", "broken", "health" (a real robot's link or
+/// sighting changed), "note"; `id` and `other` are robot IDs (0: none,
 /// negative: not a robot, e.g. -1 wall, -2 obstacle, -3 moving obstacle).
 struct RunEvent {
   TimeUs t_us = 0;

@@ -263,13 +263,27 @@ std::vector<RobotSpec> read_robots(const Reader& top) {
     if (r.has("link")) {
       if (base.kind != environment::RobotKind::Real) r.fail_key("link", "only a robot of kind real has a link");
       const Reader l = r.child("link");
-      l.allow({"port", "baud", "model", "emulate"});
+      l.allow({"port", "baud", "model", "emulate", "faults"});
       LinkSpec link;
       link.port = l.text("port", "");
       link.baud = l.integer("baud", link.baud);
       link.model = l.text("model", link.model);
       link.emulate = l.boolean("emulate", false);
       if (link.port.empty() == !link.emulate) l.fail(r.get("link"), "give either `port` or `emulate: true`");
+      if (l.has("faults")) {
+        if (!link.emulate) l.fail_key("faults", "only an emulated robot injects faults");
+        const Reader f = l.child("faults");
+        f.allow({"reply_delay_ms", "drop", "garbage", "corrupt", "disconnect_after_s", "replug_after_s"});
+        link.faults.reply_delay_ms = f.integer("reply_delay_ms", 0);
+        if (link.faults.reply_delay_ms < 0) f.fail_key("reply_delay_ms", "must not be negative");
+        for (auto [key, value] : {std::pair{"drop", &link.faults.drop}, {"garbage", &link.faults.garbage},
+                                  {"corrupt", &link.faults.corrupt}}) {
+          *value = f.non_negative(key, 0.0);
+          if (*value > 1.0) f.fail_key(key, "is a probability, at most 1");
+        }
+        link.faults.disconnect_after_s = f.non_negative("disconnect_after_s", 0.0);
+        link.faults.replug_after_s = f.non_negative("replug_after_s", 0.0);
+      }
       base.link = link;
     } else if (base.kind == environment::RobotKind::Real) {
       r.fail(list[i], "a robot of kind real needs a `link` ({port: /dev/ttyUSB0, baud: 38400} or {emulate: true})");
@@ -290,7 +304,7 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source) {
   Scenario s;
   const Reader top(root, source, "");
   top.allow({"name", "description", "mode", "field", "timing", "duration_s", "convoy", "obstacles", "tracks", "beacons",
-             "moving_obstacles", "robots", "camera"});
+             "moving_obstacles", "robots", "camera", "safety"});
   s.name = top.text("name", std::filesystem::path(source).stem().string());
   const std::string mode = top.text("mode", "distributed");
   if (mode == "distributed") {
@@ -375,6 +389,33 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source) {
     s.moving_obstacles.push_back(c);
   });
   s.robots = read_robots(top);
+  if (top.has("camera")) {
+    const Reader c = top.child("camera");
+    c.allow({"emulate", "device", "file", "calibration", "fps", "marker_diameter_m", "family"});
+    CameraSpec cam;
+    cam.line = top.line_of("camera");
+    cam.emulate = c.boolean("emulate", false);
+    if (c.has("device")) cam.device = c.integer("device", 0);
+    cam.file = c.text("file", "");
+    cam.calibration = c.text("calibration", "");
+    cam.fps = c.positive("fps", cam.fps);
+    cam.marker_diameter_m = c.positive("marker_diameter_m", cam.marker_diameter_m);
+    cam.family = c.text("family", cam.family);
+    const int sources = (cam.emulate ? 1 : 0) + (cam.device ? 1 : 0) + (cam.file.empty() ? 0 : 1);
+    if (sources != 1) top.fail_key("camera", "give exactly one of `emulate: true`, `device: N` or `file: PATH`");
+    if (!cam.emulate && cam.calibration.empty()) c.fail_key("calibration", "a real camera needs its field calibration file");
+    s.camera = cam;
+  }
+  if (top.has("safety")) {
+    const Reader f = top.child("safety");
+    f.allow({"lost_timeout_ms", "geofence_margin_m"});
+    s.lost_timeout_ms = f.integer("lost_timeout_ms", s.lost_timeout_ms);
+    if (s.lost_timeout_ms <= 0) f.fail_key("lost_timeout_ms", "must be greater than 0");
+    s.geofence_margin_m = f.non_negative("geofence_margin_m", s.geofence_margin_m);
+  }
+  const bool any_real = std::any_of(s.robots.begin(), s.robots.end(),
+                                    [](const RobotSpec& r) { return r.kind == environment::RobotKind::Real; });
+  if (any_real && !s.camera) top.fail_key("camera", "a scenario with real robots needs a `camera` to see them");
   // The static map validates its own geometry; report its complaint against the file.
   try {
     environment::StaticMap check(s.map);

@@ -38,6 +38,26 @@ struct LinkSpec {
   int baud = 38400;
   std::string model = "khepera2";  ///< protocol variant: khepera2 | epuck
   bool emulate = false;        ///< start an emulated Khepera on a pseudo-terminal instead
+  /// Faults the emulated robot injects (emulate only): reply delay, dropped, garbled and
+  /// corrupted replies (probabilities per reply), and an unplug after some seconds,
+  /// plugged back in after some more (0: never).
+  struct Faults {
+    int reply_delay_ms = 0;
+    double drop = 0.0, garbage = 0.0, corrupt = 0.0;
+    double disconnect_after_s = 0.0, replug_after_s = 0.0;
+  } faults;
+};
+
+/// The overhead camera of a run with real robots.
+struct CameraSpec {
+  bool emulate = false;          ///< render the emulated real robots (their true poses) instead of a real camera
+  std::optional<int> device;     ///< a live camera's index
+  std::string file;              ///< recorded footage (a video, an image directory or sequence)
+  std::string calibration;       ///< field calibration file (OpenCV YAML); not used when emulated
+  double fps = 30.0;             ///< frames per second (emulated, or the rate a file is replayed at)
+  double marker_diameter_m = 0.05;  ///< outer diameter of the printed markers
+  std::string family = "6ucp";   ///< marker family
+  int line = 0;
 };
 
 /// A robot's controller and its knobs.
@@ -72,6 +92,11 @@ struct Scenario {
   TimeUs broadcast_period_us = 100'000;  ///< team broadcast (distributed mode)
   double duration_s = 120.0;        ///< default run length
   ConvoyConfig convoy;              ///< the convoy's knobs (the `convoy:` block)
+  std::optional<CameraSpec> camera; ///< how real robots are seen (required when there are real robots)
+  /// Safety for real robots: stop one the camera has not seen for this long, milliseconds.
+  int lost_timeout_ms = 500;
+  /// Safety: stop a real robot whose centre comes nearer than this to the field's edge, metres.
+  double geofence_margin_m = 0.0;
   std::vector<RobotSpec> robots;    ///< sorted by ID
 };
 

@@ -15,6 +15,9 @@
 #include "sim/clock.hpp"
 #include "sim/coordinator.hpp"
 #include "sim/coupled.hpp"
+#include "vision/emulated_camera.hpp"
+#include "vision/field_tracker.hpp"
+#include "vision/frame_source.hpp"
 
 namespace rilbed::agents {
 
@@ -60,6 +63,96 @@ class WorldModel final : public sim::AtomicModel<TimeUs> {  // state: time to th
   std::vector<environment::CollisionEvent> collisions_;
 };
 
+// The overhead camera as a DEVS model: every frame period it takes a frame, tracks the
+// real robots' markers and places them in the world (World::set_observed_pose). Virtual
+// robots are not on camera; they live only in the world model (paper 001).
+class VisionModel final : public sim::AtomicModel<TimeUs> {  // state: time to the next frame
+ public:
+  using Grab = std::function<std::optional<cv::Mat>()>;
+  VisionModel(environment::World& world, vision::FieldTracker tracker, Grab grab, TimeUs period_us)
+      : sim::AtomicModel<TimeUs>("camera", 0), world_(world), tracker_(std::move(tracker)), grab_(std::move(grab)),
+        period_us_(period_us) {}
+  TimeUs time_advance() const override { return state_; }
+  void external_transition(TimeUs elapsed_us) override { state_ -= elapsed_us; }
+  void output() override {}
+  void internal_transition() override {
+    t_us_ += state_;
+    state_ = period_us_;
+    const std::optional<cv::Mat> frame = grab_();
+    if (!frame) {
+      state_ = sim::kInfinity;  // the footage ended: no more sightings
+      return;
+    }
+    ++frames_;
+    for (const vision::FieldObservation& o : tracker_.process(*frame)) {
+      if (!world_.has_robot(o.id) || world_.robot(o.id).kind != environment::RobotKind::Real) continue;
+      world_.set_observed_pose(o.id, o.pose, t_us_);
+      ++sightings_;
+    }
+  }
+  long frames() const { return frames_; }
+  long sightings() const { return sightings_; }
+
+ private:
+  environment::World& world_;
+  vision::FieldTracker tracker_;
+  Grab grab_;
+  TimeUs period_us_;
+  TimeUs t_us_ = 0;
+  long frames_ = 0, sightings_ = 0;
+};
+
+// The camera of a scenario with real robots, ready to add to the run.
+std::shared_ptr<VisionModel> make_camera(const Scenario& scenario, const RunOptions& options, environment::World& world) {
+  const CameraSpec& cam = *scenario.camera;
+  const std::string where = scenario.source.string() + ":" + std::to_string(cam.line) + ": camera";
+  std::vector<int> real_ids;
+  for (const RobotSpec& r : scenario.robots) {
+    if (r.kind == environment::RobotKind::Real) real_ids.push_back(r.id);
+  }
+  if (real_ids.empty()) return nullptr;
+  vision::MarkerFamily family = vision::MarkerFamily::six_ucp();
+  try {
+    family = vision::MarkerFamily::by_name(cam.family);
+  } catch (const std::exception& e) {
+    throw ScenarioError(where + ": " + e.what());
+  }
+  const auto period_us = static_cast<TimeUs>(std::llround(1e6 / cam.fps));
+  if (cam.emulate) {
+    if (!options.emulated_markers) throw ScenarioError(where + ": an emulated camera needs emulated real robots");
+    vision::EmulatedCameraConfig config;
+    config.fps = cam.fps;
+    config.marker_diameter_m = cam.marker_diameter_m;
+    config.seed = options.seed;
+    auto camera = std::make_shared<vision::EmulatedOverheadCamera>(scenario.map.field.width_m, scenario.map.field.height_m,
+                                                                   family, config);
+    vision::FieldTracker tracker(family, real_ids, camera->calibration());
+    auto markers = options.emulated_markers;
+    const double diameter = cam.marker_diameter_m;
+    VisionModel::Grab grab = [camera, markers, diameter]() -> std::optional<cv::Mat> {
+      std::vector<vision::SceneMarker> scene = markers();
+      for (auto& m : scene) m.diameter_m = diameter;
+      return camera->render(scene);
+    };
+    return std::make_shared<VisionModel>(world, std::move(tracker), std::move(grab), period_us);
+  }
+  const auto calibration = vision::load_field_calibration(cam.calibration);
+  if (!calibration.ok()) throw ScenarioError(where + ": " + calibration.error);
+  auto opened = cam.device ? vision::open_camera(*cam.device) : vision::open_frame_source(cam.file);
+  if (!opened.ok()) throw ScenarioError(where + ": " + opened.error);
+  std::shared_ptr<vision::FrameSource> source = std::move(opened.source);
+  vision::FieldTracker tracker(family, real_ids, *calibration.calibration);
+  VisionModel::Grab grab = [source]() -> std::optional<cv::Mat> {
+    for (;;) {
+      vision::FrameResult r = source->next();
+      if (r.kind == vision::FrameResult::Kind::Frame) return r.image;
+      if (r.kind == vision::FrameResult::Kind::End) return std::nullopt;
+      // A bad frame is skipped (the frame source names it); the next one is tried.
+    }
+  };
+  return std::make_shared<VisionModel>(world, std::move(tracker), std::move(grab), period_us);
+}
+
 int party_code(const environment::BodyRef& b) {
   switch (b.kind) {
     case environment::BodyKind::Robot: return b.id;
@@ -89,6 +182,7 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
       : sim::AtomicModel<TimeUs>("monitor", 1), s_(std::move(setup)),
         formation_(std::max<int>(1, static_cast<int>(s_.convoy_ids.size()))) {
     last_behaviour_.assign(s_.agents.size(), {});
+    last_health_.assign(s_.agents.size(), "ok");
   }
   TimeUs time_advance() const override { return state_; }
   void external_transition(TimeUs elapsed_us) override { state_ -= elapsed_us; }
@@ -126,6 +220,13 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
       const auto pose = a.body().pose();
       const std::string_view behaviour = a.behaviour();
       if (pose) samples_.push_back({t, a.body().id(), *pose, behaviour});
+      const std::string_view health = a.body().health();
+      if (health != last_health_[i]) {
+        if (s_.recorder) {
+          s_.recorder->add_event({t, "health", a.body().id(), 0, std::string(last_health_[i]) + " -> " + std::string(health)});
+        }
+        last_health_[i] = health;
+      }
       if (behaviour != last_behaviour_[i]) {
         if (s_.recorder && !last_behaviour_[i].empty()) {
           s_.recorder->add_event({t, "behaviour", a.body().id(), 0,
@@ -143,7 +244,10 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
       line << "t=" << std::fixed;
       line.precision(1);
       line << us_to_seconds(t) << "s";
-      for (const AgentModel* a : s_.agents) line << "  " << a->body().id() << ":" << a->behaviour();
+      for (const AgentModel* a : s_.agents) {
+        line << "  " << a->body().id() << ":" << a->behaviour();
+        if (a->body().health() != "ok") line << "(" << a->body().health() << ")";
+      }
       if (formation_.formed()) line << "  [formed]";
       s_.options->on_status(line.str());
     }
@@ -202,6 +306,7 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   TimeUs next_status_us_ = 0;
   std::vector<TrajectorySample> samples_;
   std::vector<std::string_view> last_behaviour_;
+  std::vector<std::string_view> last_health_;
 };
 
 // CPU time of the calling thread, seconds: what a run costs, whatever else the machine does.
@@ -300,6 +405,16 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   }
 
   result.convoy_size = static_cast<int>(convoy_ids.size());
+  std::string real_list;
+  for (const RobotSpec& r : scenario.robots) {
+    if (r.kind != environment::RobotKind::Real) continue;
+    if (!real_list.empty()) real_list += ", ";
+    real_list += std::to_string(r.id);
+  }
+  if (!real_list.empty() && (!options.realtime || options.rt_factor != 1.0)) {
+    throw ScenarioError(scenario.source.string() + ": robots " + real_list +
+                        " are real and move in wall-clock time: run with --realtime and a factor of 1");
+  }
   environment::World world(scenario.map);
   for (const auto& m : scenario.moving_obstacles) world.add_moving_obstacle(m);
   const std::vector<Pose2> poses = draw_initial_poses(scenario, pose_rng);
@@ -318,7 +433,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
       throw ScenarioError(scenario.source.string() + ":" + std::to_string(spec.line) + ": " + e.what());
     }
     if (spec.kind == environment::RobotKind::Real) {
-      std::unique_ptr<Body> body = real_bodies ? real_bodies(spec, world) : nullptr;
+      std::unique_ptr<Body> body = real_bodies ? real_bodies(spec, world, noise_rng) : nullptr;
       if (!body) {
         throw ScenarioError(scenario.source.string() + ":" + std::to_string(spec.line) + ": robot " + std::to_string(spec.id) +
                             " is real, and this run has no serial links for real robots");
@@ -379,6 +494,9 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   setup.result = &result;
   setup.period_us = scenario.control_period_us;
   auto& monitor = root->emplace<MonitorModel>(setup);
+  if (scenario.camera) {
+    if (auto camera = make_camera(scenario, options, world)) root->add(camera);
+  }
 
   sim::FastClock fast_clock;
   sim::RealTimeClock real_clock(options.rt_factor);

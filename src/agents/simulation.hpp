@@ -24,6 +24,7 @@
 #include "agents/run_recorder.hpp"
 #include "agents/scenario.hpp"
 #include "environment/world.hpp"
+#include "vision/synthetic_camera.hpp"
 
 namespace rilbed::agents {
 
@@ -42,6 +43,9 @@ struct RunOptions {
   std::function<void(const std::string&)> on_status;
   /// Record trajectories and events even without an out_dir (kept in memory, for tests).
   bool keep_in_memory = false;
+  /// With `camera: {emulate: true}`: the markers of the emulated real robots at their true
+  /// poses now (the links layer reads them from its emulators). Called on the run's thread.
+  std::function<std::vector<vision::SceneMarker>()> emulated_markers;
 };
 
 /// What a run came to.
@@ -64,7 +68,8 @@ struct RunResult {
 };
 
 /// Makes the body of a real robot (the links module supplies it); nullptr if it cannot.
-using RealBodyFactory = std::function<std::unique_ptr<Body>(const RobotSpec&, environment::World&)>;
+/// `rng` is the run's noise stream (for the robot's virtual sensors).
+using RealBodyFactory = std::function<std::unique_ptr<Body>(const RobotSpec&, environment::World&, std::mt19937_64& rng)>;
 
 /// Makes the controller named in `spec` (nullptr for a commanded convoy agent in central
 /// mode, or "none"). Throws ScenarioError for an unknown name or parameter.

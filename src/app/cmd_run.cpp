@@ -16,6 +16,7 @@
 #include "agents/scenario.hpp"
 #include "agents/simulation.hpp"
 #include "app/commands.hpp"
+#include "links/real_robots.hpp"
 
 namespace rilbed::app {
 
@@ -170,9 +171,29 @@ int run_command(const RunArgs& args) {
       std::fflush(stdout);
     };
   }
+  // Real robots: their links (and emulators) live until the run has stopped them.
+  std::unique_ptr<links::RealRobots> real;
+  agents::RealBodyFactory real_bodies;
+  const bool has_real = std::any_of(scenario.robots.begin(), scenario.robots.end(),
+                                    [](const agents::RobotSpec& r) { return r.kind == environment::RobotKind::Real; });
+  if (has_real) {
+    real = std::make_unique<links::RealRobots>(scenario, [](links::LogLevel level, const std::string& message) {
+      if (level == links::LogLevel::kError) spdlog::error("{}", message);
+      else if (level == links::LogLevel::kWarning) spdlog::warn("{}", message);
+      else if (level == links::LogLevel::kInfo) spdlog::info("{}", message);
+    });
+    real_bodies = real->body_factory();
+    options.emulated_markers = [&real] { return real->emulated_markers(); };
+  }
   try {
-    const agents::RunResult r = agents::run_scenario(scenario, options);
+    const agents::RunResult r = agents::run_scenario(scenario, options, real_bodies);
     print_result(r);
+    if (real) {
+      for (const auto& [id, emulator] : real->emulators()) {
+        const auto speeds = emulator->last_speeds();
+        std::printf("robot %d (emulated): last speed %d %d\n", id, speeds.left_units, speeds.right_units);
+      }
+    }
     if (!args.out.empty()) std::printf("run folder: %s\n", args.out.c_str());
   } catch (const agents::ScenarioError& e) {
     spdlog::error("{}", e.what());

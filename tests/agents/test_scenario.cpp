@@ -112,14 +112,27 @@ TEST(Scenario, ErrorsNameFileLineAndKey) {
 }
 
 TEST(Scenario, RealRobotsCarryTheirLink) {
-  const Scenario s = parse_scenario("robots:\n  - id: 4\n    kind: real\n    link: {port: /dev/ttyUSB0, baud: 115200}\n"
+  const Scenario s = parse_scenario("camera: {emulate: true, fps: 25}\nsafety: {lost_timeout_ms: 300, geofence_margin_m: 0.03}\n"
+                                    "robots:\n  - id: 4\n    kind: real\n    link: {port: /dev/ttyUSB0, baud: 115200}\n"
                                     "  - id: 5\n    kind: real\n    link: {emulate: true}\n",
                                     "real.yaml");
+  ASSERT_TRUE(s.camera.has_value());
+  EXPECT_TRUE(s.camera->emulate);
+  EXPECT_DOUBLE_EQ(s.camera->fps, 25.0);
+  EXPECT_EQ(s.lost_timeout_ms, 300);
+  EXPECT_DOUBLE_EQ(s.geofence_margin_m, 0.03);
   ASSERT_TRUE(s.robots[0].link.has_value());
   EXPECT_EQ(s.robots[0].link->port, "/dev/ttyUSB0");
   EXPECT_EQ(s.robots[0].link->baud, 115200);
   EXPECT_TRUE(s.robots[1].link->emulate);
   EXPECT_NE(error_of("robots:\n  - id: 1\n    link: {emulate: true}\n").find("only a robot of kind real"), std::string::npos);
+  const std::string blind = error_of("robots:\n  - id: 1\n    kind: real\n    link: {emulate: true}\n");
+  EXPECT_NE(blind.find("camera: a scenario with real robots needs a `camera`"), std::string::npos) << blind;
+  const std::string two = error_of("camera: {emulate: true, device: 0}\nrobots:\n  - id: 1\n");
+  EXPECT_NE(two.find("bad.yaml:1: camera: give exactly one of"), std::string::npos) << two;
+  const std::string uncalibrated = error_of("camera: {device: 0}\nrobots:\n  - id: 1\n");
+  EXPECT_NE(uncalibrated.find("camera.calibration: a real camera needs its field calibration file"), std::string::npos)
+      << uncalibrated;
 }
 
 TEST(Scenario, RandomPosesAreFreeAndReproducible) {
@@ -152,7 +165,7 @@ TEST(Scenario, AFieldTooCrowdedIsAnError) {
 }
 
 TEST(Scenario, ShippedScenariosLoad) {
-  for (const char* name : {"convoy_sim", "wander", "track_following", "beacon"}) {
+  for (const char* name : {"convoy_sim", "wander", "track_following", "beacon", "convoy_mixed", "convoy_real"}) {
     const auto path = std::filesystem::path(RILBED_SOURCE_DIR) / "scenarios" / (std::string(name) + ".yaml");
     EXPECT_NO_THROW(load_scenario(path)) << path;
   }

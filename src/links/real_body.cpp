@@ -1,0 +1,90 @@
+#include "links/real_body.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace rilbed::links {
+
+RealBody::RealBody(int id, environment::World& world, std::unique_ptr<KheperaLink> link, RealBodyConfig config,
+                   std::mt19937_64& rng)
+    : id_(id), world_(world), link_(std::move(link)), config_(config), rng_(rng) {
+  if (!link_) throw std::invalid_argument("robot " + std::to_string(id) + ": no link");
+  if (!world_.has_robot(id) || world_.robot(id).kind != environment::RobotKind::Real) {
+    throw std::invalid_argument("robot " + std::to_string(id) + " is not a real robot of the world");
+  }
+  // The robot's own sensors are read as often as the controller could use them.
+  link_->request_proximity();
+}
+
+RealBody::~RealBody() { link_->stop(); }
+
+environment::SensorReadings RealBody::sense(TimeUs t_us) {
+  // Virtual sensors at the camera's pose: walls, obstacles and every robot, virtual or real.
+  environment::SensorReadings r = world_.sense(id_, t_us, rng_);
+  if (const auto real = link_->latest_proximity()) {
+    if (!r.proximity) r.proximity = environment::ProximityValues{};
+    // A real obstacle and a virtual one are both "near": the nearer wins, per sensor.
+    for (int i = 0; i < environment::kProximityCount; ++i) (*r.proximity)[i] = std::max((*r.proximity)[i], real->value[i]);
+  }
+  if (const auto counters = link_->latest_counters()) r.odometry = counters->value;
+  link_->request_proximity();  // fresh for the next step (ignored if one is queued)
+  return r;
+}
+
+bool RealBody::seen_recently() const {
+  const environment::RobotState& s = world_.robot(id_);
+  return s.pose_t_us > 0 && world_.time_us() - s.pose_t_us <= static_cast<TimeUs>(config_.lost_timeout_ms) * 1000;
+}
+
+bool RealBody::heading_out(const agents::WheelCommand& wheels) const {
+  const environment::RobotState& s = world_.robot(id_);
+  const auto& field = world_.map().config().field;
+  const double m = config_.geofence_margin_m;
+  const Vec2 p = s.pose.position_m;
+  // Outward direction of every edge the robot is beyond (the margin's line).
+  Vec2 out;
+  if (p.x < m) out.x -= 1.0;
+  if (p.x > field.width_m - m) out.x += 1.0;
+  if (p.y < m) out.y -= 1.0;
+  if (p.y > field.height_m - m) out.y += 1.0;
+  if (out.x == 0.0 && out.y == 0.0) return false;
+  // Beyond the fence only turning on the spot and driving back in are allowed.
+  const double forward = 0.5 * (wheels.left + wheels.right);
+  const Vec2 heading{std::cos(s.pose.heading_rad), std::sin(s.pose.heading_rad)};
+  return forward * heading.dot(out) > 0.0;
+}
+
+std::optional<Pose2> RealBody::pose() const {
+  if (!seen_recently()) return std::nullopt;
+  return world_.robot(id_).pose;
+}
+
+void RealBody::drive(const agents::WheelCommand& wheels) {
+  held_by_.clear();
+  if (!seen_recently()) {
+    held_by_ = "lost";
+  } else if (heading_out(wheels)) {
+    held_by_ = "geofence";
+  }
+  if (!held_by_.empty()) {
+    link_->set_speeds(0, 0);
+    return;
+  }
+  link_->set_speeds(wheels.left, wheels.right);
+}
+
+void RealBody::stop() { link_->set_speeds(0, 0); }
+
+std::string_view RealBody::health() const {
+  switch (link_->state()) {
+    case LinkState::kLost: return "link lost";
+    case LinkState::kUnresponsive: return "link unresponsive";
+    default: break;
+  }
+  if (held_by_ == "lost") return "unseen";
+  if (held_by_ == "geofence") return "geofence";
+  return "ok";
+}
+
+}  // namespace rilbed::links

@@ -1,0 +1,70 @@
+// A real Khepera as an agent's body: wheel commands go out as `D` over its serial link,
+// its proximity readings combine the real `N` values with the world's virtual ones (so a
+// real robot feels virtual robots and walls), and its pose is the camera's.
+//
+// Safety (DESIGN.md): the robot is stopped instead of driven while the camera has not
+// seen it for lost_timeout_ms, and when a command would take its centre further beyond
+// the geofence (geofence_margin_m inside the field's edge; turning on the spot and
+// driving back in stay allowed); stop() and the destructor stop it too (the link's own
+// stop waits for the robot to acknowledge, within the link's retry budget).
+#pragma once
+
+#include <memory>
+#include <random>
+#include <string>
+
+#include "agents/body.hpp"
+#include "environment/world.hpp"
+#include "links/khepera_link.hpp"
+
+namespace rilbed::links {
+
+/// Knobs of a real body.
+struct RealBodyConfig {
+  /// Stop a robot the camera has not seen for this long, milliseconds of simulated time.
+  int lost_timeout_ms = 500;
+  /// Stop a robot whose centre is nearer than this to the field's edge, metres (0: only
+  /// outside the field).
+  double geofence_margin_m = 0.0;
+};
+
+/// One real robot. Not thread-safe (the run's thread calls it); the link it owns has its
+/// own thread.
+class RealBody final : public agents::Body {
+ public:
+  /// `world` and `rng` must outlive the body; the robot `id` must be in the world as a
+  /// real robot. `link` must be started.
+  RealBody(int id, environment::World& world, std::unique_ptr<KheperaLink> link, RealBodyConfig config,
+           std::mt19937_64& rng);
+  /// Stops the robot (the link's stop, acknowledged if the line allows).
+  ~RealBody() override;
+  RealBody(const RealBody&) = delete;
+  RealBody& operator=(const RealBody&) = delete;
+
+  int id() const override { return id_; }
+  environment::SensorReadings sense(TimeUs t_us) override;
+  /// The camera's pose while it is fresh (seen within lost_timeout_ms); nullopt otherwise.
+  std::optional<Pose2> pose() const override;
+  /// Drives the robot, unless it is lost or the command leads out through the geofence:
+  /// then stops it.
+  void drive(const agents::WheelCommand& wheels) override;
+  void stop() override;
+  std::string_view health() const override;
+
+  /// Why the last drive() was refused ("lost", "geofence"), or empty.
+  const std::string& held_by() const { return held_by_; }
+  const KheperaLink& link() const { return *link_; }
+
+ private:
+  bool seen_recently() const;
+  bool heading_out(const agents::WheelCommand& wheels) const;
+
+  int id_;
+  environment::World& world_;
+  std::unique_ptr<KheperaLink> link_;
+  RealBodyConfig config_;
+  std::mt19937_64& rng_;
+  std::string held_by_;
+};
+
+}  // namespace rilbed::links

@@ -1,0 +1,87 @@
+#include "links/real_robots.hpp"
+
+#include <chrono>
+#include <thread>
+
+namespace rilbed::links {
+
+namespace {
+
+const RobotModel& model_named(const std::string& name, const std::string& where) {
+  if (name == "khepera2" || name == "khepera") return khepera2_model();
+  if (name == "epuck" || name == "e-puck") return epuck_model();
+  throw agents::ScenarioError(where + ": unknown robot model '" + name + "' (khepera2, epuck)");
+}
+
+}  // namespace
+
+RealRobots::RealRobots(const agents::Scenario& scenario, LogCallback log) : scenario_(scenario), log_(std::move(log)) {}
+
+RealRobots::~RealRobots() = default;
+
+agents::RealBodyFactory RealRobots::body_factory() {
+  return [this](const agents::RobotSpec& spec, environment::World& world, std::mt19937_64& rng) -> std::unique_ptr<agents::Body> {
+    const std::string where = scenario_.source.string() + ":" + std::to_string(spec.line) + ": robot " + std::to_string(spec.id);
+    if (!spec.link) throw agents::ScenarioError(where + ": a real robot needs a link");
+    LinkConfig config;
+    config.model = model_named(spec.link->model, where);
+    config.baud = static_cast<unsigned>(spec.link->baud);
+    config.log = log_;
+    // Fresh wheel counters for the controllers' odometry, at a modest rate.
+    config.counters_period_ms = 200;
+    if (spec.link->emulate) {
+      EmulatorConfig emu;
+      emu.model = config.model;
+      emu.initial_pose = world.robot(spec.id).pose;
+      emu.seed = static_cast<std::uint64_t>(spec.id);
+      const auto& f = spec.link->faults;
+      emu.faults.reply_delay_ms = f.reply_delay_ms;
+      emu.faults.drop_probability = f.drop;
+      emu.faults.garbage_probability = f.garbage;
+      emu.faults.corrupt_probability = f.corrupt;
+      emu.faults.disconnect_after_s = f.disconnect_after_s;
+      emu.faults.replug_after_s = f.replug_after_s;
+      auto emulator = std::make_unique<KheperaEmulator>(emu);
+      config.port = emulator->device_path();
+      std::lock_guard lock(mutex_);
+      emulators_[spec.id] = std::move(emulator);
+    } else {
+      config.port = spec.link->port;
+    }
+    auto link = std::make_unique<KheperaLink>(config);
+    if (const auto error = link->start()) throw agents::ScenarioError(where + ": " + *error);
+    // The robot must answer before the run relies on it.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+    while (link->state() != LinkState::kOk && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    if (link->state() != LinkState::kOk) {
+      const std::string why = link->status().last_error;
+      link->stop(200);
+      throw agents::ScenarioError(where + ": " + config.port + " does not answer" + (why.empty() ? "" : ": " + why));
+    }
+    RealBodyConfig body;
+    body.lost_timeout_ms = scenario_.lost_timeout_ms;
+    body.geofence_margin_m = scenario_.geofence_margin_m;
+    return std::make_unique<RealBody>(spec.id, world, std::move(link), body, rng);
+  };
+}
+
+std::vector<vision::SceneMarker> RealRobots::emulated_markers() const {
+  std::lock_guard lock(mutex_);
+  std::vector<vision::SceneMarker> out;
+  for (const auto& [id, emulator] : emulators_) {
+    const Pose2 p = emulator->true_pose();
+    out.push_back({id, p.position_m.x, p.position_m.y, p.heading_rad, 0.05});
+  }
+  return out;
+}
+
+std::map<int, const KheperaEmulator*> RealRobots::emulators() const {
+  std::lock_guard lock(mutex_);
+  std::map<int, const KheperaEmulator*> out;
+  for (const auto& [id, e] : emulators_) out[id] = e.get();
+  return out;
+}
+
+}  // namespace rilbed::links

@@ -1,0 +1,103 @@
+// End-to-end tests of runs with real robots: `rilbed run` starts emulated Kheperas on
+// pseudo-terminals, drives them through the real serial link, and sees them through the
+// emulated overhead camera and the real detector. Real time, so each takes seconds.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "run_command.hpp"
+
+namespace rilbed::e2e {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string scenario_path(const std::string& name) {
+  std::string quoted = "'";
+  quoted += (fs::path(RILBED_SOURCE_DIR) / "scenarios" / (name + ".yaml")).string();
+  quoted += "'";
+  return quoted;
+}
+
+void expect_forms_and_stops(const std::string& name, int real_robots) {
+  const fs::path dir = scratch_dir(name);
+  const CommandResult r = run_rilbed("run " + scenario_path(name) + " --realtime --stop-when-formed --duration 90 --out '" +
+                                     (dir / "run").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("formed at"), std::string::npos) << r.out;
+  // Every real robot's last command was a stop.
+  int stopped = 0;
+  for (std::size_t at = r.out.find("(emulated): last speed 0 0"); at != std::string::npos;
+       at = r.out.find("(emulated): last speed 0 0", at + 1)) {
+    ++stopped;
+  }
+  EXPECT_EQ(stopped, real_robots) << r.out;
+  const auto summary = nlohmann::json::parse(read_file(dir / "run" / "summary.json"));
+  EXPECT_EQ(summary["formed"], true);
+  EXPECT_LT(summary["max_overlap_m"].get<double>(), 1e-6);
+  fs::remove_all(dir);
+}
+
+TEST(MixedRun, ConvoyMixedFormsAndStopsItsRealRobots) { expect_forms_and_stops("convoy_mixed", 2); }
+TEST(MixedRun, ConvoyRealFormsAndStopsItsRealRobots) { expect_forms_and_stops("convoy_real", 4); }
+
+TEST(MixedRun, SigintStopsEveryRealRobot) {
+  const fs::path dir = scratch_dir("mixed_sigint");
+  const std::string out = (dir / "out.txt").string();
+  const fs::path script = dir / "interrupt.sh";
+  std::ofstream(script) << "'" << RILBED_BINARY << "' run " << scenario_path("convoy_mixed") << " --realtime --duration 30 >'"
+                        << out << "' 2>&1 &\npid=$!\nsleep 3\nkill -INT $pid\nwait $pid\n";
+  const int status = std::system(("/bin/sh '" + script.string() + "'").c_str());
+  EXPECT_TRUE(WIFEXITED(status));
+  const std::string printed = read_file(out);
+  EXPECT_NE(printed.find("ended by interrupt"), std::string::npos) << printed;
+  EXPECT_NE(printed.find("robot 4 (emulated): last speed 0 0"), std::string::npos) << printed;
+  EXPECT_NE(printed.find("robot 5 (emulated): last speed 0 0"), std::string::npos) << printed;
+  fs::remove_all(dir);
+}
+
+TEST(MixedRun, FaultsNeverStopTheRun) {
+  // Robot 4's line is noisy and slow; robot 5 is unplugged after 3 s and plugged back in
+  // 2 s later. The run goes on, records both, and ends with both robots stopped.
+  const fs::path dir = scratch_dir("mixed_faults");
+  std::string text = read_file(fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_mixed.yaml");
+  const std::string real_block = "  - ids: 4-5\n    kind: real\n    link: {emulate: true}\n";
+  ASSERT_NE(text.find(real_block), std::string::npos);
+  text.replace(text.find(real_block), real_block.size(),
+               "  - id: 4\n    kind: real\n    pose: random\n    controller: convoy\n"
+               "    link: {emulate: true, faults: {garbage: 0.2, corrupt: 0.05, drop: 0.05, reply_delay_ms: 15}}\n"
+               "  - id: 5\n    kind: real\n"
+               "    link: {emulate: true, faults: {disconnect_after_s: 3, replug_after_s: 2}}\n");
+  const fs::path scenario = dir / "faults.yaml";
+  std::ofstream(scenario) << text;
+  const CommandResult r = run_rilbed("run '" + scenario.string() + "' --realtime --duration 12 --out '" + (dir / "run").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("robot 4 (emulated): last speed 0 0"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("robot 5 (emulated): last speed 0 0"), std::string::npos) << r.out;
+  const std::string events = read_file(dir / "run" / "events.csv");
+  // Robot 5's link is lost (it may pass through "unresponsive" on the way), then back.
+  const std::size_t lost = events.find("-> link lost");
+  ASSERT_NE(lost, std::string::npos) << events;
+  EXPECT_EQ(events.rfind(",health,5,0,", lost), events.rfind(",health,", lost)) << events;
+  const std::size_t back = events.find(" -> ok\n", lost);
+  ASSERT_NE(back, std::string::npos) << events;
+  EXPECT_EQ(events.rfind(",health,5,0,", back), events.rfind(",health,", back)) << events;
+  // The virtual robots went on: someone reached a leader.
+  EXPECT_NE(events.find("-> follow"), std::string::npos) << events;
+  const auto summary = nlohmann::json::parse(read_file(dir / "run" / "summary.json"));
+  EXPECT_EQ(summary["ended_by"], "duration");
+  fs::remove_all(dir);
+}
+
+TEST(MixedRun, RealRobotsNeedRealTime) {
+  const CommandResult r = run_rilbed("run " + scenario_path("convoy_mixed") + " --fast");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("are real and move in wall-clock time"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace rilbed::e2e
