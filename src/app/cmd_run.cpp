@@ -42,6 +42,7 @@ struct RunArgs {
   int jobs = 0;
   bool quiet = false;
   std::string mode;  // overrides the scenario's
+  bool all_virtual = false;
 };
 
 double percentile(std::vector<double> v, double p) {
@@ -152,6 +153,15 @@ int run_command(const RunArgs& args) {
     spdlog::error("{}", e.what());
     return kExitFailure;
   }
+  if (args.all_virtual) {
+    // The same robots, poses and controllers, every one virtual: the simulation half of a
+    // sim-to-real comparison (`rilbed compare`).
+    for (agents::RobotSpec& r : scenario.robots) {
+      r.kind = environment::RobotKind::Virtual;
+      r.link.reset();
+    }
+    scenario.camera.reset();
+  }
   if (args.mode == "central") scenario.mode = agents::ConvoyMode::kCentral;
   if (args.mode == "distributed") scenario.mode = agents::ConvoyMode::kDistributed;
   agents::RunOptions options;
@@ -226,6 +236,8 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--jobs", args->jobs, "Runs of a batch at once (default: one per core)")->check(CLI::PositiveNumber);
   cmd->add_option("--mode", args->mode, "Override the scenario's convoy mode")
       ->check(CLI::IsMember({"central", "distributed"}));
+  cmd->add_flag("--all-virtual", args->all_virtual,
+                "Make every real robot virtual (same poses and controllers): the simulation half of a sim-to-real comparison");
   cmd->add_flag("--quiet", args->quiet, "No per-second status (realtime) or per-run lines (batch)");
   cmd->callback([args] { exit_code() = run_command(*args); });
 }

@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   rilbed::app::add_score_command(app);
   rilbed::app::add_run_command(app);
   rilbed::app::add_sim_bench_command(app);
+  rilbed::app::add_compare_command(app);
   rilbed::app::add_khepera_command(app);
   rilbed::app::add_khepera_emu_command(app);
   try {

@@ -93,6 +93,32 @@ TEST(MixedRun, FaultsNeverStopTheRun) {
   fs::remove_all(dir);
 }
 
+TEST(MixedRun, SimToRealComparison) {
+  // The same scenario and seed all virtual (fast) and with the emulated real robots (real
+  // time); `rilbed compare` reports per-robot RMS distances and the formation times.
+  const fs::path dir = scratch_dir("sim2real");
+  const std::string common = " --stop-when-formed --duration 60 --seed 4 --out '";
+  const CommandResult sim = run_rilbed("run " + scenario_path("convoy_real") + " --all-virtual --fast" + common + (dir / "sim").string() + "'");
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  const CommandResult real = run_rilbed("run " + scenario_path("convoy_real") + " --realtime" + common + (dir / "real").string() + "'");
+  ASSERT_EQ(real.exit_code, 0) << real.err;
+  const CommandResult cmp = run_rilbed("compare '" + (dir / "sim").string() + "' '" + (dir / "real").string() + "'");
+  ASSERT_EQ(cmp.exit_code, 0) << cmp.err;
+  EXPECT_NE(cmp.out.find("| robot | samples | RMS distance m | max distance m |"), std::string::npos) << cmp.out;
+  for (int id = 1; id <= 4; ++id) EXPECT_NE(cmp.out.find("| " + std::to_string(id) + " | "), std::string::npos) << cmp.out;
+  EXPECT_NE(cmp.out.find("formation time: "), std::string::npos) << cmp.out;
+  EXPECT_EQ(cmp.out.find("not formed"), std::string::npos) << cmp.out;
+  // Emulated robots follow the virtual ones closely: same controller, same start.
+  const auto all = cmp.out.find("| all | ");
+  ASSERT_NE(all, std::string::npos);
+  const double rms = std::stod(cmp.out.substr(cmp.out.find(" | ", all + 7) + 3));
+  EXPECT_LT(rms, 0.15) << cmp.out;
+  const CommandResult bad = run_rilbed("compare '" + dir.string() + "' '" + (dir / "real").string() + "'");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.err.find("trajectories.csv: cannot open"), std::string::npos) << bad.err;
+  fs::remove_all(dir);
+}
+
 TEST(MixedRun, RealRobotsNeedRealTime) {
   const CommandResult r = run_rilbed("run " + scenario_path("convoy_mixed") + " --fast");
   EXPECT_EQ(r.exit_code, 1);
