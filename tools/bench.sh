@@ -49,3 +49,7 @@ for mode in distributed central; do
   end=$(date +%s.%N)
   echo "  (whole command: $(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.1f", b - a }') s)"
 done
+
+# Robot in the loop: frame arrival to the D command on each real (emulated) robot's port.
+echo
+"$BUILD_DIR/rilbed" loop-bench --real 8 --virtual 100 --frames 300

@@ -23,6 +23,8 @@ void add_run_command(CLI::App& app);
 void add_sim_bench_command(CLI::App& app);
 /// `rilbed compare`: the difference of two run folders (sim-to-real comparison).
 void add_compare_command(CLI::App& app);
+/// `rilbed loop-bench`: loop latency from a camera frame to the `D` on the serial port.
+void add_loop_bench_command(CLI::App& app);
 /// `rilbed khepera --port DEV info|drive`: talks to one real (or emulated) Khepera.
 void add_khepera_command(CLI::App& app);
 /// `rilbed khepera-emu`: an emulated Khepera on a pseudo-terminal.

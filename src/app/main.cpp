@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   rilbed::app::add_run_command(app);
   rilbed::app::add_sim_bench_command(app);
   rilbed::app::add_compare_command(app);
+  rilbed::app::add_loop_bench_command(app);
   rilbed::app::add_khepera_command(app);
   rilbed::app::add_khepera_emu_command(app);
   try {

@@ -306,10 +306,17 @@ struct KheperaLink::Impl {
       ++c.commands_sent;
       if (f.attempt > 1) ++c.retries;
     });
+    const std::optional<Command> speeds =
+        f.job.command.kind == CommandKind::kSetSpeeds ? std::optional<Command>(f.job.command) : std::nullopt;
     asio::async_write(serial, asio::buffer(*f.bytes),
-                      [this, bytes = f.bytes, generation = port_generation](const boost::system::error_code& ec, std::size_t) {
+                      [this, bytes = f.bytes, generation = port_generation, speeds](const boost::system::error_code& ec,
+                                                                                    std::size_t) {
                         if (ec == asio::error::operation_aborted || generation != port_generation) return;
-                        if (ec) port_lost("write failed: " + ec.message());
+                        if (ec) {
+                          port_lost("write failed: " + ec.message());
+                          return;
+                        }
+                        if (speeds && config.on_speeds_written) config.on_speeds_written(*speeds, std::chrono::steady_clock::now());
                       });
     reply_timer.expires_after(std::chrono::milliseconds(config.reply_timeout_ms));
     reply_timer.async_wait([this, id = f.attempt_id](const boost::system::error_code& ec) {

@@ -71,6 +71,10 @@ struct LinkConfig {
   bool stop_on_failure = true;
   /// Where messages go; may be empty.
   LogCallback log;
+  /// Called on the link's thread each time the bytes of a set-speeds command (`D`) have
+  /// been written to the port, with the speeds and the instant the write completed: what
+  /// a loop-latency measurement needs. May be empty; must return quickly.
+  std::function<void(const Command& command, std::chrono::steady_clock::time_point written)> on_speeds_written;
 };
 
 /// What the link is doing.

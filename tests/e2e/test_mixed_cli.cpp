@@ -119,6 +119,13 @@ TEST(MixedRun, SimToRealComparison) {
   fs::remove_all(dir);
 }
 
+TEST(LoopBenchCli, PrintsItsTableAndStopsTheRobots) {
+  const CommandResult r = run_rilbed("loop-bench --real 3 --virtual 20 --frames 20");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("| frame arrival to `D` written on the port (per robot) |"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("`D` written for 60 of 60 robot-frames; 3 of 3 robots stopped"), std::string::npos) << r.out;
+}
+
 TEST(MixedRun, RealRobotsNeedRealTime) {
   const CommandResult r = run_rilbed("run " + scenario_path("convoy_mixed") + " --fast");
   EXPECT_EQ(r.exit_code, 1);
