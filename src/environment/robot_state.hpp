@@ -36,6 +36,9 @@ struct RobotState {
   RobotKind kind = RobotKind::Virtual; ///< as configured
   Pose2 pose;                        ///< current pose, heading in [-pi, pi)
   TimeUs pose_t_us = 0;              ///< when pose was last set (step end or observation)
+  /// Real robots: whether the camera has placed it at least once (until then `pose` is
+  /// only where the scenario put it).
+  bool observed = false;
   double radius_m = kKheperaRadius_m;        ///< body disc
   double wheel_base_m = kKheperaWheelBase_m;  ///< between the wheels
   int left_speed_units = 0;          ///< commanded, pulses per 10 ms, in [-127, 127]

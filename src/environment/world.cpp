@@ -200,6 +200,7 @@ void World::set_observed_pose(int id, Pose2 pose, TimeUs t_us) {
     throw std::invalid_argument(label(id) + ": observed pose is not finite");
   r.pose = {pose.position_m, wrap_rad_pi(pose.heading_rad)};
   r.pose_t_us = t_us;
+  r.observed = true;
   bodies_[s].position_m = bodies_[s].previous_m = pose.position_m;
   grid_.move(s, pose.position_m);
 }

@@ -34,7 +34,7 @@ environment::SensorReadings RealBody::sense(TimeUs t_us) {
 
 bool RealBody::seen_recently() const {
   const environment::RobotState& s = world_.robot(id_);
-  return s.pose_t_us > 0 && world_.time_us() - s.pose_t_us <= static_cast<TimeUs>(config_.lost_timeout_ms) * 1000;
+  return s.observed && world_.time_us() - s.pose_t_us <= static_cast<TimeUs>(config_.lost_timeout_ms) * 1000;
 }
 
 bool RealBody::heading_out(const agents::WheelCommand& wheels) const {
@@ -52,7 +52,8 @@ bool RealBody::heading_out(const agents::WheelCommand& wheels) const {
   // Beyond the fence only turning on the spot and driving back in are allowed.
   const double forward = 0.5 * (wheels.left + wheels.right);
   const Vec2 heading{std::cos(s.pose.heading_rad), std::sin(s.pose.heading_rad)};
-  return forward * heading.dot(out) > 0.0;
+  // A hair of tolerance: a heading parallel to the edge (cos = 6e-17) is not "out".
+  return forward * heading.dot(out) > 1e-9;
 }
 
 std::optional<Pose2> RealBody::pose() const {
@@ -62,7 +63,11 @@ std::optional<Pose2> RealBody::pose() const {
 
 void RealBody::drive(const agents::WheelCommand& wheels) {
   held_by_.clear();
-  if (!seen_recently()) {
+  if (link_->state() != LinkState::kOk) {
+    // A robot whose line failed or vanished is stopped as soon as the line allows (the
+    // first command after a replug is a stop); it drives again once the link is healthy.
+    held_by_ = "link";
+  } else if (!seen_recently()) {
     held_by_ = "lost";
   } else if (heading_out(wheels)) {
     held_by_ = "geofence";

@@ -2,7 +2,8 @@
 // its proximity readings combine the real `N` values with the world's virtual ones (so a
 // real robot feels virtual robots and walls), and its pose is the camera's.
 //
-// Safety (DESIGN.md): the robot is stopped instead of driven while the camera has not
+// Safety (DESIGN.md): the robot is stopped instead of driven while its link is not
+// healthy (lost, unresponsive, or not yet answering), while the camera has not
 // seen it for lost_timeout_ms, and when a command would take its centre further beyond
 // the geofence (geofence_margin_m inside the field's edge; turning on the spot and
 // driving back in stay allowed); stop() and the destructor stop it too (the link's own
@@ -51,7 +52,7 @@ class RealBody final : public agents::Body {
   void stop() override;
   std::string_view health() const override;
 
-  /// Why the last drive() was refused ("lost", "geofence"), or empty.
+  /// Why the last drive() was refused ("link", "lost", "geofence"), or empty.
   const std::string& held_by() const { return held_by_; }
   const KheperaLink& link() const { return *link_; }
 
