@@ -263,12 +263,18 @@ std::vector<RobotSpec> read_robots(const Reader& top) {
     if (r.has("link")) {
       if (base.kind != environment::RobotKind::Real) r.fail_key("link", "only a robot of kind real has a link");
       const Reader l = r.child("link");
-      l.allow({"port", "baud", "model", "emulate", "faults"});
+      l.allow({"port", "baud", "model", "emulate", "faults", "reply_timeout_ms", "retries", "counters_period_ms"});
       LinkSpec link;
       link.port = l.text("port", "");
       link.baud = l.integer("baud", link.baud);
       link.model = l.text("model", link.model);
       link.emulate = l.boolean("emulate", false);
+      link.reply_timeout_ms = l.integer("reply_timeout_ms", link.reply_timeout_ms);
+      if (link.reply_timeout_ms <= 0) l.fail_key("reply_timeout_ms", "must be greater than 0");
+      link.retries = l.integer("retries", link.retries);
+      if (link.retries < 0) l.fail_key("retries", "must not be negative");
+      link.counters_period_ms = l.integer("counters_period_ms", link.counters_period_ms);
+      if (link.counters_period_ms < 0) l.fail_key("counters_period_ms", "must not be negative");
       if (link.port.empty() == !link.emulate) l.fail(r.get("link"), "give either `port` or `emulate: true`");
       if (l.has("faults")) {
         if (!link.emulate) l.fail_key("faults", "only an emulated robot injects faults");

@@ -38,6 +38,9 @@ struct LinkSpec {
   int baud = 38400;
   std::string model = "khepera2";  ///< protocol variant: khepera2 | epuck
   bool emulate = false;        ///< start an emulated Khepera on a pseudo-terminal instead
+  int reply_timeout_ms = 250;  ///< how long one command waits for its reply
+  int retries = 3;             ///< further attempts before a command fails
+  int counters_period_ms = 200;  ///< read the wheel counters (`H`) this often (0: never)
   /// Faults the emulated robot injects (emulate only): reply delay, dropped, garbled and
   /// corrupted replies (probabilities per reply), and an unplug after some seconds,
   /// plugged back in after some more (0: never).

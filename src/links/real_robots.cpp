@@ -27,8 +27,11 @@ agents::RealBodyFactory RealRobots::body_factory() {
     config.model = model_named(spec.link->model, where);
     config.baud = static_cast<unsigned>(spec.link->baud);
     config.log = log_;
-    // Fresh wheel counters for the controllers' odometry, at a modest rate.
-    config.counters_period_ms = 200;
+    config.reply_timeout_ms = spec.link->reply_timeout_ms;
+    config.retries = spec.link->retries;
+    // Proximity is read once per control step (RealBody::sense asks for the next one);
+    // the wheel counters at their own rate.
+    config.counters_period_ms = spec.link->counters_period_ms;
     if (spec.link->emulate) {
       EmulatorConfig emu;
       emu.model = config.model;

@@ -45,12 +45,13 @@ void expect_forms_and_stops(const std::string& name, int real_robots) {
 TEST(MixedRun, ConvoyMixedFormsAndStopsItsRealRobots) { expect_forms_and_stops("convoy_mixed", 2); }
 TEST(MixedRun, ConvoyRealFormsAndStopsItsRealRobots) { expect_forms_and_stops("convoy_real", 4); }
 
-TEST(MixedRun, SigintStopsEveryRealRobot) {
-  const fs::path dir = scratch_dir("mixed_sigint");
+// Interrupted by `signal` 3 s into a real-time run: every real robot ends stopped.
+void expect_signal_stops_every_robot(const std::string& signal) {
+  const fs::path dir = scratch_dir("mixed_" + signal);
   const std::string out = (dir / "out.txt").string();
   const fs::path script = dir / "interrupt.sh";
   std::ofstream(script) << "'" << RILBED_BINARY << "' run " << scenario_path("convoy_mixed") << " --realtime --duration 30 >'"
-                        << out << "' 2>&1 &\npid=$!\nsleep 3\nkill -INT $pid\nwait $pid\n";
+                        << out << "' 2>&1 &\npid=$!\nsleep 3\nkill -" << signal << " $pid\nwait $pid\n";
   const int status = std::system(("/bin/sh '" + script.string() + "'").c_str());
   EXPECT_TRUE(WIFEXITED(status));
   const std::string printed = read_file(out);
@@ -59,6 +60,9 @@ TEST(MixedRun, SigintStopsEveryRealRobot) {
   EXPECT_NE(printed.find("robot 5 (emulated): last speed 0 0"), std::string::npos) << printed;
   fs::remove_all(dir);
 }
+
+TEST(MixedRun, SigintStopsEveryRealRobot) { expect_signal_stops_every_robot("INT"); }
+TEST(MixedRun, SigtermStopsEveryRealRobot) { expect_signal_stops_every_robot("TERM"); }
 
 TEST(MixedRun, FaultsNeverStopTheRun) {
   // Robot 4's line is noisy and slow; robot 5 is unplugged after 3 s and plugged back in
