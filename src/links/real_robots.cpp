@@ -26,7 +26,12 @@ agents::RealBodyFactory RealRobots::body_factory() {
     LinkConfig config;
     config.model = model_named(spec.link->model, where);
     config.baud = static_cast<unsigned>(spec.link->baud);
-    config.log = log_;
+    // Messages name the robot as well as the port (the link names the port).
+    if (log_) {
+      config.log = [log = log_, id = spec.id](LogLevel level, const std::string& message) {
+        log(level, "robot " + std::to_string(id) + ": " + message);
+      };
+    }
     config.reply_timeout_ms = spec.link->reply_timeout_ms;
     config.retries = spec.link->retries;
     // Proximity is read once per control step (RealBody::sense asks for the next one);
