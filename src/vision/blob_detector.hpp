@@ -125,7 +125,8 @@ class BlobDetector {
   int fill_count_ = 0;
   int floor_range_ = 0;  // the floor's local contrast found by the last large search, grey levels
   std::uint8_t uniform_threshold_ = 0;              // nonzero: the current search uses this one threshold                             // median tile range of the last large search
-  cv::Mat visited_;                                // 8-bit, nonzero = already filled
+  cv::Mat visited_;                                // 8-bit: == epoch_ means filled in the current search
+  std::uint8_t epoch_ = 0;                         // mark value of the current search (never 0 during one)
   std::vector<int> row_min_x_, row_max_x_, col_min_y_, col_max_y_;
   std::vector<std::pair<int, int>> stack_;
 };
