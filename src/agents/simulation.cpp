@@ -418,6 +418,9 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   environment::World world(scenario.map);
   for (const auto& m : scenario.moving_obstacles) world.add_moving_obstacle(m);
   const std::vector<Pose2> poses = draw_initial_poses(scenario, pose_rng);
+  // The camera is checked (its calibration, device or footage) before any real robot's
+  // link is opened, so that a bad camera never leaves a robot started.
+  std::shared_ptr<VisionModel> camera = scenario.camera ? make_camera(scenario, options, world) : nullptr;
   std::vector<std::unique_ptr<Body>> bodies;
   for (std::size_t i = 0; i < scenario.robots.size(); ++i) {
     const RobotSpec& spec = scenario.robots[i];
@@ -494,9 +497,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   setup.result = &result;
   setup.period_us = scenario.control_period_us;
   auto& monitor = root->emplace<MonitorModel>(setup);
-  if (scenario.camera) {
-    if (auto camera = make_camera(scenario, options, world)) root->add(camera);
-  }
+  if (camera) root->add(camera);
 
   sim::FastClock fast_clock;
   sim::RealTimeClock real_clock(options.rt_factor);
