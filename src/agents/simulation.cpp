@@ -309,13 +309,6 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   std::vector<std::string_view> last_health_;
 };
 
-// CPU time of the calling thread, seconds: what a run costs, whatever else the machine does.
-double thread_cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
 double param(const RobotSpec& spec, const std::string& key, double fallback, std::set<std::string>& used) {
   used.insert(key);
   const auto it = spec.controller.params.find(key);

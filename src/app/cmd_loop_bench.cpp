@@ -14,6 +14,7 @@
 #include "agents/basic_controllers.hpp"
 #include "agents/scenario.hpp"
 #include "app/commands.hpp"
+#include "core/statistics.hpp"
 #include "environment/world.hpp"
 #include "links/khepera_emulator.hpp"
 #include "links/khepera_link.hpp"
@@ -34,18 +35,6 @@ struct LoopArgs {
   double field_w = 3.0, field_h = 2.4;
   int width = 1920, height = 1080;
 };
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[static_cast<std::size_t>(p * (v.size() - 1) + 0.5)];
-}
-
-double thread_cpu_ms() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return 1e3 * ts.tv_sec + 1e-6 * ts.tv_nsec;
-}
 
 // What a link reports when the bytes of a `D` command are on the port.
 struct WriteStamp {
@@ -139,7 +128,7 @@ int loop_bench(const LoopArgs& args) {
 
     // The frame arrives: detect, place the real robots, run their controllers, drive.
     const auto arrival = Clock::now();
-    const double cpu0 = thread_cpu_ms();
+    const double cpu0 = thread_cpu_seconds();
     for (const vision::FieldObservation& o : tracker.process(image)) {
       world.set_observed_pose(o.id, o.pose, world.time_us());
       ++seen_total;
@@ -153,7 +142,7 @@ int loop_bench(const LoopArgs& args) {
       bodies[i]->drive(controllers[i].step(in).wheels);
     }
     const auto processed = Clock::now();
-    processing_cpu_ms.push_back(thread_cpu_ms() - cpu0);
+    processing_cpu_ms.push_back(1e3 * (thread_cpu_seconds() - cpu0));
     processing_ms.push_back(std::chrono::duration<double, std::milli>(processed - arrival).count());
     // Each robot's `D` on its port.
     const auto deadline = Clock::now() + std::chrono::milliseconds(500);

@@ -16,6 +16,7 @@
 #include "agents/scenario.hpp"
 #include "agents/simulation.hpp"
 #include "app/commands.hpp"
+#include "core/statistics.hpp"
 #include "links/real_robots.hpp"
 
 namespace rilbed::app {
@@ -44,15 +45,6 @@ struct RunArgs {
   std::string mode;  // overrides the scenario's
   bool all_virtual = false;
 };
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const double rank = p * (v.size() - 1);
-  const auto lo = static_cast<std::size_t>(rank);
-  const auto hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (rank - lo) * (v[hi] - v[lo]);
-}
 
 void print_result(const agents::RunResult& r) {
   char formed[64] = "no convoy";

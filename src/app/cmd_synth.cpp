@@ -90,15 +90,7 @@ int run_synth(const SynthOptions& opt) {
     }
   }
 
-  vision::FieldCalibration calib;
-  calib.width_m = preset.field_width_m;
-  calib.height_m = preset.field_height_m;
-  calib.homography = preset.camera.pixel_to_plane_homography(0.0);
-  calib.image_size = preset.camera.image_size;
-  vision::LensModel lens;
-  lens.camera_matrix = preset.camera.camera_matrix;
-  lens.distortion.assign(preset.camera.distortion.val, preset.camera.distortion.val + 5);
-  calib.lens = lens;
+  const vision::FieldCalibration calib = preset.camera.field_calibration(preset.field_width_m, preset.field_height_m);
   if (const std::string err = vision::save_field_calibration(calib, (dir / "calibration.yaml").string()); !err.empty()) {
     spdlog::error("{}", err);
     return kExitFailure;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <ctime>
 
 namespace rilbed {
 
@@ -14,5 +15,13 @@ constexpr TimeUs seconds_to_us(double s) {
 }
 /// Microseconds to seconds.
 constexpr double us_to_seconds(TimeUs t_us) { return static_cast<double>(t_us) * 1e-6; }
+
+/// CPU time the calling thread has used, seconds: what a piece of work costs, whatever
+/// else the machine does meanwhile.
+inline double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
 
 }  // namespace rilbed

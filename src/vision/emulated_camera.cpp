@@ -27,16 +27,8 @@ EmulatedOverheadCamera::EmulatedOverheadCamera(double field_width_m, double fiel
                                                EmulatedCameraConfig config)
     : config_(config),
       camera_(overhead_for(field_width_m, field_height_m, config), std::move(family), config.conditions),
-      rng_(config.seed) {
-  calibration_.width_m = field_width_m;
-  calibration_.height_m = field_height_m;
-  calibration_.image_size = config.image_size;
-  calibration_.homography = camera_.camera().pixel_to_plane_homography(0.0);
-  LensModel lens;
-  lens.camera_matrix = camera_.camera().camera_matrix;
-  lens.distortion.assign(camera_.camera().distortion.val, camera_.camera().distortion.val + 5);
-  calibration_.lens = lens;
-}
+      calibration_(camera_.camera().field_calibration(field_width_m, field_height_m)),
+      rng_(config.seed) {}
 
 cv::Mat EmulatedOverheadCamera::render(const std::vector<SceneMarker>& markers) { return camera_.render(markers, rng_); }
 

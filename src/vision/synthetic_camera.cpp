@@ -39,6 +39,19 @@ std::vector<cv::Point2d> CameraModel::project(const std::vector<cv::Point3d>& po
   return out;
 }
 
+FieldCalibration CameraModel::field_calibration(double width_m, double height_m) const {
+  FieldCalibration calibration;
+  calibration.width_m = width_m;
+  calibration.height_m = height_m;
+  calibration.homography = pixel_to_plane_homography(0.0);
+  calibration.image_size = image_size;
+  LensModel lens;
+  lens.camera_matrix = camera_matrix;
+  lens.distortion.assign(distortion.val, distortion.val + 5);
+  calibration.lens = lens;
+  return calibration;
+}
+
 cv::Matx33d CameraModel::pixel_to_plane_homography(double z_m) const {
   cv::Matx33d r;
   cv::Rodrigues(rvec, r);

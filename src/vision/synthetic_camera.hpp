@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "vision/field_mapping.hpp"
 #include "vision/marker_family.hpp"
 
 namespace rilbed::vision {
@@ -34,6 +35,9 @@ struct CameraModel {
   std::vector<cv::Point2d> project(const std::vector<cv::Point3d>& points_m) const;
   /// Homography from undistorted pixels to the field plane z = z_m (metres).
   cv::Matx33d pixel_to_plane_homography(double z_m = 0.0) const;
+  /// The field calibration a lab would measure for this camera over a width_m x height_m
+  /// field (its exact floor homography and lens).
+  FieldCalibration field_calibration(double width_m, double height_m) const;
 };
 
 /// One marked robot in the scene.

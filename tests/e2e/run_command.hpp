@@ -34,6 +34,15 @@ inline std::string read_file(const std::filesystem::path& p) {
   return s.str();
 }
 
+/// A scenario shipped in scenarios/, as a shell argument (quoted; appended piece by piece:
+/// a leading `"'" + std::string` trips GCC 12's false -Wrestrict, PR 105329).
+inline std::string shipped_scenario_arg(const std::string& name) {
+  std::string quoted = "'";
+  quoted += (std::filesystem::path(RILBED_SOURCE_DIR) / "scenarios" / (name + ".yaml")).string();
+  quoted += "'";
+  return quoted;
+}
+
 /// Runs `RILBED_BINARY args` through /bin/sh, capturing stdout and stderr into files.
 inline CommandResult run_rilbed(const std::string& args) {
   static int counter = 0;

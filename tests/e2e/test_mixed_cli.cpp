@@ -16,16 +16,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string scenario_path(const std::string& name) {
-  std::string quoted = "'";
-  quoted += (fs::path(RILBED_SOURCE_DIR) / "scenarios" / (name + ".yaml")).string();
-  quoted += "'";
-  return quoted;
-}
 
 void expect_forms_and_stops(const std::string& name, int real_robots) {
   const fs::path dir = scratch_dir(name);
-  const CommandResult r = run_rilbed("run " + scenario_path(name) + " --realtime --stop-when-formed --duration 90 --out '" +
+  const CommandResult r = run_rilbed("run " + shipped_scenario_arg(name) + " --realtime --stop-when-formed --duration 90 --out '" +
                                      (dir / "run").string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("formed at"), std::string::npos) << r.out;
@@ -50,7 +44,7 @@ void expect_signal_stops_every_robot(const std::string& signal) {
   const fs::path dir = scratch_dir("mixed_" + signal);
   const std::string out = (dir / "out.txt").string();
   const fs::path script = dir / "interrupt.sh";
-  std::ofstream(script) << "'" << RILBED_BINARY << "' run " << scenario_path("convoy_mixed") << " --realtime --duration 30 >'"
+  std::ofstream(script) << "'" << RILBED_BINARY << "' run " << shipped_scenario_arg("convoy_mixed") << " --realtime --duration 30 >'"
                         << out << "' 2>&1 &\npid=$!\nsleep 3\nkill -" << signal << " $pid\nwait $pid\n";
   const int status = std::system(("/bin/sh '" + script.string() + "'").c_str());
   EXPECT_TRUE(WIFEXITED(status));
@@ -102,9 +96,9 @@ TEST(MixedRun, SimToRealComparison) {
   // time); `rilbed compare` reports per-robot RMS distances and the formation times.
   const fs::path dir = scratch_dir("sim2real");
   const std::string common = " --stop-when-formed --duration 60 --seed 4 --out '";
-  const CommandResult sim = run_rilbed("run " + scenario_path("convoy_real") + " --all-virtual --fast" + common + (dir / "sim").string() + "'");
+  const CommandResult sim = run_rilbed("run " + shipped_scenario_arg("convoy_real") + " --all-virtual --fast" + common + (dir / "sim").string() + "'");
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
-  const CommandResult real = run_rilbed("run " + scenario_path("convoy_real") + " --realtime" + common + (dir / "real").string() + "'");
+  const CommandResult real = run_rilbed("run " + shipped_scenario_arg("convoy_real") + " --realtime" + common + (dir / "real").string() + "'");
   ASSERT_EQ(real.exit_code, 0) << real.err;
   const CommandResult cmp = run_rilbed("compare '" + (dir / "sim").string() + "' '" + (dir / "real").string() + "'");
   ASSERT_EQ(cmp.exit_code, 0) << cmp.err;
@@ -131,7 +125,7 @@ TEST(LoopBenchCli, PrintsItsTableAndStopsTheRobots) {
 }
 
 TEST(MixedRun, RealRobotsNeedRealTime) {
-  const CommandResult r = run_rilbed("run " + scenario_path("convoy_mixed") + " --fast");
+  const CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_mixed") + " --fast");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("are real and move in wall-clock time"), std::string::npos) << r.err;
 }

@@ -16,18 +16,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The shipped scenario's path, quoted for the shell (appended piece by piece: a leading
-// `"'" + std::string` trips GCC 12's false -Wrestrict, PR 105329).
-std::string scenario(const std::string& name) {
-  std::string quoted = "'";
-  quoted += (fs::path(RILBED_SOURCE_DIR) / "scenarios" / (name + ".yaml")).string();
-  quoted += "'";
-  return quoted;
-}
 
 TEST(RunCli, OneRunWritesItsFolder) {
   const fs::path dir = scratch_dir("run_one");
-  const CommandResult r = run_rilbed("run " + scenario("convoy_sim") + " --fast --stop-when-formed --seed 5 --out '" +
+  const CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_sim") + " --fast --stop-when-formed --seed 5 --out '" +
                                      (dir / "run").string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("seed 5: formed at"), std::string::npos) << r.out;
@@ -43,7 +35,7 @@ TEST(RunCli, OneRunWritesItsFolder) {
 
 TEST(RunCli, ABatchWritesOneFolderPerSeedAndATable) {
   const fs::path dir = scratch_dir("run_batch");
-  const CommandResult r = run_rilbed("run " + scenario("convoy_sim") + " --fast --stop-when-formed --seed 10 --seeds 4 --out '" +
+  const CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_sim") + " --fast --stop-when-formed --seed 10 --seeds 4 --out '" +
                                      dir.string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   for (int seed = 10; seed < 14; ++seed) EXPECT_TRUE(fs::exists(dir / ("seed_" + std::to_string(seed)) / "summary.json"));
@@ -57,7 +49,7 @@ TEST(RunCli, ABatchWritesOneFolderPerSeedAndATable) {
 TEST(RunCli, SameSeedTwiceGivesIdenticalFiles) {
   const fs::path dir = scratch_dir("run_twice");
   for (const char* run : {"a", "b"}) {
-    const CommandResult r = run_rilbed("run " + scenario("wander") + " --duration 10 --seed 3 --out '" + (dir / run).string() + "'");
+    const CommandResult r = run_rilbed("run " + shipped_scenario_arg("wander") + " --duration 10 --seed 3 --out '" + (dir / run).string() + "'");
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   EXPECT_EQ(read_file(dir / "a" / "trajectories.csv"), read_file(dir / "b" / "trajectories.csv"));
@@ -83,7 +75,7 @@ TEST(RunCli, RealTimeRunPrintsBehavioursAndStopsOnSigint) {
   // run should the signal be missed.
   const std::string out = (dir / "out.txt").string();
   const fs::path script = dir / "interrupt.sh";
-  std::ofstream(script) << "'" << RILBED_BINARY << "' run " << scenario("convoy_sim") << " --realtime --duration 20 --out '"
+  std::ofstream(script) << "'" << RILBED_BINARY << "' run " << shipped_scenario_arg("convoy_sim") << " --realtime --duration 20 --out '"
                         << (dir / "run").string() << "' >'" << out << "' 2>&1 &\n"
                         << "pid=$!\nsleep 1.5\nkill -INT $pid\nwait $pid\n";
   const int status = std::system(("/bin/sh '" + script.string() + "'").c_str());

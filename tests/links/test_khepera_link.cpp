@@ -14,6 +14,7 @@
 
 #include "links/khepera_emulator.hpp"
 #include "links/khepera_link.hpp"
+#include "link_test_support.hpp"
 
 using namespace rilbed::links;
 using namespace std::chrono_literals;
@@ -21,33 +22,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-template <typename Predicate>
-bool eventually(Predicate predicate, std::chrono::milliseconds timeout = 3000ms) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (!predicate()) {
-    if (std::chrono::steady_clock::now() > deadline) return false;
-    std::this_thread::sleep_for(5ms);
-  }
-  return true;
-}
-
-// Collects the link's messages so a failing test can show them.
-struct LogSink {
-  std::mutex mutex;
-  std::vector<std::string> messages;
-  LogCallback callback() {
-    return [this](LogLevel, const std::string& message) {
-      std::lock_guard lock(mutex);
-      messages.push_back(message);
-    };
-  }
-  std::string text() {
-    std::lock_guard lock(mutex);
-    std::string all;
-    for (const auto& m : messages) all += m + "\n";
-    return all;
-  }
-};
+using rilbed::links::testing::eventually;
+using rilbed::links::testing::LogSink;
 
 LinkConfig config_for(const KheperaEmulator& emulator, LogSink& log, int reply_timeout_ms = 150, int retries = 3) {
   LinkConfig config;
