@@ -87,7 +87,17 @@ void RunRecorder::write_svg() const {
   // 500 pixels per metre; y flipped so that the field's +y is up on screen.
   const double scale = 500.0, margin = 20.0;
   const double w = field_.width_m * scale + 2 * margin, h = field_.height_m * scale + 2 * margin;
-  auto px = [&](Vec2 p) { return format("%.1f", margin + p.x * scale) + "," + format("%.1f", margin + (field_.height_m - p.y) * scale); };
+  // Screen coordinates of a field point, as text.
+  struct Screen {
+    std::string x, y;
+  };
+  auto screen = [&](Vec2 p) -> Screen {
+    return {format("%.1f", margin + p.x * scale), format("%.1f", margin + (field_.height_m - p.y) * scale)};
+  };
+  auto px = [&](Vec2 p) {
+    const Screen s = screen(p);
+    return s.x + "," + s.y;
+  };
   std::ofstream svg(dir_ / "trajectories.svg");
   svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << format("%.0f", w) << "\" height=\"" << format("%.0f", h)
       << "\" font-family=\"sans-serif\" font-size=\"11\">\n";
@@ -105,8 +115,8 @@ void RunRecorder::write_svg() const {
     svg << "\"/>\n";
   }
   for (const Vec2& b : field_.beacons) {
-    svg << "<circle r=\"6\" fill=\"#fc0\" stroke=\"#a80\" cx=\"" << px(b).substr(0, px(b).find(',')) << "\" cy=\""
-        << px(b).substr(px(b).find(',') + 1) << "\"/>\n";
+    const Screen s = screen(b);
+    svg << "<circle r=\"6\" fill=\"#fc0\" stroke=\"#a80\" cx=\"" << s.x << "\" cy=\"" << s.y << "\"/>\n";
   }
   int index = 0;
   for (const auto& [id, path] : paths_) {
@@ -115,20 +125,19 @@ void RunRecorder::write_svg() const {
     for (const Vec2& p : path) svg << px(p) << ' ';
     svg << "\"/>\n";
     if (!path.empty()) {
-      const std::string start = px(path.front());
-      svg << "<circle r=\"3\" fill=\"none\" stroke=\"" << c << "\" cx=\"" << start.substr(0, start.find(',')) << "\" cy=\""
-          << start.substr(start.find(',') + 1) << "\"/>\n";
+      const Screen start = screen(path.front());
+      svg << "<circle r=\"3\" fill=\"none\" stroke=\"" << c << "\" cx=\"" << start.x << "\" cy=\"" << start.y << "\"/>\n";
     }
     const auto it = last_pose_.find(id);
     if (it != last_pose_.end()) {
       const Pose2& p = it->second;
-      const std::string centre = px(p.position_m);
-      const std::string nose = px(p.position_m + Vec2{std::cos(p.heading_rad), std::sin(p.heading_rad)} * 0.0275);
-      const std::string cx = centre.substr(0, centre.find(',')), cy = centre.substr(centre.find(',') + 1);
+      const Screen centre = screen(p.position_m);
+      const Screen nose = screen(p.position_m + Vec2{std::cos(p.heading_rad), std::sin(p.heading_rad)} * 0.0275);
+      const std::string& cx = centre.x;
+      const std::string& cy = centre.y;
       svg << "<circle r=\"" << format("%.1f", 0.0275 * scale) << "\" fill=\"" << c << "\" fill-opacity=\"0.35\" stroke=\"" << c
           << "\" cx=\"" << cx << "\" cy=\"" << cy << "\"/>\n";
-      svg << "<line stroke=\"#000\" x1=\"" << cx << "\" y1=\"" << cy << "\" x2=\"" << nose.substr(0, nose.find(','))
-          << "\" y2=\"" << nose.substr(nose.find(',') + 1) << "\"/>\n";
+      svg << "<line stroke=\"#000\" x1=\"" << cx << "\" y1=\"" << cy << "\" x2=\"" << nose.x << "\" y2=\"" << nose.y << "\"/>\n";
       svg << "<text x=\"" << cx << "\" y=\"" << cy << "\" dy=\"4\" text-anchor=\"middle\">" << id << "</text>\n";
     }
   }
