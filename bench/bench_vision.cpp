@@ -13,7 +13,7 @@
 // passes) and reports the median and 90th percentile of the per-frame times.
 //
 // Usage: bench_vision [--budget SECONDS_PER_ROW] [--frames N] [--accuracy-frames N]
-//                     [--no-jpeg] [--quick]
+//                     [--no-jpeg] [--quick] [--save-frames DIR]
 // tools/bench.sh runs it with the defaults (about 2 minutes on 2 cores).
 
 #include <apriltag/apriltag.h>
@@ -33,6 +33,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <ctime>
 #include <fstream>
 #include <functional>
@@ -62,6 +63,7 @@ struct Options {
   int min_passes = 3;
   int max_passes = 200;
   bool jpeg = true;
+  std::string save_frames_dir;  // non-empty: also write the 6UCP/9UCP Table 1 frames there as PNG
 };
 
 Options parse_options(int argc, char** argv) {
@@ -81,6 +83,8 @@ Options parse_options(int argc, char** argv) {
       o.frames = std::max(2, std::atoi(next()));
     } else if (a == "--accuracy-frames") {
       o.accuracy_frames = std::max(1, std::atoi(next()));
+    } else if (a == "--save-frames") {
+      o.save_frames_dir = next();
     } else if (a == "--no-jpeg") {
       o.jpeg = false;
     } else if (a == "--quick") {
@@ -91,7 +95,7 @@ Options parse_options(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: bench_vision [--budget SECONDS_PER_ROW] [--frames N] [--accuracy-frames N] "
-                   "[--no-jpeg] [--quick]\n");
+                   "[--no-jpeg] [--quick] [--save-frames DIR]\n");
       std::exit(a == "--help" || a == "-h" ? 0 : 2);
     }
   }
@@ -328,6 +332,17 @@ struct Frame {
   cv::Mat grey;
   std::vector<Placed> truth;
 };
+
+// Writes the frames as DIR/000.png, 001.png, ... (lossless: the exact 8-bit frames the
+// detectors get), so that a profiler can replay them outside the benchmark.
+void save_frames(const std::string& dir, const std::vector<Frame>& frames) {
+  std::filesystem::create_directories(dir);
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/%03zu.png", i);
+    cv::imwrite(dir + name, frames[i].grey);
+  }
+}
 
 std::vector<Frame> render_sequence(const std::vector<std::vector<Placed>>& motion, const std::vector<int>& ids,
                                    const Pattern& pattern, const Floor& floor, double size_px, int ss,
@@ -733,6 +748,7 @@ int main(int argc, char** argv) {
     const auto aruco_frames =
         render_sequence(motion, zero_ids, count <= 8 ? aruco8 : aruco64, floor, size1, supersample1, imaging, seed);
 
+    if (!opt.save_frames_dir.empty()) save_frames(opt.save_frames_dir + "/" + std::to_string(count), ucp_frames);
     const std::string fam_note = count <= 8 ? "8 × 6UCP (IDs 1-8)" : "64 × 9UCP (IDs 1-64; 6UCP has only 8 IDs)";
     const std::string tag_note = std::to_string(count) + " × tag36h11";
     const std::string aruco_note = count <= 8 ? "8 × DICT_4X4_50" : "64 × DICT_4X4_100 (50 IDs are too few)";

@@ -148,6 +148,9 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
       out_max[tx] = std::max({maxs[l], maxs[tx], maxs[r]});
     }
   }
+  // The darkest grey a tile's neighbourhood may have and still hold a marker's black,
+  // as a fraction (in 1/256) of its brightest.
+  const int black_ratio_256 = static_cast<int>(std::clamp(config_.max_black_to_white, 0.0, 1.0) * 255.0);
   for (int ty = ay; ty <= by; ++ty) {
     const std::size_t up = static_cast<std::size_t>(std::max(0, ty - 1)) * tiles_x_;
     const std::size_t row = static_cast<std::size_t>(ty) * tiles_x_;
@@ -163,11 +166,19 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
     std::uint8_t* __restrict__ threshold = &tile_threshold_[row];
     int tx = ax;
 #if defined(__SSE2__)
+    const __m128i ratio = _mm_set1_epi16(static_cast<short>(black_ratio_256));
+    const __m128i zero = _mm_setzero_si128();
     for (; tx + 16 <= bx + 1; tx += 16) {  // sixteen tiles per step; avg_epu8 is (a + b + 1) / 2
       const __m128i mn = _mm_min_epu8(_mm_min_epu8(load16(min_up + tx), load16(min_row + tx)), load16(min_down + tx));
       const __m128i mx = _mm_max_epu8(_mm_max_epu8(load16(max_up + tx), load16(max_row + tx)), load16(max_down + tx));
       _mm_storeu_si128(reinterpret_cast<__m128i*>(range + tx), _mm_sub_epi8(mx, mn));
-      _mm_storeu_si128(reinterpret_cast<__m128i*>(threshold + tx), _mm_avg_epu8(mn, mx));
+      // No black here: mn > mx * ratio / 256, in 16-bit lanes.
+      const __m128i light_lo = _mm_cmpgt_epi16(_mm_unpacklo_epi8(mn, zero),
+                                               _mm_srli_epi16(_mm_mullo_epi16(_mm_unpacklo_epi8(mx, zero), ratio), 8));
+      const __m128i light_hi = _mm_cmpgt_epi16(_mm_unpackhi_epi8(mn, zero),
+                                               _mm_srli_epi16(_mm_mullo_epi16(_mm_unpackhi_epi8(mx, zero), ratio), 8));
+      const __m128i no_black = _mm_packs_epi16(light_lo, light_hi);
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(threshold + tx), _mm_andnot_si128(no_black, _mm_avg_epu8(mn, mx)));
     }
 #endif
     for (; tx <= bx; ++tx) {
@@ -175,7 +186,8 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
       const std::uint8_t mx = std::max(std::max(max_up[tx], max_row[tx]), max_down[tx]);
       range[tx] = static_cast<std::uint8_t>(mx - mn);
       // (mn + mx + 1) / 2 without overflow: the rounded-up average of two bytes.
-      threshold[tx] = static_cast<std::uint8_t>((mn | mx) - ((mn ^ mx) >> 1));
+      const bool no_black = mn > ((mx * black_ratio_256) >> 8);
+      threshold[tx] = no_black ? 0 : static_cast<std::uint8_t>((mn | mx) - ((mn ^ mx) >> 1));
     }
   }
   // Sensor noise alone spans some grey levels around every tile; a tile counts as

@@ -38,6 +38,13 @@ struct BlobDetectorConfig {
   /// ...but never more than this many grey levels: a frame crowded with markers must
   /// not raise the bar to the markers' own contrast.
   int max_noise_contrast = 64;
+  /// A neighbourhood of tiles whose darkest pixel is lighter than this fraction of its
+  /// brightest holds no marker's black (printed black reflects a fifth or less of what
+  /// white does) and is not searched. This keeps the floor beside a marker's white ring,
+  /// darker than the ring but nowhere near black, from being filled as dark: on a light
+  /// floor that was two thirds of all fills. Raise towards 1 for markers under heavy
+  /// glare; 1 searches every tile with contrast.
+  double max_black_to_white = 0.7;
   /// Rows between seed scan lines of a search; 0 picks a quarter of the smallest dark
   /// disc. Larger is faster and misses markers smaller than about 2 steps.
   int seed_row_step = 0;

@@ -37,7 +37,10 @@ double cumulative_at(const std::vector<double>& cumulative, double t) {
   const int n = static_cast<int>(cumulative.size()) - 1;
   const double total = cumulative[n];
   double s = t + 0.5;
-  const double wraps = std::floor(s / n);
+  // floor(s / n) without the library call (SSE2 has no rounding instruction, and this
+  // runs hundreds of times per marker).
+  int wraps = static_cast<int>(s / n);
+  if (wraps * n > s) --wraps;
   s -= wraps * n;
   int k = static_cast<int>(s);
   if (k >= n) k = n - 1;
@@ -50,6 +53,12 @@ double cumulative_at(const std::vector<double>& cumulative, double t) {
 Decoder::Decoder(const MarkerFamily& family, const std::vector<int>& ids, DecoderConfig config)
     : config_(config), ids_(ids) {
   config_.samples = std::max(24, config_.samples);
+  config_.circles = std::clamp(config_.circles, 1, 3);
+  // One circle: the middle of the annulus; two: its inner and outer; three: all.
+  constexpr auto& radii = MarkerFamily::sample_radii;
+  if (config_.circles == 1) circle_radii_ = {radii[1]};
+  if (config_.circles == 2) circle_radii_ = {radii[0], radii[2]};
+  if (config_.circles == 3) circle_radii_ = {radii[0], radii[1], radii[2]};
   // Directions of the sampling angles, computed once: the sampler runs per blob per frame.
   for (int k = 0; k < config_.samples; ++k) {
     const double a = 2.0 * kPi * k / config_.samples;
@@ -159,13 +168,13 @@ void Decoder::sample(const cv::Mat& grey, const Blob& blob, SampledSignal& out) 
   const double a = blob.shape(0, 0) * reach, b = blob.shape(0, 1) * reach;
   const double c = blob.shape(1, 0) * reach, d = blob.shape(1, 1) * reach;
   out.values.resize(n);
-  constexpr std::size_t kRadii = std::size(MarkerFamily::sample_radii);
+  const int circles = static_cast<int>(circle_radii_.size());
   for (int k = 0; k < n; ++k) {
     const double du = a * sample_directions_[k][0] + b * sample_directions_[k][1];
     const double dv = c * sample_directions_[k][0] + d * sample_directions_[k][1];
     double sum = 0.0;
-    for (double r : MarkerFamily::sample_radii) sum += read(blob.u + r * du, blob.v + r * dv);
-    out.values[k] = sum / kRadii;
+    for (int i = 0; i < circles; ++i) sum += read(blob.u + circle_radii_[i] * du, blob.v + circle_radii_[i] * dv);
+    out.values[k] = sum / circles;
   }
   // The rings: black just outside the code, white beyond the dark disc.
   const double black_r = 0.5 * (MarkerFamily::code_outer_radius + MarkerFamily::black_ring_outer_radius);
@@ -195,6 +204,44 @@ void Decoder::sample(const cv::Mat& grey, const Blob& blob, SampledSignal& out) 
   return;
 }
 
+void Decoder::sample_code(const cv::Mat& grey, const Blob& blob, double black_level, double white_level,
+                          SampledSignal& out) const {
+  out.usable = false;
+  out.black_level = black_level;
+  out.white_level = white_level;
+  out.ring_contrast = white_level - black_level;
+  out.values.clear();
+  const int n = config_.samples;
+  constexpr double r = MarkerFamily::sample_radii[std::size(MarkerFamily::sample_radii) / 2];
+  const double scale = r / MarkerFamily::black_ring_outer_radius;
+  const double a = blob.shape(0, 0) * scale, b = blob.shape(0, 1) * scale;
+  const double c = blob.shape(1, 0) * scale, d = blob.shape(1, 1) * scale;
+  // The circle is inside the code annulus, well inside the disc; it must be inside the
+  // image with its bilinear neighbours.
+  const double half_u = std::abs(a) + std::abs(b), half_v = std::abs(c) + std::abs(d);
+  if (!(blob.u - half_u >= 0.0 && blob.v - half_v >= 0.0 && blob.u + half_u < grey.cols - 1.0 &&
+        blob.v + half_v < grey.rows - 1.0)) {
+    return;
+  }
+  const std::uint8_t* data = grey.ptr<std::uint8_t>(0);
+  const std::size_t stride = grey.step[0];
+  out.values.resize(n);
+  for (int k = 0; k < n; ++k) {
+    const double u = blob.u + a * sample_directions_[k][0] + b * sample_directions_[k][1];
+    const double v = blob.v + c * sample_directions_[k][0] + d * sample_directions_[k][1];
+    const int x = static_cast<int>(u), y = static_cast<int>(v);
+    const float fx = static_cast<float>(u - x), fy = static_cast<float>(v - y);
+    const std::uint8_t* r0 = data + static_cast<std::size_t>(y) * stride + x;
+    const std::uint8_t* r1 = r0 + stride;
+    const float top = r0[0] + (r0[1] - r0[0]) * fx;
+    const float bottom = r1[0] + (r1[1] - r1[0]) * fx;
+    out.values[k] = top + (bottom - top) * fy;
+  }
+  if (out.ring_contrast < config_.min_ring_contrast) return;
+  if (quantile_spread(out.values, 0.1, 0.9) < config_.min_code_contrast * out.ring_contrast) return;
+  out.usable = true;
+}
+
 double Decoder::correlate(const std::vector<double>& cumulative, const Ideal& ideal, double lag) const {
   double acc = 0.0;
   for (std::size_t e = 0; e < ideal.edge.size(); ++e) acc += ideal.step[e] * cumulative_at(cumulative, ideal.edge[e] + lag);
@@ -211,20 +258,26 @@ void Decoder::prepare(const SampledSignal& signal, Prepared& p) const {
   const int n = config_.samples;
   const double mean = std::accumulate(signal.values.begin(), signal.values.end(), 0.0) / n;
   double norm2 = 0.0;
-  p.cumulative.assign(n + 1, 0.0);
+  p.cumulative.resize(n + 1);
+  p.cumulative[0] = 0.0;
   for (int k = 0; k < n; ++k) {
     const double x = signal.values[k] - mean;
     norm2 += x * x;
     p.cumulative[k + 1] = p.cumulative[k] + x;
   }
   p.norm = std::sqrt(norm2);
+  p.mean = mean;
+}
+
+void Decoder::prepare_doubled(const SampledSignal& signal, Prepared& p) const {
   // The running integral is periodic because the signal is mean-free; doubling it lets
   // every lag read it without wrapping.
+  const int n = config_.samples;
   p.doubled_cumulative.resize(2 * n);
   p.doubled_signal.resize(2 * n);
-  for (int k = 0; k < 2 * n; ++k) {
-    p.doubled_cumulative[k] = p.cumulative[k % n];
-    p.doubled_signal[k] = signal.values[k % n] - mean;
+  for (int k = 0; k < n; ++k) {
+    p.doubled_cumulative[k] = p.doubled_cumulative[k + n] = p.cumulative[k];
+    p.doubled_signal[k] = p.doubled_signal[k + n] = signal.values[k] - p.mean;
   }
 }
 
@@ -296,6 +349,7 @@ std::vector<CodeMatch> Decoder::match_all(const SampledSignal& signal, const Blo
     for (const auto& ideal : ideals_) out.push_back({ideal.id, -1.0, 0.0});
     return out;
   }
+  prepare_doubled(signal, p);
   if (!slice_bounds_.empty()) return match_by_key(p, blob);
   // Coarse pass: every ID at every whole-sample lag.
   thread_local std::vector<double> scratch;
@@ -340,22 +394,26 @@ std::vector<CodeMatch> Decoder::match_by_key(const Prepared& p, const Blob& blob
   for (std::size_t i = 2; i + 1 < k; ++i) {
     if (mean_over(i) > mid) code |= 1 << (i - 2);
   }
-  std::vector<int> candidates{code};
-  for (std::size_t bit = 0; bit + 3 < k; ++bit) candidates.push_back(code ^ (1 << bit));
-  // Coarse scores of the candidates, then the sub-sample search only where it matters.
-  std::vector<std::pair<int, std::pair<int, double>>> coarse;  // index, (lag, value)
-  double best = -1e300;
-  for (int c : candidates) {
-    const int id = c + 1;
-    if (id >= static_cast<int>(index_of_id_.size()) || index_of_id_[id] < 0) continue;
-    coarse.emplace_back(index_of_id_[id], local_peak(p, ideals_[index_of_id_[id]], key_lag, kKeyLagReach));
-    best = std::max(best, coarse.back().second.second);
+  // A bit whose slice reads close to the midpoint may be misread: the code with it
+  // flipped is scored too. Clear bits need no second opinion, so a clean marker costs
+  // one exact score instead of one per bit.
+  std::array<int, 32> candidates{};
+  int count = 0;
+  candidates[count++] = code;
+  const double ambiguous = kAmbiguousBit * std::abs(white - black);
+  for (std::size_t i = 2; i + 1 < k && count < static_cast<int>(candidates.size()); ++i) {
+    if (std::abs(mean_over(i) - mid) < ambiguous) candidates[count++] = code ^ (1 << (i - 2));
   }
-  constexpr double kRefineMargin = 0.1;
-  for (const auto& [index, peak] : coarse) {
-    double lag = peak.first, value = peak.second;
-    if ((best - value) / p.norm < kRefineMargin) std::tie(lag, value) = refine_peak(p, ideals_[index], peak.first, value);
-    out[index] = {ideals_[index].id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, lag)};
+  // The candidates share the key with the template, so their peaks lie where its does:
+  // each is refined around the key's whole-sample lag.
+  const int n = config_.samples;
+  const int centre = (static_cast<int>(lag + 0.5) % n + n) % n;
+  for (int i = 0; i < count; ++i) {
+    const int id = candidates[i] + 1;
+    if (id >= static_cast<int>(index_of_id_.size()) || index_of_id_[id] < 0) continue;
+    const Ideal& ideal = ideals_[index_of_id_[id]];
+    const auto [fine_lag, value] = refine_peak(p, ideal, centre, correlate(p.cumulative, ideal, centre));
+    out[index_of_id_[id]] = {ideal.id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, fine_lag)};
   }
   return out;
 }
@@ -378,6 +436,7 @@ CodeMatch Decoder::match_one(const SampledSignal& signal, const Blob& blob, int 
     if (std::abs(offset) >= kTrackLagReach) peak.first = -1;  // on the edge: it may lie beyond
   }
   if (peak.first < 0) {
+    prepare_doubled(signal, p);
     thread_local std::vector<double> scratch;
     peak = coarse_peak(p, ideal, scratch);
   }

@@ -19,6 +19,10 @@ struct DecoderConfig {
   /// Samples around the circle. More resolves narrower slices (kUCP with large k) at a
   /// linear cost; 120 gives 3 degrees per sample.
   int samples = 120;
+  /// Circles sampled across the code annulus (1 to 3), averaged per angle. More averages
+  /// out sensor noise and JPEG blocks at a linear cost in pixel reads (the sampling is
+  /// most of a full-frame decode).
+  int circles = 1;
   /// Least grey-level difference between the marker's white outer ring and its black
   /// ring. Lower accepts fainter markers and more clutter.
   double min_ring_contrast = 20.0;
@@ -61,13 +65,20 @@ class Decoder {
   /// The same into `out`, reusing its storage (no allocation once it has grown): what a
   /// per-frame loop over many blobs uses.
   void sample(const cv::Mat& grey, const Blob& blob, SampledSignal& out) const;
+  /// The cheap sampling a tracked marker's confirmation uses: one circle (the middle of
+  /// the code annulus) instead of three, and the rings' levels given by the caller (read
+  /// by the edge fit), so no ring is sampled. The same contrast tests as sample(), except
+  /// the white ring's, which the caller has made.
+  void sample_code(const cv::Mat& grey, const Blob& blob, double black_level, double white_level,
+                   SampledSignal& out) const;
 
   /// Similarity of the signal to every available ID, in the order of ids() (the paper's
   /// Table 1 row for one object). Each entry carries the heading for that ID's best lag.
   /// For more than 16 IDs the decoder first finds the heading from the slices all IDs
-  /// share, reads the code bits there, and scores only that code and the codes one bit
-  /// away, at lags within 3 samples of the key's (they share the key, so their peaks lie
-  /// there); the others get -1 (they cannot be the best match unless two bits misread).
+  /// share, reads the code bits there, and scores only that code and the codes with one
+  /// ambiguous bit (a slice that reads near the midpoint) flipped, refined around the
+  /// key's lag (they share the key, so their peaks lie there); the others get -1 (they
+  /// cannot be the best match unless a clear bit misreads).
   std::vector<CodeMatch> match_all(const SampledSignal& signal, const Blob& blob) const;
 
   /// Similarity of the signal to one ID (which must be one of ids()): what a tracked
@@ -98,9 +109,12 @@ class Decoder {
   struct Prepared {
     std::vector<double> cumulative, doubled_cumulative, doubled_signal;
     double norm = 0.0;
+    double mean = 0.0;
   };
-  // Fills `p` (reusing its storage) from the signal.
+  // Fills `p`'s running integral and norm (reusing its storage) from the signal.
   void prepare(const SampledSignal& signal, Prepared& p) const;
+  // Adds the doubled arrays that coarse_peak reads (a search over every lag).
+  void prepare_doubled(const SampledSignal& signal, Prepared& p) const;
   // Lag (samples, on the sampling axis) at which the key's bisector points along the
   // on-screen heading for this blob's ellipse: heading_on_screen's inverse.
   double lag_of_heading(const Blob& blob, double heading_deg) const;
@@ -115,8 +129,9 @@ class Decoder {
 
   static constexpr int kRingSamples = 24;  // samples on each of the two rings
   static constexpr int kExhaustiveIds = 16;  // above this many IDs, decode by key and bits
-  // Candidates share the key, so their peak lies within a few samples of the key's.
-  static constexpr int kKeyLagReach = 3;
+  // A code bit whose slice mean lies within this fraction of the key's contrast from
+  // the midpoint is ambiguous: the code with that bit flipped is scored as well.
+  static constexpr double kAmbiguousBit = 0.25;
   // A tracked marker turns at most this many samples (3 degrees each at 120) between
   // frames before its confirmation falls back to the search over every lag.
   static constexpr int kTrackLagReach = 5;
@@ -127,6 +142,7 @@ class Decoder {
   std::vector<int> index_of_id_;                         // ID -> index in ideals_, -1 if absent
   DecoderConfig config_;
   std::vector<cv::Vec2d> sample_directions_, ring_directions_;
+  std::vector<double> circle_radii_;  // as fractions of the marker's outer radius
   std::vector<int> ids_;
   std::vector<Ideal> ideals_;
 };

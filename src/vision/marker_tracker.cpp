@@ -50,7 +50,7 @@ std::vector<int> decoder_ids(const MarkerFamily& family, const std::vector<int>&
 MarkerDetection make_detection(const Blob& blob, const CodeMatch& match, bool tracked, double threshold_grey) {
   const double disc_d = 2.0 * std::sqrt(std::abs(cv::determinant(blob.shape)));
   return {match.id, blob.u,  blob.v, match.heading_deg, match.score, disc_d / MarkerFamily::black_ring_outer_radius,
-          tracked,  threshold_grey};
+          tracked,  threshold_grey, blob.shape};
 }
 
 // Blobs at a confirmed marker's place are that marker: drop them.
@@ -155,13 +155,51 @@ std::optional<MarkerDetection> MarkerTracker::confirm(const cv::Mat& grey, const
   return make_detection(blob, m, true, 0.5 * (signal_.black_level + signal_.white_level));
 }
 
+std::optional<MarkerDetection> MarkerTracker::confirm_by_edges(const cv::Mat& grey, const Track& track) {
+  const cv::Point2d p = track.predicted();
+  Blob predicted;
+  predicted.u = p.x;
+  predicted.v = p.y;
+  predicted.shape = track.shape;
+  const auto fit = fit_disc_edges(grey, predicted, track.threshold_grey, config_.edge_fit);
+  if (!fit || fit->white_fraction < decoder_.config().min_white_ring_fraction) return std::nullopt;
+  decoder_.sample_code(grey, fit->blob, fit->black_level, fit->white_level, signal_);
+  if (!signal_.usable) return std::nullopt;
+  const CodeMatch m = decoder_.match_one(signal_, fit->blob, track.id, track.heading_deg);
+  if (m.score < config_.min_assign_score || m.score < track.score - config_.confirm_drop) return std::nullopt;
+  ++stats_.blobs;
+  ++stats_.decoded;
+  ++stats_.edge_fits;
+  return make_detection(fit->blob, m, true, 0.5 * (fit->black_level + fit->white_level));
+}
+
 std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
   const cv::Mat grey = to_grey(frame);
   stats_ = FrameStats{};
   std::vector<Blob> blobs;  // found but not confirmed: decoded against the family
   std::vector<MarkerDetection> confirmed;
   std::vector<int> confirmed_ids;
-  for (const Track& t : tracks_) {
+  auto prefetch = [&](std::size_t i) {
+    if (!config_.use_edge_fit || i >= tracks_.size()) return;
+    const cv::Point2d p = tracks_[i].predicted();
+    Blob predicted;
+    predicted.u = p.x;
+    predicted.v = p.y;
+    predicted.shape = tracks_[i].shape;
+    prefetch_disc_area(grey, predicted, config_.edge_fit);
+  };
+  prefetch(0);
+  for (std::size_t i = 0; i < tracks_.size(); ++i) {
+    const Track& t = tracks_[i];
+    prefetch(i + 1);  // its pixels load while this one is fitted
+    // The cheap way first: the outline where the prediction puts it.
+    if (config_.use_edge_fit && t.missed == 0) {
+      if (auto d = confirm_by_edges(grey, t)) {
+        confirmed.push_back(*d);
+        confirmed_ids.push_back(t.id);
+        continue;
+      }
+    }
     // A track that missed frames coasts: its window moves on and widens with them.
     const cv::Point2d p = t.predicted();
     const double half = (config_.search_window_diameters + 0.5) * t.diameter_px + t.predicted_travel();
@@ -202,7 +240,8 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
   for (const MarkerDetection& d : found) {
     auto it = std::find_if(tracks_.begin(), tracks_.end(), [&](const Track& t) { return t.id == d.id; });
     if (it == tracks_.end()) {
-      tracks_.push_back({d.id, d.u, d.v, 0.0, 0.0, d.diameter_px, d.threshold_grey, d.score, d.heading_deg, 0});
+      tracks_.push_back(
+          {d.id, d.u, d.v, 0.0, 0.0, d.diameter_px, d.threshold_grey, d.score, d.heading_deg, d.disc_shape, 0});
       continue;
     }
     const int frames = it->missed;  // frames since the last sighting, >= 1
@@ -212,6 +251,7 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     it->v = d.v;
     it->diameter_px = d.diameter_px;
     it->heading_deg = d.heading_deg;
+    it->shape = d.disc_shape;
     it->threshold_grey = d.threshold_grey;
     // The reference score is set by a full decode and only lowered slowly by
     // confirmations, so a drifting code cannot ratchet its own bar down.

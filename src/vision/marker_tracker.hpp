@@ -11,6 +11,7 @@
 
 #include "vision/blob_detector.hpp"
 #include "vision/decoder.hpp"
+#include "vision/disc_edge_fit.hpp"
 #include "vision/marker_family.hpp"
 
 namespace rilbed::vision {
@@ -34,12 +35,20 @@ struct MarkerDetection {
   bool tracked = false;
   /// Grey level midway between the marker's black and white rings in this frame.
   double threshold_grey = 0.0;
+  /// Affine map from the unit circle to the outline of the marker's dark disc (see
+  /// Blob::shape), pixels.
+  cv::Matx22d disc_shape = cv::Matx22d::eye();
 };
 
 /// Knobs of the whole pipeline.
 struct TrackerConfig {
   BlobDetectorConfig blobs;
   DecoderConfig decoder;
+  /// How a tracked marker is re-found from its outline before any fill.
+  DiscEdgeFitConfig edge_fit;
+  /// Re-find tracked markers by the edge fit first (the fill remains the fallback).
+  /// Off, every tracked marker costs a fill of its disc: several times slower.
+  bool use_edge_fit = true;
   /// Smallest similarity at which an object may take an ID. Lower finds markers in
   /// worse images but lets clutter through more often.
   double min_assign_score = 0.75;
@@ -73,6 +82,7 @@ struct FrameStats {
   int blobs = 0;             ///< candidate blobs that passed the shape tests
   int decoded = 0;           ///< blobs whose signal was decodable
   int fills = 0;             ///< dark regions filled (the detector's main work)
+  int edge_fits = 0;         ///< tracked markers confirmed from their outline, without a fill
 };
 
 /// Runs the pipeline over a stream of frames of one size. Not thread-safe; one per
@@ -108,6 +118,7 @@ class MarkerTracker {
     double threshold_grey = 0;
     double score = 0;
     double heading_deg = 0;  // on screen, as last seen
+    cv::Matx22d shape = cv::Matx22d::eye();  // the disc's outline, as last seen
     int missed = 0;
     /// Where it should be in the coming frame (constant motion, coasting over misses).
     cv::Point2d predicted() const { return {u + du * (missed + 1.0), v + dv * (missed + 1.0)}; }
@@ -117,6 +128,8 @@ class MarkerTracker {
   std::vector<MarkerDetection> assign(const cv::Mat& grey, const std::vector<Blob>& blobs, bool use_tracks,
                                       const std::vector<int>& taken_ids = {});
   std::optional<MarkerDetection> confirm(const cv::Mat& grey, const Track& track, const Blob& blob);
+  // The tracked marker re-found by the edge fit around its prediction, confirmed.
+  std::optional<MarkerDetection> confirm_by_edges(const cv::Mat& grey, const Track& track);
   cv::Mat to_grey(const cv::Mat& frame);
 
   MarkerFamily family_;

@@ -62,3 +62,42 @@ TEST(BlobDetector, RoiSearchFindsOnlyInside) {
   // A blob cut by the ROI's border is not reported.
   EXPECT_TRUE(detector.detect(img, cv::Rect(190, 70, 100, 100)).empty());
 }
+
+// On a light floor (lighter than 0.7 of the markers' white), the floor beside a
+// marker's white ring is darker than the ring but holds no black: it is not searched (no
+// fill starts there). On a darker floor it is searched again, and the markers are still
+// found.
+TEST(BlobDetector, FloorBesideTheWhiteRingIsNotFilled) {
+  const auto f = MarkerFamily::six_ucp();
+  for (double floor_grey : {120.0, 160.0, 185.0, 200.0}) {
+    cv::Mat img(200, 200, CV_8UC1, cv::Scalar(floor_grey));
+    render_marker_topdown(f, 2, 32, 10.0, floor_grey).copyTo(img(cv::Rect(50, 60, 32, 32)));
+    render_marker_topdown(f, 5, 48, 100.0, floor_grey).copyTo(img(cv::Rect(110, 100, 48, 48)));
+    BlobDetector detector;
+    detector.take_fill_count();
+    EXPECT_EQ(detector.detect(img).size(), 2u) << "floor " << floor_grey;
+    const int fills = detector.take_fill_count();
+    // Each marker's disc is one fill; a few specks of the rings' anti-aliasing may add
+    // more, but not the floor tiles around the rings (there are dozens).
+    if (floor_grey > 0.7 * 240) {
+      EXPECT_LE(fills, 6) << "floor " << floor_grey;
+    }
+  }
+}
+
+// A marker under heavy glare (its black lighter than 0.7 of its white) is found only
+// with the ratio raised.
+TEST(BlobDetector, GlareNeedsTheBlackRatioRaised) {
+  const auto f = MarkerFamily::six_ucp();
+  cv::Mat marker = render_marker_topdown(f, 2, 48, 10.0, 185.0);
+  // Compress 28..240 into 170..240: black at about 0.71 of white.
+  marker.convertTo(marker, CV_8U, 70.0 / 212.0, 170.0 - 28.0 * 70.0 / 212.0);
+  cv::Mat img(120, 120, CV_8UC1, cv::Scalar(185));
+  marker.copyTo(img(cv::Rect(30, 30, 48, 48)));
+  BlobDetector strict;
+  EXPECT_TRUE(strict.detect(img).empty());
+  BlobDetectorConfig glare;
+  glare.max_black_to_white = 0.9;
+  BlobDetector lenient(glare);
+  EXPECT_EQ(lenient.detect(img).size(), 1u);
+}

@@ -120,6 +120,37 @@ TEST(MarkerTracker, TrackedFramesSkipTheFullSearch) {
   }
 }
 
+// Once tracked, markers are re-found from their outlines (no fill of their discs), and
+// the result matches what the fill-based path gives.
+TEST(MarkerTracker, TrackedFramesUseTheEdgeFit) {
+  const auto preset = scene_preset("nominal");
+  SyntheticCamera camera(preset.camera, MarkerFamily::six_ucp(), preset.conditions, preset.clutter);
+  TrackerConfig without;
+  without.use_edge_fit = false;
+  MarkerTracker by_edges(MarkerFamily::six_ucp(), {1, 2, 3, 4, 5, 6, 7, 8});
+  MarkerTracker by_fill(MarkerFamily::six_ucp(), {1, 2, 3, 4, 5, 6, 7, 8}, without);
+  cv::RNG rng(9);
+  int edge_fits = 0;
+  for (int f = 0; f < 8; ++f) {
+    const cv::Mat img = camera.render(robots_at(f / 15.0, 8, preset, 9), rng);
+    const auto a = by_edges.process(img);
+    const auto b = by_fill.process(img);
+    ASSERT_EQ(a.size(), 8u);
+    ASSERT_EQ(b.size(), 8u);
+    if (f > 0) {
+      edge_fits += by_edges.last_stats().edge_fits;
+      EXPECT_EQ(by_fill.last_stats().edge_fits, 0);
+    }
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      EXPECT_EQ(a[i].id, b[i].id);
+      EXPECT_NEAR(a[i].u, b[i].u, 0.1);
+      EXPECT_NEAR(a[i].v, b[i].v, 0.1);
+      EXPECT_NEAR(wrap_deg_180(a[i].heading_deg - b[i].heading_deg), 0.0, 1.5);
+    }
+  }
+  EXPECT_GE(edge_fits, 7 * 7);  // nearly every tracked marker of frames 1..7
+}
+
 // Markers about 24 px across under blur and noise still decode with the right heading.
 TEST(MarkerTracker, SmallMarkersUnderBlurAndNoise) {
   const auto f = MarkerFamily::six_ucp();

@@ -1,0 +1,229 @@
+#include "vision/disc_edge_fit.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+#include "core/geometry.hpp"
+#include "vision/marker_family.hpp"
+
+namespace rilbed::vision {
+
+namespace {
+
+// Radii of the middle of the black ring and of the white ring, in units of the dark
+// disc's radius (the disc's outline is 1).
+constexpr double kBlackMid =
+    0.5 * (MarkerFamily::code_outer_radius + MarkerFamily::black_ring_outer_radius) / MarkerFamily::black_ring_outer_radius;
+constexpr double kWhiteMid = 0.5 * (1.0 + MarkerFamily::black_ring_outer_radius) / MarkerFamily::black_ring_outer_radius;
+constexpr int kMaxLines = 32;
+constexpr int kMaxPoints = 4 * kMaxLines;
+
+// Walks along a line of pixels (a row or a column; `stride` bytes between neighbours)
+// from pixel `start`, towards the outside (`outward` = +1 or -1 in pixel steps), to find
+// where the grey level crosses `threshold` from the dark disc to the bright ring; at most
+// `reach` pixels either way from `start`. Returns the crossing's offset from `start` in
+// pixels (sub-pixel, linear between the two pixels around it), or NaN.
+double walk_to_edge(const std::uint8_t* start, std::ptrdiff_t stride, int outward, int reach, double threshold) {
+  const std::ptrdiff_t step = stride * outward;
+  const bool start_dark = start[0] < threshold;
+  // From dark go outwards until bright; from bright go inwards until dark.
+  const int dir = start_dark ? 1 : -1;
+  for (int i = 0; std::abs(i) < reach; i += dir) {
+    const double g = start[i * step], g_next = start[(i + dir) * step];
+    if ((g_next < threshold) != start_dark) {
+      const double dark = start_dark ? g : g_next, bright = start_dark ? g_next : g;
+      const int dark_at = start_dark ? i : i + dir;  // the bright pixel is at dark_at + 1
+      const double span = bright - dark;
+      const double t = span > 0.0 ? std::clamp((threshold - dark) / span, 0.0, 1.0) : 0.5;
+      return (dark_at + t) * outward;
+    }
+  }
+  return std::nan("");
+}
+
+// Symmetric square root of a symmetric positive-definite 2x2 matrix.
+cv::Matx22d sqrt_spd(const cv::Matx22d& c) {
+  const double s = std::sqrt(c(0, 0) * c(1, 1) - c(0, 1) * c(1, 0));
+  const double t = std::sqrt(c(0, 0) + c(1, 1) + 2.0 * s);
+  return cv::Matx22d(c(0, 0) + s, c(0, 1), c(1, 0), c(1, 1) + s) * (1.0 / t);
+}
+
+double median_of(double* values, int count) {
+  std::nth_element(values, values + count / 2, values + count);
+  return values[count / 2];
+}
+
+}  // namespace
+
+void prefetch_disc_area(const cv::Mat& grey, const Blob& predicted, const DiscEdgeFitConfig& config) {
+  const cv::Matx22d& s = predicted.shape;
+  const double extent = (1.0 + config.reach) * kWhiteMid + 0.05;
+  const double half_u = extent * (std::abs(s(0, 0)) + std::abs(s(0, 1)));
+  const double half_v = extent * (std::abs(s(1, 0)) + std::abs(s(1, 1)));
+  const int x0 = std::max(0, static_cast<int>(predicted.u - half_u));
+  const int x1 = std::min(grey.cols - 1, static_cast<int>(predicted.u + half_u) + 1);
+  const int y0 = std::max(0, static_cast<int>(predicted.v - half_v));
+  const int y1 = std::min(grey.rows - 1, static_cast<int>(predicted.v + half_v) + 1);
+  constexpr int kLine = 64;  // bytes per cache line
+  for (int y = y0; y <= y1; ++y) {
+    const std::uint8_t* row = grey.ptr<std::uint8_t>(y);
+    for (int x = x0 & ~(kLine - 1); x <= x1; x += kLine) __builtin_prefetch(row + x);
+    __builtin_prefetch(row + x1);
+  }
+}
+
+std::optional<DiscEdgeFit> fit_disc_edges(const cv::Mat& grey, const Blob& predicted, double threshold_grey,
+                                          const DiscEdgeFitConfig& config) {
+  CV_Assert(grey.type() == CV_8UC1);
+  const int lines = std::clamp(config.lines, 2, kMaxLines);
+  const cv::Matx22d& s = predicted.shape;
+  // Every read lies within the white ring's middle of the farthest crossing: check once
+  // that all of it is inside the image (with a pixel to spare).
+  const double extent = (1.0 + config.reach) * kWhiteMid;
+  const double half_u = extent * (std::abs(s(0, 0)) + std::abs(s(0, 1))) + 2.0;
+  const double half_v = extent * (std::abs(s(1, 0)) + std::abs(s(1, 1))) + 2.0;
+  if (!(predicted.u - half_u >= 0.0 && predicted.v - half_v >= 0.0 && predicted.u + half_u < grey.cols - 1.0 &&
+        predicted.v + half_v < grey.rows - 1.0)) {
+    return std::nullopt;
+  }
+  const double det_s = cv::determinant(s);
+  if (!(det_s > 0.0)) return std::nullopt;
+  const cv::Matx22d s_inv = s.inv();
+  // The predicted outline as a quadratic form: (x - c)^T q (x - c) = 1.
+  const cv::Matx22d q = s_inv.t() * s_inv;
+  const double radius_px = std::sqrt(det_s);
+  const int reach = std::max(2, static_cast<int>(std::ceil(config.reach * radius_px)));
+  const std::uint8_t* data = grey.ptr<std::uint8_t>(0);
+  const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(grey.step[0]);
+  // Nearest pixel; coordinates are positive here (inside the image), so adding a half
+  // and truncating rounds (std::lround is a library call).
+  auto nearest = [](double x) { return static_cast<int>(x + 0.5); };
+  auto pixel = [&](double x, double y) { return data[static_cast<std::ptrdiff_t>(nearest(y)) * stride + nearest(x)]; };
+
+  // Crossings, in the prediction's unit-circle frame (S^-1 (x - c), near the unit
+  // circle), and the rings' levels read on the line from the centre through each.
+  double px[kMaxPoints], py[kMaxPoints], black[kMaxPoints], white[kMaxPoints];
+  int found = 0, tried = 0;
+  auto add_point = [&](double x, double y) {
+    const double dx = x - predicted.u, dy = y - predicted.v;
+    px[found] = s_inv(0, 0) * dx + s_inv(0, 1) * dy;
+    py[found] = s_inv(1, 0) * dx + s_inv(1, 1) * dy;
+    black[found] = pixel(predicted.u + kBlackMid * dx, predicted.v + kBlackMid * dy);
+    white[found] = pixel(predicted.u + kWhiteMid * dx, predicted.v + kWhiteMid * dy);
+    ++found;
+  };
+  // Rows across the middle of the disc find its left and right edges, columns its top
+  // and bottom: each crossing is then read where the outline is steep along the line, and
+  // along a row or column the pixels are plain bytes (no interpolation).
+  for (int axis = 0; axis < 2; ++axis) {
+    // axis 0: rows (offset d in v, edges in u); axis 1: columns (offset in u, edges in v).
+    const double q_along = axis == 0 ? q(0, 0) : q(1, 1), q_across = axis == 0 ? q(1, 1) : q(0, 0);
+    const double q_mixed = q(0, 1);
+    const double half_span = 1.0 / std::sqrt(q_across - q_mixed * q_mixed / q_along);  // the outline's extent across
+    for (int i = 0; i < lines; ++i) {
+      // Lines spread over the middle 70% of the extent, where the outline is steep.
+      const double d_target = half_span * 0.7 * (2.0 * (i + 0.5) / lines - 1.0);
+      const int line = nearest((axis == 0 ? predicted.v : predicted.u) + d_target);
+      const double d = line - (axis == 0 ? predicted.v : predicted.u);
+      const double disc = q_mixed * q_mixed * d * d - q_along * (q_across * d * d - 1.0);
+      if (disc <= 0.0) continue;
+      const double mid = -q_mixed * d / q_along, half = std::sqrt(disc) / q_along;
+      for (int side : {-1, 1}) {
+        ++tried;
+        const double along = (axis == 0 ? predicted.u : predicted.v) + mid + side * half;
+        const int start = nearest(along - 0.5 * side);  // the last pixel inside
+        const std::uint8_t* p = axis == 0 ? data + line * stride + start : data + start * stride + line;
+        const double offset = walk_to_edge(p, axis == 0 ? 1 : stride, side, reach, threshold_grey);
+        if (std::isnan(offset)) continue;
+
+        const double edge = start + offset;
+        if (axis == 0) {
+          add_point(edge, line);
+        } else {
+          add_point(line, edge);
+        }
+      }
+    }
+  }
+  if (found < std::max(6.0, config.min_edge_fraction * tried)) return std::nullopt;
+
+  // The normal equations need only the moments of the points up to the fourth order;
+  // summed as plain scalars (a loop over a small phi array made the compiler store and
+  // reload it through memory, which stalled on every point).
+  double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, sxxx = 0, sxxy = 0, sxyy = 0, syyy = 0;
+  double sxxxx = 0, sxxxy = 0, sxxyy = 0, sxyyy = 0, syyyy = 0;
+  for (int i = 0; i < found; ++i) {
+    const double x = px[i], y = py[i];
+    const double xx = x * x, xy = x * y, yy = y * y;
+    sx += x;
+    sy += y;
+    sxx += xx;
+    sxy += xy;
+    syy += yy;
+    sxxx += xx * x;
+    sxxy += xx * y;
+    sxyy += x * yy;
+    syyy += yy * y;
+    sxxxx += xx * xx;
+    sxxxy += xx * xy;
+    sxxyy += xx * yy;
+    sxyyy += xy * yy;
+    syyyy += yy * yy;
+  }
+  // Rows and columns in the order x², xy, y², x, y.
+  const double normal_values[25] = {sxxxx, sxxxy, sxxyy, sxxx, sxxy,  //
+                                    sxxxy, sxxyy, sxyyy, sxxy, sxyy,  //
+                                    sxxyy, sxyyy, syyyy, sxyy, syyy,  //
+                                    sxxx,  sxxy,  sxyy,  sxx,  sxy,   //
+                                    sxxy,  sxyy,  syyy,  sxy,  syy};
+  const cv::Matx<double, 5, 5> normal(normal_values);
+  const cv::Vec<double, 5> rhs(sxx, sxy, syy, sx, sy);
+  // Matx's own solver: a fixed-size Cholesky on the stack, no allocation.
+  const cv::Vec<double, 5> conic = normal.solve(rhs, cv::DECOMP_CHOLESKY);
+  if (!std::isfinite(conic[0]) || conic == cv::Vec<double, 5>::all(0.0)) return std::nullopt;
+  cv::Matx22d m(conic[0], 0.5 * conic[1], 0.5 * conic[1], conic[2]);
+  const double det_m = cv::determinant(m);
+  if (!(m(0, 0) > 0.0 && det_m > 0.0)) return std::nullopt;  // not an ellipse
+  const cv::Vec2d q0 = m.inv() * cv::Vec2d(-0.5 * conic[3], -0.5 * conic[4]);
+  const double level = 1.0 + q0.dot(m * q0);
+  if (!(level > 0.0)) return std::nullopt;
+  m *= 1.0 / level;  // now (q - q0)^T m (q - q0) = 1 on the outline
+
+  double residual2 = 0.0;
+  for (int i = 0; i < found; ++i) {
+    const cv::Vec2d d(px[i] - q0[0], py[i] - q0[1]);
+    const double rho = std::sqrt(std::max(0.0, d.dot(m * d))) - 1.0;
+    residual2 += rho * rho;
+  }
+  if (std::sqrt(residual2 / found) > config.max_residual) return std::nullopt;
+
+  // Back to pixels: outline = centre + S (q0 + m^-1/2 u), so the shape's square is
+  // S m^-1 S (S is symmetric).
+  const cv::Matx22d cov = s * m.inv() * s;
+  const double det_c = cv::determinant(cov);
+  if (!(det_c > 0.0)) return std::nullopt;
+  const double mean = 0.5 * (cov(0, 0) + cov(1, 1));
+  const double diff = std::sqrt(0.25 * (cov(0, 0) - cov(1, 1)) * (cov(0, 0) - cov(1, 1)) + cov(0, 1) * cov(0, 1));
+  if (!(mean - diff > 0.0) || std::sqrt((mean + diff) / (mean - diff)) > config.max_axis_ratio) return std::nullopt;
+  const double area = kPi * std::sqrt(det_c);
+  const double predicted_area = kPi * std::abs(cv::determinant(s));
+  if (std::abs(area - predicted_area) > config.max_area_change * predicted_area) return std::nullopt;
+
+  DiscEdgeFit fit;
+  const cv::Vec2d c_px = cv::Vec2d(predicted.u, predicted.v) + s * q0;
+  fit.blob.u = c_px[0];
+  fit.blob.v = c_px[1];
+  fit.blob.shape = sqrt_spd(cov);
+  fit.blob.threshold = threshold_grey;
+  fit.blob.filled_area_px = area;
+  fit.black_level = median_of(black, found);
+  fit.white_level = median_of(white, found);
+  const double mid = 0.5 * (fit.black_level + fit.white_level);
+  fit.white_fraction =
+      static_cast<double>(std::count_if(white, white + found, [&](double g) { return g > mid; })) / found;
+  return fit;
+}
+
+}  // namespace rilbed::vision

@@ -1,0 +1,69 @@
+// Re-finds a tracked marker's dark disc from its outline alone: along rows and columns
+// across the outline predicted from the last frame it finds where the grey level crosses
+// the marker's own threshold, and an ellipse fitted to those crossings gives the new
+// centre and shape. It reads a few pixels per crossing instead of filling the disc,
+// which is what makes a tracked frame a small fraction of a full-frame search. When the prediction is too
+// far off (or the marker is not there), the fit says so and the caller falls back to
+// the blob detector's fill.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <optional>
+
+#include "vision/blob_detector.hpp"
+
+namespace rilbed::vision {
+
+/// Knobs of the edge fit.
+struct DiscEdgeFitConfig {
+  /// Rows, and as many columns, across the disc; each gives two crossings (at most 32).
+  /// 6 gives a tracked centre within about 0.03 px RMS of the truth on 32 px markers.
+  /// More steadies the centre (errors average as 1/sqrt(crossings)) at a linear cost of
+  /// about 5 pixel reads per crossing.
+  int lines = 6;
+  /// How far along its row or column each crossing is looked for, inwards and outwards
+  /// from the predicted outline, as a fraction of the disc's radius. The black ring is 0.29 of
+  /// it wide and the white ring 0.28, so a larger reach would run into the code or off
+  /// the marker; a prediction off by more than this falls back to the fill.
+  double reach = 0.26;
+  /// Least fraction of the crossings looked for that must be found.
+  double min_edge_fraction = 0.85;
+  /// Largest RMS distance of the crossings from the fitted ellipse, as a fraction of its
+  /// radius. A clean disc fits within about 0.02 and a square gives about 0.05; a disc
+  /// cut by another object or a crossing on the code (prediction off) does not fit.
+  double max_residual = 0.04;
+  /// Largest change of the disc's area from the prediction's, as a fraction.
+  double max_area_change = 0.3;
+  /// Largest ratio of the ellipse's axes (as BlobDetectorConfig::max_axis_ratio).
+  double max_axis_ratio = 1.8;
+};
+
+/// What the edge fit found.
+struct DiscEdgeFit {
+  /// The disc, as the blob detector would report it (centre, shape, threshold; the
+  /// filled area is the ellipse's).
+  Blob blob;
+  /// Median grey level of the black ring and of the white ring, read on the lines from
+  /// the centre through the crossings.
+  double black_level = 0.0;
+  double white_level = 0.0;
+  /// Fraction of the white-ring reads brighter than the midpoint of the two levels.
+  double white_fraction = 0.0;
+};
+
+/// Fits the outline of the disc predicted by `predicted` (its centre and shape; see
+/// Blob) in the 8-bit grey image, with `threshold_grey` the grey level between the
+/// marker's black and white rings. Returns nothing when the marker is not close enough
+/// to the prediction, not whole inside the image, or not a clean ellipse.
+std::optional<DiscEdgeFit> fit_disc_edges(const cv::Mat& grey, const Blob& predicted, double threshold_grey,
+                                          const DiscEdgeFitConfig& config = {});
+
+/// Asks the CPU to start loading the pixels fit_disc_edges will read for `predicted`,
+/// without waiting for them. A camera frame is not in the CPU's near caches when it
+/// arrives and the fit's reads are scattered, so each would wait for memory in turn;
+/// prefetching the next marker's area while fitting the current one overlaps those
+/// waits. Does nothing outside the image; changes nothing.
+void prefetch_disc_area(const cv::Mat& grey, const Blob& predicted, const DiscEdgeFitConfig& config = {});
+
+}  // namespace rilbed::vision

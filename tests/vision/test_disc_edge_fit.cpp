@@ -1,0 +1,93 @@
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+
+#include "vision/blob_detector.hpp"
+#include "vision/disc_edge_fit.hpp"
+#include "vision/synthetic_camera.hpp"
+
+using namespace rilbed::vision;
+
+namespace {
+
+constexpr int kScale = 8;
+
+// A 32 px marker at sub-pixel position (u0 + offset, v0 + offset) on a light floor,
+// area-sampled (rendered 8x larger and averaged down). Returns the image and sets the
+// true centre of the marker.
+cv::Mat marker_image(double offset, double heading_deg, cv::Point2d& centre) {
+  const auto f = MarkerFamily::six_ucp();
+  const int size_px = 32;
+  cv::Mat big(120 * kScale, 120 * kScale, CV_8UC1, cv::Scalar(185));
+  const cv::Mat marker = render_marker_topdown(f, 3, size_px * kScale, heading_deg, 185.0, 1);
+  const int shift = static_cast<int>(std::lround(offset * kScale));
+  marker.copyTo(big(cv::Rect(40 * kScale + shift, 44 * kScale + shift, marker.cols, marker.rows)));
+  cv::Mat img;
+  cv::resize(big, img, cv::Size(120, 120), 0, 0, cv::INTER_AREA);
+  centre = {40 + shift / double(kScale) + size_px / 2.0 - 0.5, 44 + shift / double(kScale) + size_px / 2.0 - 0.5};
+  return img;
+}
+
+Blob disc_at(cv::Point2d p, double radius_px) {
+  Blob b;
+  b.u = p.x;
+  b.v = p.y;
+  b.shape = cv::Matx22d(radius_px, 0, 0, radius_px);
+  return b;
+}
+
+}  // namespace
+
+// From a prediction off by up to two pixels the fit lands on the true centre, within a
+// twentieth of a pixel, and measures the disc's size and the rings' levels.
+TEST(DiscEdgeFit, RecoversTheCentreFromAnOffPrediction) {
+  for (double offset : {0.0, 0.375, 0.75}) {
+    cv::Point2d truth;
+    const cv::Mat img = marker_image(offset, 70.0, truth);
+    for (cv::Point2d error : {cv::Point2d(0, 0), cv::Point2d(1.5, -1.0), cv::Point2d(-2.0, 1.2)}) {
+      const auto fit = fit_disc_edges(img, disc_at(truth + error, 12.0), 110.0);
+      ASSERT_TRUE(fit.has_value()) << "offset " << offset << " error " << error;
+      EXPECT_NEAR(fit->blob.u, truth.x, 0.05);
+      EXPECT_NEAR(fit->blob.v, truth.y, 0.05);
+      // The dark disc is 0.78 of the marker's 16 px radius.
+      EXPECT_NEAR(std::sqrt(cv::determinant(fit->blob.shape)), 0.78 * 16, 0.4);
+      EXPECT_LT(fit->black_level, 60.0);
+      EXPECT_GT(fit->white_level, 200.0);
+      EXPECT_GT(fit->white_fraction, 0.95);
+    }
+  }
+}
+
+// The fit follows an ellipse (a tilted view) as well as a circle.
+TEST(DiscEdgeFit, FitsATiltedEllipse) {
+  cv::Mat big(200 * kScale, 200 * kScale, CV_8UC1, cv::Scalar(200));
+  const cv::Point2d c(100.3, 90.7);
+  cv::ellipse(big, {{float(c.x * kScale + 3.5), float(c.y * kScale + 3.5)}, {30.f * kScale, 20.f * kScale}, 30.f},
+              cv::Scalar(30), cv::FILLED);
+  cv::Mat img;
+  cv::resize(big, img, cv::Size(200, 200), 0, 0, cv::INTER_AREA);
+  const auto fit = fit_disc_edges(img, disc_at(c + cv::Point2d(1, 1), 12.5), 115.0);
+  ASSERT_TRUE(fit.has_value());
+  EXPECT_NEAR(fit->blob.u, c.x, 0.05);
+  EXPECT_NEAR(fit->blob.v, c.y, 0.05);
+  // Axes 15 and 10 px: the shape's determinant is their product.
+  EXPECT_NEAR(cv::determinant(fit->blob.shape), 150.0, 5.0);
+}
+
+// A prediction too far off, an empty floor, a square and a marker cut by the image's
+// border all give no fit (the caller then falls back to the fill).
+TEST(DiscEdgeFit, RefusesWhatIsNotTheDisc) {
+  cv::Point2d truth;
+  const cv::Mat img = marker_image(0.0, 0.0, truth);
+  EXPECT_FALSE(fit_disc_edges(img, disc_at(truth + cv::Point2d(7, 0), 12.0), 110.0).has_value());
+  const cv::Mat floor(120, 120, CV_8UC1, cv::Scalar(185));
+  EXPECT_FALSE(fit_disc_edges(floor, disc_at({60, 60}, 12.0), 110.0).has_value());
+  cv::Mat square(120, 120, CV_8UC1, cv::Scalar(185));
+  cv::rectangle(square, {48, 48, 24, 24}, cv::Scalar(28), cv::FILLED);
+  EXPECT_FALSE(fit_disc_edges(square, disc_at({59.5, 59.5}, 12.0), 110.0).has_value());
+  EXPECT_FALSE(fit_disc_edges(img, disc_at({10, 60}, 12.0), 110.0).has_value());
+  // The size may not jump: a disc half the predicted size is not this track's.
+  EXPECT_FALSE(fit_disc_edges(img, disc_at(truth, 18.0), 110.0).has_value());
+}
