@@ -584,21 +584,24 @@ void print_table1(const std::vector<Row>& rows) {
   const Row& full = rows.front();
   std::printf(
       "| detector | markers | ms/frame median | ms/frame p90 | CPU ms/frame median | recall | false IDs/frame "
-      "| time ÷ rilbed full-frame (wall, CPU) | centre RMS px | centre bias u, v px | frames × passes |\n");
-  std::printf("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+      "| time ÷ rilbed full-frame (wall, CPU) | centre RMS px | centre bias u, v px | heading RMS deg "
+      "| frames × passes |\n");
+  std::printf("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
   for (const Row& r : rows) {
     std::string det = r.detector;
     if (r.full_searches >= 0) {
       det += " (full search in " + std::to_string(r.full_searches) + "/" + std::to_string(r.scored_frames) +
              " frames)";
     }
-    std::printf("| %s | %s | %s | %s | %s | %s | %s | %s, %s | %s | %s, %s | %d × %d |\n", det.c_str(),
+    // The peers report corners, not a heading: only rilbed's rows have one.
+    const bool has_heading = r.detector.rfind("rilbed", 0) == 0;
+    std::printf("| %s | %s | %s | %s | %s | %s | %s | %s, %s | %s | %s, %s | %s | %d × %d |\n", det.c_str(),
                 r.markers.c_str(), fmt("%.3f", r.median()).c_str(), fmt("%.3f", r.p90()).c_str(),
                 fmt("%.3f", r.cpu_median()).c_str(), fmt("%.3f", r.score.recall()).c_str(),
                 fmt("%.2f", r.score.false_per_frame()).c_str(), fmt("%.2f", r.median() / full.median()).c_str(),
                 fmt("%.2f", r.cpu_median() / full.cpu_median()).c_str(), fmt("%.3f", r.score.centre_rms()).c_str(),
                 fmt("%+.2f", Score::mean(r.score.du)).c_str(), fmt("%+.2f", Score::mean(r.score.dv)).c_str(),
-                r.scored_frames, r.passes);
+                has_heading ? fmt("%.2f", r.score.heading_rms()).c_str() : "—", r.scored_frames, r.passes);
   }
 }
 

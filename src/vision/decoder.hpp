@@ -67,8 +67,9 @@ class Decoder {
   void sample(const cv::Mat& grey, const Blob& blob, SampledSignal& out) const;
   /// The cheap sampling a tracked marker's confirmation uses: one circle (the middle of
   /// the code annulus) instead of three, and the rings' levels given by the caller (read
-  /// by the edge fit), so no ring is sampled. The same contrast tests as sample(), except
-  /// the white ring's, which the caller has made.
+  /// by the edge fit), so no ring is sampled. Of sample()'s contrast tests only the rings'
+  /// contrast is made: the caller has tested the white ring, and confirms the one ID by
+  /// its score, which a signal without the code's spread cannot reach.
   void sample_code(const cv::Mat& grey, const Blob& blob, double black_level, double white_level,
                    SampledSignal& out) const;
 

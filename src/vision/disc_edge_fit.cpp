@@ -50,9 +50,12 @@ cv::Matx22d sqrt_spd(const cv::Matx22d& c) {
   return cv::Matx22d(c(0, 0) + s, c(0, 1), c(1, 0), c(1, 1) + s) * (1.0 / t);
 }
 
-double median_of(double* values, int count) {
-  std::nth_element(values, values + count / 2, values + count);
-  return values[count / 2];
+// The reads lie in the middle of rings over three pixels wide, on a disc that just fitted
+// an ellipse closely: a mean is as good as a median here, and cheaper.
+double mean_of(const double* values, int count) {
+  double sum = 0.0;
+  for (int i = 0; i < count; ++i) sum += values[i];
+  return sum / count;
 }
 
 }  // namespace
@@ -218,8 +221,8 @@ std::optional<DiscEdgeFit> fit_disc_edges(const cv::Mat& grey, const Blob& predi
   fit.blob.shape = sqrt_spd(cov);
   fit.blob.threshold = threshold_grey;
   fit.blob.filled_area_px = area;
-  fit.black_level = median_of(black, found);
-  fit.white_level = median_of(white, found);
+  fit.black_level = mean_of(black, found);
+  fit.white_level = mean_of(white, found);
   const double mid = 0.5 * (fit.black_level + fit.white_level);
   fit.white_fraction =
       static_cast<double>(std::count_if(white, white + found, [&](double g) { return g > mid; })) / found;

@@ -44,7 +44,7 @@ struct DiscEdgeFit {
   /// The disc, as the blob detector would report it (centre, shape, threshold; the
   /// filled area is the ellipse's).
   Blob blob;
-  /// Median grey level of the black ring and of the white ring, read on the lines from
+  /// Mean grey level of the black ring and of the white ring, read on the lines from
   /// the centre through the crossings.
   double black_level = 0.0;
   double white_level = 0.0;

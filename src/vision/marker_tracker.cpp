@@ -46,6 +46,12 @@ std::vector<int> decoder_ids(const MarkerFamily& family, const std::vector<int>&
   return all;
 }
 
+DecoderConfig confirm_config(const TrackerConfig& config) {
+  DecoderConfig c = config.decoder;
+  c.samples = config.confirm_samples;
+  return c;
+}
+
 // A detection of `blob` as `match`; the blob's disc scaled to the marker's outer size.
 MarkerDetection make_detection(const Blob& blob, const CodeMatch& match, bool tracked, double threshold_grey) {
   const double disc_d = 2.0 * std::sqrt(std::abs(cv::determinant(blob.shape)));
@@ -69,7 +75,8 @@ MarkerTracker::MarkerTracker(MarkerFamily family, std::vector<int> ids, TrackerC
       ids_(checked_ids(family_, std::move(ids))),
       config_(config),
       detector_(config.blobs),
-      decoder_(family_, decoder_ids(family_, ids_), config.decoder) {
+      decoder_(family_, decoder_ids(family_, ids_), config.decoder),
+      confirm_decoder_(family_, ids_, confirm_config(config)) {
   for (int id : ids_) {
     const auto& all = decoder_.ids();
     decoder_index_.push_back(static_cast<int>(std::find(all.begin(), all.end(), id) - all.begin()));
@@ -163,9 +170,9 @@ std::optional<MarkerDetection> MarkerTracker::confirm_by_edges(const cv::Mat& gr
   predicted.shape = track.shape;
   const auto fit = fit_disc_edges(grey, predicted, track.threshold_grey, config_.edge_fit);
   if (!fit || fit->white_fraction < decoder_.config().min_white_ring_fraction) return std::nullopt;
-  decoder_.sample_code(grey, fit->blob, fit->black_level, fit->white_level, signal_);
+  confirm_decoder_.sample_code(grey, fit->blob, fit->black_level, fit->white_level, signal_);
   if (!signal_.usable) return std::nullopt;
-  const CodeMatch m = decoder_.match_one(signal_, fit->blob, track.id, track.heading_deg);
+  const CodeMatch m = confirm_decoder_.match_one(signal_, fit->blob, track.id, track.heading_deg);
   if (m.score < config_.min_assign_score || m.score < track.score - config_.confirm_drop) return std::nullopt;
   ++stats_.blobs;
   ++stats_.decoded;
@@ -189,9 +196,10 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     prefetch_disc_area(grey, predicted, config_.edge_fit);
   };
   prefetch(0);
+  prefetch(1);
   for (std::size_t i = 0; i < tracks_.size(); ++i) {
     const Track& t = tracks_[i];
-    prefetch(i + 1);  // its pixels load while this one is fitted
+    prefetch(i + 2);  // its pixels load while this one and the next are fitted
     // The cheap way first: the outline where the prediction puts it.
     if (config_.use_edge_fit && t.missed == 0) {
       if (auto d = confirm_by_edges(grey, t)) {

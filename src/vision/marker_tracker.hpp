@@ -49,6 +49,11 @@ struct TrackerConfig {
   /// Re-find tracked markers by the edge fit first (the fill remains the fallback).
   /// Off, every tracked marker costs a fill of its disc: several times slower.
   bool use_edge_fit = true;
+  /// Samples around the circle when a marker re-found by the edge fit is confirmed
+  /// against its own ID. Fewer than the full decode's (decoder.samples) since one ID is
+  /// checked, not told apart from the family; the heading is still refined below a
+  /// sample. More costs linearly.
+  int confirm_samples = 60;
   /// Smallest similarity at which an object may take an ID. Lower finds markers in
   /// worse images but lets clutter through more often.
   double min_assign_score = 0.75;
@@ -138,6 +143,7 @@ class MarkerTracker {
   TrackerConfig config_;
   BlobDetector detector_;
   Decoder decoder_;
+  Decoder confirm_decoder_;  // the listed IDs only, at confirm_samples: the edge-fit confirmation
   std::vector<Track> tracks_;
   FrameStats stats_;
   int frames_since_full_ = 0;
