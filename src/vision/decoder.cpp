@@ -431,10 +431,11 @@ CodeMatch Decoder::match_one(const SampledSignal& signal, const Blob& blob, int 
   std::pair<int, double> peak{-1, 0.0};
   if (expected_heading_deg) {
     const int centre = static_cast<int>(std::lround(lag_of_heading(blob, *expected_heading_deg))) % config_.samples;
-    peak = local_peak(p, ideal, centre, kTrackLagReach);
+    const int reach = static_cast<int>(std::ceil(kTrackReachDeg * config_.samples / 360.0));
+    peak = local_peak(p, ideal, centre, reach);
     const int offset = ((peak.first - centre) % config_.samples + config_.samples + config_.samples / 2) %
                            config_.samples - config_.samples / 2;
-    if (std::abs(offset) >= kTrackLagReach) peak.first = -1;  // on the edge: it may lie beyond
+    if (std::abs(offset) >= reach) peak.first = -1;  // on the edge: it may lie beyond
   }
   if (peak.first < 0) {
     prepare_doubled(signal, p);

@@ -85,7 +85,7 @@ class Decoder {
   /// Similarity of the signal to one ID (which must be one of ids()): what a tracked
   /// marker needs to confirm its ID at a fraction of match_all's cost.
   /// With `expected_heading_deg` (the heading last seen, on screen) only lags within a
-  /// few samples of it are searched; if the best of them lies on the window's edge (the
+  /// 15 degrees of it are searched; if the best of them lies on the window's edge (the
   /// marker turned further), every lag is searched as without it.
   CodeMatch match_one(const SampledSignal& signal, const Blob& blob, int id,
                       std::optional<double> expected_heading_deg = std::nullopt) const;
@@ -133,9 +133,9 @@ class Decoder {
   // A code bit whose slice mean lies within this fraction of the key's contrast from
   // the midpoint is ambiguous: the code with that bit flipped is scored as well.
   static constexpr double kAmbiguousBit = 0.25;
-  // A tracked marker turns at most this many samples (3 degrees each at 120) between
-  // frames before its confirmation falls back to the search over every lag.
-  static constexpr int kTrackLagReach = 5;
+  // A tracked marker turns at most this many degrees between frames before its
+  // confirmation falls back to the search over every lag.
+  static constexpr double kTrackReachDeg = 15.0;
   void build_key_template(const MarkerFamily& family);
   std::vector<CodeMatch> match_by_key(const Prepared& p, const Blob& blob) const;
   Ideal key_;                                            // key and guards only

@@ -21,7 +21,7 @@ struct DiscEdgeFitConfig {
   /// 6 gives a tracked centre within about 0.03 px RMS of the truth on 32 px markers.
   /// More steadies the centre (errors average as 1/sqrt(crossings)) at a linear cost of
   /// about 5 pixel reads per crossing.
-  int lines = 6;
+  int lines = 4;
   /// How far along its row or column each crossing is looked for, inwards and outwards
   /// from the predicted outline, as a fraction of the disc's radius. The black ring is 0.29 of
   /// it wide and the white ring 0.28, so a larger reach would run into the code or off

@@ -168,7 +168,14 @@ std::optional<MarkerDetection> MarkerTracker::confirm_by_edges(const cv::Mat& gr
   predicted.u = p.x;
   predicted.v = p.y;
   predicted.shape = track.shape;
-  const auto fit = fit_disc_edges(grey, predicted, track.threshold_grey, config_.edge_fit);
+  auto fit = fit_disc_edges(grey, predicted, track.threshold_grey, config_.edge_fit);
+  if (!fit && (track.du != 0.0 || track.dv != 0.0)) {
+    // It may have stopped or turned back (a bounce): where it was last is the other
+    // cheap guess before a fill.
+    predicted.u = track.u;
+    predicted.v = track.v;
+    fit = fit_disc_edges(grey, predicted, track.threshold_grey, config_.edge_fit);
+  }
   if (!fit || fit->white_fraction < decoder_.config().min_white_ring_fraction) return std::nullopt;
   confirm_decoder_.sample_code(grey, fit->blob, fit->black_level, fit->white_level, signal_);
   if (!signal_.usable) return std::nullopt;
@@ -195,11 +202,12 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     predicted.shape = tracks_[i].shape;
     prefetch_disc_area(grey, predicted, config_.edge_fit);
   };
-  prefetch(0);
-  prefetch(1);
+  // A few markers ahead: far enough for memory to answer, near enough not to evict.
+  constexpr std::size_t kPrefetchAhead = 8;
+  for (std::size_t i = 0; i < kPrefetchAhead; ++i) prefetch(i);
   for (std::size_t i = 0; i < tracks_.size(); ++i) {
     const Track& t = tracks_[i];
-    prefetch(i + 2);  // its pixels load while this one and the next are fitted
+    prefetch(i + kPrefetchAhead);  // its pixels load while the ones before it are fitted
     // The cheap way first: the outline where the prediction puts it.
     if (config_.use_edge_fit && t.missed == 0) {
       if (auto d = confirm_by_edges(grey, t)) {
