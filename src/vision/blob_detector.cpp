@@ -61,8 +61,8 @@ void BlobDetector::prepare(const cv::Mat& grey) {
   contrast_tiles_.assign(tiles, 0);
   contrast_tile_count_.assign(tiles_y_, 0);
   row_max_scratch_.assign(tiles, 0);
-  visited_ = cv::Mat::zeros(size_, CV_8UC1);
-  epoch_ = 0;
+  dark_ = cv::Mat::zeros(size_, CV_8UC1);
+  dark_written_.assign(tiles, 0);
   row_min_x_.assign(size_.height, 0);
   row_max_x_.assign(size_.height, -1);
   col_min_y_.assign(size_.width, 0);
@@ -254,26 +254,44 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
   }
 }
 
-bool BlobDetector::flood_fill(const cv::Mat& grey, cv::Rect roi, int seed_x, int seed_y, Fill& fill) {
-  // The darkness test is bound to a row once per span, not looked up per pixel; one
-  // threshold over the whole ROI (a tracked search) needs no tile lookup at all.
-  if (uniform_threshold_ > 0) {
-    const std::uint8_t t = uniform_threshold_;
-    return fill_region(roi, seed_x, seed_y, fill, [&](int y) {
-      const std::uint8_t* row = grey.ptr<std::uint8_t>(y);
-      return [row, t](int x) { return row[x] < t; };
-    });
+void BlobDetector::build_dark_mask(const cv::Mat& grey, cv::Rect roi) {
+  const int t_px = config_.tile_px;
+  const int tx0 = roi.x / t_px, tx1 = (roi.x + roi.width - 1) / t_px;
+  const int ty0 = roi.y / t_px, ty1 = (roi.y + roi.height - 1) / t_px;
+  for (int ty = ty0; ty <= ty1; ++ty) {
+    const int y0 = ty * t_px, y1 = std::min(size_.height, y0 + t_px);
+    for (int tx = tx0; tx <= tx1; ++tx) {
+      const std::size_t tile = static_cast<std::size_t>(ty) * tiles_x_ + tx;
+      const std::uint8_t t = tile_threshold_[tile];
+      const int x0 = tx * t_px, x1 = std::min(size_.width, x0 + t_px);
+      if (t == 0) {
+        // No contrast: nothing dark. Clear the block only if an earlier search wrote it.
+        if (dark_written_[tile]) {
+          for (int y = y0; y < y1; ++y) std::fill(dark_.ptr<std::uint8_t>(y) + x0, dark_.ptr<std::uint8_t>(y) + x1, 0);
+          dark_written_[tile] = 0;
+        }
+        continue;
+      }
+      dark_written_[tile] = 1;
+      for (int y = y0; y < y1; ++y) {
+        const std::uint8_t* in = grey.ptr<std::uint8_t>(y);
+        std::uint8_t* out = dark_.ptr<std::uint8_t>(y);
+        int x = x0;
+#if defined(__SSE2__)
+        if (x1 - x0 == 8) {  // the default tiles: eight pixels in one compare, x < t is max(x, t - 1) == t - 1
+          const __m128i limit = _mm_set1_epi8(static_cast<char>(t - 1));
+          const __m128i v = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(in + x));
+          _mm_storel_epi64(reinterpret_cast<__m128i*>(out + x), _mm_cmpeq_epi8(_mm_max_epu8(v, limit), limit));
+          continue;
+        }
+#endif
+        for (; x < x1; ++x) out[x] = in[x] < t ? 0xFF : 0;
+      }
+    }
   }
-  return fill_region(roi, seed_x, seed_y, fill, [&](int y) {
-    const std::uint8_t* row = grey.ptr<std::uint8_t>(y);
-    const std::uint8_t* thresholds = &tile_threshold_[static_cast<std::size_t>(tile_row_[y]) * tiles_x_];
-    const int* cols = tile_col_.data();
-    return [row, thresholds, cols](int x) { return row[x] < thresholds[cols[x]]; };
-  });
 }
 
-template <class RowDarkFn>
-bool BlobDetector::fill_region(cv::Rect roi, int seed_x, int seed_y, Fill& fill, RowDarkFn row_dark) {
+bool BlobDetector::flood_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill) {
   const double max_disc_d = config_.max_diameter_px * kDiscFraction;
   const int max_area = static_cast<int>(kPi * max_disc_d * max_disc_d / 4.0 * 1.3) + 16;
   // A region far beyond any marker is still labelled (so it is not seeded again and
@@ -283,20 +301,25 @@ bool BlobDetector::fill_region(cv::Rect roi, int seed_x, int seed_y, Fill& fill,
   const int max_extent = static_cast<int>(max_disc_d * 1.2) + 2;
   const int rx0 = roi.x, rx1 = roi.x + roi.width - 1, ry0 = roi.y, ry1 = roi.y + roi.height - 1;
   fill = Fill{0, seed_x, seed_x, seed_y, seed_y, false, false};
-  const std::uint8_t epoch = epoch_;
 
-  stack_.clear();
-  stack_.emplace_back(seed_x, seed_y);
-  while (!stack_.empty()) {
-    auto [sx, y] = stack_.back();
-    stack_.pop_back();
-    std::uint8_t* vis = visited_.ptr<std::uint8_t>(y);
-    const auto dark = row_dark(y);
-    if (vis[sx] == epoch || !dark(sx)) continue;
-    int xl = sx, xr = sx;
-    while (xl > rx0 && vis[xl - 1] != epoch && dark(xl - 1)) --xl;
-    while (xr < rx1 && vis[xr + 1] != epoch && dark(xr + 1)) ++xr;
-    std::fill(vis + xl, vis + xr + 1, epoch);
+  // A stack of seeds, each with the span of the row it was found from: that span is
+  // already filled, so the seed's own span need not look back into it.
+  struct Seed {
+    int x, y, parent_y, parent_x0, parent_x1;
+  };
+  thread_local std::vector<Seed> stack;
+  stack.clear();
+  stack.push_back({seed_x, seed_y, seed_y, 1, 0});
+  while (!stack.empty()) {
+    const Seed seed = stack.back();
+    stack.pop_back();
+    const int y = seed.y;
+    std::uint8_t* dark = dark_.ptr<std::uint8_t>(y);
+    if (!dark[seed.x]) continue;  // filled since it was pushed
+    int xl = seed.x, xr = seed.x;
+    while (xl > rx0 && dark[xl - 1]) --xl;
+    while (xr < rx1 && dark[xr + 1]) ++xr;
+    std::fill(dark + xl, dark + xr + 1, 0);
     fill.area += xr - xl + 1;
     if (xl == rx0 || xr == rx1 || y == ry0 || y == ry1) fill.touches_border = true;
     fill.x0 = std::min(fill.x0, xl);
@@ -314,12 +337,17 @@ bool BlobDetector::fill_region(cv::Rect roi, int seed_x, int seed_y, Fill& fill,
     if (fill.area > hard_limit) break;
     for (int ny : {y - 1, y + 1}) {
       if (ny < ry0 || ny > ry1) continue;
-      const std::uint8_t* nvis = visited_.ptr<std::uint8_t>(ny);
-      const auto ndark = row_dark(ny);
+      const std::uint8_t* ndark = dark_.ptr<std::uint8_t>(ny);
+      // On the parent's row, the part under the parent's span is filled: skip it.
+      const bool parent = ny == seed.parent_y;
       for (int x = xl; x <= xr; ++x) {
-        if (nvis[x] != epoch && ndark(x)) {
-          stack_.emplace_back(x, ny);
-          while (x < xr && nvis[x + 1] != epoch && ndark(x + 1)) ++x;  // one seed per run
+        if (parent && x >= seed.parent_x0 && x <= seed.parent_x1) {
+          x = seed.parent_x1;
+          continue;
+        }
+        if (ndark[x]) {
+          stack.push_back({x, ny, y, xl, xr});
+          while (x < xr && ndark[x + 1]) ++x;  // one seed per run
         }
       }
     }
@@ -460,23 +488,16 @@ bool BlobDetector::begin_search(const cv::Mat& grey, cv::Rect& roi, std::optiona
   prepare(grey);
   roi &= cv::Rect(0, 0, grey.cols, grey.rows);
   if (roi.width < 3 || roi.height < 3) return false;
-  // A new search forgets the last one's marks by moving to a new mark value instead of
-  // clearing them; the marks are cleared for real once every 255 searches.
-  if (++epoch_ == 0) {
-    visited_.setTo(0);
-    epoch_ = 1;
-  }
-  uniform_threshold_ = 0;
   if (fixed_threshold) {
     const auto t = static_cast<std::uint8_t>(std::clamp(*fixed_threshold, 1.0, 255.0));
-    uniform_threshold_ = t;
     const int t_px = config_.tile_px;
     for (int ty = roi.y / t_px; ty <= (roi.y + roi.height - 1) / t_px; ++ty) {
       for (int tx = roi.x / t_px; tx <= (roi.x + roi.width - 1) / t_px; ++tx) tile_threshold_[ty * tiles_x_ + tx] = t;
     }
-    return true;
+  } else {
+    compute_thresholds(grey, roi);
   }
-  compute_thresholds(grey, roi);
+  build_dark_mask(grey, roi);
   return true;
 }
 
@@ -485,7 +506,7 @@ bool BlobDetector::try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blo
   const double min_area = kPi * min_disc_d * min_disc_d / 4.0 / config_.max_axis_ratio * 0.8;
   Fill fill;
   ++fill_count_;
-  const bool whole = flood_fill(grey, roi, x, y, fill);
+  const bool whole = flood_fill(roi, x, y, fill);
   const bool candidate = whole && fill.area >= min_area;
   if (candidate) {
     // Column extents of the filled outline, from its row spans: only candidates pay
@@ -516,10 +537,8 @@ std::vector<Blob> BlobDetector::scan(const cv::Mat& grey, cv::Rect roi) {
   const int step = config_.seed_row_step > 0 ? config_.seed_row_step
                                              : std::max(1, static_cast<int>(min_disc_d / 4.0));
   for (int y = roi.y + step / 2; y < roi.y + roi.height; y += step) {
-    const std::uint8_t* row = grey.ptr<std::uint8_t>(y);
-    const std::uint8_t* vis = visited_.ptr<std::uint8_t>(y);
+    const std::uint8_t* dark = dark_.ptr<std::uint8_t>(y);
     const std::size_t tile_row = static_cast<std::size_t>(tile_row_[y]) * tiles_x_;
-    const std::uint8_t* tile_thresholds = &tile_threshold_[tile_row];
     const int x_end = roi.x + roi.width;
     // Only the tiles with contrast (listed when their thresholds were set): a tile
     // without contrast holds no dark pixel, and most of a plain floor is such tiles.
@@ -527,19 +546,16 @@ std::vector<Blob> BlobDetector::scan(const cv::Mat& grey, cv::Rect roi) {
     const int listed = contrast_tile_count_[tile_row_[y]];
     for (int i = 0; i < listed; ++i) {
       const int tx = list[i];
-      const std::uint8_t t = tile_thresholds[tx];
       const int xa = std::max(roi.x, tx * config_.tile_px), xb = std::min(x_end, (tx + 1) * config_.tile_px);
 #if defined(__SSE2__)
       // Most contrast tiles hold no dark pixel on a given seed row (the bright side of an
-      // edge): one compare of eight pixels skips them. x < t is max(x, t - 1) == t - 1.
-      if (xb - xa == 8 && xa + 16 <= grey.cols) {
-        const __m128i limit = _mm_set1_epi8(static_cast<char>(t - 1));
-        const __m128i v = load16(row + xa);
-        if ((_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_max_epu8(v, limit), limit)) & 0xFF) == 0) continue;
+      // edge): one load of eight mask bytes skips them.
+      if (xb - xa == 8) {
+        if (_mm_cvtsi128_si64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(dark + xa))) == 0) continue;
       }
 #endif
       for (int x = xa; x < xb; ++x) {
-        if (vis[x] == epoch_ || row[x] >= t) continue;
+        if (!dark[x]) continue;
         Blob blob;
         if (try_seed(grey, roi, x, y, blob)) blobs.push_back(blob);
       }
@@ -559,10 +575,10 @@ bool BlobDetector::seed_near(const cv::Mat& grey, cv::Rect roi, cv::Point2d expe
   if (y <= roi.y || y >= roi.y + roi.height - 1 || x0 <= roi.x || x0 >= roi.x + roi.width - 1) return false;
   // Walk outwards from the prediction to the first dark pixel: the marker's hole, a dark
   // slice or its black ring, all parts of the one dark disc.
-  const std::uint8_t* row = grey.ptr<std::uint8_t>(y);
+  const std::uint8_t* dark = dark_.ptr<std::uint8_t>(y);
   for (int d = 0; d < roi.width / 2; ++d) {
     for (int x : {x0 - d, x0 + d}) {
-      if (x <= roi.x || x >= roi.x + roi.width - 1 || row[x] >= threshold_at(x, y)) continue;
+      if (x <= roi.x || x >= roi.x + roi.width - 1 || !dark[x]) continue;
       // The dark region nearest the prediction is the marker, or the prediction failed.
       return try_seed(grey, roi, x, y, blob) &&
              std::hypot(blob.u - expected_px.x, blob.v - expected_px.y) < 0.5 * blob.disc_diameter_px();

@@ -112,9 +112,7 @@ class BlobDetector {
   std::vector<Blob> scan(const cv::Mat& grey, cv::Rect roi);
   bool try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blob& blob);
   void compute_thresholds(const cv::Mat& grey, cv::Rect roi);
-  bool flood_fill(const cv::Mat& grey, cv::Rect roi, int seed_x, int seed_y, Fill& fill);
-  template <class RowDarkFn>
-  bool fill_region(cv::Rect roi, int seed_x, int seed_y, Fill& fill, RowDarkFn row_dark);
+  bool flood_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill);
   bool measure(const cv::Mat& grey, const Fill& fill, Blob& blob) const;
   std::uint8_t threshold_at(int x, int y) const { return tile_threshold_[tile_row_[y] * tiles_x_ + tile_col_[x]]; }
 
@@ -131,9 +129,12 @@ class BlobDetector {
   mutable std::vector<std::array<double, 3>> row_chords_, col_chords_;  // measure()'s scratch
   int fill_count_ = 0;
   int floor_range_ = 0;  // the floor's local contrast found by the last large search, grey levels
-  std::uint8_t uniform_threshold_ = 0;              // nonzero: the current search uses this one threshold                             // median tile range of the last large search
-  cv::Mat visited_;                                // 8-bit: == epoch_ means filled in the current search
-  std::uint8_t epoch_ = 0;                         // mark value of the current search (never 0 during one)
+  // Per pixel, nonzero while it is dark (below its threshold) and not yet filled in the
+  // current search: the fill and the seed scan test one byte, and a fill clears what it
+  // takes. Valid inside the current search's ROI only; written per tile of contrast.
+  cv::Mat dark_;
+  std::vector<std::uint8_t> dark_written_;  // per tile: its block of dark_ may hold nonzero bytes
+  void build_dark_mask(const cv::Mat& grey, cv::Rect roi);
   std::vector<int> row_min_x_, row_max_x_, col_min_y_, col_max_y_;
   std::vector<std::pair<int, int>> stack_;
 };

@@ -107,7 +107,8 @@ Decoder::Decoder(const MarkerFamily& family, const std::vector<int>& ids, Decode
   }
   index_of_id_.assign(family.max_id() + 1, -1);
   for (std::size_t i = 0; i < ids.size(); ++i) index_of_id_[ids[i]] = static_cast<int>(i);
-  if (static_cast<int>(ids.size()) > kExhaustiveIds) build_key_template(family);
+  build_key_template(family);
+  decode_by_bits_ = static_cast<int>(ids.size()) > kExhaustiveIds;
 }
 
 void Decoder::build_key_template(const MarkerFamily& family) {
@@ -351,14 +352,20 @@ std::vector<CodeMatch> Decoder::match_all(const SampledSignal& signal, const Blo
     return out;
   }
   prepare_doubled(signal, p);
-  if (!slice_bounds_.empty()) return match_by_key(p, blob);
-  // Coarse pass: every ID at every whole-sample lag.
+  if (decode_by_bits_) return match_by_key(p, blob);
+  // Every ID shares the key and its guards, so every ID's peak lies where the key's
+  // does: find that lag once (every lag, the key's few edges), then score each ID at the
+  // whole-sample lags next to it.
   thread_local std::vector<double> scratch;
   thread_local std::vector<std::pair<int, double>> peaks;
   peaks.clear();
+  const auto [key_lag, key_value] = coarse_peak(p, key_, scratch);
+  const double lag = refine_peak(p, key_, key_lag, key_value).first;
+  const int n = config_.samples;
+  const int centre = (static_cast<int>(lag + 0.5) % n + n) % n;
   double family_best = -1e300;
   for (const Ideal& ideal : ideals_) {
-    peaks.push_back(coarse_peak(p, ideal, scratch));
+    peaks.push_back(local_peak(p, ideal, centre, 1));
     family_best = std::max(family_best, peaks.back().second);
   }
   // Fine pass only for IDs that could win.

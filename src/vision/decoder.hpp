@@ -75,6 +75,8 @@ class Decoder {
 
   /// Similarity of the signal to every available ID, in the order of ids() (the paper's
   /// Table 1 row for one object). Each entry carries the heading for that ID's best lag.
+  /// The lag comes first from the key and guards every ID shares (correlated at every
+  /// lag); each ID is then scored at the lags next to it.
   /// For more than 16 IDs the decoder first finds the heading from the slices all IDs
   /// share, reads the code bits there, and scores only that code and the codes with one
   /// ambiguous bit (a slice that reads near the midpoint) flipped, refined around the
@@ -139,6 +141,7 @@ class Decoder {
   void build_key_template(const MarkerFamily& family);
   std::vector<CodeMatch> match_by_key(const Prepared& p, const Blob& blob) const;
   Ideal key_;                                            // key and guards only
+  bool decode_by_bits_ = false;                          // more than kExhaustiveIds IDs: match_by_key
   std::vector<std::pair<double, double>> slice_bounds_;  // slices at lag 0, in samples; empty: exhaustive
   std::vector<int> index_of_id_;                         // ID -> index in ideals_, -1 if absent
   DecoderConfig config_;
