@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "core/geometry.hpp"
+#include "vision/circle_sampler.hpp"
 
 namespace rilbed::vision {
 
@@ -60,14 +61,8 @@ Decoder::Decoder(const MarkerFamily& family, const std::vector<int>& ids, Decode
   if (config_.circles == 2) circle_radii_ = {radii[0], radii[2]};
   if (config_.circles == 3) circle_radii_ = {radii[0], radii[1], radii[2]};
   // Directions of the sampling angles, computed once: the sampler runs per blob per frame.
-  for (int k = 0; k < config_.samples; ++k) {
-    const double a = 2.0 * kPi * k / config_.samples;
-    sample_directions_.emplace_back(std::cos(a), -std::sin(a));
-  }
-  for (int k = 0; k < kRingSamples; ++k) {
-    const double a = 2.0 * kPi * (k + 0.5) / kRingSamples;
-    ring_directions_.emplace_back(std::cos(a), -std::sin(a));
-  }
+  sample_directions_ = CircleDirections::make(config_.samples);
+  ring_directions_ = CircleDirections::make(kRingSamples, 0.5);
   const double n = config_.samples;
   const double deg_per_sample = 360.0 / n;
   for (int id : ids) {
@@ -155,54 +150,40 @@ void Decoder::sample(const cv::Mat& grey, const Blob& blob, SampledSignal& out) 
       blob.v + half_v > grey.rows - 1.001) {
     return;
   }
-  const std::uint8_t* data = grey.ptr<std::uint8_t>(0);
-  const std::size_t stride = grey.step[0];
-  // Unchecked bilinear read at (u, v), inside the image by the test above.
-  auto read = [&](double u, double v) {
-    const int x = static_cast<int>(u), y = static_cast<int>(v);
-    const double fx = u - x, fy = v - y;
-    const std::uint8_t* r0 = data + y * stride + x;
-    const std::uint8_t* r1 = r0 + stride;
-    return (r0[0] + (r0[1] - r0[0]) * fx) * (1 - fy) + (r1[0] + (r1[1] - r1[0]) * fx) * fy;
-  };
-  // shape maps the unit circle to the dark disc; scale it to the marker's radius units.
-  const double a = blob.shape(0, 0) * reach, b = blob.shape(0, 1) * reach;
-  const double c = blob.shape(1, 0) * reach, d = blob.shape(1, 1) * reach;
-  out.values.resize(n);
-  const int circles = static_cast<int>(circle_radii_.size());
-  for (int k = 0; k < n; ++k) {
-    const double du = a * sample_directions_[k][0] + b * sample_directions_[k][1];
-    const double dv = c * sample_directions_[k][0] + d * sample_directions_[k][1];
-    double sum = 0.0;
-    for (int i = 0; i < circles; ++i) sum += read(blob.u + circle_radii_[i] * du, blob.v + circle_radii_[i] * dv);
-    out.values[k] = sum / circles;
-  }
-  // The rings: black just outside the code, white beyond the dark disc.
+  // shape maps the unit circle to the dark disc; radii below are in the marker's units.
+  thread_local std::vector<float> black, white, circle;
+  black.resize(ring_directions_.cos.size());
+  white.resize(ring_directions_.cos.size());
+  circle.resize(sample_directions_.cos.size());
+  // The rings first: black just outside the code, white beyond the dark disc. A blob
+  // without them is not decoded at all.
   const double black_r = 0.5 * (MarkerFamily::code_outer_radius + MarkerFamily::black_ring_outer_radius);
   const double white_r = 0.5 * (MarkerFamily::black_ring_outer_radius + 1.0);
-  std::array<double, kRingSamples> black{}, white{};
-  for (int k = 0; k < kRingSamples; ++k) {
-    const double du = a * ring_directions_[k][0] + b * ring_directions_[k][1];
-    const double dv = c * ring_directions_[k][0] + d * ring_directions_[k][1];
-    black[k] = read(blob.u + black_r * du, blob.v + black_r * dv);
-    white[k] = read(blob.u + white_r * du, blob.v + white_r * dv);
-  }
-  const std::array<double, kRingSamples> white_copy = white;
-  std::nth_element(black.begin(), black.begin() + kRingSamples / 2, black.end());
-  std::nth_element(white.begin(), white.begin() + kRingSamples / 2, white.end());
-  const double black_level = black[kRingSamples / 2];
-  const double white_level = white[kRingSamples / 2];
-  out.ring_contrast = white_level - black_level;
-  out.black_level = black_level;
-  out.white_level = white_level;
+  sample_ellipse(grey, blob.u, blob.v, blob.shape, reach * black_r, ring_directions_, black.data());
+  sample_ellipse(grey, blob.u, blob.v, blob.shape, reach * white_r, ring_directions_, white.data());
+  std::array<float, kRingSamples> black_sorted{}, white_sorted{};
+  std::copy_n(black.begin(), kRingSamples, black_sorted.begin());
+  std::copy_n(white.begin(), kRingSamples, white_sorted.begin());
+  std::nth_element(black_sorted.begin(), black_sorted.begin() + kRingSamples / 2, black_sorted.end());
+  std::nth_element(white_sorted.begin(), white_sorted.begin() + kRingSamples / 2, white_sorted.end());
+  out.black_level = black_sorted[kRingSamples / 2];
+  out.white_level = white_sorted[kRingSamples / 2];
+  out.ring_contrast = out.white_level - out.black_level;
   if (out.ring_contrast < config_.min_ring_contrast) return;
-  const double mid = 0.5 * (black_level + white_level);
-  const auto bright = std::count_if(white_copy.begin(), white_copy.end(), [&](double g) { return g > mid; });
+  const double mid = 0.5 * (out.black_level + out.white_level);
+  const auto bright = std::count_if(white.begin(), white.begin() + kRingSamples, [&](float g) { return g > mid; });
   if (bright < config_.min_white_ring_fraction * kRingSamples) return;
+
+  out.values.assign(n, 0.0);
+  for (double r : circle_radii_) {
+    sample_ellipse(grey, blob.u, blob.v, blob.shape, reach * r, sample_directions_, circle.data());
+    for (int k = 0; k < n; ++k) out.values[k] += circle[k];
+  }
+  const double circles = static_cast<double>(circle_radii_.size());
+  for (double& value : out.values) value /= circles;
   const double spread = quantile_spread(out.values, 0.1, 0.9);
   if (spread < config_.min_code_contrast * out.ring_contrast) return;
   out.usable = true;
-  return;
 }
 
 void Decoder::sample_code(const cv::Mat& grey, const Blob& blob, double black_level, double white_level,
@@ -215,29 +196,18 @@ void Decoder::sample_code(const cv::Mat& grey, const Blob& blob, double black_le
   const int n = config_.samples;
   constexpr double r = MarkerFamily::sample_radii[std::size(MarkerFamily::sample_radii) / 2];
   const double scale = r / MarkerFamily::black_ring_outer_radius;
-  const double a = blob.shape(0, 0) * scale, b = blob.shape(0, 1) * scale;
-  const double c = blob.shape(1, 0) * scale, d = blob.shape(1, 1) * scale;
   // The circle is inside the code annulus, well inside the disc; it must be inside the
   // image with its bilinear neighbours.
-  const double half_u = std::abs(a) + std::abs(b), half_v = std::abs(c) + std::abs(d);
+  const double half_u = scale * (std::abs(blob.shape(0, 0)) + std::abs(blob.shape(0, 1)));
+  const double half_v = scale * (std::abs(blob.shape(1, 0)) + std::abs(blob.shape(1, 1)));
   if (!(blob.u - half_u >= 0.0 && blob.v - half_v >= 0.0 && blob.u + half_u < grey.cols - 1.0 &&
         blob.v + half_v < grey.rows - 1.0)) {
     return;
   }
-  const std::uint8_t* data = grey.ptr<std::uint8_t>(0);
-  const std::size_t stride = grey.step[0];
-  out.values.resize(n);
-  for (int k = 0; k < n; ++k) {
-    const double u = blob.u + a * sample_directions_[k][0] + b * sample_directions_[k][1];
-    const double v = blob.v + c * sample_directions_[k][0] + d * sample_directions_[k][1];
-    const int x = static_cast<int>(u), y = static_cast<int>(v);
-    const float fx = static_cast<float>(u - x), fy = static_cast<float>(v - y);
-    const std::uint8_t* r0 = data + static_cast<std::size_t>(y) * stride + x;
-    const std::uint8_t* r1 = r0 + stride;
-    const float top = r0[0] + (r0[1] - r0[0]) * fx;
-    const float bottom = r1[0] + (r1[1] - r1[0]) * fx;
-    out.values[k] = top + (bottom - top) * fy;
-  }
+  thread_local std::vector<float> circle;
+  circle.resize(sample_directions_.cos.size());
+  sample_ellipse(grey, blob.u, blob.v, blob.shape, scale, sample_directions_, circle.data());
+  out.values.assign(circle.begin(), circle.begin() + n);
   // No code-spread test: the caller confirms one ID by its score, which a signal
   // without the code's spread cannot reach.
   if (out.ring_contrast < config_.min_ring_contrast) return;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "vision/blob_detector.hpp"
+#include "vision/circle_sampler.hpp"
 #include "vision/marker_family.hpp"
 
 namespace rilbed::vision {
@@ -145,7 +146,7 @@ class Decoder {
   std::vector<std::pair<double, double>> slice_bounds_;  // slices at lag 0, in samples; empty: exhaustive
   std::vector<int> index_of_id_;                         // ID -> index in ideals_, -1 if absent
   DecoderConfig config_;
-  std::vector<cv::Vec2d> sample_directions_, ring_directions_;
+  CircleDirections sample_directions_, ring_directions_;
   std::vector<double> circle_radii_;  // as fractions of the marker's outer radius
   std::vector<int> ids_;
   std::vector<Ideal> ideals_;

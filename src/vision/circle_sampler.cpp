@@ -1,0 +1,81 @@
+#include "vision/circle_sampler.hpp"
+
+#include <cmath>
+#include <cstdint>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include "core/geometry.hpp"
+
+namespace rilbed::vision {
+
+CircleDirections CircleDirections::make(int count, double phase) {
+  CircleDirections d;
+  d.count = count;
+  const int padded = (count + 3) & ~3;
+  // Padding directions are zero: they read the centre, which is inside the image.
+  d.cos.assign(padded, 0.0f);
+  d.sin.assign(padded, 0.0f);
+  for (int k = 0; k < count; ++k) {
+    const double a = 2.0 * kPi * (k + phase) / count;
+    d.cos[k] = static_cast<float>(std::cos(a));
+    d.sin[k] = static_cast<float>(-std::sin(a));
+  }
+  return d;
+}
+
+void sample_ellipse(const cv::Mat& grey, double centre_u, double centre_v, const cv::Matx22d& shape, double radius,
+                    const CircleDirections& directions, float* out) {
+  const std::uint8_t* data = grey.ptr<std::uint8_t>(0);
+  const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(grey.step[0]);
+  const auto a = static_cast<float>(shape(0, 0) * radius), b = static_cast<float>(shape(0, 1) * radius);
+  const auto c = static_cast<float>(shape(1, 0) * radius), d = static_cast<float>(shape(1, 1) * radius);
+  const auto cu = static_cast<float>(centre_u), cv = static_cast<float>(centre_v);
+  const int n = static_cast<int>(directions.cos.size());
+  auto pixel_quad = [&](int x, int y, float fx, float fy) {
+    const std::uint8_t* p = data + static_cast<std::ptrdiff_t>(y) * stride + x;
+    const float top = p[0] + (p[1] - p[0]) * fx;
+    const float bottom = p[stride] + (p[stride + 1] - p[stride]) * fx;
+    return top + (bottom - top) * fy;
+  };
+#if defined(__SSE2__)
+  // Four points per step: their coordinates, whole and fractional parts in SSE; the
+  // sixteen pixel reads are scalar (SSE2 has no gather), the interpolation is SSE again.
+  const __m128 va = _mm_set1_ps(a), vb = _mm_set1_ps(b), vc = _mm_set1_ps(c), vd = _mm_set1_ps(d);
+  const __m128 vcu = _mm_set1_ps(cu), vcv = _mm_set1_ps(cv);
+  alignas(16) int xs[4], ys[4];
+  alignas(16) float p00[4], p01[4], p10[4], p11[4];
+  for (int k = 0; k < n; k += 4) {
+    const __m128 dx = _mm_loadu_ps(&directions.cos[k]), dy = _mm_loadu_ps(&directions.sin[k]);
+    const __m128 u = _mm_add_ps(vcu, _mm_add_ps(_mm_mul_ps(va, dx), _mm_mul_ps(vb, dy)));
+    const __m128 v = _mm_add_ps(vcv, _mm_add_ps(_mm_mul_ps(vc, dx), _mm_mul_ps(vd, dy)));
+    const __m128i ui = _mm_cvttps_epi32(u), vi = _mm_cvttps_epi32(v);  // floor: coordinates are positive
+    const __m128 fx = _mm_sub_ps(u, _mm_cvtepi32_ps(ui)), fy = _mm_sub_ps(v, _mm_cvtepi32_ps(vi));
+    _mm_store_si128(reinterpret_cast<__m128i*>(xs), ui);
+    _mm_store_si128(reinterpret_cast<__m128i*>(ys), vi);
+    for (int j = 0; j < 4; ++j) {
+      const std::uint8_t* p = data + static_cast<std::ptrdiff_t>(ys[j]) * stride + xs[j];
+      p00[j] = p[0];
+      p01[j] = p[1];
+      p10[j] = p[stride];
+      p11[j] = p[stride + 1];
+    }
+    const __m128 a00 = _mm_load_ps(p00), a01 = _mm_load_ps(p01), a10 = _mm_load_ps(p10), a11 = _mm_load_ps(p11);
+    const __m128 top = _mm_add_ps(a00, _mm_mul_ps(_mm_sub_ps(a01, a00), fx));
+    const __m128 bottom = _mm_add_ps(a10, _mm_mul_ps(_mm_sub_ps(a11, a10), fx));
+    _mm_storeu_ps(out + k, _mm_add_ps(top, _mm_mul_ps(_mm_sub_ps(bottom, top), fy)));
+  }
+#else
+  for (int k = 0; k < n; ++k) {
+    const float u = cu + a * directions.cos[k] + b * directions.sin[k];
+    const float v = cv + c * directions.cos[k] + d * directions.sin[k];
+    const int x = static_cast<int>(u), y = static_cast<int>(v);
+    out[k] = pixel_quad(x, y, u - x, v - y);
+  }
+#endif
+  (void)pixel_quad;
+}
+
+}  // namespace rilbed::vision

@@ -1,0 +1,29 @@
+// Bilinear grey levels at many points of an ellipse in an 8-bit image, four at a time:
+// the decoder's sampling of a marker's code circle and rings, which is most of a full
+// decode's pixel work.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <vector>
+
+namespace rilbed::vision {
+
+/// Unit directions around a circle, kept as separate float arrays (what the four-wide
+/// sampler reads), padded to a multiple of four.
+struct CircleDirections {
+  std::vector<float> cos, sin;
+  int count = 0;  ///< directions in use (the arrays may be longer)
+  /// `count` directions at angles 2π(k + phase)/count, k = 0..count-1, counter-clockwise
+  /// on screen (v down): (cos a, -sin a).
+  static CircleDirections make(int count, double phase = 0.0);
+};
+
+/// Writes to `out[k]` the bilinear grey level at centre + radius · M · d_k, where M maps
+/// the unit circle onto the ellipse (as Blob::shape) and d_k are the directions. The
+/// caller guarantees that every point and its right and lower neighbours are inside the
+/// image (no check here). `out` must hold directions.cos.size() floats.
+void sample_ellipse(const cv::Mat& grey, double centre_u, double centre_v, const cv::Matx22d& shape, double radius,
+                    const CircleDirections& directions, float* out);
+
+}  // namespace rilbed::vision
