@@ -19,6 +19,8 @@ constexpr double kDiscFraction = MarkerFamily::black_ring_outer_radius;
 // Pixels are sampled every kStatStep rows for the tile statistics (every column): the
 // thinnest feature they must see (a 24 px marker's black ring) is over 2 px wide.
 constexpr int kStatStep = 2;
+// Zero bytes kept on each side of every row of the dark mask.
+constexpr int kMaskPad = 16;
 }  // namespace
 
 #if defined(__SSE2__)
@@ -61,7 +63,10 @@ void BlobDetector::prepare(const cv::Mat& grey) {
   contrast_tiles_.assign(tiles, 0);
   contrast_tile_count_.assign(tiles_y_, 0);
   row_max_scratch_.assign(tiles, 0);
-  dark_ = cv::Mat::zeros(size_, CV_8UC1);
+  // Sixteen zero bytes beside every row, so that sixteen-byte loads around any pixel of
+  // a row stay in the buffer and read "not dark" outside the image.
+  dark_storage_ = cv::Mat::zeros(size_.height, size_.width + 2 * kMaskPad, CV_8UC1);
+  dark_ = dark_storage_(cv::Rect(kMaskPad, 0, size_.width, size_.height));
   dark_written_.assign(tiles, 0);
   row_min_x_.assign(size_.height, 0);
   row_max_x_.assign(size_.height, -1);
@@ -258,38 +263,103 @@ void BlobDetector::build_dark_mask(const cv::Mat& grey, cv::Rect roi) {
   const int t_px = config_.tile_px;
   const int tx0 = roi.x / t_px, tx1 = (roi.x + roi.width - 1) / t_px;
   const int ty0 = roi.y / t_px, ty1 = (roi.y + roi.height - 1) / t_px;
+  thread_local std::vector<int> contrast;  // tile columns with contrast in this tile row
   for (int ty = ty0; ty <= ty1; ++ty) {
     const int y0 = ty * t_px, y1 = std::min(size_.height, y0 + t_px);
+    const std::size_t row = static_cast<std::size_t>(ty) * tiles_x_;
+    contrast.clear();
     for (int tx = tx0; tx <= tx1; ++tx) {
-      const std::size_t tile = static_cast<std::size_t>(ty) * tiles_x_ + tx;
-      const std::uint8_t t = tile_threshold_[tile];
-      const int x0 = tx * t_px, x1 = std::min(size_.width, x0 + t_px);
-      if (t == 0) {
-        // No contrast: nothing dark. Clear the block only if an earlier search wrote it.
-        if (dark_written_[tile]) {
-          for (int y = y0; y < y1; ++y) std::fill(dark_.ptr<std::uint8_t>(y) + x0, dark_.ptr<std::uint8_t>(y) + x1, 0);
-          dark_written_[tile] = 0;
-        }
-        continue;
+      if (tile_threshold_[row + tx] != 0) {
+        contrast.push_back(tx);
+        dark_written_[row + tx] = 1;
+      } else if (dark_written_[row + tx]) {
+        // No contrast now, but an earlier search wrote this block: nothing is dark.
+        const int x0 = tx * t_px, x1 = std::min(size_.width, x0 + t_px);
+        for (int y = y0; y < y1; ++y) std::fill(dark_.ptr<std::uint8_t>(y) + x0, dark_.ptr<std::uint8_t>(y) + x1, 0);
+        dark_written_[row + tx] = 0;
       }
-      dark_written_[tile] = 1;
-      for (int y = y0; y < y1; ++y) {
-        const std::uint8_t* in = grey.ptr<std::uint8_t>(y);
-        std::uint8_t* out = dark_.ptr<std::uint8_t>(y);
-        int x = x0;
+    }
+    // Row by row across the tile row (not tile by tile down it), so that the frame is
+    // read as a stream: a new frame is not in the caches yet.
+    for (int y = y0; y < y1; ++y) {
+      const std::uint8_t* in = grey.ptr<std::uint8_t>(y);
+      std::uint8_t* out = dark_.ptr<std::uint8_t>(y);
+      for (int tx : contrast) {
+        const std::uint8_t t = tile_threshold_[row + tx];
+        const int x0 = tx * t_px, x1 = std::min(size_.width, x0 + t_px);
 #if defined(__SSE2__)
         if (x1 - x0 == 8) {  // the default tiles: eight pixels in one compare, x < t is max(x, t - 1) == t - 1
           const __m128i limit = _mm_set1_epi8(static_cast<char>(t - 1));
-          const __m128i v = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(in + x));
-          _mm_storel_epi64(reinterpret_cast<__m128i*>(out + x), _mm_cmpeq_epi8(_mm_max_epu8(v, limit), limit));
+          const __m128i v = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(in + x0));
+          _mm_storel_epi64(reinterpret_cast<__m128i*>(out + x0), _mm_cmpeq_epi8(_mm_max_epu8(v, limit), limit));
           continue;
         }
 #endif
-        for (; x < x1; ++x) out[x] = in[x] < t ? 0xFF : 0;
+        for (int x = x0; x < x1; ++x) out[x] = in[x] < t ? 0xFF : 0;
       }
     }
   }
 }
+
+namespace {
+
+// The first and last pixel of the run of nonzero mask bytes through `x` (mask[x] != 0),
+// in a row with zero padding on both sides (so every run ends inside the buffer).
+int run_start(const std::uint8_t* mask, int x) {
+#if defined(__SSE2__)
+  for (;;) {  // sixteen bytes ending at x, looking for the last zero
+    const unsigned zeros =
+        static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(load16(mask + x - 15), _mm_setzero_si128())));
+    if (zeros != 0) return x - 15 + (31 - __builtin_clz(zeros)) + 1;
+    x -= 16;
+  }
+#else
+  while (mask[x - 1]) --x;
+  return x;
+#endif
+}
+
+int run_end(const std::uint8_t* mask, int x) {
+#if defined(__SSE2__)
+  for (;;) {  // sixteen bytes starting at x, looking for the first zero
+    const unsigned zeros =
+        static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(load16(mask + x), _mm_setzero_si128())));
+    if (zeros != 0) return x + __builtin_ctz(zeros) - 1;
+    x += 16;
+  }
+#else
+  while (mask[x + 1]) ++x;
+  return x;
+#endif
+}
+
+// Calls `seed(x)` once per run of nonzero mask bytes within [a, b], at the run's first
+// pixel in that range.
+template <class SeedFn>
+void for_each_run(const std::uint8_t* mask, int a, int b, SeedFn&& seed) {
+#if defined(__SSE2__)
+  unsigned carry = 0;  // the pixel before the chunk was dark (and in range)
+  for (int x = a; x <= b; x += 16) {
+    unsigned bits =
+        ~static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(load16(mask + x), _mm_setzero_si128()))) & 0xFFFFu;
+    if (b - x < 15) bits &= (1u << (b - x + 1)) - 1;
+    unsigned starts = bits & ~((bits << 1) | carry);
+    while (starts != 0) {
+      seed(x + __builtin_ctz(starts));
+      starts &= starts - 1;
+    }
+    carry = (bits >> 15) & 1u;
+  }
+#else
+  for (int x = a; x <= b; ++x) {
+    if (!mask[x]) continue;
+    seed(x);
+    while (x < b && mask[x + 1]) ++x;
+  }
+#endif
+}
+
+}  // namespace
 
 bool BlobDetector::flood_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill) {
   const double max_disc_d = config_.max_diameter_px * kDiscFraction;
@@ -316,9 +386,8 @@ bool BlobDetector::flood_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill) 
     const int y = seed.y;
     std::uint8_t* dark = dark_.ptr<std::uint8_t>(y);
     if (!dark[seed.x]) continue;  // filled since it was pushed
-    int xl = seed.x, xr = seed.x;
-    while (xl > rx0 && dark[xl - 1]) --xl;
-    while (xr < rx1 && dark[xr + 1]) ++xr;
+    const int xl = std::max(rx0, run_start(dark, seed.x));
+    const int xr = std::min(rx1, run_end(dark, seed.x));
     std::fill(dark + xl, dark + xr + 1, 0);
     fill.area += xr - xl + 1;
     if (xl == rx0 || xr == rx1 || y == ry0 || y == ry1) fill.touches_border = true;
@@ -339,16 +408,12 @@ bool BlobDetector::flood_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill) 
       if (ny < ry0 || ny > ry1) continue;
       const std::uint8_t* ndark = dark_.ptr<std::uint8_t>(ny);
       // On the parent's row, the part under the parent's span is filled: skip it.
-      const bool parent = ny == seed.parent_y;
-      for (int x = xl; x <= xr; ++x) {
-        if (parent && x >= seed.parent_x0 && x <= seed.parent_x1) {
-          x = seed.parent_x1;
-          continue;
-        }
-        if (ndark[x]) {
-          stack.push_back({x, ny, y, xl, xr});
-          while (x < xr && ndark[x + 1]) ++x;  // one seed per run
-        }
+      auto push = [&](int x) { stack.push_back({x, ny, y, xl, xr}); };
+      if (ny == seed.parent_y) {
+        for_each_run(ndark, xl, std::min(xr, seed.parent_x0 - 1), push);
+        for_each_run(ndark, std::max(xl, seed.parent_x1 + 1), xr, push);
+      } else {
+        for_each_run(ndark, xl, xr, push);
       }
     }
   }

@@ -132,7 +132,8 @@ class BlobDetector {
   // Per pixel, nonzero while it is dark (below its threshold) and not yet filled in the
   // current search: the fill and the seed scan test one byte, and a fill clears what it
   // takes. Valid inside the current search's ROI only; written per tile of contrast.
-  cv::Mat dark_;
+  cv::Mat dark_;          // a view into dark_storage_, the image's size
+  cv::Mat dark_storage_;  // dark_ with zero bytes beside each row
   std::vector<std::uint8_t> dark_written_;  // per tile: its block of dark_ may hold nonzero bytes
   void build_dark_mask(const cv::Mat& grey, cv::Rect roi);
   std::vector<int> row_min_x_, row_max_x_, col_min_y_, col_max_y_;
