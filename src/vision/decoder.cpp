@@ -286,24 +286,26 @@ std::pair<int, double> Decoder::local_peak(const Prepared& p, const Ideal& ideal
 }
 
 std::pair<double, double> Decoder::refine_peak(const Prepared& p, const Ideal& ideal, int lag, double value) const {
-  // Golden-section search of the (unimodal near its peak) correlation on
-  // [lag - 1, lag + 1]; 10 steps narrow it to 0.02 samples (0.06 degrees at 120).
-  double lo = lag - 1.0, hi = lag + 1.0;
-  constexpr double kInvPhi = 0.6180339887498949;
-  double m1 = hi - kInvPhi * (hi - lo), m2 = lo + kInvPhi * (hi - lo);
-  double c1 = correlate(p.cumulative, ideal, m1), c2 = correlate(p.cumulative, ideal, m2);
-  for (int it = 0; it < 10; ++it) {
-    if (c1 < c2) {
-      lo = m1; m1 = m2; c1 = c2;
-      m2 = lo + kInvPhi * (hi - lo);
-      c2 = correlate(p.cumulative, ideal, m2);
-    } else {
-      hi = m2; m2 = m1; c2 = c1;
-      m1 = hi - kInvPhi * (hi - lo);
-      c1 = correlate(p.cumulative, ideal, m1);
+  // The running integral is linear between bin boundaries, so the correlation (a sum of
+  // it at each edge plus the lag) is piecewise linear in the lag, with corners where an
+  // edge crosses a bin boundary. Its maximum on [lag - 1, lag + 1] is at one of those
+  // corners or an end: evaluating them all finds it exactly (two corners per edge).
+  const double lo = lag - 1.0, hi = lag + 1.0;
+  double best_lag = lag, best = value;
+  auto consider = [&](double t) {
+    const double c = correlate(p.cumulative, ideal, t);
+    if (c > best) {
+      best = c;
+      best_lag = t;
     }
+  };
+  consider(lo);
+  consider(hi);
+  for (double edge : ideal.edge) {
+    // Corners where edge + t + 0.5 is a whole number.
+    for (double t = std::ceil(lo + edge + 0.5) - edge - 0.5; t <= hi; t += 1.0) consider(t);
   }
-  return {0.5 * (lo + hi), std::max({value, c1, c2})};
+  return {best_lag, best};
 }
 
 std::vector<CodeMatch> Decoder::match_all(const SampledSignal& signal, const Blob& blob) const {

@@ -103,18 +103,20 @@ std::optional<DiscEdgeFit> fit_disc_edges(const cv::Mat& grey, const Blob& predi
   // Nearest pixel; coordinates are positive here (inside the image), so adding a half
   // and truncating rounds (std::lround is a library call).
   auto nearest = [](double x) { return static_cast<int>(x + 0.5); };
-  auto pixel = [&](double x, double y) { return data[static_cast<std::ptrdiff_t>(nearest(y)) * stride + nearest(x)]; };
+  // The rings' half-widths along a row: at least their radial half-widths (0.15 and 0.14
+  // of the radius) anywhere in the middle of the disc.
+  const int black_step = std::max(1, nearest((1.0 - kBlackMid) * radius_px));
+  const int white_step = std::max(1, nearest((kWhiteMid - 1.0) * radius_px));
 
   // Crossings, in the prediction's unit-circle frame (S^-1 (x - c), near the unit
-  // circle), and the rings' levels read on the line from the centre through each.
+  // circle); and on the rows, the rings' levels read on the same row (pixels the walk
+  // has mostly brought into the cache already).
   double px[kMaxPoints], py[kMaxPoints], black[kMaxPoints], white[kMaxPoints];
-  int found = 0, tried = 0;
+  int found = 0, tried = 0, levels = 0;
   auto add_point = [&](double x, double y) {
     const double dx = x - predicted.u, dy = y - predicted.v;
     px[found] = s_inv(0, 0) * dx + s_inv(0, 1) * dy;
     py[found] = s_inv(1, 0) * dx + s_inv(1, 1) * dy;
-    black[found] = pixel(predicted.u + kBlackMid * dx, predicted.v + kBlackMid * dy);
-    white[found] = pixel(predicted.u + kWhiteMid * dx, predicted.v + kWhiteMid * dy);
     ++found;
   };
   // Rows across the middle of the disc find its left and right edges, columns its top
@@ -144,6 +146,11 @@ std::optional<DiscEdgeFit> fit_disc_edges(const cv::Mat& grey, const Blob& predi
         const double edge = start + offset;
         if (axis == 0) {
           add_point(edge, line);
+          const std::uint8_t* row = data + line * stride;
+          const int at = nearest(edge);
+          black[levels] = row[at - side * black_step];
+          white[levels] = row[at + side * white_step];
+          ++levels;
         } else {
           add_point(line, edge);
         }
@@ -221,11 +228,12 @@ std::optional<DiscEdgeFit> fit_disc_edges(const cv::Mat& grey, const Blob& predi
   fit.blob.shape = sqrt_spd(cov);
   fit.blob.threshold = threshold_grey;
   fit.blob.filled_area_px = area;
-  fit.black_level = mean_of(black, found);
-  fit.white_level = mean_of(white, found);
+  if (levels < 4) return std::nullopt;
+  fit.black_level = mean_of(black, levels);
+  fit.white_level = mean_of(white, levels);
   const double mid = 0.5 * (fit.black_level + fit.white_level);
   fit.white_fraction =
-      static_cast<double>(std::count_if(white, white + found, [&](double g) { return g > mid; })) / found;
+      static_cast<double>(std::count_if(white, white + levels, [&](double g) { return g > mid; })) / levels;
   return fit;
 }
 

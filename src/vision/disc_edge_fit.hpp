@@ -44,8 +44,8 @@ struct DiscEdgeFit {
   /// The disc, as the blob detector would report it (centre, shape, threshold; the
   /// filled area is the ellipse's).
   Blob blob;
-  /// Mean grey level of the black ring and of the white ring, read on the lines from
-  /// the centre through the crossings.
+  /// Mean grey level of the black ring and of the white ring, read on the rows of the
+  /// crossings, inside and outside each.
   double black_level = 0.0;
   double white_level = 0.0;
   /// Fraction of the white-ring reads brighter than the midpoint of the two levels.
