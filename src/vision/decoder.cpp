@@ -214,9 +214,19 @@ void Decoder::sample_code(const cv::Mat& grey, const Blob& blob, double black_le
   out.usable = true;
 }
 
-double Decoder::correlate(const std::vector<double>& cumulative, const Ideal& ideal, double lag) const {
+double Decoder::correlate(const Prepared& p, const Ideal& ideal, double lag) const {
+  // The lag into [0, n) once; then every edge + lag lies in [0, 2n) and reads the doubled
+  // running integral directly (no wrapping per edge).
+  const double n = config_.samples;
+  while (lag < 0.0) lag += n;
+  while (lag >= n) lag -= n;
+  const double* c = p.doubled_cumulative.data();
   double acc = 0.0;
-  for (std::size_t e = 0; e < ideal.edge.size(); ++e) acc += ideal.step[e] * cumulative_at(cumulative, ideal.edge[e] + lag);
+  for (std::size_t e = 0; e < ideal.edge.size(); ++e) {
+    const double s = ideal.edge[e] + lag + 0.5;
+    const int k = static_cast<int>(s);
+    acc += ideal.step[e] * (c[k] + (s - k) * (c[k + 1] - c[k]));
+  }
   return acc;
 }
 
@@ -239,18 +249,21 @@ void Decoder::prepare(const SampledSignal& signal, Prepared& p) const {
   }
   p.norm = std::sqrt(norm2);
   p.mean = mean;
+  // The running integral is periodic because the signal is mean-free; doubling it lets
+  // correlate() read any edge + lag in [0, 2n) without wrapping.
+  // (Two more entries: edge + lag + 0.5 < 2n + 0.5 reads up to index 2n + 1.)
+  p.doubled_cumulative.resize(2 * n + 2);
+  for (int k = 0; k < n; ++k) p.doubled_cumulative[k] = p.doubled_cumulative[k + n] = p.cumulative[k];
+  p.doubled_cumulative[2 * n] = p.cumulative[0];
+  p.doubled_cumulative[2 * n + 1] = p.cumulative[1];
 }
 
 void Decoder::prepare_doubled(const SampledSignal& signal, Prepared& p) const {
-  // The running integral is periodic because the signal is mean-free; doubling it lets
-  // every lag read it without wrapping.
+  // The mean-free signal doubled beside the doubled running integral: coarse_peak reads
+  // both at every lag without wrapping.
   const int n = config_.samples;
-  p.doubled_cumulative.resize(2 * n);
   p.doubled_signal.resize(2 * n);
-  for (int k = 0; k < n; ++k) {
-    p.doubled_cumulative[k] = p.doubled_cumulative[k + n] = p.cumulative[k];
-    p.doubled_signal[k] = p.doubled_signal[k + n] = signal.values[k] - p.mean;
-  }
+  for (int k = 0; k < n; ++k) p.doubled_signal[k] = p.doubled_signal[k + n] = signal.values[k] - p.mean;
 }
 
 double Decoder::lag_of_heading(const Blob& blob, double heading_deg) const {
@@ -279,7 +292,7 @@ std::pair<int, double> Decoder::local_peak(const Prepared& p, const Ideal& ideal
   std::pair<int, double> best{centre_lag, -1e300};
   for (int d = -reach; d <= reach; ++d) {
     const int lag = ((centre_lag + d) % n + n) % n;
-    const double c = correlate(p.cumulative, ideal, lag);
+    const double c = correlate(p, ideal, lag);
     if (c > best.second) best = {lag, c};
   }
   return best;
@@ -293,7 +306,7 @@ std::pair<double, double> Decoder::refine_peak(const Prepared& p, const Ideal& i
   const double lo = lag - 1.0, hi = lag + 1.0;
   double best_lag = lag, best = value;
   auto consider = [&](double t) {
-    const double c = correlate(p.cumulative, ideal, t);
+    const double c = correlate(p, ideal, t);
     if (c > best) {
       best = c;
       best_lag = t;
@@ -392,7 +405,7 @@ std::vector<CodeMatch> Decoder::match_by_key(const Prepared& p, const Blob& blob
     const int id = candidates[i] + 1;
     if (id >= static_cast<int>(index_of_id_.size()) || index_of_id_[id] < 0) continue;
     const Ideal& ideal = ideals_[index_of_id_[id]];
-    const auto [fine_lag, value] = refine_peak(p, ideal, centre, correlate(p.cumulative, ideal, centre));
+    const auto [fine_lag, value] = refine_peak(p, ideal, centre, correlate(p, ideal, centre));
     out[index_of_id_[id]] = {ideal.id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, fine_lag)};
   }
   return out;

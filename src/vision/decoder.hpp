@@ -117,7 +117,7 @@ class Decoder {
   };
   // Fills `p`'s running integral and norm (reusing its storage) from the signal.
   void prepare(const SampledSignal& signal, Prepared& p) const;
-  // Adds the doubled arrays that coarse_peak reads (a search over every lag).
+  // Adds the doubled signal that coarse_peak reads (a search over every lag).
   void prepare_doubled(const SampledSignal& signal, Prepared& p) const;
   // Lag (samples, on the sampling axis) at which the key's bisector points along the
   // on-screen heading for this blob's ellipse: heading_on_screen's inverse.
@@ -128,7 +128,7 @@ class Decoder {
   std::pair<int, double> local_peak(const Prepared& p, const Ideal& ideal, int centre_lag, int reach) const;
   // The lag refined below one sample, with its correlation.
   std::pair<double, double> refine_peak(const Prepared& p, const Ideal& ideal, int lag, double value) const;
-  double correlate(const std::vector<double>& cumulative, const Ideal& ideal, double lag) const;
+  double correlate(const Prepared& p, const Ideal& ideal, double lag) const;
   double heading_on_screen(const Blob& blob, double lag) const;
 
   static constexpr int kRingSamples = 24;  // samples on each of the two rings
