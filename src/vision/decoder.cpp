@@ -179,8 +179,10 @@ void Decoder::sample(const cv::Mat& grey, const Blob& blob, SampledSignal& out) 
     sample_ellipse(grey, blob.u, blob.v, blob.shape, reach * r, sample_directions_, circle.data());
     for (int k = 0; k < n; ++k) out.values[k] += circle[k];
   }
-  const double circles = static_cast<double>(circle_radii_.size());
-  for (double& value : out.values) value /= circles;
+  if (circle_radii_.size() > 1) {
+    const double inv_circles = 1.0 / static_cast<double>(circle_radii_.size());
+    for (double& value : out.values) value *= inv_circles;
+  }
   const double spread = quantile_spread(out.values, 0.1, 0.9);
   if (spread < config_.min_code_contrast * out.ring_contrast) return;
   out.usable = true;

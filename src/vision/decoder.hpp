@@ -131,7 +131,7 @@ class Decoder {
   double correlate(const Prepared& p, const Ideal& ideal, double lag) const;
   double heading_on_screen(const Blob& blob, double lag) const;
 
-  static constexpr int kRingSamples = 24;  // samples on each of the two rings
+  static constexpr int kRingSamples = 16;  // samples on each of the two rings (medians, a white-ring count)
   static constexpr int kExhaustiveIds = 16;  // above this many IDs, decode by key and bits
   // A code bit whose slice mean lies within this fraction of the key's contrast from
   // the midpoint is ambiguous: the code with that bit flipped is scored as well.
