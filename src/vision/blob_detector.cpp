@@ -586,11 +586,14 @@ bool BlobDetector::try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blo
   if (candidate) {
     // Column extents of the filled outline, from its row spans: only candidates pay
     // for them (a long strip of tape is filled, but never measured).
+    // Rows go down, so a column's first row is its top and its last its bottom; the
+    // two plain loops per row vectorise.
+    int* __restrict__ col_min = col_min_y_.data();
+    int* __restrict__ col_max = col_max_y_.data();
     for (int r = fill.y0; r <= fill.y1; ++r) {
-      for (int c = row_min_x_[r]; c <= row_max_x_[r]; ++c) {
-        if (col_max_y_[c] < col_min_y_[c]) col_min_y_[c] = r;
-        col_max_y_[c] = r;
-      }
+      const int c0 = row_min_x_[r], c1 = row_max_x_[r];
+      for (int c = c0; c <= c1; ++c) col_min[c] = col_max[c] < col_min[c] ? r : col_min[c];
+      for (int c = c0; c <= c1; ++c) col_max[c] = r;
     }
   }
   const bool ok = candidate && measure(grey, fill, blob);
