@@ -151,6 +151,32 @@ TEST(MarkerTracker, TrackedFramesUseTheEdgeFit) {
   EXPECT_GE(edge_fits, 7 * 7);  // nearly every tracked marker of frames 1..7
 }
 
+// A marker that jumps further than the edge fit reaches (a dropped frame, a bump) is
+// found again by the fill around its prediction, with its ID, in the same frame.
+TEST(MarkerTracker, AJumpBeyondTheEdgeFitFallsBackToTheFill) {
+  const auto f = MarkerFamily::six_ucp();
+  MarkerTracker tracker(f, {3, 6});
+  auto frame_with = [&](int x3, int y3) {
+    cv::Mat img(240, 320, CV_8UC1, cv::Scalar(185));
+    render_marker_topdown(f, 3, 32, 30.0).copyTo(img(cv::Rect(x3, y3, 32, 32)));
+    render_marker_topdown(f, 6, 32, 200.0).copyTo(img(cv::Rect(220, 150, 32, 32)));
+    return img;
+  };
+  ASSERT_EQ(tracker.process(frame_with(100, 80)).size(), 2u);
+  ASSERT_EQ(tracker.process(frame_with(100, 80)).size(), 2u);
+  EXPECT_EQ(tracker.last_stats().edge_fits, 2);
+  EXPECT_EQ(tracker.last_stats().fills, 0);
+  const auto found = tracker.process(frame_with(109, 86));  // 11 px away from where it was
+  ASSERT_EQ(found.size(), 2u);
+  EXPECT_EQ(found[0].id, 3);
+  EXPECT_NEAR(found[0].u, 109 + 15.5, 0.2);
+  EXPECT_NEAR(found[0].v, 86 + 15.5, 0.2);
+  EXPECT_TRUE(found[0].tracked);
+  EXPECT_EQ(tracker.last_stats().edge_fits, 1);  // marker 6 only
+  EXPECT_GE(tracker.last_stats().fills, 1);
+  EXPECT_FALSE(tracker.last_stats().full_search);
+}
+
 // Markers about 24 px across under blur and noise still decode with the right heading.
 TEST(MarkerTracker, SmallMarkersUnderBlurAndNoise) {
   const auto f = MarkerFamily::six_ucp();
