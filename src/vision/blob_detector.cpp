@@ -259,7 +259,7 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
   }
 }
 
-void BlobDetector::build_dark_mask(const cv::Mat& grey, cv::Rect roi) {
+void BlobDetector::build_dark_mask(const cv::Mat& grey, cv::Rect roi, bool local_thresholds) {
   const int t_px = config_.tile_px;
   const int tx0 = roi.x / t_px, tx1 = (roi.x + roi.width - 1) / t_px;
   const int ty0 = roi.y / t_px, ty1 = (roi.y + roi.height - 1) / t_px;
@@ -269,7 +269,14 @@ void BlobDetector::build_dark_mask(const cv::Mat& grey, cv::Rect roi) {
     const std::size_t row = static_cast<std::size_t>(ty) * tiles_x_;
     contrast.clear();
     for (int tx = tx0; tx <= tx1; ++tx) {
-      if (tile_threshold_[row + tx] != 0) {
+      const std::uint8_t t = tile_threshold_[row + tx];
+      // A tile whose own pixels all lie just below its threshold is floor beside a
+      // marker whose black only grazes the neighbourhood, not black: printed black lies
+      // far below the midpoint. It would be filled whole, for nothing.
+      // (Only with thresholds from this search's own tile statistics.)
+      const bool floor_below = local_thresholds && t != 0 && tile_max_[row + tx] < t &&
+                               4 * (t - tile_min_[row + tx]) < tile_range_[row + tx];
+      if (t != 0 && !floor_below) {
         contrast.push_back(tx);
         dark_written_[row + tx] = 1;
       } else if (dark_written_[row + tx]) {
@@ -572,7 +579,7 @@ bool BlobDetector::begin_search(const cv::Mat& grey, cv::Rect& roi, std::optiona
   } else {
     compute_thresholds(grey, roi);
   }
-  build_dark_mask(grey, roi);
+  build_dark_mask(grey, roi, !fixed_threshold);
   return true;
 }
 

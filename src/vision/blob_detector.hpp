@@ -135,7 +135,9 @@ class BlobDetector {
   cv::Mat dark_;          // a view into dark_storage_, the image's size
   cv::Mat dark_storage_;  // dark_ with zero bytes beside each row
   std::vector<std::uint8_t> dark_written_;  // per tile: its block of dark_ may hold nonzero bytes
-  void build_dark_mask(const cv::Mat& grey, cv::Rect roi);
+  // `local_thresholds`: the tile thresholds come from this search's tile statistics
+  // (not one fixed threshold), so those statistics may be consulted too.
+  void build_dark_mask(const cv::Mat& grey, cv::Rect roi, bool local_thresholds);
   std::vector<int> row_min_x_, row_max_x_, col_min_y_, col_max_y_;
   std::vector<std::pair<int, int>> stack_;
 };
