@@ -21,6 +21,17 @@ constexpr double kDiscFraction = MarkerFamily::black_ring_outer_radius;
 constexpr int kStatStep = 2;
 // Zero bytes kept on each side of every row of the dark mask.
 constexpr int kMaskPad = 16;
+// Dark-mask bits: below the threshold (filled), and well below it (may seed a fill).
+constexpr std::uint8_t kDarkBit = 1, kDeepBit = 2;
+
+// The grey level below which a pixel may seed a fill: a quarter of the neighbourhood's
+// range below the threshold (a quarter above its darkest pixel), where a marker's black
+// always lies and the floor's mottling just under the threshold does not. With a fixed
+// threshold (a tracked search) there is no range: every dark pixel may seed.
+std::uint8_t deep_threshold(std::uint8_t threshold, std::uint8_t range, bool local_thresholds) {
+  if (!local_thresholds) return threshold;
+  return static_cast<std::uint8_t>(std::max(1, threshold - range / 4));
+}
 }  // namespace
 
 #if defined(__SSE2__)
@@ -275,7 +286,7 @@ void BlobDetector::build_dark_mask(const cv::Mat& grey, cv::Rect roi, bool local
       // far below the midpoint. It would be filled whole, for nothing.
       // (Only with thresholds from this search's own tile statistics.)
       const bool floor_below = local_thresholds && t != 0 && tile_max_[row + tx] < t &&
-                               4 * (t - tile_min_[row + tx]) < tile_range_[row + tx];
+                               5 * (t - tile_min_[row + tx]) < 2 * tile_range_[row + tx];
       if (t != 0 && !floor_below) {
         contrast.push_back(tx);
         dark_written_[row + tx] = 1;
@@ -293,16 +304,22 @@ void BlobDetector::build_dark_mask(const cv::Mat& grey, cv::Rect roi, bool local
       std::uint8_t* out = dark_.ptr<std::uint8_t>(y);
       for (int tx : contrast) {
         const std::uint8_t t = tile_threshold_[row + tx];
+        const std::uint8_t deep = deep_threshold(t, tile_range_[row + tx], local_thresholds);
         const int x0 = tx * t_px, x1 = std::min(size_.width, x0 + t_px);
 #if defined(__SSE2__)
-        if (x1 - x0 == 8) {  // the default tiles: eight pixels in one compare, x < t is max(x, t - 1) == t - 1
+        if (x1 - x0 == 8) {  // the default tiles: eight pixels per compare; x < t is max(x, t - 1) == t - 1
           const __m128i limit = _mm_set1_epi8(static_cast<char>(t - 1));
+          const __m128i deep_limit = _mm_set1_epi8(static_cast<char>(deep - 1));
           const __m128i v = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(in + x0));
-          _mm_storel_epi64(reinterpret_cast<__m128i*>(out + x0), _mm_cmpeq_epi8(_mm_max_epu8(v, limit), limit));
+          const __m128i is_dark = _mm_cmpeq_epi8(_mm_max_epu8(v, limit), limit);
+          const __m128i is_deep = _mm_cmpeq_epi8(_mm_max_epu8(v, deep_limit), deep_limit);
+          const __m128i bits = _mm_or_si128(_mm_and_si128(is_dark, _mm_set1_epi8(kDarkBit)),
+                                            _mm_and_si128(is_deep, _mm_set1_epi8(kDeepBit)));
+          _mm_storel_epi64(reinterpret_cast<__m128i*>(out + x0), bits);
           continue;
         }
 #endif
-        for (int x = x0; x < x1; ++x) out[x] = in[x] < t ? 0xFF : 0;
+        for (int x = x0; x < x1; ++x) out[x] = (in[x] < t ? kDarkBit : 0) | (in[x] < deep ? kDeepBit : 0);
       }
     }
   }
@@ -633,14 +650,15 @@ std::vector<Blob> BlobDetector::scan(const cv::Mat& grey, cv::Rect roi) {
       const int tx = list[i];
       const int xa = std::max(roi.x, tx * config_.tile_px), xb = std::min(x_end, (tx + 1) * config_.tile_px);
 #if defined(__SSE2__)
-      // Most contrast tiles hold no dark pixel on a given seed row (the bright side of an
-      // edge): one load of eight mask bytes skips them.
+      // Most contrast tiles hold no pixel dark enough to seed a fill on a given seed row
+      // (the bright side of an edge): one load of eight mask bytes skips them.
       if (xb - xa == 8) {
-        if (_mm_cvtsi128_si64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(dark + xa))) == 0) continue;
+        constexpr long long kDeepBytes = 0x0202020202020202LL;
+        if ((_mm_cvtsi128_si64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(dark + xa))) & kDeepBytes) == 0) continue;
       }
 #endif
       for (int x = xa; x < xb; ++x) {
-        if (!dark[x]) continue;
+        if (!(dark[x] & kDeepBit)) continue;
         Blob blob;
         if (try_seed(grey, roi, x, y, blob)) blobs.push_back(blob);
       }

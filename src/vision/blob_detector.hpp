@@ -130,8 +130,9 @@ class BlobDetector {
   int fill_count_ = 0;
   int floor_range_ = 0;  // the floor's local contrast found by the last large search, grey levels
   // Per pixel, nonzero while it is dark (below its threshold) and not yet filled in the
-  // current search: the fill and the seed scan test one byte, and a fill clears what it
-  // takes. Valid inside the current search's ROI only; written per tile of contrast.
+  // current search (bit 1; bit 2 when it is dark enough to seed a fill): the fill and the
+  // seed scan test one byte, and a fill clears what it takes. Valid inside the current
+  // search's ROI only; written per tile of contrast.
   cv::Mat dark_;          // a view into dark_storage_, the image's size
   cv::Mat dark_storage_;  // dark_ with zero bytes beside each row
   std::vector<std::uint8_t> dark_written_;  // per tile: its block of dark_ may hold nonzero bytes
