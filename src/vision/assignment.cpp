@@ -71,23 +71,68 @@ std::vector<int> assign_max_similarity(const std::vector<std::vector<double>>& s
   std::vector<int> result(rows, -1);
   if (cols == 0) return result;
   // Pairs below the threshold weigh 0, so taking one is worth nothing; every allowed
-  // pair weighs its (positive) similarity. Costs are negated weights.
+  // pair weighs its (positive) similarity.
   auto weight = [&](int r, int c) {
     const double s = similarity[r][c];
     return s >= min_similarity && s > 0.0 ? s : 0.0;
   };
-  const bool transpose = rows > cols;
-  const int n = transpose ? cols : rows, m = transpose ? rows : cols;
-  std::vector<std::vector<double>> cost(n, std::vector<double>(m));
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < m; ++j) cost[i][j] = -(transpose ? weight(j, i) : weight(i, j));
+  // The best assignment splits over the connected parts of the graph of allowed pairs
+  // (rows joined by a column both may take): each part is solved alone. A frame of
+  // markers is mostly parts of one object and one ID, which need no search at all.
+  std::vector<int> part(rows), owner(cols, -1);
+  for (int r = 0; r < rows; ++r) part[r] = r;
+  auto find = [&](int r) {
+    while (part[r] != r) r = part[r] = part[part[r]];
+    return r;
+  };
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      if (weight(r, c) <= 0.0) continue;
+      if (owner[c] < 0) {
+        owner[c] = r;
+      } else {
+        part[find(r)] = find(owner[c]);
+      }
+    }
   }
-  const std::vector<int> match = hungarian_min_cost(cost, n, m);
-  for (int i = 0; i < n; ++i) {
-    const int j = match[i];
-    if (j < 0) continue;
-    const int r = transpose ? j : i, c = transpose ? i : j;
-    if (weight(r, c) > 0.0) result[r] = c;
+  std::vector<std::vector<int>> members(rows);
+  for (int r = 0; r < rows; ++r) members[find(r)].push_back(r);
+  for (int root = 0; root < rows; ++root) {
+    const std::vector<int>& part_rows = members[root];
+    if (part_rows.empty()) continue;
+    if (part_rows.size() == 1) {  // one object: its best allowed ID, if any
+      const int r = part_rows[0];
+      double best = 0.0;
+      for (int c = 0; c < cols; ++c) {
+        if (weight(r, c) > best) {
+          best = weight(r, c);
+          result[r] = c;
+        }
+      }
+      continue;
+    }
+    std::vector<int> part_cols;
+    for (int c = 0; c < cols; ++c) {
+      if (owner[c] >= 0 && find(owner[c]) == root) part_cols.push_back(c);
+    }
+    const int pr = static_cast<int>(part_rows.size()), pc = static_cast<int>(part_cols.size());
+    // Costs are negated weights; the Hungarian form wants rows <= columns.
+    const bool transpose = pr > pc;
+    const int n = transpose ? pc : pr, m = transpose ? pr : pc;
+    std::vector<std::vector<double>> cost(n, std::vector<double>(m));
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < m; ++j) {
+        const int r = part_rows[transpose ? j : i], c = part_cols[transpose ? i : j];
+        cost[i][j] = -weight(r, c);
+      }
+    }
+    const std::vector<int> match = hungarian_min_cost(cost, n, m);
+    for (int i = 0; i < n; ++i) {
+      const int j = match[i];
+      if (j < 0) continue;
+      const int r = part_rows[transpose ? j : i], c = part_cols[transpose ? i : j];
+      if (weight(r, c) > 0.0) result[r] = c;
+    }
   }
   return result;
 }

@@ -34,12 +34,17 @@ TEST(Assignment, MoreIdsThanObjectsAndEmpty) {
 }
 
 // Brute force over all permutations agrees on random matrices.
+// Dense matrices (one connected part) and sparse ones (several parts, solved apart, as
+// a frame of markers is), against brute force.
 TEST(Assignment, MatchesBruteForce) {
   std::srand(3);
-  for (int trial = 0; trial < 200; ++trial) {
-    const int rows = 1 + std::rand() % 5, cols = 1 + std::rand() % 5;
+  for (int trial = 0; trial < 400; ++trial) {
+    const bool sparse = trial >= 200;
+    const int rows = 1 + std::rand() % (sparse ? 7 : 5), cols = 1 + std::rand() % (sparse ? 7 : 5);
     std::vector<std::vector<double>> s(rows, std::vector<double>(cols));
-    for (auto& r : s) for (auto& v : r) v = (std::rand() % 1000) / 1000.0;
+    for (auto& r : s) {
+      for (auto& v : r) v = sparse && std::rand() % 10 < 7 ? 0.0 : (std::rand() % 1000) / 1000.0;
+    }
     const double threshold = 0.3;
     const auto a = assign_max_similarity(s, threshold);
     double got = 0.0;
