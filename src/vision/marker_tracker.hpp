@@ -52,7 +52,8 @@ struct TrackerConfig {
   /// Samples around the circle when a marker re-found by the edge fit is confirmed
   /// against its own ID. Fewer than the full decode's (decoder.samples) since one ID is
   /// checked, not told apart from the family; the heading is still refined below a
-  /// sample. More costs linearly.
+  /// sample, but less precisely: on the recorded clips 60 gives 0.8-0.9 degrees RMS and
+  /// 120 the full decode's 0.5-0.7, for about a quarter more time per tracked frame.
   int confirm_samples = 60;
   /// Smallest similarity at which an object may take an ID. Lower finds markers in
   /// worse images but lets clutter through more often.
