@@ -72,8 +72,8 @@ void prefetch_disc_area(const cv::Mat& grey, const Blob& predicted, const DiscEd
   constexpr int kLine = 64;  // bytes per cache line
   for (int y = y0; y <= y1; ++y) {
     const std::uint8_t* row = grey.ptr<std::uint8_t>(y);
-    for (int x = x0 & ~(kLine - 1); x <= x1; x += kLine) __builtin_prefetch(row + x);
-    __builtin_prefetch(row + x1);
+    for (int x = x0 & ~(kLine - 1); x <= x1; x += kLine) __builtin_prefetch(row + x, 0, 1);
+    __builtin_prefetch(row + x1, 0, 1);
   }
 }
 

@@ -203,7 +203,7 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     prefetch_disc_area(grey, predicted, config_.edge_fit);
   };
   // A few markers ahead: far enough for memory to answer, near enough not to evict.
-  constexpr std::size_t kPrefetchAhead = 8;
+  constexpr std::size_t kPrefetchAhead = 4;
   for (std::size_t i = 0; i < kPrefetchAhead; ++i) prefetch(i);
   for (std::size_t i = 0; i < tracks_.size(); ++i) {
     const Track& t = tracks_[i];
