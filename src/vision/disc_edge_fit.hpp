@@ -59,8 +59,8 @@ struct DiscEdgeFit {
 std::optional<DiscEdgeFit> fit_disc_edges(const cv::Mat& grey, const Blob& predicted, double threshold_grey,
                                           const DiscEdgeFitConfig& config = {});
 
-/// Asks the CPU to start loading the pixels fit_disc_edges will read for `predicted`,
-/// without waiting for them. A camera frame is not in the CPU's near caches when it
+/// Asks the CPU to start loading (into its L2 cache) the pixels fit_disc_edges will read
+/// for `predicted`, without waiting for them. A camera frame is not in the CPU's near caches when it
 /// arrives and the fit's reads are scattered, so each would wait for memory in turn;
 /// prefetching the next marker's area while fitting the current one overlaps those
 /// waits. Does nothing outside the image; changes nothing.
