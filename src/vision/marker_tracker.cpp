@@ -162,12 +162,18 @@ std::optional<MarkerDetection> MarkerTracker::confirm(const cv::Mat& grey, const
   return make_detection(blob, m, true, 0.5 * (signal_.black_level + signal_.white_level));
 }
 
+Blob MarkerTracker::Track::predicted_disc() const {
+  const cv::Point2d p = predicted();
+  Blob disc;
+  disc.u = p.x;
+  disc.v = p.y;
+  disc.shape = shape;
+  disc.threshold = threshold_grey;
+  return disc;
+}
+
 std::optional<MarkerDetection> MarkerTracker::confirm_by_edges(const cv::Mat& grey, const Track& track) {
-  const cv::Point2d p = track.predicted();
-  Blob predicted;
-  predicted.u = p.x;
-  predicted.v = p.y;
-  predicted.shape = track.shape;
+  Blob predicted = track.predicted_disc();
   auto fit = fit_disc_edges(grey, predicted, track.threshold_grey, config_.edge_fit);
   if (!fit && (track.du != 0.0 || track.dv != 0.0)) {
     // It may have stopped or turned back (a bounce): where it was last is the other
@@ -194,13 +200,7 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
   std::vector<MarkerDetection> confirmed;
   std::vector<int> confirmed_ids;
   auto prefetch = [&](std::size_t i) {
-    if (!config_.use_edge_fit || i >= tracks_.size()) return;
-    const cv::Point2d p = tracks_[i].predicted();
-    Blob predicted;
-    predicted.u = p.x;
-    predicted.v = p.y;
-    predicted.shape = tracks_[i].shape;
-    prefetch_disc_area(grey, predicted, config_.edge_fit);
+    if (config_.use_edge_fit && i < tracks_.size()) prefetch_disc_area(grey, tracks_[i].predicted_disc(), config_.edge_fit);
   };
   // A few markers ahead: far enough for memory to answer, near enough not to evict.
   constexpr std::size_t kPrefetchAhead = 4;

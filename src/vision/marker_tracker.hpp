@@ -130,6 +130,8 @@ class MarkerTracker {
     cv::Point2d predicted() const { return {u + du * (missed + 1.0), v + dv * (missed + 1.0)}; }
     /// How far it moves by then, pixels.
     double predicted_travel() const { return (missed + 1.0) * std::hypot(du, dv); }
+    /// Its disc where it should be in the coming frame, as last seen otherwise.
+    Blob predicted_disc() const;
   };
   std::vector<MarkerDetection> assign(const cv::Mat& grey, const std::vector<Blob>& blobs, bool use_tracks,
                                       const std::vector<int>& taken_ids = {});
