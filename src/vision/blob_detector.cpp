@@ -274,7 +274,7 @@ void BlobDetector::build_dark_mask(const cv::Mat& grey, cv::Rect roi, bool local
   const int t_px = config_.tile_px;
   const int tx0 = roi.x / t_px, tx1 = (roi.x + roi.width - 1) / t_px;
   const int ty0 = roi.y / t_px, ty1 = (roi.y + roi.height - 1) / t_px;
-  thread_local std::vector<int> contrast;  // tile columns with contrast in this tile row
+  std::vector<int>& contrast = mask_tiles_;  // tile columns with contrast in this tile row
   for (int ty = ty0; ty <= ty1; ++ty) {
     const int y0 = ty * t_px, y1 = std::min(size_.height, y0 + t_px);
     const std::size_t row = static_cast<std::size_t>(ty) * tiles_x_;
@@ -414,14 +414,11 @@ bool BlobDetector::flood_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill) 
 
   // A stack of seeds, each with the span of the row it was found from: that span is
   // already filled, so the seed's own span need not look back into it.
-  struct Seed {
-    int x, y, parent_y, parent_x0, parent_x1;
-  };
-  thread_local std::vector<Seed> stack;
+  std::vector<FillSeed>& stack = fill_stack_;
   stack.clear();
   stack.push_back({seed_x, seed_y, seed_y, 1, 0});
   while (!stack.empty()) {
-    const Seed seed = stack.back();
+    const FillSeed seed = stack.back();
     stack.pop_back();
     const int y = seed.y;
     std::uint8_t* dark = dark_.ptr<std::uint8_t>(y);

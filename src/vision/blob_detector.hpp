@@ -140,7 +140,12 @@ class BlobDetector {
   // (not one fixed threshold), so those statistics may be consulted too.
   void build_dark_mask(const cv::Mat& grey, cv::Rect roi, bool local_thresholds);
   std::vector<int> row_min_x_, row_max_x_, col_min_y_, col_max_y_;
-  std::vector<std::pair<int, int>> stack_;
+  // flood_fill()'s stack: a seed with the span of the row it was found from.
+  struct FillSeed {
+    int x, y, parent_y, parent_x0, parent_x1;
+  };
+  std::vector<FillSeed> fill_stack_;
+  std::vector<int> mask_tiles_;  // build_dark_mask()'s scratch: tiles with contrast in a tile row
 };
 
 }  // namespace rilbed::vision

@@ -19,6 +19,16 @@ struct CircleDirections {
   static CircleDirections make(int count, double phase = 0.0);
 };
 
+/// Half-width and half-height, pixels, of the box around the ellipse
+/// centre + radius · shape · (unit circle) (shape as Blob::shape).
+cv::Vec2d ellipse_half_extent(const cv::Matx22d& shape, double radius);
+
+/// True when the box around that ellipse, widened by `margin_px`, lies inside the image
+/// together with the right and lower neighbours a bilinear read takes: the check
+/// sample_ellipse() leaves to its caller.
+bool ellipse_inside(const cv::Mat& grey, double centre_u, double centre_v, const cv::Matx22d& shape, double radius,
+                    double margin_px = 0.0);
+
 /// Writes to `out[k]` the bilinear grey level at centre + radius · M · d_k, where M maps
 /// the unit circle onto the ellipse (as Blob::shape) and d_k are the directions. The
 /// caller guarantees that every point and its right and lower neighbours are inside the

@@ -31,22 +31,19 @@ double quantile_spread(const std::vector<double>& v, double lo, double hi) {
   return 255.0 - std::max(level_lo, 0);
 }
 
-// Value at fractional index t of the cumulative integral of a piecewise-constant
-// periodic signal with unit-width bins centred on integers (cumulative[0] = 0 at
-// t = -0.5, cumulative[k+1] = sum of bins 0..k).
-double cumulative_at(const std::vector<double>& cumulative, double t) {
-  const int n = static_cast<int>(cumulative.size()) - 1;
-  const double total = cumulative[n];
-  double s = t + 0.5;
-  // floor(s / n) without the library call (SSE2 has no rounding instruction, and this
-  // runs hundreds of times per marker).
-  int wraps = static_cast<int>(s / n);
-  if (wraps * n > s) --wraps;
-  s -= wraps * n;
-  int k = static_cast<int>(s);
-  if (k >= n) k = n - 1;
-  const double frac = s - k;
-  return wraps * total + cumulative[k] + frac * (cumulative[k + 1] - cumulative[k]);
+// The doubled running integral `c` (unit-width bins centred on whole samples) at
+// fractional sample t in [0, 2n): linear between bin boundaries.
+double doubled_integral_at(const double* c, double t) {
+  const double s = t + 0.5;
+  const int k = static_cast<int>(s);
+  return c[k] + (s - k) * (c[k + 1] - c[k]);
+}
+
+// t wrapped once into [0, n).
+double wrap_samples(double t, double n) {
+  while (t < 0.0) t += n;
+  while (t >= n) t -= n;
+  return t;
 }
 
 }  // namespace
@@ -144,12 +141,7 @@ void Decoder::sample(const cv::Mat& grey, const Blob& blob, SampledSignal& out) 
   const int n = config_.samples;
   // The whole marker must lie inside the image; then no sample needs a bounds check.
   const double reach = 1.0 / MarkerFamily::black_ring_outer_radius;
-  const double half_u = reach * (std::abs(blob.shape(0, 0)) + std::abs(blob.shape(0, 1)));
-  const double half_v = reach * (std::abs(blob.shape(1, 0)) + std::abs(blob.shape(1, 1)));
-  if (blob.u - half_u < 0.0 || blob.v - half_v < 0.0 || blob.u + half_u > grey.cols - 1.001 ||
-      blob.v + half_v > grey.rows - 1.001) {
-    return;
-  }
+  if (!ellipse_inside(grey, blob.u, blob.v, blob.shape, reach)) return;
   // shape maps the unit circle to the dark disc; radii below are in the marker's units.
   thread_local std::vector<float> black, white, circle;
   black.resize(ring_directions_.cos.size());
@@ -200,12 +192,7 @@ void Decoder::sample_code(const cv::Mat& grey, const Blob& blob, double black_le
   const double scale = r / MarkerFamily::black_ring_outer_radius;
   // The circle is inside the code annulus, well inside the disc; it must be inside the
   // image with its bilinear neighbours.
-  const double half_u = scale * (std::abs(blob.shape(0, 0)) + std::abs(blob.shape(0, 1)));
-  const double half_v = scale * (std::abs(blob.shape(1, 0)) + std::abs(blob.shape(1, 1)));
-  if (!(blob.u - half_u >= 0.0 && blob.v - half_v >= 0.0 && blob.u + half_u < grey.cols - 1.0 &&
-        blob.v + half_v < grey.rows - 1.0)) {
-    return;
-  }
+  if (!ellipse_inside(grey, blob.u, blob.v, blob.shape, scale)) return;
   thread_local std::vector<float> circle;
   circle.resize(sample_directions_.cos.size());
   sample_ellipse(grey, blob.u, blob.v, blob.shape, scale, sample_directions_, circle.data());
@@ -216,18 +203,17 @@ void Decoder::sample_code(const cv::Mat& grey, const Blob& blob, double black_le
   out.usable = true;
 }
 
+double Decoder::integral_at(const Prepared& p, double t) const {
+  return doubled_integral_at(p.doubled_cumulative.data(), wrap_samples(t, config_.samples));
+}
+
 double Decoder::correlate(const Prepared& p, const Ideal& ideal, double lag) const {
   // The lag into [0, n) once; then every edge + lag lies in [0, 2n) and reads the doubled
   // running integral directly (no wrapping per edge).
-  const double n = config_.samples;
-  while (lag < 0.0) lag += n;
-  while (lag >= n) lag -= n;
-  const double* c = p.doubled_cumulative.data();
+  lag = wrap_samples(lag, config_.samples);
   double acc = 0.0;
   for (std::size_t e = 0; e < ideal.edge.size(); ++e) {
-    const double s = ideal.edge[e] + lag + 0.5;
-    const int k = static_cast<int>(s);
-    acc += ideal.step[e] * (c[k] + (s - k) * (c[k + 1] - c[k]));
+    acc += ideal.step[e] * doubled_integral_at(p.doubled_cumulative.data(), ideal.edge[e] + lag);
   }
   return acc;
 }
@@ -380,7 +366,7 @@ std::vector<CodeMatch> Decoder::match_by_key(const Prepared& p, const Blob& blob
   const double lag = refine_peak(p, key_, key_lag, key_value).first;
   auto mean_over = [&](std::size_t slice) {
     const auto [a, b] = slice_bounds_[slice];
-    return (cumulative_at(p.cumulative, b + lag) - cumulative_at(p.cumulative, a + lag)) / (b - a);
+    return (integral_at(p, b + lag) - integral_at(p, a + lag)) / (b - a);
   };
   const std::size_t k = slice_bounds_.size();
   const double white = mean_over(0), black = 0.5 * (mean_over(1) + mean_over(k - 1));

@@ -129,6 +129,8 @@ class Decoder {
   // The lag refined below one sample, with its correlation.
   std::pair<double, double> refine_peak(const Prepared& p, const Ideal& ideal, int lag, double value) const;
   double correlate(const Prepared& p, const Ideal& ideal, double lag) const;
+  // The running integral at fractional sample t (any t; it is periodic).
+  double integral_at(const Prepared& p, double t) const;
   double heading_on_screen(const Blob& blob, double lag) const;
 
   static constexpr int kRingSamples = 16;  // samples on each of the two rings (medians, a white-ring count)

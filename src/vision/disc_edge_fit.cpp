@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "core/geometry.hpp"
+#include "vision/circle_sampler.hpp"
 #include "vision/marker_family.hpp"
 
 namespace rilbed::vision {
@@ -62,12 +63,11 @@ double mean_of(const double* values, int count) {
 void prefetch_disc_area(const cv::Mat& grey, const Blob& predicted, const DiscEdgeFitConfig& config) {
   const cv::Matx22d& s = predicted.shape;
   const double extent = (1.0 + config.reach) * kWhiteMid + 0.05;
-  const double half_u = extent * (std::abs(s(0, 0)) + std::abs(s(0, 1)));
-  const double half_v = extent * (std::abs(s(1, 0)) + std::abs(s(1, 1)));
-  const int x0 = std::max(0, static_cast<int>(predicted.u - half_u));
-  const int x1 = std::min(grey.cols - 1, static_cast<int>(predicted.u + half_u) + 1);
-  const int y0 = std::max(0, static_cast<int>(predicted.v - half_v));
-  const int y1 = std::min(grey.rows - 1, static_cast<int>(predicted.v + half_v) + 1);
+  const cv::Vec2d half = ellipse_half_extent(s, extent);
+  const int x0 = std::max(0, static_cast<int>(predicted.u - half[0]));
+  const int x1 = std::min(grey.cols - 1, static_cast<int>(predicted.u + half[0]) + 1);
+  const int y0 = std::max(0, static_cast<int>(predicted.v - half[1]));
+  const int y1 = std::min(grey.rows - 1, static_cast<int>(predicted.v + half[1]) + 1);
   constexpr int kLine = 64;  // bytes per cache line
   // Locality 1: towards L2. L1 has too few slots for misses and drops most of a burst
   // of several markers' areas; L2 takes them all in time.
@@ -86,12 +86,7 @@ std::optional<DiscEdgeFit> fit_disc_edges(const cv::Mat& grey, const Blob& predi
   // Every read lies within the white ring's middle of the farthest crossing: check once
   // that all of it is inside the image (with a pixel to spare).
   const double extent = (1.0 + config.reach) * kWhiteMid;
-  const double half_u = extent * (std::abs(s(0, 0)) + std::abs(s(0, 1))) + 2.0;
-  const double half_v = extent * (std::abs(s(1, 0)) + std::abs(s(1, 1))) + 2.0;
-  if (!(predicted.u - half_u >= 0.0 && predicted.v - half_v >= 0.0 && predicted.u + half_u < grey.cols - 1.0 &&
-        predicted.v + half_v < grey.rows - 1.0)) {
-    return std::nullopt;
-  }
+  if (!ellipse_inside(grey, predicted.u, predicted.v, s, extent, 2.0)) return std::nullopt;
   const double det_s = cv::determinant(s);
   if (!(det_s > 0.0)) return std::nullopt;
   const cv::Matx22d s_inv = s.inv();
