@@ -23,6 +23,9 @@ constexpr int kStatStep = 2;
 constexpr int kMaskPad = 16;
 // Dark-mask bits: below the threshold (filled), and well below it (may seed a fill).
 constexpr std::uint8_t kDarkBit = 1, kDeepBit = 2;
+// Least dark fraction of a swept region for the sweep to stand: a marker's black ring
+// is half its dark disc's area, and its hole and two black guard slices add more.
+constexpr double kMinDarkFraction = 0.5;
 
 // The grey level below which a pixel may seed a fill: a quarter of the neighbourhood's
 // range below the threshold (a quarter above its darkest pixel), where a marker's black
@@ -300,45 +303,65 @@ void BlobDetector::build_dark_mask(const cv::Mat& grey, cv::Rect roi, bool local
     // Row by row across the tile row (not tile by tile down it), so that the frame is
     // read as a stream: a new frame is not in the caches yet.
     const std::size_t listed = contrast.size();
+#if defined(__SSE2__)
+    if (t_px == 8) {
+      // The default tiles, eight pixels per tile; two neighbouring tiles in one
+      // sixteen-byte step. The steps' limits are set once per tile row, not per pixel row.
+      // x < t is max(x, t - 1) == t - 1.
+      mask_steps_.clear();
+      int narrow_tile = -1;  // a last tile narrower than eight pixels, done byte by byte
+      for (std::size_t i = 0; i < listed; ++i) {
+        const int tx = contrast[i];
+        const int x0 = tx * 8;
+        if (x0 + 8 > size_.width) {
+          narrow_tile = tx;
+          continue;
+        }
+        const bool pair = i + 1 < listed && contrast[i + 1] == tx + 1 && x0 + 16 <= size_.width;
+        const int tx2 = pair ? tx + 1 : tx;
+        auto limit_of = [&](int x) { return static_cast<char>(tile_threshold_[row + x] - 1); };
+        auto deep_of = [&](int x) {
+          return static_cast<char>(deep_threshold(tile_threshold_[row + x], tile_range_[row + x], local_thresholds) - 1);
+        };
+        mask_steps_.push_back({_mm_unpacklo_epi64(_mm_set1_epi8(limit_of(tx)), _mm_set1_epi8(limit_of(tx2))),
+                               _mm_unpacklo_epi64(_mm_set1_epi8(deep_of(tx)), _mm_set1_epi8(deep_of(tx2))), x0, pair});
+        i += pair;
+      }
+      const __m128i dark_bit = _mm_set1_epi8(kDarkBit), deep_bit = _mm_set1_epi8(kDeepBit);
+      for (int y = y0; y < y1; ++y) {
+        const std::uint8_t* in = grey.ptr<std::uint8_t>(y);
+        std::uint8_t* out = dark_.ptr<std::uint8_t>(y);
+        for (const MaskStep& step : mask_steps_) {
+          const __m128i v = step.pair ? load16(in + step.x0)
+                                      : _mm_loadl_epi64(reinterpret_cast<const __m128i*>(in + step.x0));
+          const __m128i is_dark = _mm_cmpeq_epi8(_mm_max_epu8(v, step.limit), step.limit);
+          const __m128i is_deep = _mm_cmpeq_epi8(_mm_max_epu8(v, step.deep_limit), step.deep_limit);
+          const __m128i bits = _mm_or_si128(_mm_and_si128(is_dark, dark_bit), _mm_and_si128(is_deep, deep_bit));
+          if (step.pair) {
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(out + step.x0), bits);
+          } else {
+            _mm_storel_epi64(reinterpret_cast<__m128i*>(out + step.x0), bits);
+          }
+        }
+        if (narrow_tile >= 0) mask_tile_row_bytes(in, out, row, narrow_tile, local_thresholds);
+      }
+      continue;
+    }
+#endif
     for (int y = y0; y < y1; ++y) {
       const std::uint8_t* in = grey.ptr<std::uint8_t>(y);
       std::uint8_t* out = dark_.ptr<std::uint8_t>(y);
-      for (std::size_t i = 0; i < listed; ++i) {
-        const int tx = contrast[i];
-        const std::uint8_t t = tile_threshold_[row + tx];
-        const std::uint8_t deep = deep_threshold(t, tile_range_[row + tx], local_thresholds);
-        const int x0 = tx * t_px, x1 = std::min(size_.width, x0 + t_px);
-#if defined(__SSE2__)
-        if (x1 - x0 == 8) {
-          // The default tiles, eight pixels per tile; two neighbouring tiles in one
-          // sixteen-byte step. x < t is max(x, t - 1) == t - 1.
-          const bool pair = i + 1 < listed && contrast[i + 1] == tx + 1 && x0 + 16 <= size_.width;
-          __m128i limit = _mm_set1_epi8(static_cast<char>(t - 1));
-          __m128i deep_limit = _mm_set1_epi8(static_cast<char>(deep - 1));
-          if (pair) {
-            const std::uint8_t t2 = tile_threshold_[row + tx + 1];
-            const std::uint8_t deep2 = deep_threshold(t2, tile_range_[row + tx + 1], local_thresholds);
-            limit = _mm_unpacklo_epi64(limit, _mm_set1_epi8(static_cast<char>(t2 - 1)));
-            deep_limit = _mm_unpacklo_epi64(deep_limit, _mm_set1_epi8(static_cast<char>(deep2 - 1)));
-          }
-          const __m128i v = pair ? load16(in + x0) : _mm_loadl_epi64(reinterpret_cast<const __m128i*>(in + x0));
-          const __m128i is_dark = _mm_cmpeq_epi8(_mm_max_epu8(v, limit), limit);
-          const __m128i is_deep = _mm_cmpeq_epi8(_mm_max_epu8(v, deep_limit), deep_limit);
-          const __m128i bits = _mm_or_si128(_mm_and_si128(is_dark, _mm_set1_epi8(kDarkBit)),
-                                            _mm_and_si128(is_deep, _mm_set1_epi8(kDeepBit)));
-          if (pair) {
-            _mm_storeu_si128(reinterpret_cast<__m128i*>(out + x0), bits);
-            ++i;
-          } else {
-            _mm_storel_epi64(reinterpret_cast<__m128i*>(out + x0), bits);
-          }
-          continue;
-        }
-#endif
-        for (int x = x0; x < x1; ++x) out[x] = (in[x] < t ? kDarkBit : 0) | (in[x] < deep ? kDeepBit : 0);
-      }
+      for (std::size_t i = 0; i < listed; ++i) mask_tile_row_bytes(in, out, row, contrast[i], local_thresholds);
     }
   }
+}
+
+void BlobDetector::mask_tile_row_bytes(const std::uint8_t* in, std::uint8_t* out, std::size_t tile_row_index, int tx,
+                                       bool local_thresholds) const {
+  const std::uint8_t t = tile_threshold_[tile_row_index + tx];
+  const std::uint8_t deep = deep_threshold(t, tile_range_[tile_row_index + tx], local_thresholds);
+  const int x0 = tx * config_.tile_px, x1 = std::min(size_.width, x0 + config_.tile_px);
+  for (int x = x0; x < x1; ++x) out[x] = (in[x] < t ? kDarkBit : 0) | (in[x] < deep ? kDeepBit : 0);
 }
 
 namespace {
@@ -399,7 +422,146 @@ void for_each_run(const std::uint8_t* mask, int a, int b, SeedFn&& seed) {
 #endif
 }
 
+// The first and the last nonzero mask byte in [a, b], or -1 when there is none.
+int first_dark(const std::uint8_t* mask, int a, int b) {
+#if defined(__SSE2__)
+  for (int x = a; x <= b; x += 16) {
+    unsigned bits =
+        ~static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(load16(mask + x), _mm_setzero_si128()))) & 0xFFFFu;
+    if (b - x < 15) bits &= (1u << (b - x + 1)) - 1;
+    if (bits != 0) return x + __builtin_ctz(bits);
+  }
+  return -1;
+#else
+  for (int x = a; x <= b; ++x) {
+    if (mask[x]) return x;
+  }
+  return -1;
+#endif
+}
+
+int last_dark(const std::uint8_t* mask, int a, int b) {
+#if defined(__SSE2__)
+  for (int x = b; x >= a; x -= 16) {  // sixteen bytes ending at x
+    unsigned bits =
+        ~static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(load16(mask + x - 15), _mm_setzero_si128()))) & 0xFFFFu;
+    if (x - a < 15) bits &= ~((1u << (15 - (x - a))) - 1);
+    if (bits != 0) return x - 15 + (31 - __builtin_clz(bits));
+  }
+  return -1;
+#else
+  for (int x = b; x >= a; --x) {
+    if (mask[x]) return x;
+  }
+  return -1;
+#endif
+}
+
+// How many mask bytes in [a, b] are nonzero.
+int count_nonzero(const std::uint8_t* mask, int a, int b) {
+  int count = 0;
+#if defined(__SSE2__)
+  int x = a;
+  for (; x + 15 <= b; x += 16) {
+    count += 16 - __builtin_popcount(
+                      static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(load16(mask + x), _mm_setzero_si128()))));
+  }
+  for (; x <= b; ++x) count += mask[x] != 0;
+#else
+  for (int x = a; x <= b; ++x) count += mask[x] != 0;
+#endif
+  return count;
+}
+
 }  // namespace
+
+bool BlobDetector::sweep_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill) {
+  const double max_disc_d = config_.max_diameter_px * kDiscFraction;
+  const int max_area = static_cast<int>(kPi * max_disc_d * max_disc_d / 4.0 * 1.3) + 16;
+  const int max_extent = static_cast<int>(max_disc_d * 1.2) + 2;
+  const int rx0 = roi.x, rx1 = roi.x + roi.width - 1, ry0 = roi.y, ry1 = roi.y + roi.height - 1;
+  auto mask_row = [&](int y) { return dark_.ptr<std::uint8_t>(y); };
+  int top = seed_y, bottom = seed_y;
+  row_min_x_[seed_y] = std::max(rx0, run_start(mask_row(seed_y), seed_x));
+  row_max_x_[seed_y] = std::min(rx1, run_end(mask_row(seed_y), seed_x));
+  // Widens row y's extent by every run that overlaps [a, b] (the neighbouring row's
+  // extent joined with its own); false when the row has nothing dark there.
+  auto grow = [&](int y, int a, int b) {
+    if (row_max_x_[y] >= row_min_x_[y]) {
+      a = std::min(a, row_min_x_[y]);
+      b = std::max(b, row_max_x_[y]);
+    }
+    const std::uint8_t* mask = mask_row(y);
+    const int first = first_dark(mask, a, b);
+    if (first < 0) return false;
+    const int xl = std::max(rx0, run_start(mask, first));
+    const int xr = std::min(rx1, run_end(mask, last_dark(mask, first, b)));
+    if (row_max_x_[y] < row_min_x_[y] || xl < row_min_x_[y] || xr > row_max_x_[y]) {
+      row_min_x_[y] = xl;
+      row_max_x_[y] = xr;
+      return true;
+    }
+    return false;
+  };
+  // Sweeps down, up and down again (and so on) until one changes nothing: three for a
+  // marker seeded anywhere on its disc, as each row's extent only grows by what
+  // touches its neighbour's.
+  bool ok = true;
+  constexpr int kMaxSweeps = 6;
+  int sweeps = 0;
+  for (bool changed = true, down = true; changed && ok; down = !down) {
+    if (++sweeps > kMaxSweeps) {
+      ok = false;
+      break;
+    }
+    changed = false;
+    if (down) {
+      for (int y = top + 1; y <= ry1; ++y) {
+        const bool grew = grow(y, row_min_x_[y - 1], row_max_x_[y - 1]);
+        changed |= grew;
+        if (row_max_x_[y] - row_min_x_[y] > max_extent) ok = false;  // no marker: stop early
+        if (y > bottom) {
+          if (!grew) break;
+          bottom = y;
+        }
+        if (!ok || bottom - top > max_extent) break;
+      }
+    } else {
+      for (int y = bottom - 1; y >= ry0; --y) {
+        const bool grew = grow(y, row_min_x_[y + 1], row_max_x_[y + 1]);
+        changed |= grew;
+        if (row_max_x_[y] - row_min_x_[y] > max_extent) ok = false;
+        if (y < top) {
+          if (!grew) break;
+          top = y;
+        }
+        if (!ok || bottom - top > max_extent) break;
+      }
+    }
+    if (bottom - top > max_extent) ok = false;
+    // The first two sweeps always change something; a third that changes nothing ends.
+    if (sweeps == 1) changed = true;
+  }
+  fill = Fill{0, rx1, rx0, top, bottom, false, false};
+  for (int y = top; y <= bottom && ok; ++y) {
+    fill.x0 = std::min(fill.x0, row_min_x_[y]);
+    fill.x1 = std::max(fill.x1, row_max_x_[y]);
+    fill.area += count_nonzero(mask_row(y), row_min_x_[y], row_max_x_[y]);
+  }
+  fill.touches_border = fill.x0 == rx0 || fill.x1 == rx1 || top == ry0 || bottom == ry1;
+  if (!ok || fill.area > max_area || fill.x1 - fill.x0 > max_extent || fill.touches_border) {
+    clear_row_extents(top, bottom);
+    return false;
+  }
+  return true;
+}
+
+void BlobDetector::clear_row_extents(int y0, int y1) {
+  for (int y = y0; y <= y1; ++y) {
+    row_min_x_[y] = 0;
+    row_max_x_[y] = -1;
+  }
+}
 
 bool BlobDetector::flood_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill) {
   const double max_disc_d = config_.max_diameter_px * kDiscFraction;
@@ -614,36 +776,61 @@ bool BlobDetector::begin_search(const cv::Mat& grey, cv::Rect& roi, std::optiona
 }
 
 bool BlobDetector::try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blob& blob) {
+  ++fill_count_;
+  Fill fill;
+  // The sweep first: it finds a marker's disc at a fraction of the fill's cost. Its
+  // region is kept only when it is a disc at least half dark (a marker's black ring
+  // alone is half its disc): a region that is not, such as the floor around a marker
+  // on a dark mat or a circular floor track around robots, may enclose dark shapes
+  // that are not connected to it, and only the true fill tells them apart.
+  if (sweep_fill(roi, x, y, fill)) {
+    const bool ok = fill.area >= kMinDarkFraction * region_area(fill) && measure_region(grey, fill, blob);
+    if (ok) {
+      for (int r = fill.y0; r <= fill.y1; ++r) {
+        std::uint8_t* mask = dark_.ptr<std::uint8_t>(r);
+        std::fill(mask + row_min_x_[r], mask + row_max_x_[r] + 1, 0);
+      }
+    }
+    reset_region(fill);
+    if (ok) return true;
+  }
+  const bool whole = flood_fill(roi, x, y, fill);
+  const bool ok = whole && measure_region(grey, fill, blob);
+  reset_region(fill);
+  return ok;
+}
+
+int BlobDetector::region_area(const Fill& fill) const {
+  int area = 0;
+  for (int r = fill.y0; r <= fill.y1; ++r) area += std::max(0, row_max_x_[r] - row_min_x_[r] + 1);
+  return area;
+}
+
+bool BlobDetector::measure_region(const cv::Mat& grey, const Fill& fill, Blob& blob) {
   const double min_disc_d = config_.min_diameter_px * kDiscFraction;
   const double min_area = kPi * min_disc_d * min_disc_d / 4.0 / config_.max_axis_ratio * 0.8;
-  Fill fill;
-  ++fill_count_;
-  const bool whole = flood_fill(roi, x, y, fill);
-  const bool candidate = whole && fill.area >= min_area;
-  if (candidate) {
-    // Column extents of the filled outline, from its row spans: only candidates pay
-    // for them (a long strip of tape is filled, but never measured).
-    // Rows go down, so a column's first row is its top and its last its bottom; the
-    // two plain loops per row vectorise.
-    int* __restrict__ col_min = col_min_y_.data();
-    int* __restrict__ col_max = col_max_y_.data();
-    for (int r = fill.y0; r <= fill.y1; ++r) {
-      const int c0 = row_min_x_[r], c1 = row_max_x_[r];
-      for (int c = c0; c <= c1; ++c) col_min[c] = col_max[c] < col_min[c] ? r : col_min[c];
-      for (int c = c0; c <= c1; ++c) col_max[c] = r;
-    }
-  }
-  const bool ok = candidate && measure(grey, fill, blob);
-  // Reset the chord bookkeeping of the rows and columns this fill touched.
+  if (fill.area < min_area) return false;
+  // Column extents of the region, from its row extents: only candidates pay for them
+  // (a long strip of tape is filled, but never measured).
+  // Rows go down, so a column's first row is its top and its last its bottom; the
+  // two plain loops per row vectorise.
+  int* __restrict__ col_min = col_min_y_.data();
+  int* __restrict__ col_max = col_max_y_.data();
   for (int r = fill.y0; r <= fill.y1; ++r) {
-    row_min_x_[r] = 0;
-    row_max_x_[r] = -1;
+    const int c0 = row_min_x_[r], c1 = row_max_x_[r];
+    for (int c = c0; c <= c1; ++c) col_min[c] = col_max[c] < col_min[c] ? r : col_min[c];
+    for (int c = c0; c <= c1; ++c) col_max[c] = r;
   }
+  return measure(grey, fill, blob);
+}
+
+void BlobDetector::reset_region(const Fill& fill) {
+  // Reset the chord bookkeeping of the rows and columns the region touched.
+  clear_row_extents(fill.y0, fill.y1);
   for (int c = fill.x0; c <= fill.x1; ++c) {
     col_min_y_[c] = 0;
     col_max_y_[c] = -1;
   }
-  return ok;
 }
 
 std::vector<Blob> BlobDetector::scan(const cv::Mat& grey, cv::Rect roi) {

@@ -6,6 +6,10 @@
 
 #include <opencv2/core.hpp>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -112,8 +116,20 @@ class BlobDetector {
   std::vector<Blob> scan(const cv::Mat& grey, cv::Rect roi);
   bool try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blob& blob);
   void compute_thresholds(const cv::Mat& grey, cv::Rect roi);
+  // The dark region through the seed, as row extents in row_min_x_/row_max_x_.
+  // sweep_fill() follows each row's extent from its neighbours' (cheap; exact for a
+  // marker's disc, but an enclosing shape's extents also take what it encloses); it
+  // leaves the mask as it is, and false (with the extents reset) for a region cut by
+  // the ROI or too large. flood_fill() is the exact run-by-run fill; it clears what it
+  // takes from the mask and says false for a region cut by the ROI or too large.
+  bool sweep_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill);
   bool flood_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill);
   bool measure(const cv::Mat& grey, const Fill& fill, Blob& blob) const;
+  // Column extents from the row extents, then measure(); false for a region too small.
+  bool measure_region(const cv::Mat& grey, const Fill& fill, Blob& blob);
+  int region_area(const Fill& fill) const;  // pixels within the row extents
+  void reset_region(const Fill& fill);      // row and column extents back to empty
+  void clear_row_extents(int y0, int y1);
   std::uint8_t threshold_at(int x, int y) const { return tile_threshold_[tile_row_[y] * tiles_x_ + tile_col_[x]]; }
 
   BlobDetectorConfig config_;
@@ -139,6 +155,10 @@ class BlobDetector {
   // `local_thresholds`: the tile thresholds come from this search's tile statistics
   // (not one fixed threshold), so those statistics may be consulted too.
   void build_dark_mask(const cv::Mat& grey, cv::Rect roi, bool local_thresholds);
+  // One row of tile `tx` of the mask, byte by byte (`tile_row_index`: the tile row's
+  // first index in the tile arrays; `in` and `out`: the grey and mask rows).
+  void mask_tile_row_bytes(const std::uint8_t* in, std::uint8_t* out, std::size_t tile_row_index, int tx,
+                           bool local_thresholds) const;
   std::vector<int> row_min_x_, row_max_x_, col_min_y_, col_max_y_;
   // flood_fill()'s stack: a seed with the span of the row it was found from.
   struct FillSeed {
@@ -146,6 +166,16 @@ class BlobDetector {
   };
   std::vector<FillSeed> fill_stack_;
   std::vector<int> mask_tiles_;  // build_dark_mask()'s scratch: tiles with contrast in a tile row
+#if defined(__SSE2__)
+  // build_dark_mask()'s scratch: per tile (or pair of neighbouring tiles) with contrast
+  // in a tile row, where it starts and the grey limits (threshold - 1) of each half.
+  struct MaskStep {
+    __m128i limit, deep_limit;
+    int x0;
+    bool pair;
+  };
+  std::vector<MaskStep> mask_steps_;
+#endif
 };
 
 }  // namespace rilbed::vision

@@ -2,6 +2,9 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
+#include <cmath>
+
 #include "vision/blob_detector.hpp"
 #include "vision/synthetic_camera.hpp"
 
@@ -100,4 +103,44 @@ TEST(BlobDetector, GlareNeedsTheBlackRatioRaised) {
   glare.max_black_to_white = 0.9;
   BlobDetector lenient(glare);
   EXPECT_EQ(lenient.detect(img).size(), 1u);
+}
+
+// A thin circular floor track around robots is an ellipse-shaped dark region whose row
+// extents hold the markers inside it: the markers must still be found on their own
+// (the extent sweep does not stand for a region that is mostly light inside).
+TEST(BlobDetector, CircularTrackAroundMarkersDoesNotHideThem) {
+  const auto f = MarkerFamily::six_ucp();
+  cv::Mat img(360, 360, CV_8UC1, cv::Scalar(190));
+  cv::circle(img, {180, 180}, 140, cv::Scalar(30), 6, cv::LINE_AA);
+  render_marker_topdown(f, 2, 32, 10.0, 190.0).copyTo(img(cv::Rect(120, 150, 32, 32)));
+  render_marker_topdown(f, 6, 40, 70.0, 190.0).copyTo(img(cv::Rect(200, 190, 40, 40)));
+  BlobDetector detector;
+  const auto blobs = detector.detect(img);
+  auto found_at = [&](double u, double v) {
+    return std::any_of(blobs.begin(), blobs.end(),
+                       [&](const Blob& b) { return std::hypot(b.u - u, b.v - v) < 0.5; });
+  };
+  EXPECT_TRUE(found_at(120 + 15.5, 150 + 15.5));
+  EXPECT_TRUE(found_at(200 + 19.5, 190 + 19.5));
+}
+
+// The extent sweep and the run-by-run fill agree on a marker's disc wherever the seed
+// falls on it: every seed row of a search finds the same blob.
+TEST(BlobDetector, MarkerFoundTheSameFromEverySeedRow) {
+  const auto f = MarkerFamily::six_ucp();
+  for (int id = 1; id <= 8; ++id) {
+    for (double heading : {0.0, 90.0, 200.0, 300.0}) {
+      cv::Mat img(100, 100, CV_8UC1, cv::Scalar(185));
+      render_marker_topdown(f, id, 48, heading, 185.0).copyTo(img(cv::Rect(26, 26, 48, 48)));
+      for (int step : {1, 2, 3, 5}) {
+        BlobDetectorConfig config;
+        config.seed_row_step = step;
+        BlobDetector detector(config);
+        const auto blobs = detector.detect(img);
+        ASSERT_EQ(blobs.size(), 1u) << "id " << id << " heading " << heading << " step " << step;
+        EXPECT_NEAR(blobs[0].u, 49.5, 0.05);
+        EXPECT_NEAR(blobs[0].v, 49.5, 0.05);
+      }
+    }
+  }
 }
