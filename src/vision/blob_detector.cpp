@@ -84,6 +84,7 @@ void BlobDetector::prepare(const cv::Mat& grey) {
   dark_written_.assign(tiles, 0);
   row_min_x_.assign(size_.height, 0);
   row_max_x_.assign(size_.height, -1);
+  row_stamp_.assign(size_.height, 0);
   col_min_y_.assign(size_.width, 0);
   col_max_y_.assign(size_.width, -1);
 }
@@ -460,16 +461,15 @@ int last_dark(const std::uint8_t* mask, int a, int b) {
 // How many mask bytes in [a, b] are nonzero.
 int count_nonzero(const std::uint8_t* mask, int a, int b) {
   int count = 0;
-#if defined(__SSE2__)
   int x = a;
-  for (; x + 15 <= b; x += 16) {
-    count += 16 - __builtin_popcount(
-                      static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(load16(mask + x), _mm_setzero_si128()))));
-  }
-  for (; x <= b; ++x) count += mask[x] != 0;
-#else
-  for (int x = a; x <= b; ++x) count += mask[x] != 0;
+#if defined(__SSE2__)
+  // min(byte, 1) summed by psadbw: no population count (not in baseline x86-64).
+  __m128i sums = _mm_setzero_si128();
+  const __m128i one = _mm_set1_epi8(1);
+  for (; x + 15 <= b; x += 16) sums = _mm_add_epi64(sums, _mm_sad_epu8(_mm_min_epu8(load16(mask + x), one), _mm_setzero_si128()));
+  count = _mm_cvtsi128_si32(sums) + _mm_cvtsi128_si32(_mm_srli_si128(sums, 8));
 #endif
+  for (; x <= b; ++x) count += mask[x] != 0;
   return count;
 }
 
@@ -487,60 +487,68 @@ bool BlobDetector::sweep_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill) 
   // Widens row y's extent by every run that overlaps [a, b] (the neighbouring row's
   // extent joined with its own); false when the row has nothing dark there.
   auto grow = [&](int y, int a, int b) {
-    if (row_max_x_[y] >= row_min_x_[y]) {
-      a = std::min(a, row_min_x_[y]);
-      b = std::max(b, row_max_x_[y]);
-    }
     const std::uint8_t* mask = mask_row(y);
-    const int first = first_dark(mask, a, b);
-    if (first < 0) return false;
-    const int xl = std::max(rx0, run_start(mask, first));
-    const int xr = std::min(rx1, run_end(mask, last_dark(mask, first, b)));
-    if (row_max_x_[y] < row_min_x_[y] || xl < row_min_x_[y] || xr > row_max_x_[y]) {
-      row_min_x_[y] = xl;
-      row_max_x_[y] = xr;
+    const int l = row_min_x_[y], r = row_max_x_[y];
+    if (r < l) {  // a new row
+      const int first = first_dark(mask, a, b);
+      if (first < 0) return false;
+      row_min_x_[y] = std::max(rx0, run_start(mask, first));
+      row_max_x_[y] = std::min(rx1, run_end(mask, last_dark(mask, first, b)));
       return true;
     }
-    return false;
+    // Only the parts of [a, b] beside the extent can add to it (the pixels just outside
+    // an extent are not dark: it ends where its runs do).
+    bool grew = false;
+    if (a < l) {
+      const int first = first_dark(mask, a, l - 1);
+      if (first >= 0) {
+        row_min_x_[y] = std::max(rx0, run_start(mask, first));
+        grew = true;
+      }
+    }
+    if (b > r) {
+      const int last = last_dark(mask, r + 1, b);
+      if (last >= 0) {
+        row_max_x_[y] = std::min(rx1, run_end(mask, last));
+        grew = true;
+      }
+    }
+    return grew;
   };
   // Sweeps down, up and down again (and so on) until one changes nothing: three for a
   // marker seeded anywhere on its disc, as each row's extent only grows by what
-  // touches its neighbour's.
+  // touches its neighbour's. A row is looked at again only when the neighbour the sweep
+  // comes from changed in this sweep or the one before (`row_stamp_`: the sweep in which
+  // a row last changed); otherwise it already holds all that touches that neighbour.
   bool ok = true;
   constexpr int kMaxSweeps = 6;
-  int sweeps = 0;
-  for (bool changed = true, down = true; changed && ok; down = !down) {
-    if (++sweeps > kMaxSweeps) {
+  int sweep = 1;
+  row_stamp_[seed_y] = 1;
+  for (bool changed = true, down = true; changed && ok; down = !down, ++sweep) {
+    if (sweep > kMaxSweeps) {
       ok = false;
       break;
     }
     changed = false;
-    if (down) {
-      for (int y = top + 1; y <= ry1; ++y) {
-        const bool grew = grow(y, row_min_x_[y - 1], row_max_x_[y - 1]);
-        changed |= grew;
-        if (row_max_x_[y] - row_min_x_[y] > max_extent) ok = false;  // no marker: stop early
-        if (y > bottom) {
-          if (!grew) break;
-          bottom = y;
-        }
-        if (!ok || bottom - top > max_extent) break;
+    const int dir = down ? 1 : -1;
+    for (int y = (down ? top : bottom) + dir; y >= ry0 && y <= ry1; y += dir) {
+      const bool is_new = y > bottom || y < top;
+      if (!is_new && row_stamp_[y - dir] < sweep - 1) continue;
+      const bool grew = grow(y, row_min_x_[y - dir], row_max_x_[y - dir]);
+      if (grew) {
+        changed = true;
+        row_stamp_[y] = sweep;
       }
-    } else {
-      for (int y = bottom - 1; y >= ry0; --y) {
-        const bool grew = grow(y, row_min_x_[y + 1], row_max_x_[y + 1]);
-        changed |= grew;
-        if (row_max_x_[y] - row_min_x_[y] > max_extent) ok = false;
-        if (y < top) {
-          if (!grew) break;
-          top = y;
-        }
-        if (!ok || bottom - top > max_extent) break;
+      if (row_max_x_[y] - row_min_x_[y] > max_extent) ok = false;  // no marker: stop early
+      if (is_new) {
+        if (!grew) break;
+        (down ? bottom : top) = y;
       }
+      if (!ok || bottom - top > max_extent) break;
     }
     if (bottom - top > max_extent) ok = false;
     // The first two sweeps always change something; a third that changes nothing ends.
-    if (sweeps == 1) changed = true;
+    if (sweep == 1) changed = true;
   }
   fill = Fill{0, rx1, rx0, top, bottom, false, false};
   for (int y = top; y <= bottom && ok; ++y) {

@@ -160,6 +160,7 @@ class BlobDetector {
   void mask_tile_row_bytes(const std::uint8_t* in, std::uint8_t* out, std::size_t tile_row_index, int tx,
                            bool local_thresholds) const;
   std::vector<int> row_min_x_, row_max_x_, col_min_y_, col_max_y_;
+  std::vector<int> row_stamp_;  // sweep_fill()'s scratch: per row, the sweep that last changed it
   // flood_fill()'s stack: a seed with the span of the row it was found from.
   struct FillSeed {
     int x, y, parent_y, parent_x0, parent_x1;
