@@ -78,9 +78,13 @@ void prefetch_disc_area(const cv::Mat& grey, const Blob& predicted, const DiscEd
   }
 }
 
-std::optional<DiscEdgeFit> fit_disc_edges(const cv::Mat& grey, const Blob& predicted, double threshold_grey,
-                                          const DiscEdgeFitConfig& config) {
-  CV_Assert(grey.type() == CV_8UC1);
+namespace {
+
+// One fit from `predicted`. When too few crossings are found but enough to say where
+// the disc lies, `shift_px` (if given) receives the prediction's error, estimated from
+// those found.
+std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, double threshold_grey,
+                                    const DiscEdgeFitConfig& config, cv::Vec2d* shift_px) {
   const int lines = std::clamp(config.lines, 2, kMaxLines);
   const cv::Matx22d& s = predicted.shape;
   // Every read lies within the white ring's middle of the farthest crossing: check once
@@ -153,7 +157,29 @@ std::optional<DiscEdgeFit> fit_disc_edges(const cv::Mat& grey, const Blob& predi
       }
     }
   }
-  if (found < std::max(6.0, config.min_edge_fraction * tried)) return std::nullopt;
+  if (found < std::max(6.0, config.min_edge_fraction * tried)) {
+    // A disc that moved off the prediction by more than the reach shows its crossings on
+    // one side only. Those found still say where it went: each crossing's distance from
+    // the unit circle is about the shift's component along its direction, and the shift
+    // follows by least squares.
+    if (shift_px == nullptr || found < 6) return std::nullopt;
+    double a00 = 0, a01 = 0, a11 = 0, b0 = 0, b1 = 0;
+    for (int i = 0; i < found; ++i) {
+      const double r = std::hypot(px[i], py[i]);
+      if (!(r > 0.0)) continue;
+      const double ux = px[i] / r, uy = py[i] / r, d = r - 1.0;
+      a00 += ux * ux;
+      a01 += ux * uy;
+      a11 += uy * uy;
+      b0 += ux * d;
+      b1 += uy * d;
+    }
+    const double det = a00 * a11 - a01 * a01;
+    if (!(det > 1e-6 * found * found)) return std::nullopt;
+    const cv::Vec2d t((a11 * b0 - a01 * b1) / det, (a00 * b1 - a01 * b0) / det);
+    *shift_px = s * t;
+    return std::nullopt;
+  }
 
   // The normal equations need only the moments of the points up to the fourth order;
   // summed as plain scalars (a loop over a small phi array made the compiler store and
@@ -231,6 +257,23 @@ std::optional<DiscEdgeFit> fit_disc_edges(const cv::Mat& grey, const Blob& predi
   fit.white_fraction =
       static_cast<double>(std::count_if(white, white + levels, [&](double g) { return g > mid; })) / levels;
   return fit;
+}
+
+}  // namespace
+
+std::optional<DiscEdgeFit> fit_disc_edges(const cv::Mat& grey, const Blob& predicted, double threshold_grey,
+                                          const DiscEdgeFitConfig& config) {
+  CV_Assert(grey.type() == CV_8UC1);
+  cv::Vec2d shift(0.0, 0.0);
+  if (auto fit = fit_from(grey, predicted, threshold_grey, config, &shift)) return fit;
+  // Once more from where the crossings found say the disc went (less than the disc's
+  // radius away, or it is not this disc): one more fit costs a tenth of a fill.
+  const double moved2 = shift.dot(shift);
+  if (!(moved2 > 0.0) || moved2 > cv::determinant(predicted.shape)) return std::nullopt;
+  Blob moved = predicted;
+  moved.u += shift[0];
+  moved.v += shift[1];
+  return fit_from(grey, moved, threshold_grey, config, nullptr);
 }
 
 }  // namespace rilbed::vision

@@ -62,6 +62,23 @@ TEST(DiscEdgeFit, RecoversTheCentreFromAnOffPrediction) {
   }
 }
 
+// A marker that moved a little further than the crossings' reach (4 px here; a robot
+// speeding up or turning between frames) shows its crossings on one side only; the fit
+// estimates the shift from them, fits again from there and lands on the true centre
+// without a fill. (Each of these shifts fails without the second fit. Much larger ones
+// put the walks inside the code, and the caller's fill takes over.)
+TEST(DiscEdgeFit, FollowsADiscBeyondItsReach) {
+  cv::Point2d truth;
+  const cv::Mat img = marker_image(0.375, 200.0, truth);
+  for (cv::Point2d error : {cv::Point2d(4.0, 1.0), cv::Point2d(4.5, 0.5), cv::Point2d(3.0, 3.0), cv::Point2d(0.5, -5.0), cv::Point2d(-5.0, -1.0)}) {
+    const auto fit = fit_disc_edges(img, disc_at(truth + error, 12.0), 110.0);
+    EXPECT_TRUE(fit.has_value()) << "error " << error;
+    if (!fit) continue;
+    EXPECT_NEAR(fit->blob.u, truth.x, 0.1) << "error " << error;
+    EXPECT_NEAR(fit->blob.v, truth.y, 0.1) << "error " << error;
+  }
+}
+
 // The fit follows an ellipse (a tilted view) as well as a circle.
 TEST(DiscEdgeFit, FitsATiltedEllipse) {
   cv::Mat big(200 * kScale, 200 * kScale, CV_8UC1, cv::Scalar(200));
