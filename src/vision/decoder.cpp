@@ -7,6 +7,10 @@
 #include <stdexcept>
 #include <tuple>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "core/geometry.hpp"
 #include "vision/circle_sampler.hpp"
 
@@ -14,21 +18,83 @@ namespace rilbed::vision {
 
 namespace {
 
-// The spread between the lo- and hi-quantiles of grey levels (0..255), by counting
-// into one histogram: no copy, no sort, no branches that depend on the data's order.
-double quantile_spread(const std::vector<double>& v, double lo, double hi) {
-  std::array<std::uint16_t, 256> histogram{};
-  for (double g : v) ++histogram[static_cast<std::size_t>(std::clamp(g, 0.0, 255.0))];
-  const auto rank_lo = static_cast<std::size_t>(lo * (v.size() - 1));
-  const auto rank_hi = static_cast<std::size_t>(hi * (v.size() - 1));
-  std::size_t seen = 0;
-  int level_lo = -1;
-  for (int level = 0; level < 256; ++level) {
-    seen += histogram[level];
-    if (level_lo < 0 && seen > rank_lo) level_lo = level;
-    if (seen > rank_hi) return level - level_lo;
+// The smallest grey level L with more than `rank` of the levels at or below it, by
+// bisection over L with a count per step (sixteen levels per compare): no histogram to
+// clear and scan, and few branches. `levels` holds `count` levels rounded down, padded
+// with 255 to a multiple of sixteen (padding never counts: L stays below 255).
+int level_of_rank(const std::uint8_t* levels, int count, int rank) {
+  const int padded = (count + 15) & ~15;
+  auto at_or_below = [&](int level) {
+    int n = 0;
+#if defined(__SSE2__)
+    const __m128i l = _mm_set1_epi8(static_cast<char>(level)), one = _mm_set1_epi8(1);
+    __m128i sums = _mm_setzero_si128();
+    for (int i = 0; i < padded; i += 16) {
+      const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(levels + i));
+      const __m128i below = _mm_and_si128(_mm_cmpeq_epi8(_mm_min_epu8(v, l), v), one);
+      sums = _mm_add_epi64(sums, _mm_sad_epu8(below, _mm_setzero_si128()));
+    }
+    n = _mm_cvtsi128_si32(sums) + _mm_cvtsi128_si32(_mm_srli_si128(sums, 8));
+#else
+    for (int i = 0; i < padded; ++i) n += levels[i] <= level;
+#endif
+    return n;
+  };
+  int lo = 0, hi = 255;  // at_or_below(255) is everything: more than any rank
+  while (lo < hi) {
+    const int mid = (lo + hi) / 2;
+    if (at_or_below(mid) > rank) {
+      hi = mid;
+    } else {
+      lo = mid + 1;
+    }
   }
-  return 255.0 - std::max(level_lo, 0);
+  return lo;
+}
+
+// The spread between the lo- and hi-quantiles of grey levels (0..255, rounded down).
+double quantile_spread(const std::vector<double>& v, double lo, double hi) {
+  thread_local std::vector<std::uint8_t> levels;
+  const int n = static_cast<int>(v.size());
+  levels.assign(static_cast<std::size_t>((n + 15) & ~15), 255);
+  for (int i = 0; i < n; ++i) levels[i] = static_cast<std::uint8_t>(std::clamp(v[i], 0.0, 255.0));
+  const auto rank_lo = static_cast<int>(lo * (n - 1));
+  const auto rank_hi = static_cast<int>(hi * (n - 1));
+  return level_of_rank(levels.data(), n, rank_hi) - level_of_rank(levels.data(), n, rank_lo);
+}
+
+// Batcher's odd-even merge sort as a list of compare-exchanges, for a fixed size.
+template <int N>
+struct SortingNetwork {
+  std::array<std::pair<int, int>, N * N> pairs{};
+  int count = 0;
+  constexpr SortingNetwork() {
+    for (int p = 1; p < N; p <<= 1) {
+      for (int k = p; k >= 1; k >>= 1) {
+        for (int j = k % p; j + k < N; j += 2 * k) {
+          for (int i = 0; i < std::min(k, N - j - k); ++i) {
+            if ((i + j) / (2 * p) == (i + j + k) / (2 * p)) pairs[count++] = {i + j, i + j + k};
+          }
+        }
+      }
+    }
+  }
+};
+
+// The median (the upper one of an even count) of N floats, by a sorting network: min
+// and max per step, no branches, where nth_element's insertion sort mispredicted.
+template <int N>
+float median_of(const float* values) {
+  static constexpr SortingNetwork<N> kNetwork;
+  std::array<float, N> v;
+  std::copy_n(values, N, v.begin());
+  for (int c = 0; c < kNetwork.count; ++c) {
+    const auto [i, j] = kNetwork.pairs[c];
+    const float a = v[i], b = v[j];
+    v[i] = std::min(a, b);
+    v[j] = std::max(a, b);
+  }
+  return v[N / 2];
 }
 
 // The doubled running integral `c` (unit-width bins centred on whole samples) at
@@ -153,13 +219,8 @@ void Decoder::sample(const cv::Mat& grey, const Blob& blob, SampledSignal& out) 
   const double white_r = 0.5 * (MarkerFamily::black_ring_outer_radius + 1.0);
   sample_ellipse(grey, blob.u, blob.v, blob.shape, reach * black_r, ring_directions_, black.data());
   sample_ellipse(grey, blob.u, blob.v, blob.shape, reach * white_r, ring_directions_, white.data());
-  std::array<float, kRingSamples> black_sorted{}, white_sorted{};
-  std::copy_n(black.begin(), kRingSamples, black_sorted.begin());
-  std::copy_n(white.begin(), kRingSamples, white_sorted.begin());
-  std::nth_element(black_sorted.begin(), black_sorted.begin() + kRingSamples / 2, black_sorted.end());
-  std::nth_element(white_sorted.begin(), white_sorted.begin() + kRingSamples / 2, white_sorted.end());
-  out.black_level = black_sorted[kRingSamples / 2];
-  out.white_level = white_sorted[kRingSamples / 2];
+  out.black_level = median_of<kRingSamples>(black.data());
+  out.white_level = median_of<kRingSamples>(white.data());
   out.ring_contrast = out.white_level - out.black_level;
   if (out.ring_contrast < config_.min_ring_contrast) return;
   const double mid = 0.5 * (out.black_level + out.white_level);
