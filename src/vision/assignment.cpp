@@ -1,6 +1,7 @@
 #include "vision/assignment.hpp"
 
 #include <limits>
+#include <span>
 #include <stdexcept>
 
 namespace rilbed::vision {
@@ -65,15 +66,23 @@ std::vector<int> assign_max_similarity(const std::vector<std::vector<double>>& s
   const int rows = static_cast<int>(similarity.size());
   if (rows == 0) return {};
   const int cols = static_cast<int>(similarity[0].size());
+  std::vector<double> flat;
+  flat.reserve(static_cast<std::size_t>(rows) * cols);
   for (const auto& row : similarity) {
     if (static_cast<int>(row.size()) != cols) throw std::invalid_argument("ragged similarity matrix");
+    flat.insert(flat.end(), row.begin(), row.end());
   }
+  return assign_max_similarity(flat.data(), rows, cols, min_similarity);
+}
+
+std::vector<int> assign_max_similarity(const double* similarity, int rows, int cols, double min_similarity) {
+  if (rows <= 0) return {};
   std::vector<int> result(rows, -1);
-  if (cols == 0) return result;
+  if (cols <= 0) return result;
   // Pairs below the threshold weigh 0, so taking one is worth nothing; every allowed
   // pair weighs its (positive) similarity.
   auto weight = [&](int r, int c) {
-    const double s = similarity[r][c];
+    const double s = similarity[static_cast<std::size_t>(r) * cols + c];
     return s >= min_similarity && s > 0.0 ? s : 0.0;
   };
   // The best assignment splits over the connected parts of the graph of allowed pairs
@@ -95,10 +104,16 @@ std::vector<int> assign_max_similarity(const std::vector<std::vector<double>>& s
       }
     }
   }
-  std::vector<std::vector<int>> members(rows);
-  for (int r = 0; r < rows; ++r) members[find(r)].push_back(r);
+  // The rows of each part, grouped by its root (a counting sort).
+  std::vector<int> first_of(rows + 1, 0), ordered(rows);
+  for (int r = 0; r < rows; ++r) ++first_of[find(r) + 1];
+  for (int root = 0; root < rows; ++root) first_of[root + 1] += first_of[root];
+  {
+    std::vector<int> next(first_of.begin(), first_of.end() - 1);
+    for (int r = 0; r < rows; ++r) ordered[next[find(r)]++] = r;
+  }
   for (int root = 0; root < rows; ++root) {
-    const std::vector<int>& part_rows = members[root];
+    const std::span<const int> part_rows(ordered.data() + first_of[root], ordered.data() + first_of[root + 1]);
     if (part_rows.empty()) continue;
     if (part_rows.size() == 1) {  // one object: its best allowed ID, if any
       const int r = part_rows[0];

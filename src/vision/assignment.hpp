@@ -15,4 +15,8 @@ namespace rilbed::vision {
 std::vector<int> assign_max_similarity(const std::vector<std::vector<double>>& similarity,
                                        double min_similarity);
 
+/// The same on a row-major `rows` x `cols` matrix (not owned; `similarity[r * cols + c]`),
+/// for a caller that keeps one buffer from frame to frame.
+std::vector<int> assign_max_similarity(const double* similarity, int rows, int cols, double min_similarity);
+
 }  // namespace rilbed::vision

@@ -372,10 +372,15 @@ std::pair<double, double> Decoder::refine_peak(const Prepared& p, const Ideal& i
 
 std::vector<CodeMatch> Decoder::match_all(const SampledSignal& signal, const Blob& blob) const {
   std::vector<CodeMatch> out;
-  out.reserve(ideals_.size());
+  match_all(signal, blob, out);
+  return out;
+}
+
+void Decoder::match_all(const SampledSignal& signal, const Blob& blob, std::vector<CodeMatch>& out) const {
+  out.clear();
   if (!signal.usable || signal.values.size() != static_cast<std::size_t>(config_.samples)) {
     for (const auto& ideal : ideals_) out.push_back({ideal.id, -1.0, 0.0});
-    return out;
+    return;
   }
   // Per-thread scratch: the decoder is shared and immutable, and a frame decodes many
   // blobs, so the buffers are reused instead of allocated per blob.
@@ -383,10 +388,13 @@ std::vector<CodeMatch> Decoder::match_all(const SampledSignal& signal, const Blo
   prepare(signal, p);
   if (p.norm <= 0.0) {
     for (const auto& ideal : ideals_) out.push_back({ideal.id, -1.0, 0.0});
-    return out;
+    return;
   }
   prepare_doubled(signal, p);
-  if (decode_by_bits_) return match_by_key(p, blob);
+  if (decode_by_bits_) {
+    match_by_key(p, blob, out);
+    return;
+  }
   // Every ID shares the key and its guards, so every ID's peak lies where the key's
   // does: find that lag once (every lag, the key's few edges), then score each ID at the
   // whole-sample lags next to it.
@@ -411,16 +419,14 @@ std::vector<CodeMatch> Decoder::match_all(const SampledSignal& signal, const Blo
     }
     out.push_back({ideals_[i].id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, lag)});
   }
-  return out;
 }
 
-std::vector<CodeMatch> Decoder::match_by_key(const Prepared& p, const Blob& blob) const {
+void Decoder::match_by_key(const Prepared& p, const Blob& blob, std::vector<CodeMatch>& out) const {
   // Heading first, from the key and guards alone; then the code bits read at that
   // heading; then the exact cross-covariance for the code read and for every code one
   // bit away (the only IDs a misread bit can hide). The cost no longer grows with the
   // number of IDs.
-  std::vector<CodeMatch> out;
-  out.reserve(ideals_.size());
+  out.clear();
   for (const auto& ideal : ideals_) out.push_back({ideal.id, -1.0, 0.0});
   thread_local std::vector<double> scratch;
   const auto [key_lag, key_value] = coarse_peak(p, key_, scratch);
@@ -457,7 +463,6 @@ std::vector<CodeMatch> Decoder::match_by_key(const Prepared& p, const Blob& blob
     const auto [fine_lag, value] = refine_peak(p, ideal, centre, correlate(p, ideal, centre));
     out[index_of_id_[id]] = {ideal.id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, fine_lag)};
   }
-  return out;
 }
 
 CodeMatch Decoder::match_one(const SampledSignal& signal, const Blob& blob, int id,

@@ -84,6 +84,8 @@ class Decoder {
   /// key's lag (they share the key, so their peaks lie there); the others get -1 (they
   /// cannot be the best match unless a clear bit misreads).
   std::vector<CodeMatch> match_all(const SampledSignal& signal, const Blob& blob) const;
+  /// The same into `out` (replacing its contents, reusing its storage).
+  void match_all(const SampledSignal& signal, const Blob& blob, std::vector<CodeMatch>& out) const;
 
   /// Similarity of the signal to one ID (which must be one of ids()): what a tracked
   /// marker needs to confirm its ID at a fraction of match_all's cost.
@@ -142,7 +144,7 @@ class Decoder {
   // confirmation falls back to the search over every lag.
   static constexpr double kTrackReachDeg = 15.0;
   void build_key_template(const MarkerFamily& family);
-  std::vector<CodeMatch> match_by_key(const Prepared& p, const Blob& blob) const;
+  void match_by_key(const Prepared& p, const Blob& blob, std::vector<CodeMatch>& out) const;
   Ideal key_;                                            // key and guards only
   bool decode_by_bits_ = false;                          // more than kExhaustiveIds IDs: match_by_key
   std::vector<std::pair<double, double>> slice_bounds_;  // slices at lag 0, in samples; empty: exhaustive

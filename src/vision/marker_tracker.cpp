@@ -105,22 +105,24 @@ cv::Mat MarkerTracker::to_grey(const cv::Mat& frame) {
 
 std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const std::vector<Blob>& blobs,
                                                    bool use_tracks, const std::vector<int>& taken_ids) {
-  std::vector<std::vector<double>> similarity;
-  std::vector<std::vector<CodeMatch>> matches;
-  std::vector<double> thresholds;
-  similarity.reserve(blobs.size());
-  matches.reserve(blobs.size());
+  // Buffers kept from frame to frame: a frame of 64 markers made 130 allocations here.
+  const std::size_t columns = ids_.size();
+  similarity_.assign(blobs.size() * columns, -1.0);
+  if (matches_.size() < blobs.size()) matches_.resize(blobs.size());
+  thresholds_.clear();
   stats_.blobs += static_cast<int>(blobs.size());
-  for (const Blob& blob : blobs) {
+  for (std::size_t b = 0; b < blobs.size(); ++b) {
+    const Blob& blob = blobs[b];
     decoder_.sample(grey, blob, signal_);
     if (signal_.usable) ++stats_.decoded;
-    thresholds.push_back(0.5 * (signal_.black_level + signal_.white_level));
-    matches.push_back(decoder_.match_all(signal_, blob));
+    thresholds_.push_back(0.5 * (signal_.black_level + signal_.white_level));
+    std::vector<CodeMatch>& matches = matches_[b];
+    decoder_.match_all(signal_, blob, matches);
     double family_best = -1.0;
-    for (const CodeMatch& m : matches.back()) family_best = std::max(family_best, m.score);
-    std::vector<double> row(ids_.size(), -1.0);
-    for (std::size_t c = 0; c < ids_.size(); ++c) {
-      const double score = matches.back()[decoder_index_[c]].score;
+    for (const CodeMatch& m : matches) family_best = std::max(family_best, m.score);
+    double* row = &similarity_[b * columns];
+    for (std::size_t c = 0; c < columns; ++c) {
+      const double score = matches[decoder_index_[c]].score;
       if (score < config_.min_assign_score || score < family_best - config_.family_margin) continue;
       if (std::find(taken_ids.begin(), taken_ids.end(), ids_[c]) != taken_ids.end()) continue;
       row[c] = score;
@@ -132,13 +134,13 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
         if (std::hypot(blob.u - p.x, blob.v - p.y) < gate) row[c] += config_.track_bonus;
       }
     }
-    similarity.push_back(std::move(row));
   }
-  const std::vector<int> chosen = assign_max_similarity(similarity, config_.min_assign_score);
+  const std::vector<int> chosen = assign_max_similarity(similarity_.data(), static_cast<int>(blobs.size()),
+                                                        static_cast<int>(columns), config_.min_assign_score);
   std::vector<MarkerDetection> out;
   for (std::size_t r = 0; r < blobs.size(); ++r) {
     if (chosen[r] < 0) continue;
-    out.push_back(make_detection(blobs[r], matches[r][decoder_index_[chosen[r]]], false, thresholds[r]));
+    out.push_back(make_detection(blobs[r], matches_[r][decoder_index_[chosen[r]]], false, thresholds_[r]));
   }
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
   return out;

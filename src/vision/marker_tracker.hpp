@@ -143,6 +143,11 @@ class MarkerTracker {
   MarkerFamily family_;
   std::vector<int> ids_;
   std::vector<int> decoder_index_;  // for each of ids_, its column in the decoder's matches
+  // assign()'s buffers, kept between frames: blobs x ids_ similarities (row-major), each
+  // blob's matches from the decoder, each blob's black/white midpoint.
+  std::vector<double> similarity_;
+  std::vector<std::vector<CodeMatch>> matches_;
+  std::vector<double> thresholds_;
   TrackerConfig config_;
   BlobDetector detector_;
   Decoder decoder_;
