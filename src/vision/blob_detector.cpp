@@ -283,7 +283,9 @@ void BlobDetector::build_dark_mask(const cv::Mat& grey, cv::Rect roi, bool local
     const int y0 = ty * t_px, y1 = std::min(size_.height, y0 + t_px);
     const std::size_t row = static_cast<std::size_t>(ty) * tiles_x_;
     contrast.clear();
-    for (int tx = tx0; tx <= tx1; ++tx) {
+    // Only tiles with a threshold or with an earlier search's mask need a look; sixteen
+    // at a time, most of a plain floor is skipped in one compare.
+    auto visit = [&](int tx) {
       const std::uint8_t t = tile_threshold_[row + tx];
       // A tile whose own pixels all lie just below its threshold is floor beside a
       // marker whose black only grazes the neighbourhood, not black: printed black lies
@@ -300,7 +302,19 @@ void BlobDetector::build_dark_mask(const cv::Mat& grey, cv::Rect roi, bool local
         for (int y = y0; y < y1; ++y) std::fill(dark_.ptr<std::uint8_t>(y) + x0, dark_.ptr<std::uint8_t>(y) + x1, 0);
         dark_written_[row + tx] = 0;
       }
+    };
+    int tx = tx0;
+#if defined(__SSE2__)
+    for (; tx + 16 <= tx1 + 1; tx += 16) {
+      const __m128i either = _mm_or_si128(load16(&tile_threshold_[row + tx]), load16(&dark_written_[row + tx]));
+      unsigned bits = ~static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(either, _mm_setzero_si128()))) & 0xFFFFu;
+      while (bits != 0) {  // in increasing order: the list stays sorted
+        visit(tx + __builtin_ctz(bits));
+        bits &= bits - 1;
+      }
     }
+#endif
+    for (; tx <= tx1; ++tx) visit(tx);
     // Row by row across the tile row (not tile by tile down it), so that the frame is
     // read as a stream: a new frame is not in the caches yet.
     const std::size_t listed = contrast.size();
@@ -467,6 +481,14 @@ int count_nonzero(const std::uint8_t* mask, int a, int b) {
   __m128i sums = _mm_setzero_si128();
   const __m128i one = _mm_set1_epi8(1);
   for (; x + 15 <= b; x += 16) sums = _mm_add_epi64(sums, _mm_sad_epu8(_mm_min_epu8(load16(mask + x), one), _mm_setzero_si128()));
+  if (x <= b) {
+    // The last few bytes in one step: the row's zero padding keeps the load inside the
+    // buffer, and the bytes beyond b are masked off.
+    alignas(16) static constexpr std::uint8_t kOnes[32] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+    const __m128i keep = _mm_loadu_si128(reinterpret_cast<const __m128i*>(kOnes + 16 - (b - x + 1)));
+    sums = _mm_add_epi64(sums, _mm_sad_epu8(_mm_min_epu8(load16(mask + x), keep), _mm_setzero_si128()));
+    x = b + 1;
+  }
   count = _mm_cvtsi128_si32(sums) + _mm_cvtsi128_si32(_mm_srli_si128(sums, 8));
 #endif
   for (; x <= b; ++x) count += mask[x] != 0;
@@ -659,11 +681,52 @@ struct ChordMoments {
   }
 };
 
-// Expected length of the chord at offset `d` across an ellipse whose quadratic form
-// is q_along*s^2 + 2*q_mixed*s*d + q_across*d^2 = 1.
-double ellipse_chord(double q_along, double q_mixed, double q_across, double d, double inv_q_along) {
-  const double disc = q_mixed * q_mixed * d * d - q_along * (q_across * d * d - 1.0);
-  return disc > 0.0 ? 2.0 * std::sqrt(disc) * inv_q_along : 0.0;
+// Mean deviation of the chords {a, b, position across} from those of the ellipse whose
+// quadratic form is q_along*s^2 + 2*q_mixed*s*d + q_across*d^2 = 1 around
+// (centre_along, centre_across): the difference in length plus the offset of the
+// midpoint, over the number of chords and the longest chord. Two chords per step with
+// SSE2 (two square roots in one instruction): this ran once per chord per candidate.
+double chord_error(const std::vector<std::array<double, 3>>& chords, double q_along, double q_mixed,
+                   double q_across, double centre_along, double centre_across) {
+  const double inv_q_along = 1.0 / q_along;
+  // The chord at offset d has half-length sqrt(disc) / q_along, with
+  // disc = q_mixed^2 d^2 - q_along (q_across d^2 - 1) = q_along + k2 d^2.
+  const double k2 = q_mixed * q_mixed - q_along * q_across;
+  const double mid_slope = q_mixed * inv_q_along;
+  double err = 0.0, longest = 0.0;
+  std::size_t i = 0;
+#if defined(__SSE2__)
+  const __m128d v_k0 = _mm_set1_pd(q_along), v_k2 = _mm_set1_pd(k2), v_two_inv = _mm_set1_pd(2.0 * inv_q_along);
+  const __m128d v_centre_across = _mm_set1_pd(centre_across), v_centre_along = _mm_set1_pd(centre_along);
+  const __m128d v_slope = _mm_set1_pd(mid_slope), v_half = _mm_set1_pd(0.5), v_zero = _mm_setzero_pd();
+  const __m128d abs_mask = _mm_castsi128_pd(_mm_set1_epi64x(0x7FFFFFFFFFFFFFFFLL));
+  __m128d v_err = _mm_setzero_pd(), v_longest = _mm_setzero_pd();
+  for (; i + 2 <= chords.size(); i += 2) {
+    const __m128d a = _mm_set_pd(chords[i + 1][0], chords[i][0]);
+    const __m128d b = _mm_set_pd(chords[i + 1][1], chords[i][1]);
+    const __m128d d = _mm_sub_pd(_mm_set_pd(chords[i + 1][2], chords[i][2]), v_centre_across);
+    const __m128d disc = _mm_add_pd(v_k0, _mm_mul_pd(v_k2, _mm_mul_pd(d, d)));
+    const __m128d model = _mm_mul_pd(_mm_sqrt_pd(_mm_max_pd(disc, v_zero)), v_two_inv);
+    v_longest = _mm_max_pd(v_longest, model);
+    const __m128d mid_model = _mm_sub_pd(v_centre_along, _mm_mul_pd(v_slope, d));
+    const __m128d len_err = _mm_and_pd(_mm_sub_pd(_mm_sub_pd(b, a), model), abs_mask);
+    const __m128d mid_err = _mm_and_pd(_mm_sub_pd(_mm_mul_pd(v_half, _mm_add_pd(a, b)), mid_model), abs_mask);
+    v_err = _mm_add_pd(v_err, _mm_add_pd(len_err, mid_err));
+  }
+  err = _mm_cvtsd_f64(v_err) + _mm_cvtsd_f64(_mm_unpackhi_pd(v_err, v_err));
+  longest = std::max(_mm_cvtsd_f64(v_longest), _mm_cvtsd_f64(_mm_unpackhi_pd(v_longest, v_longest)));
+#endif
+  for (; i < chords.size(); ++i) {
+    const auto& c = chords[i];
+    const double d = c[2] - centre_across;
+    const double disc = q_along + k2 * d * d;
+    const double model = disc > 0.0 ? 2.0 * std::sqrt(disc) * inv_q_along : 0.0;
+    longest = std::max(longest, model);
+    // The chord's midpoint must also sit where the ellipse's does.
+    const double mid_model = centre_along - mid_slope * d;
+    err += std::abs((c[1] - c[0]) - model) + std::abs(0.5 * (c[0] + c[1]) - mid_model);
+  }
+  return longest > 0.0 ? err / (chords.size() * longest) : 1.0;
 }
 
 }  // namespace
@@ -737,19 +800,6 @@ bool BlobDetector::measure(const cv::Mat& grey, const Fill& fill, Blob& blob) co
 
   const double inv = 1.0 / (4.0 * det);
   const double qxx = syy * inv, qyy = sxx * inv, qxy = -sxy * inv;
-  auto chord_error = [](const std::vector<std::array<double, 3>>& chords, double q_along, double q_mixed,
-                        double q_across, double centre_along, double centre_across) {
-    double err = 0.0, longest = 0.0;
-    const double inv_q_along = 1.0 / q_along;
-    for (const auto& c : chords) {
-      const double model = ellipse_chord(q_along, q_mixed, q_across, c[2] - centre_across, inv_q_along);
-      longest = std::max(longest, model);
-      // The chord's midpoint must also sit where the ellipse's does.
-      const double mid_model = centre_along - q_mixed * (c[2] - centre_across) * inv_q_along;
-      err += std::abs((c[1] - c[0]) - model) + std::abs(0.5 * (c[0] + c[1]) - mid_model);
-    }
-    return longest > 0.0 ? err / (chords.size() * longest) : 1.0;
-  };
   if (chord_error(row_chords, qxx, qxy, qyy, cx, cy) > config_.max_chord_error) return false;
   if (chord_error(col_chords, qyy, qxy, qxx, cy, cx) > config_.max_chord_error) return false;
 
@@ -819,15 +869,14 @@ bool BlobDetector::measure_region(const cv::Mat& grey, const Fill& fill, Blob& b
   const double min_area = kPi * min_disc_d * min_disc_d / 4.0 / config_.max_axis_ratio * 0.8;
   if (fill.area < min_area) return false;
   // Column extents of the region, from its row extents: only candidates pay for them
-  // (a long strip of tape is filled, but never measured).
-  // Rows go down, so a column's first row is its top and its last its bottom; the
-  // two plain loops per row vectorise.
-  int* __restrict__ col_min = col_min_y_.data();
-  int* __restrict__ col_max = col_max_y_.data();
+  // (a long strip of tape is filled, but never measured). A column's bottom is the last
+  // row (going down) that covers it and its top the last going up: two plain fills per
+  // row, which vectorise, where one pass needed a compare per column.
   for (int r = fill.y0; r <= fill.y1; ++r) {
-    const int c0 = row_min_x_[r], c1 = row_max_x_[r];
-    for (int c = c0; c <= c1; ++c) col_min[c] = col_max[c] < col_min[c] ? r : col_min[c];
-    for (int c = c0; c <= c1; ++c) col_max[c] = r;
+    if (row_max_x_[r] >= row_min_x_[r]) std::fill(&col_max_y_[row_min_x_[r]], &col_max_y_[row_max_x_[r]] + 1, r);
+  }
+  for (int r = fill.y1; r >= fill.y0; --r) {
+    if (row_max_x_[r] >= row_min_x_[r]) std::fill(&col_min_y_[row_min_x_[r]], &col_min_y_[row_max_x_[r]] + 1, r);
   }
   return measure(grey, fill, blob);
 }
