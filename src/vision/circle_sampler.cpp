@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -54,11 +55,17 @@ void sample_ellipse(const cv::Mat& grey, double centre_u, double centre_v, const
   };
 #if defined(__SSE2__)
   // Four points per step: their coordinates, whole and fractional parts in SSE; the
-  // sixteen pixel reads are scalar (SSE2 has no gather), the interpolation is SSE again.
+  // pixel reads are scalar (SSE2 has no gather), two neighbours per 16-bit read, and the
+  // interpolation is SSE again.
   const __m128 va = _mm_set1_ps(a), vb = _mm_set1_ps(b), vc = _mm_set1_ps(c), vd = _mm_set1_ps(d);
   const __m128 vcu = _mm_set1_ps(cu), vcv = _mm_set1_ps(cv);
+  const __m128i low_byte = _mm_set1_epi32(0xFF);
   alignas(16) int xs[4], ys[4];
-  alignas(16) float p00[4], p01[4], p10[4], p11[4];
+  auto pair_at = [](const std::uint8_t* p) {  // p[0] | p[1] << 8, from any address
+    std::uint16_t w;
+    std::memcpy(&w, p, sizeof w);
+    return static_cast<int>(w);
+  };
   for (int k = 0; k < n; k += 4) {
     const __m128 dx = _mm_loadu_ps(&directions.cos[k]), dy = _mm_loadu_ps(&directions.sin[k]);
     const __m128 u = _mm_add_ps(vcu, _mm_add_ps(_mm_mul_ps(va, dx), _mm_mul_ps(vb, dy)));
@@ -67,14 +74,15 @@ void sample_ellipse(const cv::Mat& grey, double centre_u, double centre_v, const
     const __m128 fx = _mm_sub_ps(u, _mm_cvtepi32_ps(ui)), fy = _mm_sub_ps(v, _mm_cvtepi32_ps(vi));
     _mm_store_si128(reinterpret_cast<__m128i*>(xs), ui);
     _mm_store_si128(reinterpret_cast<__m128i*>(ys), vi);
-    for (int j = 0; j < 4; ++j) {
-      const std::uint8_t* p = data + static_cast<std::ptrdiff_t>(ys[j]) * stride + xs[j];
-      p00[j] = p[0];
-      p01[j] = p[1];
-      p10[j] = p[stride];
-      p11[j] = p[stride + 1];
-    }
-    const __m128 a00 = _mm_load_ps(p00), a01 = _mm_load_ps(p01), a10 = _mm_load_ps(p10), a11 = _mm_load_ps(p11);
+    const std::uint8_t* p0 = data + static_cast<std::ptrdiff_t>(ys[0]) * stride + xs[0];
+    const std::uint8_t* p1 = data + static_cast<std::ptrdiff_t>(ys[1]) * stride + xs[1];
+    const std::uint8_t* p2 = data + static_cast<std::ptrdiff_t>(ys[2]) * stride + xs[2];
+    const std::uint8_t* p3 = data + static_cast<std::ptrdiff_t>(ys[3]) * stride + xs[3];
+    const __m128i upper = _mm_setr_epi32(pair_at(p0), pair_at(p1), pair_at(p2), pair_at(p3));
+    const __m128i lower = _mm_setr_epi32(pair_at(p0 + stride), pair_at(p1 + stride), pair_at(p2 + stride),
+                                         pair_at(p3 + stride));
+    const __m128 a00 = _mm_cvtepi32_ps(_mm_and_si128(upper, low_byte)), a01 = _mm_cvtepi32_ps(_mm_srli_epi32(upper, 8));
+    const __m128 a10 = _mm_cvtepi32_ps(_mm_and_si128(lower, low_byte)), a11 = _mm_cvtepi32_ps(_mm_srli_epi32(lower, 8));
     const __m128 top = _mm_add_ps(a00, _mm_mul_ps(_mm_sub_ps(a01, a00), fx));
     const __m128 bottom = _mm_add_ps(a10, _mm_mul_ps(_mm_sub_ps(a11, a10), fx));
     _mm_storeu_ps(out + k, _mm_add_ps(top, _mm_mul_ps(_mm_sub_ps(bottom, top), fy)));

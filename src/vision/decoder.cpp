@@ -161,12 +161,20 @@ Decoder::Decoder(const MarkerFamily& family, const std::vector<int>& ids, Decode
       ideal.edge_index.push_back(index % config_.samples);
       ideal.edge_frac.push_back(e + 0.5 - index);
     }
+    order_knots(ideal);
     ideals_.push_back(std::move(ideal));
   }
   index_of_id_.assign(family.max_id() + 1, -1);
   for (std::size_t i = 0; i < ids.size(); ++i) index_of_id_[ids[i]] = static_cast<int>(i);
   build_key_template(family);
   decode_by_bits_ = static_cast<int>(ids.size()) > kExhaustiveIds;
+}
+
+void Decoder::order_knots(Ideal& ideal) {
+  ideal.knot_order.resize(ideal.edge.size());
+  std::iota(ideal.knot_order.begin(), ideal.knot_order.end(), 0);
+  std::stable_sort(ideal.knot_order.begin(), ideal.knot_order.end(),
+                   [&](int a, int b) { return ideal.edge_frac[a] > ideal.edge_frac[b]; });
 }
 
 void Decoder::build_key_template(const MarkerFamily& family) {
@@ -190,6 +198,7 @@ void Decoder::build_key_template(const MarkerFamily& family) {
     key_.edge_index.push_back(index % config_.samples);
     key_.edge_frac.push_back(e + 0.5 - index);
   }
+  order_knots(key_);
   slice_bounds_.clear();
   for (const auto& s : slices) slice_bounds_.emplace_back(s.start_deg / deg_per_sample, s.end_deg / deg_per_sample);
 }
@@ -351,22 +360,53 @@ std::pair<double, double> Decoder::refine_peak(const Prepared& p, const Ideal& i
   // The running integral is linear between bin boundaries, so the correlation (a sum of
   // it at each edge plus the lag) is piecewise linear in the lag, with corners where an
   // edge crosses a bin boundary. Its maximum on [lag - 1, lag + 1] is at one of those
-  // corners or an end: evaluating them all finds it exactly (two corners per edge).
+  // corners or an end. Going up from lag - 1 the corners come in an order fixed per
+  // ideal (knot_order, then the same again one sample later), and at each the slope
+  // changes by one edge's term: one walk finds every corner's value, in time linear in
+  // the edges (evaluating each corner afresh was quadratic).
+  const int n = config_.samples;
+  const std::size_t edges = ideal.edge.size();
   const double lo = lag - 1.0, hi = lag + 1.0;
   double best_lag = lag, best = value;
-  auto consider = [&](double t) {
-    const double c = correlate(p, ideal, t);
+  auto consider = [&](double t, double c) {
     if (c > best) {
       best = c;
       best_lag = t;
     }
   };
-  consider(lo);
-  consider(hi);
-  for (double edge : ideal.edge) {
-    // Corners where edge + t + 0.5 is a whole number.
-    for (double t = std::ceil(lo + edge + 0.5) - edge - 0.5; t <= hi; t += 1.0) consider(t);
+  const double* c = p.doubled_cumulative.data();  // 2n + 2 entries
+  const int lo_bin = ((lag - 1) % n + n) % n;
+  constexpr std::size_t kMaxEdges = 64;
+  if (edges > kMaxEdges) {  // no family has this many; evaluate every corner afresh
+    consider(lo, correlate(p, ideal, lo));
+    consider(hi, correlate(p, ideal, hi));
+    for (double edge : ideal.edge) {
+      for (double t = std::ceil(lo + edge + 0.5) - edge - 0.5; t <= hi; t += 1.0) consider(t, correlate(p, ideal, t));
+    }
+    return {best_lag, best};
   }
+  // Per edge, the bin its running integral is read in just above lo, and the slope.
+  std::array<int, kMaxEdges> bin;
+  double slope = 0.0;
+  for (std::size_t e = 0; e < edges; ++e) {
+    bin[e] = ideal.edge_index[e] + lo_bin;  // < 2n - 1: two steps up stay inside
+    slope += ideal.step[e] * (c[bin[e] + 1] - c[bin[e]]);
+  }
+  double f = correlate(p, ideal, lo), t_prev = lo;
+  consider(lo, f);
+  for (int whole = 0; whole < 2; ++whole) {
+    for (int e : ideal.knot_order) {
+      // The boundary lies (1 - edge_frac) above a whole lag, in (0, 1].
+      const double t = lo + whole + (1.0 - ideal.edge_frac[e]);
+      if (t >= hi) continue;
+      f += slope * (t - t_prev);
+      t_prev = t;
+      consider(t, f);
+      const int k = bin[e]++;
+      slope += ideal.step[e] * ((c[k + 2] - c[k + 1]) - (c[k + 1] - c[k]));
+    }
+  }
+  consider(hi, f + slope * (hi - t_prev));
   return {best_lag, best};
 }
 

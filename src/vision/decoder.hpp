@@ -109,6 +109,9 @@ class Decoder {
     std::vector<double> step;  // normalised level before the edge minus level after it
     std::vector<int> edge_index;     // floor(edge + 0.5): the bin the edge falls in
     std::vector<double> edge_frac;   // edge + 0.5 - edge_index
+    // Edges in the order their running-integral bin boundaries are met going up from a
+    // whole lag (by decreasing edge_frac): what refine_peak walks through.
+    std::vector<int> knot_order;
   };
   // The mean-free signal's running integral, plain (n + 1) and doubled (2n, with the
   // signal itself doubled beside it), and its norm.
@@ -144,6 +147,7 @@ class Decoder {
   // confirmation falls back to the search over every lag.
   static constexpr double kTrackReachDeg = 15.0;
   void build_key_template(const MarkerFamily& family);
+  static void order_knots(Ideal& ideal);
   void match_by_key(const Prepared& p, const Blob& blob, std::vector<CodeMatch>& out) const;
   Ideal key_;                                            // key and guards only
   bool decode_by_bits_ = false;                          // more than kExhaustiveIds IDs: match_by_key
