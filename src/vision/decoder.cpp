@@ -296,24 +296,32 @@ double Decoder::heading_on_screen(const Blob& blob, double lag) const {
 
 void Decoder::prepare(const SampledSignal& signal, Prepared& p) const {
   const int n = config_.samples;
-  const double mean = std::accumulate(signal.values.begin(), signal.values.end(), 0.0) / n;
-  double norm2 = 0.0;
-  p.cumulative.resize(n + 1);
-  p.cumulative[0] = 0.0;
-  for (int k = 0; k < n; ++k) {
-    const double x = signal.values[k] - mean;
-    norm2 += x * x;
-    p.cumulative[k + 1] = p.cumulative[k] + x;
+  const double* x = signal.values.data();
+  // Two partial sums: the compiler keeps one dependency chain per sum.
+  double sum0 = 0.0, sum1 = 0.0;
+  int k = 0;
+  for (; k + 1 < n; k += 2) {
+    sum0 += x[k];
+    sum1 += x[k + 1];
   }
-  p.norm = std::sqrt(norm2);
-  p.mean = mean;
+  if (k < n) sum0 += x[k];
+  const double mean = (sum0 + sum1) / n;
   // The running integral is periodic because the signal is mean-free; doubling it lets
   // correlate() read any edge + lag in [0, 2n) without wrapping.
   // (Two more entries: edge + lag + 0.5 < 2n + 0.5 reads up to index 2n + 1.)
   p.doubled_cumulative.resize(2 * n + 2);
-  for (int k = 0; k < n; ++k) p.doubled_cumulative[k] = p.doubled_cumulative[k + n] = p.cumulative[k];
-  p.doubled_cumulative[2 * n] = p.cumulative[0];
-  p.doubled_cumulative[2 * n + 1] = p.cumulative[1];
+  double* c = p.doubled_cumulative.data();
+  double norm2 = 0.0, running = 0.0;
+  for (k = 0; k < n; ++k) {
+    c[k] = c[k + n] = running;
+    const double centred = x[k] - mean;
+    norm2 += centred * centred;
+    running += centred;
+  }
+  c[2 * n] = c[0];
+  c[2 * n + 1] = c[1];
+  p.norm = std::sqrt(norm2);
+  p.mean = mean;
 }
 
 void Decoder::prepare_doubled(const SampledSignal& signal, Prepared& p) const {

@@ -113,10 +113,10 @@ class Decoder {
     // whole lag (by decreasing edge_frac): what refine_peak walks through.
     std::vector<int> knot_order;
   };
-  // The mean-free signal's running integral, plain (n + 1) and doubled (2n, with the
-  // signal itself doubled beside it), and its norm.
+  // The mean-free signal's running integral doubled (2n + 2 entries; with the signal
+  // itself doubled beside it for a search over every lag), and its norm.
   struct Prepared {
-    std::vector<double> cumulative, doubled_cumulative, doubled_signal;
+    std::vector<double> doubled_cumulative, doubled_signal;
     double norm = 0.0;
     double mean = 0.0;
   };

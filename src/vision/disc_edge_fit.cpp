@@ -23,24 +23,31 @@ constexpr int kMaxPoints = 4 * kMaxLines;
 // Walks along a line of pixels (a row or a column; `stride` bytes between neighbours)
 // from pixel `start`, towards the outside (`outward` = +1 or -1 in pixel steps), to find
 // where the grey level crosses `threshold` from the dark disc to the bright ring; at most
-// `reach` pixels either way from `start`. Returns the crossing's offset from `start` in
-// pixels (sub-pixel, linear between the two pixels around it), or NaN.
-double walk_to_edge(const std::uint8_t* start, std::ptrdiff_t stride, int outward, int reach, double threshold) {
+// `reach` pixels either way from `start`. `bright_from` is the least whole grey level at
+// or above the threshold (so a pixel is dark when below it: integer compares in the
+// loop). Returns the crossing's offset from `start` in pixels (sub-pixel, linear between
+// the two pixels around it), or NaN.
+double walk_to_edge(const std::uint8_t* start, std::ptrdiff_t stride, int outward, int reach, double threshold,
+                    int bright_from) {
   const std::ptrdiff_t step = stride * outward;
-  const bool start_dark = start[0] < threshold;
-  // From dark go outwards until bright; from bright go inwards until dark.
-  const int dir = start_dark ? 1 : -1;
-  for (int i = 0; std::abs(i) < reach; i += dir) {
-    const double g = start[i * step], g_next = start[(i + dir) * step];
-    if ((g_next < threshold) != start_dark) {
-      const double dark = start_dark ? g : g_next, bright = start_dark ? g_next : g;
-      const int dark_at = start_dark ? i : i + dir;  // the bright pixel is at dark_at + 1
-      const double span = bright - dark;
-      const double t = span > 0.0 ? std::clamp((threshold - dark) / span, 0.0, 1.0) : 0.5;
-      return (dark_at + t) * outward;
-    }
+  int dark_at = 0;  // offset (in pixels, outwards) of the dark pixel; the bright one follows
+  if (start[0] < bright_from) {
+    // From dark, outwards to the first bright pixel.
+    int i = 1;
+    while (i <= reach && start[i * step] < bright_from) ++i;
+    if (i > reach) return std::nan("");
+    dark_at = i - 1;
+  } else {
+    // From bright, inwards to the first dark pixel.
+    int i = 1;
+    while (i <= reach && start[-i * step] >= bright_from) ++i;
+    if (i > reach) return std::nan("");
+    dark_at = -i;
   }
-  return std::nan("");
+  const double dark = start[dark_at * step], bright = start[(dark_at + 1) * step];
+  const double span = bright - dark;
+  const double t = span > 0.0 ? std::clamp((threshold - dark) / span, 0.0, 1.0) : 0.5;
+  return (dark_at + t) * outward;
 }
 
 // Solves a x = b for a symmetric positive-definite 5x5 `a` (row-major) by Cholesky,
@@ -103,8 +110,17 @@ void prefetch_disc_area(const cv::Mat& grey, const Blob& predicted, const DiscEd
   constexpr int kLine = 64;  // bytes per cache line
   // Locality 1: towards L2. L1 has too few slots for misses and drops most of a burst
   // of several markers' areas; L2 takes them all in time.
-  for (int y = y0; y <= y1; ++y) {
-    const std::uint8_t* row = grey.ptr<std::uint8_t>(y);
+  const std::uint8_t* row = grey.ptr<std::uint8_t>(y0);
+  const std::size_t stride = grey.step[0];
+  if (x1 - x0 < kLine) {
+    // A marker up to a line wide (the common case): its two ends cover each row.
+    for (int y = y0; y <= y1; ++y, row += stride) {
+      __builtin_prefetch(row + x0, 0, 1);
+      __builtin_prefetch(row + x1, 0, 1);
+    }
+    return;
+  }
+  for (int y = y0; y <= y1; ++y, row += stride) {
     for (int x = x0 & ~(kLine - 1); x <= x1; x += kLine) __builtin_prefetch(row + x, 0, 1);
     __builtin_prefetch(row + x1, 0, 1);
   }
@@ -130,6 +146,7 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
   const cv::Matx22d q = s_inv.t() * s_inv;
   const double radius_px = std::sqrt(det_s);
   const int reach = std::max(2, static_cast<int>(std::ceil(config.reach * radius_px)));
+  const int bright_from = static_cast<int>(std::ceil(threshold_grey));
   const std::uint8_t* data = grey.ptr<std::uint8_t>(0);
   const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(grey.step[0]);
   // Nearest pixel; coordinates are positive here (inside the image), so adding a half
@@ -172,7 +189,7 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
         const double along = (axis == 0 ? predicted.u : predicted.v) + mid + side * half;
         const int start = nearest(along - 0.5 * side);  // the last pixel inside
         const std::uint8_t* p = axis == 0 ? data + line * stride + start : data + start * stride + line;
-        const double offset = walk_to_edge(p, axis == 0 ? 1 : stride, side, reach, threshold_grey);
+        const double offset = walk_to_edge(p, axis == 0 ? 1 : stride, side, reach, threshold_grey, bright_from);
         if (std::isnan(offset)) continue;
 
         const double edge = start + offset;
