@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 #include <tuple>
@@ -341,9 +342,46 @@ double Decoder::lag_of_heading(const Blob& blob, double heading_deg) const {
 
 std::pair<int, double> Decoder::coarse_peak(const Prepared& p, const Ideal& ideal, std::vector<double>& scratch) const {
   const int n = config_.samples;
+  const std::size_t edges = ideal.edge.size();
+#if defined(__SSE2__)
+  constexpr std::size_t kMaxEdges = 16;
+  if (edges <= kMaxEdges && n % 2 == 0) {
+    // Two lags per step, every edge summed in registers and the best kept per lane: one
+    // pass, no array of all lags to write, read back and search. The sum per lag is
+    // formed in the same order as below, and ties go to the lowest lag, as
+    // std::max_element's do.
+    const double* cs[kMaxEdges];
+    const double* xs[kMaxEdges];
+    __m128d steps[kMaxEdges], fracs[kMaxEdges];
+    for (std::size_t e = 0; e < edges; ++e) {
+      cs[e] = &p.doubled_cumulative[ideal.edge_index[e]];  // + lag < 2n: no modulo
+      xs[e] = &p.doubled_signal[ideal.edge_index[e]];
+      steps[e] = _mm_set1_pd(ideal.step[e]);
+      fracs[e] = _mm_set1_pd(ideal.edge_frac[e]);
+    }
+    __m128d best = _mm_set1_pd(-std::numeric_limits<double>::infinity());
+    __m128d best_lag = _mm_setzero_pd(), lag_pair = _mm_set_pd(1.0, 0.0);
+    const __m128d two = _mm_set1_pd(2.0);
+    for (int lag = 0; lag < n; lag += 2) {
+      __m128d v = _mm_setzero_pd();
+      for (std::size_t e = 0; e < edges; ++e) {
+        const __m128d c = _mm_loadu_pd(cs[e] + lag), x = _mm_loadu_pd(xs[e] + lag);
+        v = _mm_add_pd(v, _mm_mul_pd(steps[e], _mm_add_pd(c, _mm_mul_pd(fracs[e], x))));
+      }
+      const __m128d better = _mm_cmpgt_pd(v, best);
+      best = _mm_or_pd(_mm_and_pd(better, v), _mm_andnot_pd(better, best));
+      best_lag = _mm_or_pd(_mm_and_pd(better, lag_pair), _mm_andnot_pd(better, best_lag));
+      lag_pair = _mm_add_pd(lag_pair, two);
+    }
+    const double even = _mm_cvtsd_f64(best), odd = _mm_cvtsd_f64(_mm_unpackhi_pd(best, best));
+    const double even_lag = _mm_cvtsd_f64(best_lag), odd_lag = _mm_cvtsd_f64(_mm_unpackhi_pd(best_lag, best_lag));
+    const bool take_odd = odd > even || (odd == even && odd_lag < even_lag);
+    return {static_cast<int>(take_odd ? odd_lag : even_lag), take_odd ? odd : even};
+  }
+#endif
   scratch.assign(n, 0.0);
   // Edge by edge over all lags: contiguous loops the compiler vectorises.
-  for (std::size_t e = 0; e < ideal.edge.size(); ++e) {
+  for (std::size_t e = 0; e < edges; ++e) {
     const double* c = &p.doubled_cumulative[ideal.edge_index[e]];  // + lag < 2n: no modulo
     const double* x = &p.doubled_signal[ideal.edge_index[e]];
     const double step = ideal.step[e], frac = ideal.edge_frac[e];
