@@ -46,7 +46,7 @@ __m128i load16(const std::uint8_t* p) { return _mm_loadu_si128(reinterpret_cast<
 
 double Blob::disc_diameter_px() const { return 2.0 * std::sqrt(filled_area_px / kPi); }
 
-// Bookkeeping of one flood fill.
+// Bookkeeping of one region (swept or filled).
 struct BlobDetector::Fill {
   int area = 0;
   int x0 = 0, x1 = 0, y0 = 0, y1 = 0;  // bounding box, inclusive

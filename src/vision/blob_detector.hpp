@@ -1,7 +1,8 @@
 // Finds the dark, circular blobs that 6UCP markers make in a grey image: a local
 // threshold (tile min/max, the local form of the paper's contrast stretch), a seeded
-// scanline flood fill, and shape tests on the filled outline. Each blob comes with a
-// sub-pixel centroid and the ellipse that the marker's circle projects to.
+// sweep of row extents (a run-by-run flood fill for regions that are not disc-like), and
+// shape tests on the region's outline. Each blob comes with a sub-pixel centroid and the
+// ellipse that the marker's circle projects to.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -122,6 +123,10 @@ class BlobDetector {
   // leaves the mask as it is, and false (with the extents reset) for a region cut by
   // the ROI or too large. flood_fill() is the exact run-by-run fill; it clears what it
   // takes from the mask and says false for a region cut by the ROI or too large.
+  // try_seed() keeps a swept region only when it is a disc at least half dark; so a
+  // dark ring that is itself marker-shaped and at least half dark (a thick one, with a
+  // hole under 0.7 of its diameter) hides a marker lying inside its hole from a
+  // full-frame search. A thin track or a square of floor does not.
   bool sweep_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill);
   bool flood_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill);
   bool measure(const cv::Mat& grey, const Fill& fill, Blob& blob) const;
