@@ -842,7 +842,10 @@ bool BlobDetector::try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blo
   // on a dark mat or a circular floor track around robots, may enclose dark shapes
   // that are not connected to it, and only the true fill tells them apart.
   if (sweep_fill(roi, x, y, fill)) {
-    const bool ok = fill.area >= kMinDarkFraction * region_area(fill) && measure_region(grey, fill, blob);
+    // A marker's centre is its black hole; a dark ring around some other shape has its
+    // hole there. (A centre lighter than the threshold only sends a marker to the fill.)
+    const bool ok = fill.area >= kMinDarkFraction * region_area(fill) && measure_region(grey, fill, blob) &&
+                    centre_is_dark(blob);
     if (ok) {
       for (int r = fill.y0; r <= fill.y1; ++r) {
         std::uint8_t* mask = dark_.ptr<std::uint8_t>(r);
@@ -856,6 +859,11 @@ bool BlobDetector::try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blo
   const bool ok = whole && measure_region(grey, fill, blob);
   reset_region(fill);
   return ok;
+}
+
+bool BlobDetector::centre_is_dark(const Blob& blob) const {
+  const int x = static_cast<int>(std::lround(blob.u)), y = static_cast<int>(std::lround(blob.v));
+  return x >= 0 && y >= 0 && x < size_.width && y < size_.height && dark_.at<std::uint8_t>(y, x) != 0;
 }
 
 int BlobDetector::region_area(const Fill& fill) const {

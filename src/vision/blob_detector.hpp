@@ -123,16 +123,17 @@ class BlobDetector {
   // leaves the mask as it is, and false (with the extents reset) for a region cut by
   // the ROI or too large. flood_fill() is the exact run-by-run fill; it clears what it
   // takes from the mask and says false for a region cut by the ROI or too large.
-  // try_seed() keeps a swept region only when it is a disc at least half dark; so a
-  // dark ring that is itself marker-shaped and at least half dark (a thick one, with a
-  // hole under 0.7 of its diameter) hides a marker lying inside its hole from a
-  // full-frame search. A thin track or a square of floor does not.
+  // try_seed() keeps a swept region only when it is a disc at least half dark with a
+  // dark centre (as a marker's black hole); anything else is filled again exactly. So
+  // only a thick dark ring (a hole under 0.7 of its diameter) with a marker inside whose
+  // black lies on the ring's very centre hides that marker from a full-frame search.
   bool sweep_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill);
   bool flood_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill);
   bool measure(const cv::Mat& grey, const Fill& fill, Blob& blob) const;
   // Column extents from the row extents, then measure(); false for a region too small.
   bool measure_region(const cv::Mat& grey, const Fill& fill, Blob& blob);
   int region_area(const Fill& fill) const;  // pixels within the row extents
+  bool centre_is_dark(const Blob& blob) const;  // the mask at the blob's centre pixel
   void reset_region(const Fill& fill);      // row and column extents back to empty
   void clear_row_extents(int y0, int y1);
   std::uint8_t threshold_at(int x, int y) const { return tile_threshold_[tile_row_[y] * tiles_x_ + tile_col_[x]]; }

@@ -124,6 +124,20 @@ TEST(BlobDetector, CircularTrackAroundMarkersDoesNotHideThem) {
   EXPECT_TRUE(found_at(200 + 19.5, 190 + 19.5));
 }
 
+// A thick dark ring (more than half dark, like a marker's disc) around a marker off its
+// centre: the ring's row extents hold the marker too, and only its light centre tells
+// the detector to fill it exactly and find the marker on its own.
+TEST(BlobDetector, ThickRingAroundAMarkerDoesNotHideIt) {
+  const auto f = MarkerFamily::six_ucp();
+  cv::Mat img(200, 200, CV_8UC1, cv::Scalar(190));
+  cv::circle(img, {100, 100}, 50, cv::Scalar(30), 20, cv::LINE_AA);  // radii 40..60: 0.56 dark
+  render_marker_topdown(f, 3, 32, 40.0, 190.0).copyTo(img(cv::Rect(98, 70, 32, 32)));
+  BlobDetector detector;
+  const auto blobs = detector.detect(img);
+  EXPECT_TRUE(std::any_of(blobs.begin(), blobs.end(),
+                          [](const Blob& b) { return std::hypot(b.u - 113.5, b.v - 85.5) < 0.5; }));
+}
+
 // The extent sweep and the run-by-run fill agree on a marker's disc wherever the seed
 // falls on it: every seed row of a search finds the same blob.
 TEST(BlobDetector, MarkerFoundTheSameFromEverySeedRow) {
