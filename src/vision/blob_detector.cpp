@@ -19,6 +19,14 @@ constexpr double kDiscFraction = MarkerFamily::black_ring_outer_radius;
 // Pixels are sampled every kStatStep rows for the tile statistics (every column): the
 // thinnest feature they must see (a 24 px marker's black ring) is over 2 px wide.
 constexpr int kStatStep = 2;
+// The statistics pass asks for the rows it samples of the tile row this many rows
+// ahead, and the mask pass for all rows of the next tile row's tiles with contrast
+// (the rows the statistics skipped), towards L2. A frame from a camera is in no cache,
+// and the hardware's own prefetcher stops at every 4 KiB page (three rows of a
+// 1280-pixel frame): without the hints a 64-marker search took a quarter longer on a
+// frame flushed from the caches than on one left in L3 by an earlier pass.
+// Two tile rows ahead leaves the memory time to answer; one was too close.
+constexpr int kPrefetchTileRows = 2;
 // Zero bytes kept on each side of every row of the dark mask.
 constexpr int kMaskPad = 16;
 // Dark-mask bits: below the threshold (filled), and well below it (may seed a fill).
@@ -95,6 +103,7 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
   const int ty0 = std::max(0, roi.y / t - 1), ty1 = std::min(tiles_y_ - 1, (roi.y + roi.height - 1) / t + 1);
   for (int ty = ty0; ty <= ty1; ++ty) {
     const int y_end = std::min(size_.height, (ty + 1) * t);
+    prefetch_sampled_rows(grey, ty + kPrefetchTileRows, tx0, tx1);
     int tx = tx0;
 #if defined(__SSE2__)
     // The default 8-pixel tiles two at a time: one 16-byte load per sampled row, then
@@ -274,6 +283,33 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
   }
 }
 
+void BlobDetector::prefetch_sampled_rows(const cv::Mat& grey, int ty, int tx0, int tx1) const {
+  if (ty >= tiles_y_) return;
+  const int t = config_.tile_px;
+  const int x0 = tx0 * t, x1 = std::min(size_.width, (tx1 + 1) * t) - 1;
+  for (int y = ty * t; y < std::min(size_.height, (ty + 1) * t); y += kStatStep) {
+    const std::uint8_t* row = grey.ptr<std::uint8_t>(y);
+    for (int x = x0 & ~63; x <= x1; x += 64) __builtin_prefetch(row + x, 0, 1);
+  }
+}
+
+void BlobDetector::prefetch_contrast_tiles(const cv::Mat& grey, int ty) const {
+  if (ty >= tiles_y_) return;
+  const int t = config_.tile_px;
+  const std::int16_t* list = &contrast_tiles_[static_cast<std::size_t>(ty) * tiles_x_];
+  const int listed = contrast_tile_count_[ty];
+  for (int y = ty * t; y < std::min(size_.height, (ty + 1) * t); ++y) {
+    const std::uint8_t* row = grey.ptr<std::uint8_t>(y);
+    int last_line = -1;
+    for (int i = 0; i < listed; ++i) {
+      const int x = list[i] * t;
+      if (x >> 6 == last_line) continue;  // one hint per cache line
+      last_line = x >> 6;
+      __builtin_prefetch(row + x, 0, 1);
+    }
+  }
+}
+
 void BlobDetector::build_dark_mask(const cv::Mat& grey, cv::Rect roi, bool local_thresholds) {
   const int t_px = config_.tile_px;
   const int tx0 = roi.x / t_px, tx1 = (roi.x + roi.width - 1) / t_px;
@@ -318,6 +354,8 @@ void BlobDetector::build_dark_mask(const cv::Mat& grey, cv::Rect roi, bool local
     // Row by row across the tile row (not tile by tile down it), so that the frame is
     // read as a stream: a new frame is not in the caches yet.
     const std::size_t listed = contrast.size();
+    // The next tile row's list is this search's only with its own statistics.
+    if (local_thresholds && ty + 1 <= ty1) prefetch_contrast_tiles(grey, ty + 1);
 #if defined(__SSE2__)
     if (t_px == 8) {
       // The default tiles, eight pixels per tile; two neighbouring tiles in one

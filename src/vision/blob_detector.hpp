@@ -161,6 +161,11 @@ class BlobDetector {
   // `local_thresholds`: the tile thresholds come from this search's tile statistics
   // (not one fixed threshold), so those statistics may be consulted too.
   void build_dark_mask(const cv::Mat& grey, cv::Rect roi, bool local_thresholds);
+  // Ask for pixels towards L2 ahead of the passes that read them (hints, no effect on
+  // results): the rows the statistics sample in tile row `ty` (tile columns tx0..tx1),
+  // and every row of the tiles with contrast listed for tile row `ty`.
+  void prefetch_sampled_rows(const cv::Mat& grey, int ty, int tx0, int tx1) const;
+  void prefetch_contrast_tiles(const cv::Mat& grey, int ty) const;
   // One row of tile `tx` of the mask, byte by byte (`tile_row_index`: the tile row's
   // first index in the tile arrays; `in` and `out`: the grey and mask rows).
   void mask_tile_row_bytes(const std::uint8_t* in, std::uint8_t* out, std::size_t tile_row_index, int tx,
