@@ -8,9 +8,11 @@
 //
 // Everything measured runs single-threaded: OpenCV with setNumThreads(0) and OpenCL
 // off, AprilTag with nthreads = 1. Timing is std::chrono::steady_clock around each
-// detector call on frames already in memory (8-bit grey), after a warm-up pass; each
+// detector call on frames already in memory (8-bit grey) but flushed from the caches,
+// after a warm-up pass; each
 // row repeats the whole frame sequence until a time budget is spent (at least 3
-// passes) and reports the median and 90th percentile of the per-frame times.
+// passes), in rounds where the detectors take turns, and reports the median and 90th
+// percentile of the per-frame times.
 //
 // Usage: bench_vision [--budget SECONDS_PER_ROW] [--frames N] [--accuracy-frames N]
 //                     [--no-jpeg] [--quick] [--save-frames DIR]
@@ -19,6 +21,10 @@
 #include <apriltag/apriltag.h>
 #include <apriltag/tag36h11.h>
 #include <sched.h>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include <opencv2/aruco.hpp>
 #include <opencv2/core.hpp>
@@ -471,19 +477,62 @@ double thread_cpu_ms() {
 
 using DetectFn = std::function<std::vector<Det>(const cv::Mat&)>;
 
-// One untimed pass scores the detector and warms caches up; then timed passes over all
-// frames until the budget is spent.
-Row run_full_frame(const std::string& name, const std::string& markers, const std::vector<Frame>& frames,
-                   const DetectFn& detect, const Options& opt) {
+// Each row is timed in kRounds rounds, the detectors of a table taking turns (rilbed,
+// AprilTag, ArUco, rilbed, ...), each round spending a share of the row's budget: a
+// burst of other load on a shared machine then falls on every detector alike instead
+// of on whichever row happened to run, and the ratios stay put from run to run.
+constexpr int kRounds = 4;
+
+// Evicts the frame's pixels from every cache level before a timed call, so that each
+// detector meets the frame as it arrives from a camera: written to memory by the
+// capture hardware, not in any cache. (Repeated passes over a sequence would otherwise
+// leave much of it in a large shared L3, and the more so for a detector that reads
+// little of each frame.) The detectors' own state stays where it is, as between frames
+// of a live run.
+void evict(const cv::Mat& frame) {
+#if defined(__SSE2__)
+  for (int y = 0; y < frame.rows; ++y) {
+    const std::uint8_t* row = frame.ptr<std::uint8_t>(y);
+    const std::size_t bytes = frame.cols * frame.elemSize();
+    for (std::size_t x = 0; x < bytes; x += 64) _mm_clflush(row + x);
+    _mm_clflush(row + bytes - 1);
+  }
+  _mm_mfence();
+#else
+  (void)frame;  // no portable eviction: frames may be partly cached between passes
+#endif
+}
+
+// One budget's share: whole passes until it is spent, at least `min_passes`.
+struct Share {
+  double budget_s;
+  int min_passes, max_passes;
+};
+
+Share round_share(const Options& opt) {
+  return {opt.budget_s / kRounds, std::max(1, (opt.min_passes + kRounds - 1) / kRounds),
+          std::max(1, opt.max_passes / kRounds)};
+}
+
+// One untimed pass scores the detector and warms caches up; time_full_frame then adds
+// timed passes over all frames.
+Row score_full_frame(const std::string& name, const std::string& markers, const std::vector<Frame>& frames,
+                     const DetectFn& detect) {
   Row row;
   row.detector = name;
   row.markers = markers;
   for (const Frame& f : frames) row.score.add(f.truth, detect(f.grey));
   row.scored_frames = static_cast<int>(frames.size());
+  return row;
+}
+
+void time_full_frame(Row& row, const std::vector<Frame>& frames, const DetectFn& detect, const Share& share) {
   const auto start = Clock::now();
-  while (row.passes < opt.min_passes ||
-         (row.passes < opt.max_passes && ms_since(start) < opt.budget_s * 1000.0)) {
+  for (int passes = 0; passes < share.min_passes ||
+                       (passes < share.max_passes && ms_since(start) < share.budget_s * 1000.0);
+       ++passes) {
     for (const Frame& f : frames) {
+      evict(f.grey);
       const double c0 = thread_cpu_ms();
       const auto t0 = Clock::now();
       const std::vector<Det> d = detect(f.grey);
@@ -493,7 +542,6 @@ Row run_full_frame(const std::string& name, const std::string& markers, const st
     }
     ++row.passes;
   }
-  return row;
 }
 
 std::vector<Det> to_dets(const std::vector<rv::MarkerDetection>& found) {
@@ -506,8 +554,8 @@ std::vector<Det> to_dets(const std::vector<rv::MarkerDetection>& found) {
 // MarkerTracker::process over the moving sequence; each pass starts from reset() and
 // its first frame (a full-frame search that starts the tracks) is neither timed nor
 // scored.
-Row run_tracked(const std::string& name, const std::string& markers, const std::vector<Frame>& frames,
-                rv::MarkerTracker& tracker, const Options& opt) {
+Row score_tracked(const std::string& name, const std::string& markers, const std::vector<Frame>& frames,
+                  rv::MarkerTracker& tracker) {
   Row row;
   row.detector = name;
   row.markers = markers;
@@ -520,12 +568,18 @@ Row run_tracked(const std::string& name, const std::string& markers, const std::
     if (tracker.last_stats().full_search) ++row.full_searches;
   }
   row.scored_frames = static_cast<int>(frames.size()) - 1;
+  return row;
+}
+
+void time_tracked(Row& row, const std::vector<Frame>& frames, rv::MarkerTracker& tracker, const Share& share) {
   const auto start = Clock::now();
-  while (row.passes < opt.min_passes ||
-         (row.passes < opt.max_passes && ms_since(start) < opt.budget_s * 1000.0)) {
+  for (int passes = 0; passes < share.min_passes ||
+                       (passes < share.max_passes && ms_since(start) < share.budget_s * 1000.0);
+       ++passes) {
     tracker.reset();
     g_sink = g_sink + tracker.process(frames[0].grey).size();
     for (std::size_t i = 1; i < frames.size(); ++i) {
+      evict(frames[i].grey);
       const double c0 = thread_cpu_ms();
       const auto t0 = Clock::now();
       const auto found = tracker.process(frames[i].grey);
@@ -535,7 +589,6 @@ Row run_tracked(const std::string& name, const std::string& markers, const std::
     }
     ++row.passes;
   }
-  return row;
 }
 
 // ------------------------------------------------------------------ machine
@@ -670,12 +723,15 @@ int main(int argc, char** argv) {
       opt.frames, size1);
   std::printf(
       "- Timing: steady_clock around each detector call on an in-memory 8-bit grey frame (result conversion "
-      "included, frame rendering and colour conversion not). One untimed pass first (it also yields recall), then "
-      "whole passes over the sequence until %.1f s per row are spent (at least %d, at most %d passes); median and "
-      "90th percentile of the wall time over all timed frames. The CPU column is the median of the thread's own CPU "
+      "included, frame rendering and colour conversion not). Before each timed call the frame's pixels are flushed "
+      "from every cache level (clflush), as a frame from a camera arrives in memory, not in a cache; the detector's "
+      "own state is left as it is. One untimed pass first (it also yields recall), then "
+      "whole passes over the sequence until %.1f s per row are spent (at least %d, at most %d passes), in %d rounds "
+      "in which the detectors of a table take turns (so that other load on a shared machine falls on all of them "
+      "alike); median and 90th percentile of the wall time over all timed frames. The CPU column is the median of the thread's own CPU "
       "time (CLOCK_THREAD_CPUTIME_ID) for the same calls: on a shared machine it leaves out time other processes "
       "took. The ratio column divides medians, wall and CPU.\n",
-      opt.budget_s, opt.min_passes, opt.max_passes);
+      opt.budget_s, opt.min_passes, opt.max_passes, kRounds);
   std::printf(
       "- Recall: fraction of rendered markers for which a detection with the right ID lies within %.0f px of the "
       "true centre. False IDs: detections that match no rendered marker that way (wrong ID, duplicate, or "
@@ -757,14 +813,23 @@ int main(int argc, char** argv) {
     const std::string aruco_note = count <= 8 ? "8 × DICT_4X4_50" : "64 × DICT_4X4_100 (50 IDs are too few)";
 
     std::vector<Row>& rows = count <= 8 ? rows8 : rows64;
-    rv::MarkerTracker full_tracker(fam, ucp_ids);
-    rows.push_back(run_full_frame("rilbed full-frame", fam_note, ucp_frames,
-                                  [&](const cv::Mat& g) { return to_dets(full_tracker.detect_full_frame(g)); }, opt));
-    rv::MarkerTracker tracker(fam, ucp_ids);
-    rows.push_back(run_tracked("rilbed tracked", fam_note, ucp_frames, tracker, opt));
-    rows.push_back(run_full_frame("AprilTag 3, quad_decimate 2 (default)", tag_note, tag_frames, apriltag_fn(td2), opt));
-    rows.push_back(run_full_frame("AprilTag 3, quad_decimate 1", tag_note, tag_frames, apriltag_fn(td1), opt));
-    rows.push_back(run_full_frame("OpenCV ArUco, default parameters", aruco_note, aruco_frames, aruco_fn(count <= 8 ? dict50 : dict100), opt));
+    rv::MarkerTracker full_tracker(fam, ucp_ids), tracker(fam, ucp_ids);
+    const DetectFn rilbed_full = [&](const cv::Mat& g) { return to_dets(full_tracker.detect_full_frame(g)); };
+    const DetectFn april2 = apriltag_fn(td2), april1 = apriltag_fn(td1);
+    const DetectFn aruco = aruco_fn(count <= 8 ? dict50 : dict100);
+    rows.push_back(score_full_frame("rilbed full-frame", fam_note, ucp_frames, rilbed_full));
+    rows.push_back(score_tracked("rilbed tracked", fam_note, ucp_frames, tracker));
+    rows.push_back(score_full_frame("AprilTag 3, quad_decimate 2 (default)", tag_note, tag_frames, april2));
+    rows.push_back(score_full_frame("AprilTag 3, quad_decimate 1", tag_note, tag_frames, april1));
+    rows.push_back(score_full_frame("OpenCV ArUco, default parameters", aruco_note, aruco_frames, aruco));
+    const Share share = round_share(opt);
+    for (int round = 0; round < kRounds; ++round) {
+      time_full_frame(rows[0], ucp_frames, rilbed_full, share);
+      time_tracked(rows[1], ucp_frames, tracker, share);
+      time_full_frame(rows[2], tag_frames, april2, share);
+      time_full_frame(rows[3], tag_frames, april1, share);
+      time_full_frame(rows[4], aruco_frames, aruco, share);
+    }
   }
 
   std::printf("## Table 1 — speed and recall, %dx%d, markers %.0f px across\n\n", kFrameSize.width,
