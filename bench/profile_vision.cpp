@@ -13,9 +13,14 @@
 // reset per pass, so the first frame is a full search). Each run makes --passes passes
 // over the frames and takes the median of the per-frame CPU times of the thread; the
 // figure printed is the lowest median of --runs runs, the least disturbed by other
-// processes on a shared machine. Frames are met cold (a sequence of 30 frames of 0.9 MB
-// does not fit the caches) unless --warm reads each frame once just before it is timed.
+// processes on a shared machine. Frames are met cold, as bench_vision meets them (each
+// frame's lines flushed from every cache level before the call), unless --warm reads
+// each frame once just before it is timed.
 #include <opencv2/imgcodecs.hpp>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include <algorithm>
 #include <cstdio>
@@ -85,6 +90,20 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
+// Flushes the frame's lines from every cache level (as bench_vision does).
+void evict(const cv::Mat& frame) {
+#if defined(__SSE2__)
+  for (int y = 0; y < frame.rows; ++y) {
+    const std::uint8_t* row = frame.ptr<std::uint8_t>(y);
+    for (int x = 0; x < frame.cols; x += 64) _mm_clflush(row + x);
+    _mm_clflush(row + frame.cols - 1);
+  }
+  _mm_mfence();
+#else
+  (void)frame;
+#endif
+}
+
 // Reads every byte's cache line of the frame once, so that it is in the caches.
 void touch(const cv::Mat& frame) {
   unsigned sum = 0;
@@ -143,7 +162,11 @@ int main(int argc, char** argv) {
     for (int pass = 0; pass < opt.passes; ++pass) {
       tracker.reset();
       for (std::size_t i = 0; i < frames.size(); ++i) {
-        if (opt.warm) touch(frames[i]);
+        if (opt.warm) {
+          touch(frames[i]);
+        } else {
+          evict(frames[i]);
+        }
         const double t0 = thread_cpu_ms();
         const auto detections = full ? tracker.detect_full_frame(frames[i]) : tracker.process(frames[i]);
         const double t1 = thread_cpu_ms();
