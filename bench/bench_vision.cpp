@@ -18,13 +18,12 @@
 //                     [--no-jpeg] [--quick] [--save-frames DIR]
 // tools/bench.sh runs it with the defaults (about 2 minutes on 2 cores).
 
+#include "frame_cache.hpp"
+
 #include <apriltag/apriltag.h>
 #include <apriltag/tag36h11.h>
 #include <sched.h>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 #include <opencv2/aruco.hpp>
 #include <opencv2/core.hpp>
@@ -483,25 +482,12 @@ using DetectFn = std::function<std::vector<Det>(const cv::Mat&)>;
 // of on whichever row happened to run, and the ratios stay put from run to run.
 constexpr int kRounds = 4;
 
-// Evicts the frame's pixels from every cache level before a timed call, so that each
-// detector meets the frame as it arrives from a camera: written to memory by the
-// capture hardware, not in any cache. (Repeated passes over a sequence would otherwise
-// leave much of it in a large shared L3, and the more so for a detector that reads
-// little of each frame.) The detectors' own state stays where it is, as between frames
-// of a live run.
-void evict(const cv::Mat& frame) {
-#if defined(__SSE2__)
-  for (int y = 0; y < frame.rows; ++y) {
-    const std::uint8_t* row = frame.ptr<std::uint8_t>(y);
-    const std::size_t bytes = frame.cols * frame.elemSize();
-    for (std::size_t x = 0; x < bytes; x += 64) _mm_clflush(row + x);
-    _mm_clflush(row + bytes - 1);
-  }
-  _mm_mfence();
-#else
-  (void)frame;  // no portable eviction: frames may be partly cached between passes
-#endif
-}
+// Each timed call meets its frame flushed from every cache level (frame_cache.hpp): as
+// a frame arrives from a camera, written to memory by the capture hardware. (Repeated
+// passes over a sequence would otherwise leave much of it in a large shared L3, and the
+// more so for a detector that reads little of each frame.) The detectors' own state
+// stays where it is, as between frames of a live run.
+using rilbed::bench::evict;
 
 // One budget's share: whole passes until it is spent, at least `min_passes`.
 struct Share {

@@ -18,9 +18,6 @@
 // each frame once just before it is timed.
 #include <opencv2/imgcodecs.hpp>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 #include <algorithm>
 #include <cstdio>
@@ -31,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "frame_cache.hpp"
 #include "vision/marker_tracker.hpp"
 
 namespace {
@@ -90,31 +88,6 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
-// Flushes the frame's lines from every cache level (as bench_vision does).
-void evict(const cv::Mat& frame) {
-#if defined(__SSE2__)
-  for (int y = 0; y < frame.rows; ++y) {
-    const std::uint8_t* row = frame.ptr<std::uint8_t>(y);
-    for (int x = 0; x < frame.cols; x += 64) _mm_clflush(row + x);
-    _mm_clflush(row + frame.cols - 1);
-  }
-  _mm_mfence();
-#else
-  (void)frame;
-#endif
-}
-
-// Reads every byte's cache line of the frame once, so that it is in the caches.
-void touch(const cv::Mat& frame) {
-  unsigned sum = 0;
-  for (int y = 0; y < frame.rows; ++y) {
-    const std::uint8_t* row = frame.ptr<std::uint8_t>(y);
-    for (int x = 0; x < frame.cols; x += 64) sum += row[x];
-  }
-  volatile unsigned sink = sum;
-  (void)sink;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -163,9 +136,9 @@ int main(int argc, char** argv) {
       tracker.reset();
       for (std::size_t i = 0; i < frames.size(); ++i) {
         if (opt.warm) {
-          touch(frames[i]);
+          rilbed::bench::touch(frames[i]);
         } else {
-          evict(frames[i]);
+          rilbed::bench::evict(frames[i]);
         }
         const double t0 = thread_cpu_ms();
         const auto detections = full ? tracker.detect_full_frame(frames[i]) : tracker.process(frames[i]);
