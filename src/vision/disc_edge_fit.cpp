@@ -99,15 +99,49 @@ double mean_of(const double* values, int count) {
 
 }  // namespace
 
-void prefetch_disc_area(const cv::Mat& grey, const Blob& predicted, const DiscEdgeFitConfig& config) {
-  const cv::Matx22d& s = predicted.shape;
+namespace {
+
+// The pixels fit_disc_edges may read for `predicted` (the white ring's middle beyond the
+// farthest crossing), clipped to the image: x0..x1, y0..y1 inclusive; empty when x1 < x0
+// or y1 < y0.
+struct PixelBox {
+  int x0, x1, y0, y1;
+  bool empty() const { return x1 < x0 || y1 < y0; }
+};
+
+PixelBox disc_area(const cv::Mat& grey, const Blob& predicted, const DiscEdgeFitConfig& config) {
   const double extent = (1.0 + config.reach) * kWhiteMid + 0.05;
-  const cv::Vec2d half = ellipse_half_extent(s, extent);
-  const int x0 = std::max(0, static_cast<int>(predicted.u - half[0]));
-  const int x1 = std::min(grey.cols - 1, static_cast<int>(predicted.u + half[0]) + 1);
-  const int y0 = std::max(0, static_cast<int>(predicted.v - half[1]));
-  const int y1 = std::min(grey.rows - 1, static_cast<int>(predicted.v + half[1]) + 1);
-  constexpr int kLine = 64;  // bytes per cache line
+  const cv::Vec2d half = ellipse_half_extent(predicted.shape, extent);
+  return {std::max(0, static_cast<int>(predicted.u - half[0])),
+          std::min(grey.cols - 1, static_cast<int>(predicted.u + half[0]) + 1),
+          std::max(0, static_cast<int>(predicted.v - half[1])),
+          std::min(grey.rows - 1, static_cast<int>(predicted.v + half[1]) + 1)};
+}
+
+constexpr int kLine = 64;  // bytes per cache line
+
+}  // namespace
+
+std::uint8_t load_disc_area(const cv::Mat& grey, const Blob& predicted, const DiscEdgeFitConfig& config) {
+  const PixelBox box = disc_area(grey, predicted, config);
+  if (box.empty()) return 0;
+  const int x0 = box.x0, x1 = box.x1, y0 = box.y0, y1 = box.y1;
+  // One byte per cache line, OR-ed together: independent loads, which the CPU keeps
+  // many of in flight at once.
+  std::uint8_t any = 0;
+  const std::uint8_t* row = grey.ptr<std::uint8_t>(y0);
+  const std::size_t stride = grey.step[0];
+  for (int y = y0; y <= y1; ++y, row += stride) {
+    for (int x = x0 & ~(kLine - 1); x <= x1; x += kLine) any |= row[x];
+    any |= row[x1];
+  }
+  return any;
+}
+
+void prefetch_disc_area(const cv::Mat& grey, const Blob& predicted, const DiscEdgeFitConfig& config) {
+  const PixelBox box = disc_area(grey, predicted, config);
+  if (box.empty()) return;
+  const int x0 = box.x0, x1 = box.x1, y0 = box.y0, y1 = box.y1;
   // Locality 1: towards L2. L1 has too few slots for misses and drops most of a burst
   // of several markers' areas; L2 takes them all in time.
   const std::uint8_t* row = grey.ptr<std::uint8_t>(y0);

@@ -206,10 +206,17 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
   };
   // A few markers ahead: far enough for memory to answer, near enough not to evict.
   constexpr std::size_t kPrefetchAhead = 4;
-  for (std::size_t i = 0; i < kPrefetchAhead; ++i) prefetch(i);
+  // The first markers' pixels are read at once with plain loads (many in flight), not
+  // hinted: with nothing else waiting on memory yet, the CPU dropped most of a burst of
+  // hints, and an 8-marker tracked frame took a third longer on a frame just written
+  // to memory. Beyond these, hints a few markers ahead overlap the loads with the fits.
+  constexpr std::size_t kLoadFirst = 8;
+  for (std::size_t i = 0; i < kLoadFirst && i < tracks_.size(); ++i) {
+    if (config_.use_edge_fit) load_sink_ |= load_disc_area(grey, tracks_[i].predicted_disc(), config_.edge_fit);
+  }
   for (std::size_t i = 0; i < tracks_.size(); ++i) {
     const Track& t = tracks_[i];
-    prefetch(i + kPrefetchAhead);  // its pixels load while the ones before it are fitted
+    if (i + kPrefetchAhead >= kLoadFirst) prefetch(i + kPrefetchAhead);  // loads while the ones before it are fitted
     // The cheap way first: the outline where the prediction puts it.
     if (config_.use_edge_fit && t.missed == 0) {
       if (auto d = confirm_by_edges(grey, t)) {

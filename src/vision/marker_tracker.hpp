@@ -148,6 +148,7 @@ class MarkerTracker {
   std::vector<double> similarity_;
   std::vector<std::vector<CodeMatch>> matches_;
   std::vector<double> thresholds_;
+  std::uint8_t load_sink_ = 0;  // keeps load_disc_area()'s loads (its value is never used)
   TrackerConfig config_;
   BlobDetector detector_;
   Decoder decoder_;

@@ -110,3 +110,18 @@ TEST(DiscEdgeFit, RefusesWhatIsNotTheDisc) {
   // The size may not jump: a disc half the predicted size is not this track's.
   EXPECT_FALSE(fit_disc_edges(img, disc_at(truth, 18.0), 110.0).has_value());
 }
+
+// load_disc_area reads the marker's area (one byte per cache line and the area's last
+// column) and nothing outside the image, whatever the prediction.
+TEST(DiscEdgeFit, LoadDiscAreaReadsTheAreaOnly) {
+  cv::Mat img(120, 200, CV_8UC1, cv::Scalar(0));
+  EXPECT_EQ(load_disc_area(img, disc_at({100, 60}, 12.0)), 0);
+  img.at<std::uint8_t>(60, 64) = 0x40;  // a cache line's first byte inside the area
+  EXPECT_EQ(load_disc_area(img, disc_at({70, 60}, 12.0)), 0x40);
+  EXPECT_EQ(load_disc_area(img, disc_at({160, 60}, 12.0)), 0);  // far from it
+  // Predictions at and beyond the image's corners are clipped to it.
+  for (cv::Point2d p : {cv::Point2d(0, 0), cv::Point2d(199, 119), cv::Point2d(-50, 30), cv::Point2d(260, 200)}) {
+    load_disc_area(img, disc_at(p, 12.0));
+    prefetch_disc_area(img, disc_at(p, 12.0));
+  }
+}
