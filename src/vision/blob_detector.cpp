@@ -56,7 +56,8 @@ double Blob::disc_diameter_px() const { return 2.0 * std::sqrt(filled_area_px / 
 
 // Bookkeeping of one region (swept or filled).
 struct BlobDetector::Fill {
-  int area = 0;
+  int area = 0;         // dark pixels in the region
+  int extent_area = 0;  // pixels within its row extents (a sweep's; the fill leaves 0)
   int x0 = 0, x1 = 0, y0 = 0, y1 = 0;  // bounding box, inclusive
   bool touches_border = false;
   bool too_large = false;
@@ -610,11 +611,12 @@ bool BlobDetector::sweep_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill) 
     // The first two sweeps always change something; a third that changes nothing ends.
     if (sweep == 1) changed = true;
   }
-  fill = Fill{0, rx1, rx0, top, bottom, false, false};
+  fill = Fill{0, 0, rx1, rx0, top, bottom, false, false};
   for (int y = top; y <= bottom && ok; ++y) {
     fill.x0 = std::min(fill.x0, row_min_x_[y]);
     fill.x1 = std::max(fill.x1, row_max_x_[y]);
     fill.area += count_nonzero(mask_row(y), row_min_x_[y], row_max_x_[y]);
+    fill.extent_area += row_max_x_[y] - row_min_x_[y] + 1;
   }
   fill.touches_border = fill.x0 == rx0 || fill.x1 == rx1 || top == ry0 || bottom == ry1;
   if (!ok || fill.area > max_area || fill.x1 - fill.x0 > max_extent || fill.touches_border) {
@@ -640,7 +642,7 @@ bool BlobDetector::flood_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill) 
   // No marker's disc is wider or taller than this (tilt only shrinks one axis).
   const int max_extent = static_cast<int>(max_disc_d * 1.2) + 2;
   const int rx0 = roi.x, rx1 = roi.x + roi.width - 1, ry0 = roi.y, ry1 = roi.y + roi.height - 1;
-  fill = Fill{0, seed_x, seed_x, seed_y, seed_y, false, false};
+  fill = Fill{0, 0, seed_x, seed_x, seed_y, seed_y, false, false};
 
   // A stack of seeds, each with the span of the row it was found from: that span is
   // already filled, so the seed's own span need not look back into it.
@@ -882,7 +884,7 @@ bool BlobDetector::try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blo
   if (sweep_fill(roi, x, y, fill)) {
     // A marker's centre is its black hole; a dark ring around some other shape has its
     // hole there. (A centre lighter than the threshold only sends a marker to the fill.)
-    const bool ok = fill.area >= kMinDarkFraction * region_area(fill) && measure_region(grey, fill, blob) &&
+    const bool ok = fill.area >= kMinDarkFraction * fill.extent_area && measure_region(grey, fill, blob) &&
                     centre_is_dark(blob);
     if (ok) {
       for (int r = fill.y0; r <= fill.y1; ++r) {
@@ -902,12 +904,6 @@ bool BlobDetector::try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blo
 bool BlobDetector::centre_is_dark(const Blob& blob) const {
   const int x = static_cast<int>(std::lround(blob.u)), y = static_cast<int>(std::lround(blob.v));
   return x >= 0 && y >= 0 && x < size_.width && y < size_.height && dark_.at<std::uint8_t>(y, x) != 0;
-}
-
-int BlobDetector::region_area(const Fill& fill) const {
-  int area = 0;
-  for (int r = fill.y0; r <= fill.y1; ++r) area += std::max(0, row_max_x_[r] - row_min_x_[r] + 1);
-  return area;
 }
 
 bool BlobDetector::measure_region(const cv::Mat& grey, const Fill& fill, Blob& blob) {

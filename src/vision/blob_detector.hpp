@@ -132,7 +132,6 @@ class BlobDetector {
   bool measure(const cv::Mat& grey, const Fill& fill, Blob& blob) const;
   // Column extents from the row extents, then measure(); false for a region too small.
   bool measure_region(const cv::Mat& grey, const Fill& fill, Blob& blob);
-  int region_area(const Fill& fill) const;  // pixels within the row extents
   bool centre_is_dark(const Blob& blob) const;  // the mask at the blob's centre pixel
   void reset_region(const Fill& fill);      // row and column extents back to empty
   void clear_row_extents(int y0, int y1);

@@ -97,10 +97,6 @@ double mean_of(const double* values, int count) {
   return sum / count;
 }
 
-}  // namespace
-
-namespace {
-
 // The pixels fit_disc_edges may read for `predicted` (the white ring's middle beyond the
 // farthest crossing), clipped to the image: x0..x1, y0..y1 inclusive; empty when x1 < x0
 // or y1 < y0.

@@ -201,8 +201,10 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
   std::vector<Blob> blobs;  // found but not confirmed: decoded against the family
   std::vector<MarkerDetection> confirmed;
   std::vector<int> confirmed_ids;
+  // Only tracks seen last frame try the edge fit, so only their areas are asked for.
+  auto fits = [&](std::size_t i) { return config_.use_edge_fit && i < tracks_.size() && tracks_[i].missed == 0; };
   auto prefetch = [&](std::size_t i) {
-    if (config_.use_edge_fit && i < tracks_.size()) prefetch_disc_area(grey, tracks_[i].predicted_disc(), config_.edge_fit);
+    if (fits(i)) prefetch_disc_area(grey, tracks_[i].predicted_disc(), config_.edge_fit);
   };
   // A few markers ahead: far enough for memory to answer, near enough not to evict.
   constexpr std::size_t kPrefetchAhead = 4;
@@ -211,8 +213,8 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
   // hints, and an 8-marker tracked frame took a third longer on a frame just written
   // to memory. Beyond these, hints a few markers ahead overlap the loads with the fits.
   constexpr std::size_t kLoadFirst = 8;
-  for (std::size_t i = 0; i < kLoadFirst && i < tracks_.size(); ++i) {
-    if (config_.use_edge_fit) load_sink_ |= load_disc_area(grey, tracks_[i].predicted_disc(), config_.edge_fit);
+  for (std::size_t i = 0; i < kLoadFirst; ++i) {
+    if (fits(i)) load_sink_ |= load_disc_area(grey, tracks_[i].predicted_disc(), config_.edge_fit);
   }
   for (std::size_t i = 0; i < tracks_.size(); ++i) {
     const Track& t = tracks_[i];
