@@ -12,6 +12,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "core/fast_trig.hpp"
 #include "core/geometry.hpp"
 #include "vision/circle_sampler.hpp"
 
@@ -119,6 +120,8 @@ Decoder::Decoder(const MarkerFamily& family, const std::vector<int>& ids, Decode
     : config_(config), ids_(ids) {
   config_.samples = std::max(24, config_.samples);
   config_.circles = std::clamp(config_.circles, 1, 3);
+  track_reach_samples_ = static_cast<int>(std::ceil(kTrackReachDeg * config_.samples / 360.0));
+  local_window_pad_ = 2 * track_reach_samples_;
   // One circle: the middle of the annulus; two: its inner and outer; three: all.
   constexpr auto& radii = MarkerFamily::sample_radii;
   if (config_.circles == 1) circle_radii_ = {radii[1]};
@@ -290,37 +293,66 @@ double Decoder::correlate(const Prepared& p, const Ideal& ideal, double lag) con
 }
 
 double Decoder::heading_on_screen(const Blob& blob, double lag) const {
-  const double a = 2.0 * kPi * lag / config_.samples;
-  const cv::Vec2d dir = blob.shape * cv::Vec2d(std::cos(a), -std::sin(a));
-  return wrap_deg_360(rad_to_deg(std::atan2(-dir[1], dir[0])));
+  // Polynomial trigonometry (core/fast_trig.hpp): this runs for every decoded marker,
+  // and the library's took a tenth of a tracked marker's time.
+  double s = 0.0, c = 0.0;
+  fast_sincos(2.0 * kPi * lag / config_.samples, s, c);
+  const cv::Vec2d dir = blob.shape * cv::Vec2d(c, -s);
+  // Within [-180, 180]: one turn added at most (no fmod, as wrap_deg_360 needs).
+  double heading_deg = rad_to_deg(fast_atan2(-dir[1], dir[0]));
+  if (heading_deg < 0.0) heading_deg += 360.0;
+  return heading_deg >= 360.0 ? heading_deg - 360.0 : heading_deg;
 }
 
 void Decoder::prepare(const SampledSignal& signal, Prepared& p) const {
   const int n = config_.samples;
   const double* x = signal.values.data();
-  // Two partial sums: the compiler keeps one dependency chain per sum.
-  double sum0 = 0.0, sum1 = 0.0;
-  int k = 0;
-  for (; k + 1 < n; k += 2) {
-    sum0 += x[k];
-    sum1 += x[k + 1];
-  }
-  if (k < n) sum0 += x[k];
-  const double mean = (sum0 + sum1) / n;
   // The running integral is periodic because the signal is mean-free; doubling it lets
   // correlate() read any edge + lag in [0, 2n) without wrapping.
   // (Two more entries: edge + lag + 0.5 < 2n + 0.5 reads up to index 2n + 1.)
-  p.doubled_cumulative.resize(2 * n + 2);
+  // (And a few more for local_peak's window, which reads whole lags past 2n.)
+  const int tail = 2 + local_window_pad_;
+  p.doubled_cumulative.resize(2 * n + tail);
   double* c = p.doubled_cumulative.data();
-  double norm2 = 0.0, running = 0.0;
+  double mean = 0.0, norm2 = 0.0;
+  int k = 0;
+#if defined(__SSE2__)
+  // Two samples per step. The running integral of a pair [a, b] starting from r is
+  // [r, r + a], and r moves on by a + b: one shuffle and two adds per pair.
+  __m128d sums = _mm_setzero_pd();
+  for (; k + 1 < n; k += 2) sums = _mm_add_pd(sums, _mm_loadu_pd(x + k));
+  double sum = _mm_cvtsd_f64(sums) + _mm_cvtsd_f64(_mm_unpackhi_pd(sums, sums));
+  if (k < n) sum += x[k];
+  mean = sum / n;
+  const __m128d means = _mm_set1_pd(mean);
+  __m128d squares = _mm_setzero_pd(), running = _mm_setzero_pd();  // running: r in both lanes
+  for (k = 0; k + 1 < n; k += 2) {
+    const __m128d centred = _mm_sub_pd(_mm_loadu_pd(x + k), means);
+    squares = _mm_add_pd(squares, _mm_mul_pd(centred, centred));
+    const __m128d before = _mm_add_pd(running, _mm_unpacklo_pd(_mm_setzero_pd(), centred));  // [r, r + a]
+    _mm_storeu_pd(c + k, before);
+    _mm_storeu_pd(c + k + n, before);
+    running = _mm_add_pd(running, _mm_add_pd(centred, _mm_shuffle_pd(centred, centred, 1)));
+  }
+  norm2 = _mm_cvtsd_f64(squares) + _mm_cvtsd_f64(_mm_unpackhi_pd(squares, squares));
+  if (k < n) {
+    const double centred = x[k] - mean;
+    c[k] = c[k + n] = _mm_cvtsd_f64(running);
+    norm2 += centred * centred;
+  }
+#else
+  double sum = 0.0;
+  for (k = 0; k < n; ++k) sum += x[k];
+  mean = sum / n;
+  double running = 0.0;
   for (k = 0; k < n; ++k) {
     c[k] = c[k + n] = running;
     const double centred = x[k] - mean;
     norm2 += centred * centred;
     running += centred;
   }
-  c[2 * n] = c[0];
-  c[2 * n + 1] = c[1];
+#endif
+  for (k = 0; k < tail; ++k) c[2 * n + k] = c[k];
   p.norm = std::sqrt(norm2);
   p.mean = mean;
 }
@@ -334,9 +366,10 @@ void Decoder::prepare_doubled(const SampledSignal& signal, Prepared& p) const {
 }
 
 double Decoder::lag_of_heading(const Blob& blob, double heading_deg) const {
-  const double h = deg_to_rad(heading_deg);
-  const cv::Vec2d dir = blob.shape.inv() * cv::Vec2d(std::cos(h), -std::sin(h));
-  const double lag = std::atan2(-dir[1], dir[0]) * config_.samples / (2.0 * kPi);
+  double s = 0.0, c = 0.0;
+  fast_sincos(deg_to_rad(heading_deg), s, c);
+  const cv::Vec2d dir = blob.shape.inv() * cv::Vec2d(c, -s);
+  const double lag = fast_atan2(-dir[1], dir[0]) * config_.samples / (2.0 * kPi);
   return lag < 0.0 ? lag + config_.samples : lag;
 }
 
@@ -393,13 +426,52 @@ std::pair<int, double> Decoder::coarse_peak(const Prepared& p, const Ideal& idea
 
 std::pair<int, double> Decoder::local_peak(const Prepared& p, const Ideal& ideal, int centre_lag, int reach) const {
   const int n = config_.samples;
-  std::pair<int, double> best{centre_lag, -1e300};
-  for (int d = -reach; d <= reach; ++d) {
-    const int lag = ((centre_lag + d) % n + n) % n;
-    const double c = correlate(p, ideal, lag);
-    if (c > best.second) best = {lag, c};
+  const int first = ((centre_lag - reach) % n + n) % n;
+  const int count = 2 * reach + 1;
+  // Every lag of the window at once, edge by edge: at a whole lag each edge reads the
+  // running integral at a fixed fraction into its bin, so lag + 1 is the next entry (no
+  // wrap and no fraction per lag, where correlate() computes both for any lag).
+  constexpr int kMaxLags = 32;
+  const int padded = (count + 1) & ~1;
+  const std::size_t last_read = static_cast<std::size_t>(2 * n - 2 + padded);  // edge_index + lag + 1, at most
+  if (padded > kMaxLags || last_read >= p.doubled_cumulative.size()) {
+    std::pair<int, double> best{centre_lag, -1e300};
+    for (int d = 0; d < count; ++d) {
+      const int lag = (first + d) % n;
+      const double c = correlate(p, ideal, lag);
+      if (c > best.second) best = {lag, c};
+    }
+    return best;
   }
-  return best;
+  alignas(16) double values[kMaxLags];
+  const double* c = p.doubled_cumulative.data();
+#if defined(__SSE2__)
+  for (int j = 0; j < padded; j += 2) {
+    __m128d v = _mm_setzero_pd();
+    for (std::size_t e = 0; e < ideal.edge.size(); ++e) {
+      const double* at = c + ideal.edge_index[e] + first + j;
+      const __m128d lo = _mm_loadu_pd(at), hi = _mm_loadu_pd(at + 1);
+      const __m128d in_bin = _mm_add_pd(lo, _mm_mul_pd(_mm_set1_pd(ideal.edge_frac[e]), _mm_sub_pd(hi, lo)));
+      v = _mm_add_pd(v, _mm_mul_pd(_mm_set1_pd(ideal.step[e]), in_bin));
+    }
+    _mm_store_pd(values + j, v);
+  }
+#else
+  for (int j = 0; j < padded; ++j) {
+    double v = 0.0;
+    for (std::size_t e = 0; e < ideal.edge.size(); ++e) {
+      const double* at = c + ideal.edge_index[e] + first + j;
+      v += ideal.step[e] * (at[0] + ideal.edge_frac[e] * (at[1] - at[0]));
+    }
+    values[j] = v;
+  }
+#endif
+  // The first of equal values wins, as in a scan from the window's low end.
+  int best = 0;
+  for (int d = 1; d < count; ++d) {
+    if (values[d] > values[best]) best = d;
+  }
+  return {(first + best) % n, values[best]};
 }
 
 std::pair<double, double> Decoder::refine_peak(const Prepared& p, const Ideal& ideal, int lag, double value) const {
@@ -563,7 +635,7 @@ CodeMatch Decoder::match_one(const SampledSignal& signal, const Blob& blob, int 
   std::pair<int, double> peak{-1, 0.0};
   if (expected_heading_deg) {
     const int centre = static_cast<int>(std::lround(lag_of_heading(blob, *expected_heading_deg))) % config_.samples;
-    const int reach = static_cast<int>(std::ceil(kTrackReachDeg * config_.samples / 360.0));
+    const int reach = track_reach_samples_;
     peak = local_peak(p, ideal, centre, reach);
     const int offset = ((peak.first - centre) % config_.samples + config_.samples + config_.samples / 2) %
                            config_.samples - config_.samples / 2;

@@ -129,7 +129,8 @@ class Decoder {
   double lag_of_heading(const Blob& blob, double heading_deg) const;
   // Best whole-sample lag of one ideal and its (unnormalised) correlation.
   std::pair<int, double> coarse_peak(const Prepared& p, const Ideal& ideal, std::vector<double>& scratch) const;
-  // Best whole-sample lag within `reach` samples of `centre_lag`.
+  // Best whole-sample lag within `reach` samples of `centre_lag` (the first of equal ones
+  // from the low end).
   std::pair<int, double> local_peak(const Prepared& p, const Ideal& ideal, int centre_lag, int reach) const;
   // The lag refined below one sample, with its correlation.
   std::pair<double, double> refine_peak(const Prepared& p, const Ideal& ideal, int lag, double value) const;
@@ -146,6 +147,8 @@ class Decoder {
   // A tracked marker turns at most this many degrees between frames before its
   // confirmation falls back to the search over every lag.
   static constexpr double kTrackReachDeg = 15.0;
+  int track_reach_samples_ = 0;  // kTrackReachDeg in samples, rounded up
+  int local_window_pad_ = 0;     // entries past 2n + 2 that local_peak's widest window reads
   void build_key_template(const MarkerFamily& family);
   static void order_knots(Ideal& ideal);
   void match_by_key(const Prepared& p, const Blob& blob, std::vector<CodeMatch>& out) const;

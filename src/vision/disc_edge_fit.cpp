@@ -4,6 +4,10 @@
 #include <cmath>
 #include <cstdint>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "core/geometry.hpp"
 #include "vision/circle_sampler.hpp"
 #include "vision/marker_family.hpp"
@@ -127,6 +131,11 @@ std::uint8_t load_disc_area(const cv::Mat& grey, const Blob& predicted, const Di
   std::uint8_t any = 0;
   const std::uint8_t* row = grey.ptr<std::uint8_t>(y0);
   const std::size_t stride = grey.step[0];
+  if (x1 - x0 < kLine) {
+    // A marker up to a line wide (the common case): its two ends cover each row.
+    for (int y = y0; y <= y1; ++y, row += stride) any |= row[x0] | row[x1];
+    return any;
+  }
   for (int y = y0; y <= y1; ++y, row += stride) {
     for (int x = x0 & ~(kLine - 1); x <= x1; x += kLine) any |= row[x];
     any |= row[x1];
@@ -261,11 +270,41 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
   }
 
   // The normal equations need only the moments of the points up to the fourth order;
-  // summed as plain scalars (a loop over a small phi array made the compiler store and
-  // reload it through memory, which stalled on every point).
+  // summed in named accumulators (a loop over a small phi array made the compiler store
+  // and reload it through memory, which stalled on every point).
   double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, sxxx = 0, sxxy = 0, sxyy = 0, syyy = 0;
   double sxxxx = 0, sxxxy = 0, sxxyy = 0, sxyyy = 0, syyyy = 0;
-  for (int i = 0; i < found; ++i) {
+  int first_single = 0;
+#if defined(__SSE2__)
+  {
+    // Two points per step, one in each lane; the lanes are added at the end.
+    __m128d mx = _mm_setzero_pd(), my = mx, mxx = mx, mxy = mx, myy = mx, mxxx = mx, mxxy = mx, mxyy = mx,
+            myyy = mx, mxxxx = mx, mxxxy = mx, mxxyy = mx, mxyyy = mx, myyyy = mx;
+    for (; first_single + 1 < found; first_single += 2) {
+      const __m128d x = _mm_loadu_pd(px + first_single), y = _mm_loadu_pd(py + first_single);
+      const __m128d xx = _mm_mul_pd(x, x), xy = _mm_mul_pd(x, y), yy = _mm_mul_pd(y, y);
+      mx = _mm_add_pd(mx, x);
+      my = _mm_add_pd(my, y);
+      mxx = _mm_add_pd(mxx, xx);
+      mxy = _mm_add_pd(mxy, xy);
+      myy = _mm_add_pd(myy, yy);
+      mxxx = _mm_add_pd(mxxx, _mm_mul_pd(xx, x));
+      mxxy = _mm_add_pd(mxxy, _mm_mul_pd(xx, y));
+      mxyy = _mm_add_pd(mxyy, _mm_mul_pd(x, yy));
+      myyy = _mm_add_pd(myyy, _mm_mul_pd(yy, y));
+      mxxxx = _mm_add_pd(mxxxx, _mm_mul_pd(xx, xx));
+      mxxxy = _mm_add_pd(mxxxy, _mm_mul_pd(xx, xy));
+      mxxyy = _mm_add_pd(mxxyy, _mm_mul_pd(xx, yy));
+      mxyyy = _mm_add_pd(mxyyy, _mm_mul_pd(xy, yy));
+      myyyy = _mm_add_pd(myyyy, _mm_mul_pd(yy, yy));
+    }
+    auto lanes = [](__m128d v) { return _mm_cvtsd_f64(v) + _mm_cvtsd_f64(_mm_unpackhi_pd(v, v)); };
+    sx = lanes(mx), sy = lanes(my), sxx = lanes(mxx), sxy = lanes(mxy), syy = lanes(myy);
+    sxxx = lanes(mxxx), sxxy = lanes(mxxy), sxyy = lanes(mxyy), syyy = lanes(myyy);
+    sxxxx = lanes(mxxxx), sxxxy = lanes(mxxxy), sxxyy = lanes(mxxyy), sxyyy = lanes(mxyyy), syyyy = lanes(myyyy);
+  }
+#endif
+  for (int i = first_single; i < found; ++i) {
     const double x = px[i], y = py[i];
     const double xx = x * x, xy = x * y, yy = y * y;
     sx += x;

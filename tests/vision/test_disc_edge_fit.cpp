@@ -111,14 +111,19 @@ TEST(DiscEdgeFit, RefusesWhatIsNotTheDisc) {
   EXPECT_FALSE(fit_disc_edges(img, disc_at(truth, 18.0), 110.0).has_value());
 }
 
-// load_disc_area reads the marker's area (one byte per cache line and the area's last
-// column) and nothing outside the image, whatever the prediction.
+// load_disc_area reads the marker's area (at least a byte of every cache line of it)
+// and nothing outside the image, whatever the prediction.
 TEST(DiscEdgeFit, LoadDiscAreaReadsTheAreaOnly) {
   cv::Mat img(120, 200, CV_8UC1, cv::Scalar(0));
   EXPECT_EQ(load_disc_area(img, disc_at({100, 60}, 12.0)), 0);
-  img.at<std::uint8_t>(60, 64) = 0x40;  // a cache line's first byte inside the area
+  img(cv::Rect(50, 40, 41, 41)).setTo(0x40);  // the disc, its rings and the walks' reach around (70, 60)
+  img.at<std::uint8_t>(60, 150) = 0x01;        // a pixel far from it
   EXPECT_EQ(load_disc_area(img, disc_at({70, 60}, 12.0)), 0x40);
-  EXPECT_EQ(load_disc_area(img, disc_at({160, 60}, 12.0)), 0);  // far from it
+  EXPECT_EQ(load_disc_area(img, disc_at({100, 100}, 12.0)), 0);  // beside both
+  // A marker wider than a cache line reads every line of its rows.
+  cv::Mat wide(300, 400, CV_8UC1, cv::Scalar(0));
+  wide.at<std::uint8_t>(150, 192) = 0x08;  // inside, on neither end of its row
+  EXPECT_EQ(load_disc_area(wide, disc_at({192.5, 150}, 40.0)), 0x08);
   // Predictions at and beyond the image's corners are clipped to it.
   for (cv::Point2d p : {cv::Point2d(0, 0), cv::Point2d(199, 119), cv::Point2d(-50, 30), cv::Point2d(260, 200)}) {
     load_disc_area(img, disc_at(p, 12.0));
