@@ -201,50 +201,53 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
   // has mostly brought into the cache already).
   double px[kMaxPoints], py[kMaxPoints], black[kMaxPoints], white[kMaxPoints];
   int found = 0, tried = 0, levels = 0;
-  auto add_point = [&](double x, double y) {
-    const double dx = x - predicted.u, dy = y - predicted.v;
-    px[found] = s_inv(0, 0) * dx + s_inv(0, 1) * dy;
-    py[found] = s_inv(1, 0) * dx + s_inv(1, 1) * dy;
-    ++found;
-  };
   // Rows across the middle of the disc find its left and right edges, columns its top
   // and bottom: each crossing is then read where the outline is steep along the line, and
-  // along a row or column the pixels are plain bytes (no interpolation).
-  for (int axis = 0; axis < 2; ++axis) {
-    // axis 0: rows (offset d in v, edges in u); axis 1: columns (offset in u, edges in v).
-    const double q_along = axis == 0 ? q(0, 0) : q(1, 1), q_across = axis == 0 ? q(1, 1) : q(0, 0);
-    const double q_mixed = q(0, 1);
-    const double half_span = 1.0 / std::sqrt(q_across - q_mixed * q_mixed / q_along);  // the outline's extent across
+  // along a row or column the pixels are plain bytes (no interpolation). The axis is a
+  // template parameter: the loop body has no per-crossing choice between the two.
+  const double cu = predicted.u, cv = predicted.v;
+  auto cross_lines = [&]<bool kRows>() {
+    // Along: the direction of the line (u for a row); across: between lines.
+    const double q_along = kRows ? q(0, 0) : q(1, 1), q_across = kRows ? q(1, 1) : q(0, 0);
+    const double q_mixed = q(0, 1), inv_q_along = 1.0 / q_along;
+    const double half_span = 1.0 / std::sqrt(q_across - q_mixed * q_mixed * inv_q_along);  // the outline's extent across
+    const double base_along = kRows ? cu : cv, base_across = kRows ? cv : cu;
+    const std::ptrdiff_t step_along = kRows ? 1 : stride, step_across = kRows ? stride : 1;
+    // The unit-circle frame's columns: a crossing at (along, across) offsets maps to
+    // s_inv (du, dv).
+    const double inv_along_x = kRows ? s_inv(0, 0) : s_inv(0, 1), inv_along_y = kRows ? s_inv(1, 0) : s_inv(1, 1);
+    const double inv_across_x = kRows ? s_inv(0, 1) : s_inv(0, 0), inv_across_y = kRows ? s_inv(1, 1) : s_inv(1, 0);
     for (int i = 0; i < lines; ++i) {
       // Lines spread over the middle 70% of the extent, where the outline is steep.
       const double d_target = half_span * 0.7 * (2.0 * (i + 0.5) / lines - 1.0);
-      const int line = nearest((axis == 0 ? predicted.v : predicted.u) + d_target);
-      const double d = line - (axis == 0 ? predicted.v : predicted.u);
+      const int line = nearest(base_across + d_target);
+      const double d = line - base_across;
       const double disc = q_mixed * q_mixed * d * d - q_along * (q_across * d * d - 1.0);
       if (disc <= 0.0) continue;
-      const double mid = -q_mixed * d / q_along, half = std::sqrt(disc) / q_along;
-      for (int side : {-1, 1}) {
+      const double mid = -q_mixed * d * inv_q_along, half = std::sqrt(disc) * inv_q_along;
+      const std::uint8_t* line_start = data + line * step_across;
+      const double across_x = inv_across_x * d, across_y = inv_across_y * d;
+      for (int side = -1; side <= 1; side += 2) {
         ++tried;
-        const double along = (axis == 0 ? predicted.u : predicted.v) + mid + side * half;
-        const int start = nearest(along - 0.5 * side);  // the last pixel inside
-        const std::uint8_t* p = axis == 0 ? data + line * stride + start : data + start * stride + line;
-        const double offset = walk_to_edge(p, axis == 0 ? 1 : stride, side, reach, threshold_grey, bright_from);
+        const int start = nearest(base_along + mid + side * half - 0.5 * side);  // the last pixel inside
+        const double offset =
+            walk_to_edge(line_start + start * step_along, step_along, side, reach, threshold_grey, bright_from);
         if (std::isnan(offset)) continue;
-
-        const double edge = start + offset;
-        if (axis == 0) {
-          add_point(edge, line);
-          const std::uint8_t* row = data + line * stride;
-          const int at = nearest(edge);
-          black[levels] = row[at - side * black_step];
-          white[levels] = row[at + side * white_step];
+        const double along = start + offset - base_along;
+        px[found] = inv_along_x * along + across_x;
+        py[found] = inv_along_y * along + across_y;
+        ++found;
+        if constexpr (kRows) {
+          const int at = nearest(start + offset);
+          black[levels] = line_start[at - side * black_step];
+          white[levels] = line_start[at + side * white_step];
           ++levels;
-        } else {
-          add_point(line, edge);
         }
       }
     }
-  }
+  };
+  cross_lines.template operator()<true>();
+  cross_lines.template operator()<false>();
   if (found < std::max(6.0, config.min_edge_fraction * tried)) {
     // A disc that moved off the prediction by more than the reach shows its crossings on
     // one side only. Those found still say where it went: each crossing's distance from
