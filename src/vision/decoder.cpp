@@ -634,11 +634,23 @@ CodeMatch Decoder::match_one(const SampledSignal& signal, const Blob& blob, int 
   if (p.norm <= 0.0) return {id, -1.0, 0.0};
   std::pair<int, double> peak{-1, 0.0};
   if (expected_heading_deg) {
-    const int centre = static_cast<int>(std::lround(lag_of_heading(blob, *expected_heading_deg))) % config_.samples;
+    const int n = config_.samples;
+    const int centre = static_cast<int>(std::lround(lag_of_heading(blob, *expected_heading_deg))) % n;
     const int reach = track_reach_samples_;
-    peak = local_peak(p, ideal, centre, reach);
-    const int offset = ((peak.first - centre) % config_.samples + config_.samples + config_.samples / 2) %
-                           config_.samples - config_.samples / 2;
+    // The lags next to the expected one first, then uphill one lag at a time while the
+    // peak lies on the edge of what has been scored. The correlation falls on both sides
+    // of a marker's peak for as far as its narrowest slice (5.7 samples of 60 for 9UCP,
+    // 9 for 6UCP), beyond the reach, so the climb stops at the window's best; a marker
+    // that turned a little costs three lags instead of the whole window.
+    peak = local_peak(p, ideal, centre, 1);
+    int offset = ((peak.first - centre) % n + n + n / 2) % n - n / 2;
+    while (offset != 0 && std::abs(offset) < reach) {
+      const int next = ((centre + offset + (offset > 0 ? 1 : -1)) % n + n) % n;
+      const auto beyond = local_peak(p, ideal, next, 0);
+      if (!(beyond.second > peak.second)) break;
+      peak = beyond;
+      offset += offset > 0 ? 1 : -1;
+    }
     if (std::abs(offset) >= reach) peak.first = -1;  // on the edge: it may lie beyond
   }
   if (peak.first < 0) {
