@@ -101,21 +101,26 @@ double mean_of(const double* values, int count) {
   return sum / count;
 }
 
-// The pixels fit_disc_edges may read for `predicted` (the white ring's middle beyond the
-// farthest crossing), clipped to the image: x0..x1, y0..y1 inclusive; empty when x1 < x0
-// or y1 < y0.
+// The pixels worth loading before fit_disc_edges runs on `predicted`, clipped to the
+// image: x0..x1, y0..y1 inclusive; empty when x1 < x0 or y1 < y0. Across, as far as its
+// reads go (the white ring's middle beyond the farthest crossing); down, only the rows
+// the predicted disc spans. The columns' walks read a pixel or two beyond the outline,
+// and those few lines are fetched on demand while other work goes on: a cold frame
+// waits for every line loaded up front, and loading the marker's whole height took
+// longer than it saved (8-marker tracked frame on flushed frames: 0.0113 ms with rows
+// out to the walks' reach, 0.0105 ms with the disc's rows; 3 rows fewer was 0.0116).
 struct PixelBox {
   int x0, x1, y0, y1;
   bool empty() const { return x1 < x0 || y1 < y0; }
 };
 
 PixelBox disc_area(const cv::Mat& grey, const Blob& predicted, const DiscEdgeFitConfig& config) {
-  const double extent = (1.0 + config.reach) * kWhiteMid + 0.05;
-  const cv::Vec2d half = ellipse_half_extent(predicted.shape, extent);
-  return {std::max(0, static_cast<int>(predicted.u - half[0])),
-          std::min(grey.cols - 1, static_cast<int>(predicted.u + half[0]) + 1),
-          std::max(0, static_cast<int>(predicted.v - half[1])),
-          std::min(grey.rows - 1, static_cast<int>(predicted.v + half[1]) + 1)};
+  const double half_w = ellipse_half_extent(predicted.shape, (1.0 + config.reach) * kWhiteMid + 0.05)[0];
+  const double half_h = ellipse_half_extent(predicted.shape, 1.0)[1];
+  return {std::max(0, static_cast<int>(predicted.u - half_w)),
+          std::min(grey.cols - 1, static_cast<int>(predicted.u + half_w) + 1),
+          std::max(0, static_cast<int>(predicted.v - half_h)),
+          std::min(grey.rows - 1, static_cast<int>(predicted.v + half_h) + 1)};
 }
 
 constexpr int kLine = 64;  // bytes per cache line

@@ -60,7 +60,9 @@ std::optional<DiscEdgeFit> fit_disc_edges(const cv::Mat& grey, const Blob& predi
                                           const DiscEdgeFitConfig& config = {});
 
 /// Asks the CPU to start loading (into its L2 cache) the pixels fit_disc_edges will read
-/// for `predicted`, without waiting for them. A camera frame is not in the CPU's near caches when it
+/// for `predicted` (the rows of the predicted disc, as wide as the fit's reads; the few
+/// pixels its walks read beyond the disc's rows are left to be fetched on demand),
+/// without waiting for them. A camera frame is not in the CPU's near caches when it
 /// arrives and the fit's reads are scattered, so each would wait for memory in turn;
 /// prefetching the next marker's area while fitting the current one overlaps those
 /// waits. Does nothing outside the image; changes nothing.

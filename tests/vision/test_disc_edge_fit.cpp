@@ -116,7 +116,7 @@ TEST(DiscEdgeFit, RefusesWhatIsNotTheDisc) {
 TEST(DiscEdgeFit, LoadDiscAreaReadsTheAreaOnly) {
   cv::Mat img(120, 200, CV_8UC1, cv::Scalar(0));
   EXPECT_EQ(load_disc_area(img, disc_at({100, 60}, 12.0)), 0);
-  img(cv::Rect(50, 40, 41, 41)).setTo(0x40);  // the disc, its rings and the walks' reach around (70, 60)
+  img(cv::Rect(50, 47, 41, 27)).setTo(0x40);  // the rows of the disc at (70, 60), as wide as the fit reads
   img.at<std::uint8_t>(60, 150) = 0x01;        // a pixel far from it
   EXPECT_EQ(load_disc_area(img, disc_at({70, 60}, 12.0)), 0x40);
   EXPECT_EQ(load_disc_area(img, disc_at({100, 100}, 12.0)), 0);  // beside both
