@@ -3,10 +3,13 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <string>
 
 #include "core/geometry.hpp"
 #include "vision/blob_detector.hpp"
 #include "vision/decoder.hpp"
+#include "vision/marker_tracker.hpp"
 #include "vision/synthetic_camera.hpp"
 
 using namespace rilbed;
@@ -109,5 +112,44 @@ TEST(Decoder, TwelveSliceFamilyDecodesByKeyAndBits) {
     // Only the code read and its one-bit neighbours are scored.
     const auto scored = std::count_if(matches.begin(), matches.end(), [](const auto& m) { return m.score > -1.0; });
     EXPECT_LE(scored, 10);
+  }
+}
+
+// A tracked confirmation (match_one with the heading last seen) finds the same peak as a
+// search over every lag when the marker turned a little (the lags next to the expected
+// one) or further within the window (the climb towards its edge). Turned well beyond
+// the window, it finds the true peak or a poor one that no caller accepts (below
+// TrackerConfig::min_assign_score; the tracker then decodes the marker afresh), never
+// a confident wrong heading.
+TEST(Decoder, MatchOneFindsThePeakFromTheHeadingLastSeen) {
+  const double min_assign_score = TrackerConfig{}.min_assign_score;
+  for (const char* family : {"6ucp", "9ucp"}) {
+    const auto f = MarkerFamily::by_name(family);
+    const int id = f.max_id() > 8 ? 42 : 6;
+    for (int samples : {60, 120}) {
+      DecoderConfig config;
+      config.samples = samples;
+      Decoder decoder(f, {id}, config);
+      BlobDetector detector;
+      for (double heading : {12.0, 137.5, 301.0}) {
+        const cv::Mat img = canvas_with_marker(f, id, 64, heading);
+        const auto blobs = detector.detect(img);
+        ASSERT_EQ(blobs.size(), 1u);
+        const auto signal = decoder.sample(img, blobs[0]);
+        ASSERT_TRUE(signal.usable);
+        const CodeMatch everywhere = decoder.match_one(signal, blobs[0], id);
+        EXPECT_GT(everywhere.score, 0.9) << family << " " << samples << " " << heading;
+        EXPECT_NEAR(wrap_deg_180(everywhere.heading_deg - heading), 0.0, 1.5) << family << " " << samples;
+        for (double turned : {0.0, 4.0, -4.0, 9.0, -9.0, 13.0, -13.0, 40.0, -90.0, 180.0}) {
+          const CodeMatch near = decoder.match_one(signal, blobs[0], id, wrap_deg_360(heading - turned));
+          const std::string where = std::string(family) + " samples " + std::to_string(samples) + " turned " +
+                                    std::to_string(turned);
+          if (std::abs(turned) < 15.0 || near.score >= min_assign_score) {
+            EXPECT_NEAR(near.score, everywhere.score, 1e-9) << where;
+            EXPECT_NEAR(wrap_deg_180(near.heading_deg - everywhere.heading_deg), 0.0, 1e-6) << where;
+          }
+        }
+      }
+    }
   }
 }
