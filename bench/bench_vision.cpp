@@ -19,6 +19,7 @@
 // tools/bench.sh runs it with the defaults (about 2 minutes on 2 cores).
 
 #include "frame_cache.hpp"
+#include "timing.hpp"
 
 #include <apriltag/apriltag.h>
 #include <apriltag/tag36h11.h>
@@ -53,7 +54,12 @@ namespace rv = rilbed::vision;
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using rilbed::bench::Clock;
+using rilbed::bench::measure_timer_overhead;
+using rilbed::bench::ms_since;
+using rilbed::bench::net_ms;
+using rilbed::bench::thread_cpu_ms;
+using rilbed::bench::TimerOverhead;
 constexpr double kPi = 3.14159265358979323846;
 // Printed grey levels (as the synthetic camera and render_marker_topdown use).
 constexpr double kWhite = 240.0, kBlack = 28.0, kFloorGrey = 185.0;
@@ -462,49 +468,9 @@ struct Row {
   double cpu_median() const { return percentile(cpu_ms, 0.5); }
 };
 
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
+constexpr int kTimerIntervals = 20001;  // empty intervals that measure the timer's cost
+TimerOverhead g_timer_overhead;         // set once in main, before any timing
 
-// CPU time of the calling thread: on a shared machine it leaves out the time other
-// processes held the core.
-double thread_cpu_ms() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
-// What the timing itself costs: the median of empty intervals read exactly as a timed
-// call is (thread CPU clock, steady clock, then both again). Reading the thread's CPU
-// clock is a system call (about half a microsecond on a VM), a few per cent of a tracked
-// frame and nothing of a peer's: it is subtracted from every sample of every detector.
-struct TimerOverhead {
-  double wall_ms = 0.0;
-  double cpu_ms = 0.0;
-};
-
-TimerOverhead measure_timer_overhead() {
-  constexpr int kIntervals = 20001;
-  std::vector<double> wall, cpu;
-  wall.reserve(kIntervals);
-  cpu.reserve(kIntervals);
-  for (int i = 0; i < kIntervals; ++i) {
-    const double c0 = thread_cpu_ms();
-    const auto t0 = Clock::now();
-    wall.push_back(ms_since(t0));
-    cpu.push_back(thread_cpu_ms() - c0);
-  }
-  auto median = [](std::vector<double>& v) {
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    return v[v.size() / 2];
-  };
-  return {median(wall), median(cpu)};
-}
-
-TimerOverhead g_timer_overhead;  // set once in main, before any timing
-
-// A timed interval less the timer's own cost (never below zero).
-double net_ms(double measured_ms, double overhead_ms) { return std::max(0.0, measured_ms - overhead_ms); }
 
 using DetectFn = std::function<std::vector<Det>(const cv::Mat&)>;
 
@@ -683,7 +649,7 @@ int main(int argc, char** argv) {
   cv::setNumThreads(0);
   cv::ocl::setUseOpenCL(false);
   const auto wall_start = Clock::now();
-  g_timer_overhead = measure_timer_overhead();
+  g_timer_overhead = measure_timer_overhead(kTimerIntervals);
 
   const Imaging imaging{1.3, 0.6, 2.0, opt.jpeg ? 85 : 0};
 
@@ -752,7 +718,7 @@ int main(int argc, char** argv) {
       "took. From every sample the timer's own cost is subtracted: the median of %d empty intervals read the "
       "same way, %.3f us wall and %.3f us CPU on this run (reading the thread's CPU clock is a system call). "
       "The ratio column divides medians, wall and CPU.\n",
-      opt.budget_s, opt.min_passes, opt.max_passes, kRounds, 20001, g_timer_overhead.wall_ms * 1e3,
+      opt.budget_s, opt.min_passes, opt.max_passes, kRounds, kTimerIntervals, g_timer_overhead.wall_ms * 1e3,
       g_timer_overhead.cpu_ms * 1e3);
   std::printf(
       "- Recall: fraction of rendered markers for which a detection with the right ID lies within %.0f px of the "

@@ -29,30 +29,14 @@
 #include <vector>
 
 #include "frame_cache.hpp"
+#include "timing.hpp"
 #include "vision/marker_tracker.hpp"
 
 namespace {
 
 using rilbed::vision::MarkerFamily;
 using rilbed::vision::MarkerTracker;
-
-double thread_cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
-}
-
-// The median cost of an empty interval read as a timed call is (two reads of the thread's
-// CPU clock, a system call): subtracted from every sample, as bench_vision does.
-double timer_overhead_ms() {
-  std::vector<double> empty(20001);
-  for (double& e : empty) {
-    const double t0 = thread_cpu_ms();
-    e = thread_cpu_ms() - t0;
-  }
-  std::nth_element(empty.begin(), empty.begin() + empty.size() / 2, empty.end());
-  return empty[empty.size() / 2];
-}
+using rilbed::bench::thread_cpu_ms;
 
 struct Options {
   std::string dir;
@@ -139,7 +123,8 @@ int main(int argc, char** argv) {
   MarkerTracker tracker(family, ids);
   const bool full = opt.mode == "full";
 
-  const double overhead_ms = timer_overhead_ms();
+  // The timer's own cost, measured and subtracted as bench_vision does.
+  const double overhead_ms = rilbed::bench::measure_timer_overhead().cpu_ms;
   double best_median = 0.0, best_p90 = 0.0;
   double found = 0.0, fills = 0.0, edge_fits = 0.0;
   for (int run = 0; run < opt.runs; ++run) {
@@ -157,7 +142,7 @@ int main(int argc, char** argv) {
         const auto detections = full ? tracker.detect_full_frame(frames[i]) : tracker.process(frames[i]);
         const double t1 = thread_cpu_ms();
         if (!full && i == 0) continue;  // the first frame of a pass is a full search
-        times.push_back(std::max(0.0, t1 - t0 - overhead_ms));
+        times.push_back(rilbed::bench::net_ms(t1 - t0, overhead_ms));
         ++timed;
         found_sum += static_cast<long>(detections.size());
         fill_sum += tracker.last_stats().fills;

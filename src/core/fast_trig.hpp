@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cmath>
+#include <iterator>
 
 #include "core/geometry.hpp"
 
@@ -52,9 +53,11 @@ inline double fast_atan2(double y, double x) {
     offset = 0.25 * kPi;
   }
   const double t2 = t * t;
-  constexpr int kTerms = 14;  // powers 1, 3, ..., 27
+  // (-1)^j / (2j + 1) for the powers 1, 3, ..., 27, summed by Horner in t^2.
+  constexpr double kSeries[] = {1.0,       -1.0 / 3,  1.0 / 5,   -1.0 / 7,  1.0 / 9,   -1.0 / 11, 1.0 / 13,
+                                -1.0 / 15, 1.0 / 17,  -1.0 / 19, 1.0 / 21,  -1.0 / 23, 1.0 / 25,  -1.0 / 27};
   double p = 0.0;
-  for (int j = kTerms - 1; j >= 0; --j) p = (j % 2 == 0 ? 1.0 : -1.0) / (2 * j + 1) + t2 * p;
+  for (int j = static_cast<int>(std::size(kSeries)) - 1; j >= 0; --j) p = kSeries[j] + t2 * p;
   double angle = offset + t * p;
   if (ay > ax) angle = 0.5 * kPi - angle;
   if (x < 0.0) angle = kPi - angle;

@@ -121,7 +121,6 @@ Decoder::Decoder(const MarkerFamily& family, const std::vector<int>& ids, Decode
   config_.samples = std::max(24, config_.samples);
   config_.circles = std::clamp(config_.circles, 1, 3);
   track_reach_samples_ = static_cast<int>(std::ceil(kTrackReachDeg * config_.samples / 360.0));
-  local_window_pad_ = 2 * track_reach_samples_;
   // One circle: the middle of the annulus; two: its inner and outer; three: all.
   constexpr auto& radii = MarkerFamily::sample_radii;
   if (config_.circles == 1) circle_radii_ = {radii[1]};
@@ -311,7 +310,7 @@ void Decoder::prepare(const SampledSignal& signal, Prepared& p) const {
   // correlate() read any edge + lag in [0, 2n) without wrapping.
   // (Two more entries: edge + lag + 0.5 < 2n + 0.5 reads up to index 2n + 1.)
   // (And a few more for local_peak's window, which reads whole lags past 2n.)
-  const int tail = 2 + local_window_pad_;
+  const int tail = 2 + kLocalWindowPad;
   p.doubled_cumulative.resize(2 * n + tail);
   double* c = p.doubled_cumulative.data();
   double mean = 0.0, norm2 = 0.0;

@@ -148,7 +148,10 @@ class Decoder {
   // confirmation falls back to the search over every lag.
   static constexpr double kTrackReachDeg = 15.0;
   int track_reach_samples_ = 0;  // kTrackReachDeg in samples, rounded up
-  int local_window_pad_ = 0;     // entries past 2n + 2 that local_peak's widest window reads
+  // Entries of the running integral past 2n + 2 that local_peak reads for the windows the
+  // decoder uses (at most one lag either side, scored as two pairs of lags); a wider
+  // window falls back to correlate() per lag.
+  static constexpr int kLocalWindowPad = 1;
   void build_key_template(const MarkerFamily& family);
   static void order_knots(Ideal& ideal);
   void match_by_key(const Prepared& p, const Blob& blob, std::vector<CodeMatch>& out) const;
