@@ -175,6 +175,12 @@ namespace {
 // One fit from `predicted`. When too few crossings are found but enough to say where
 // the disc lies, `shift_px` (if given) receives the prediction's error, estimated from
 // those found.
+//
+// The crossings are kept as pixel offsets from the predicted centre divided by the
+// predicted radius (well conditioned, and one multiply per crossing). The algebraic
+// conic fit below is the same in any frame related to that one by a linear map (each
+// point's residual is unchanged), and so is the residual test; only the shift estimate
+// of a failed fit needs the prediction's unit-circle frame, and maps its few points there.
 std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, double threshold_grey,
                                     const DiscEdgeFitConfig& config, cv::Vec2d* shift_px) {
   const int lines = std::clamp(config.lines, 2, kMaxLines);
@@ -183,12 +189,14 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
   // that all of it is inside the image (with a pixel to spare).
   const double extent = (1.0 + config.reach) * kWhiteMid;
   if (!ellipse_inside(grey, predicted.u, predicted.v, s, extent, 2.0)) return std::nullopt;
-  const double det_s = cv::determinant(s);
+  const double det_s = s(0, 0) * s(1, 1) - s(0, 1) * s(1, 0);
   if (!(det_s > 0.0)) return std::nullopt;
-  const cv::Matx22d s_inv = s.inv();
-  // The predicted outline as a quadratic form: (x - c)^T q (x - c) = 1.
-  const cv::Matx22d q = s_inv.t() * s_inv;
-  const double radius_px = std::sqrt(det_s);
+  // The predicted outline as a quadratic form: (x - c)^T q (x - c) = 1, q = (S S^T)^-1.
+  const double inv_det2 = 1.0 / (det_s * det_s);
+  const double q00 = (s(1, 0) * s(1, 0) + s(1, 1) * s(1, 1)) * inv_det2;
+  const double q11 = (s(0, 0) * s(0, 0) + s(0, 1) * s(0, 1)) * inv_det2;
+  const double q01 = -(s(0, 0) * s(1, 0) + s(0, 1) * s(1, 1)) * inv_det2;
+  const double radius_px = std::sqrt(det_s), inv_radius = 1.0 / radius_px;
   const int reach = std::max(2, static_cast<int>(std::ceil(config.reach * radius_px)));
   const int bright_from = static_cast<int>(std::ceil(threshold_grey));
   const std::uint8_t* data = grey.ptr<std::uint8_t>(0);
@@ -201,10 +209,11 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
   const int black_step = std::max(1, nearest((1.0 - kBlackMid) * radius_px));
   const int white_step = std::max(1, nearest((kWhiteMid - 1.0) * radius_px));
 
-  // Crossings, in the prediction's unit-circle frame (S^-1 (x - c), near the unit
-  // circle); and on the rows, the rings' levels read on the same row (pixels the walk
-  // has mostly brought into the cache already).
-  double px[kMaxPoints], py[kMaxPoints], black[kMaxPoints], white[kMaxPoints];
+  // Crossings (pixel offsets from the predicted centre over the radius); and on the
+  // rows, the rings' levels read on the same row (pixels the walk has mostly brought
+  // into the cache already).
+  alignas(16) double px[kMaxPoints], py[kMaxPoints];
+  double black[kMaxPoints], white[kMaxPoints];
   int found = 0, tried = 0, levels = 0;
   // Rows across the middle of the disc find its left and right edges, columns its top
   // and bottom: each crossing is then read where the outline is steep along the line, and
@@ -213,34 +222,31 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
   const double cu = predicted.u, cv = predicted.v;
   auto cross_lines = [&]<bool kRows>() {
     // Along: the direction of the line (u for a row); across: between lines.
-    const double q_along = kRows ? q(0, 0) : q(1, 1), q_across = kRows ? q(1, 1) : q(0, 0);
-    const double q_mixed = q(0, 1), inv_q_along = 1.0 / q_along;
-    const double half_span = 1.0 / std::sqrt(q_across - q_mixed * q_mixed * inv_q_along);  // the outline's extent across
+    const double q_along = kRows ? q00 : q11, q_across = kRows ? q11 : q00;
+    const double inv_q_along = 1.0 / q_along;
+    const double half_span = 1.0 / std::sqrt(q_across - q01 * q01 * inv_q_along);  // the outline's extent across
     const double base_along = kRows ? cu : cv, base_across = kRows ? cv : cu;
     const std::ptrdiff_t step_along = kRows ? 1 : stride, step_across = kRows ? stride : 1;
-    // The unit-circle frame's columns: a crossing at (along, across) offsets maps to
-    // s_inv (du, dv).
-    const double inv_along_x = kRows ? s_inv(0, 0) : s_inv(0, 1), inv_along_y = kRows ? s_inv(1, 0) : s_inv(1, 1);
-    const double inv_across_x = kRows ? s_inv(0, 1) : s_inv(0, 0), inv_across_y = kRows ? s_inv(1, 1) : s_inv(1, 0);
+    double* along_out = kRows ? px : py;
+    double* across_out = kRows ? py : px;
     for (int i = 0; i < lines; ++i) {
       // Lines spread over the middle 70% of the extent, where the outline is steep.
       const double d_target = half_span * 0.7 * (2.0 * (i + 0.5) / lines - 1.0);
       const int line = nearest(base_across + d_target);
       const double d = line - base_across;
-      const double disc = q_mixed * q_mixed * d * d - q_along * (q_across * d * d - 1.0);
+      const double disc = q01 * q01 * d * d - q_along * (q_across * d * d - 1.0);
       if (disc <= 0.0) continue;
-      const double mid = -q_mixed * d * inv_q_along, half = std::sqrt(disc) * inv_q_along;
+      const double mid = base_along - q01 * d * inv_q_along, half = std::sqrt(disc) * inv_q_along;
       const std::uint8_t* line_start = data + line * step_across;
-      const double across_x = inv_across_x * d, across_y = inv_across_y * d;
+      const double across = d * inv_radius;
       for (int side = -1; side <= 1; side += 2) {
         ++tried;
-        const int start = nearest(base_along + mid + side * half - 0.5 * side);  // the last pixel inside
+        const int start = nearest(mid + side * half - 0.5 * side);  // the last pixel inside
         const double offset =
             walk_to_edge(line_start + start * step_along, step_along, side, reach, threshold_grey, bright_from);
         if (std::isnan(offset)) continue;
-        const double along = start + offset - base_along;
-        px[found] = inv_along_x * along + across_x;
-        py[found] = inv_along_y * along + across_y;
+        along_out[found] = (start + offset - base_along) * inv_radius;
+        across_out[found] = across;
         ++found;
         if constexpr (kRows) {
           const int at = nearest(start + offset);
@@ -255,15 +261,18 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
   cross_lines.template operator()<false>();
   if (found < std::max(6.0, config.min_edge_fraction * tried)) {
     // A disc that moved off the prediction by more than the reach shows its crossings on
-    // one side only. Those found still say where it went: each crossing's distance from
-    // the unit circle is about the shift's component along its direction, and the shift
+    // one side only. Those found still say where it went: in the prediction's
+    // unit-circle frame (S^-1 times the pixel offset) each crossing's distance from the
+    // unit circle is about the shift's component along its direction, and the shift
     // follows by least squares.
     if (shift_px == nullptr || found < 6) return std::nullopt;
+    const cv::Matx22d to_unit = s.inv() * radius_px;
     double a00 = 0, a01 = 0, a11 = 0, b0 = 0, b1 = 0;
     for (int i = 0; i < found; ++i) {
-      const double r = std::hypot(px[i], py[i]);
+      const cv::Vec2d p = to_unit * cv::Vec2d(px[i], py[i]);
+      const double r = std::hypot(p[0], p[1]);
       if (!(r > 0.0)) continue;
-      const double ux = px[i] / r, uy = py[i] / r, d = r - 1.0;
+      const double ux = p[0] / r, uy = p[1] / r, d = r - 1.0;
       a00 += ux * ux;
       a01 += ux * uy;
       a11 += uy * uy;
@@ -276,6 +285,7 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
     *shift_px = s * t;
     return std::nullopt;
   }
+  if (levels < 4) return std::nullopt;
 
   // The normal equations need only the moments of the points up to the fourth order;
   // summed in named accumulators (a loop over a small phi array made the compiler store
@@ -289,7 +299,7 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
     __m128d mx = _mm_setzero_pd(), my = mx, mxx = mx, mxy = mx, myy = mx, mxxx = mx, mxxy = mx, mxyy = mx,
             myyy = mx, mxxxx = mx, mxxxy = mx, mxxyy = mx, mxyyy = mx, myyyy = mx;
     for (; first_single + 1 < found; first_single += 2) {
-      const __m128d x = _mm_loadu_pd(px + first_single), y = _mm_loadu_pd(py + first_single);
+      const __m128d x = _mm_load_pd(px + first_single), y = _mm_load_pd(py + first_single);
       const __m128d xx = _mm_mul_pd(x, x), xy = _mm_mul_pd(x, y), yy = _mm_mul_pd(y, y);
       mx = _mm_add_pd(mx, x);
       my = _mm_add_pd(my, y);
@@ -337,44 +347,51 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
                                     sxxx,  sxxy,  sxyy,  sxx,  sxy,   //
                                     sxxy,  sxyy,  syyy,  sxy,  syy};
   const double rhs_values[5] = {sxx, sxy, syy, sx, sy};
-  cv::Vec<double, 5> conic;
-  if (!solve_spd5(normal_values, rhs_values, conic.val)) return std::nullopt;
-  cv::Matx22d m(conic[0], 0.5 * conic[1], 0.5 * conic[1], conic[2]);
-  const double det_m = cv::determinant(m);
-  if (!(m(0, 0) > 0.0 && det_m > 0.0)) return std::nullopt;  // not an ellipse
-  const cv::Vec2d q0 = m.inv() * cv::Vec2d(-0.5 * conic[3], -0.5 * conic[4]);
-  const double level = 1.0 + q0.dot(m * q0);
+  double conic[5];
+  if (!solve_spd5(normal_values, rhs_values, conic)) return std::nullopt;
+  // The conic A x² + B xy + C y² + D x + E y = 1 as (x - x0)^T m (x - x0) = 1.
+  double m00 = conic[0], m01 = 0.5 * conic[1], m11 = conic[2];
+  const double det_m = m00 * m11 - m01 * m01;
+  if (!(m00 > 0.0 && det_m > 0.0)) return std::nullopt;  // not an ellipse
+  const double inv_det_m = 1.0 / det_m;
+  const double hx = -0.5 * conic[3], hy = -0.5 * conic[4];
+  const double x0 = (m11 * hx - m01 * hy) * inv_det_m, y0 = (m00 * hy - m01 * hx) * inv_det_m;
+  const double level = 1.0 + x0 * hx + y0 * hy;  // 1 + x0^T m x0, as m x0 = h
   if (!(level > 0.0)) return std::nullopt;
-  m *= 1.0 / level;  // now (q - q0)^T m (q - q0) = 1 on the outline
+  const double inv_level = 1.0 / level;
+  m00 *= inv_level;
+  m01 *= inv_level;
+  m11 *= inv_level;
 
+  // RMS of each crossing's distance from the ellipse, radially, as a fraction of the
+  // ellipse's radius there (the same in every linearly related frame).
   double residual2 = 0.0;
   for (int i = 0; i < found; ++i) {
-    const cv::Vec2d d(px[i] - q0[0], py[i] - q0[1]);
-    const double rho = std::sqrt(std::max(0.0, d.dot(m * d))) - 1.0;
+    const double dx = px[i] - x0, dy = py[i] - y0;
+    const double rho = std::sqrt(std::max(0.0, m00 * dx * dx + 2.0 * m01 * dx * dy + m11 * dy * dy)) - 1.0;
     residual2 += rho * rho;
   }
-  if (std::sqrt(residual2 / found) > config.max_residual) return std::nullopt;
+  if (residual2 > config.max_residual * config.max_residual * found) return std::nullopt;
 
-  // Back to pixels: outline = centre + S (q0 + m^-1/2 u), so the shape's square is
-  // S m^-1 S (S is symmetric).
-  const cv::Matx22d cov = s * m.inv() * s;
-  const double det_c = cv::determinant(cov);
+  // Back to pixels: the outline is centre + radius (x0 + m^-1/2 u), so the shape's
+  // square is radius² m^-1.
+  const double cov_scale = radius_px * radius_px / (det_m * inv_level * inv_level);
+  const cv::Matx22d cov(m11 * cov_scale, -m01 * cov_scale, -m01 * cov_scale, m00 * cov_scale);
+  const double det_c = cov(0, 0) * cov(1, 1) - cov(0, 1) * cov(1, 0);
   if (!(det_c > 0.0)) return std::nullopt;
   const double mean = 0.5 * (cov(0, 0) + cov(1, 1));
   const double diff = std::sqrt(0.25 * (cov(0, 0) - cov(1, 1)) * (cov(0, 0) - cov(1, 1)) + cov(0, 1) * cov(0, 1));
   if (!(mean - diff > 0.0) || std::sqrt((mean + diff) / (mean - diff)) > config.max_axis_ratio) return std::nullopt;
   const double area = kPi * std::sqrt(det_c);
-  const double predicted_area = kPi * std::abs(cv::determinant(s));
+  const double predicted_area = kPi * det_s;
   if (std::abs(area - predicted_area) > config.max_area_change * predicted_area) return std::nullopt;
 
   DiscEdgeFit fit;
-  const cv::Vec2d c_px = cv::Vec2d(predicted.u, predicted.v) + s * q0;
-  fit.blob.u = c_px[0];
-  fit.blob.v = c_px[1];
+  fit.blob.u = predicted.u + radius_px * x0;
+  fit.blob.v = predicted.v + radius_px * y0;
   fit.blob.shape = sqrt_spd(cov);
   fit.blob.threshold = threshold_grey;
   fit.blob.filled_area_px = area;
-  if (levels < 4) return std::nullopt;
   fit.black_level = mean_of(black, levels);
   fit.white_level = mean_of(white, levels);
   const double mid = 0.5 * (fit.black_level + fit.white_level);
