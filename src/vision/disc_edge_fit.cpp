@@ -24,34 +24,42 @@ constexpr double kWhiteMid = 0.5 * (1.0 + MarkerFamily::black_ring_outer_radius)
 constexpr int kMaxLines = 32;
 constexpr int kMaxPoints = 4 * kMaxLines;
 
-// Walks along a line of pixels (a row or a column; `stride` bytes between neighbours)
-// from pixel `start`, towards the outside (`outward` = +1 or -1 in pixel steps), to find
-// where the grey level crosses `threshold` from the dark disc to the bright ring; at most
+// Walks along a line of pixels (a row or a column) from pixel `start` towards the
+// outside (`step` bytes per pixel outwards: the stride, negative inwards) to find where
+// the grey level crosses `threshold` from the dark disc to the bright ring; at most
 // `reach` pixels either way from `start`. `bright_from` is the least whole grey level at
 // or above the threshold (so a pixel is dark when below it: integer compares in the
-// loop). Returns the crossing's offset from `start` in pixels (sub-pixel, linear between
-// the two pixels around it), or NaN.
-double walk_to_edge(const std::uint8_t* start, std::ptrdiff_t stride, int outward, int reach, double threshold,
-                    int bright_from) {
-  const std::ptrdiff_t step = stride * outward;
-  int dark_at = 0;  // offset (in pixels, outwards) of the dark pixel; the bright one follows
-  if (start[0] < bright_from) {
+// loop). Sets `offset` to the crossing's distance from `start` in pixels, outwards
+// (sub-pixel, linear between the two pixels around it); false when there is none.
+// Inline, with the pixels around the crossing kept from the walk's own reads.
+inline bool walk_to_edge(const std::uint8_t* start, std::ptrdiff_t step, int reach, double threshold,
+                         int bright_from, double& offset) {
+  int dark_at = 0, dark = start[0], bright = 0;  // the dark pixel (offset outwards) and the bright one after it
+  if (dark < bright_from) {
     // From dark, outwards to the first bright pixel.
     int i = 1;
-    while (i <= reach && start[i * step] < bright_from) ++i;
-    if (i > reach) return std::nan("");
+    for (; i <= reach; ++i) {
+      bright = start[i * step];
+      if (bright >= bright_from) break;
+      dark = bright;
+    }
+    if (i > reach) return false;
     dark_at = i - 1;
   } else {
     // From bright, inwards to the first dark pixel.
+    bright = dark;
     int i = 1;
-    while (i <= reach && start[-i * step] >= bright_from) ++i;
-    if (i > reach) return std::nan("");
+    for (; i <= reach; ++i) {
+      dark = start[-i * step];
+      if (dark < bright_from) break;
+      bright = dark;
+    }
+    if (i > reach) return false;
     dark_at = -i;
   }
-  const double dark = start[dark_at * step], bright = start[(dark_at + 1) * step];
-  const double span = bright - dark;
-  const double t = span > 0.0 ? std::clamp((threshold - dark) / span, 0.0, 1.0) : 0.5;
-  return (dark_at + t) * outward;
+  // dark < bright_from <= bright, and threshold lies in (dark, bright]: no clamp needed.
+  offset = dark_at + (threshold - dark) / (bright - dark);
+  return true;
 }
 
 // Solves a x = b for a symmetric positive-definite 5x5 `a` (row-major) by Cholesky,
@@ -60,26 +68,35 @@ double walk_to_edge(const std::uint8_t* start, std::ptrdiff_t stride, int outwar
 bool solve_spd5(const double* a, const double* b, double* x) {
   constexpr int n = 5;
   double l[n][n] = {};
+  // Fully unrolled (a fixed size): the loop bookkeeping cost as much as the arithmetic.
+#pragma GCC unroll 5
   for (int j = 0; j < n; ++j) {
     double d = a[j * n + j];
+#pragma GCC unroll 5
     for (int k = 0; k < j; ++k) d -= l[j][k] * l[j][k];
     if (!(d > 0.0)) return false;
     l[j][j] = std::sqrt(d);
     const double inv = 1.0 / l[j][j];
+#pragma GCC unroll 5
     for (int i = j + 1; i < n; ++i) {
       double v = a[i * n + j];
+#pragma GCC unroll 5
       for (int k = 0; k < j; ++k) v -= l[i][k] * l[j][k];
       l[i][j] = v * inv;
     }
   }
   double y[n];
+#pragma GCC unroll 5
   for (int i = 0; i < n; ++i) {  // L y = b
     double v = b[i];
+#pragma GCC unroll 5
     for (int k = 0; k < i; ++k) v -= l[i][k] * y[k];
     y[i] = v / l[i][i];
   }
+#pragma GCC unroll 5
   for (int i = n - 1; i >= 0; --i) {  // L^T x = y
     double v = y[i];
+#pragma GCC unroll 5
     for (int k = i + 1; k < n; ++k) v -= l[k][i] * x[k];
     x[i] = v / l[i][i];
   }
@@ -239,12 +256,16 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
       const double mid = base_along - q01 * d * inv_q_along, half = std::sqrt(disc) * inv_q_along;
       const std::uint8_t* line_start = data + line * step_across;
       const double across = d * inv_radius;
+#pragma GCC unroll 2
       for (int side = -1; side <= 1; side += 2) {
         ++tried;
         const int start = nearest(mid + side * half - 0.5 * side);  // the last pixel inside
-        const double offset =
-            walk_to_edge(line_start + start * step_along, step_along, side, reach, threshold_grey, bright_from);
-        if (std::isnan(offset)) continue;
+        double offset = 0.0;
+        if (!walk_to_edge(line_start + start * step_along, side * step_along, reach, threshold_grey, bright_from,
+                          offset)) {
+          continue;
+        }
+        offset *= side;
         along_out[found] = (start + offset - base_along) * inv_radius;
         across_out[found] = across;
         ++found;
@@ -366,7 +387,25 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
   // RMS of each crossing's distance from the ellipse, radially, as a fraction of the
   // ellipse's radius there (the same in every linearly related frame).
   double residual2 = 0.0;
-  for (int i = 0; i < found; ++i) {
+  int first_unpaired = 0;
+#if defined(__SSE2__)
+  {
+    // Two crossings per step (a square root each: one instruction for both).
+    const __m128d vx0 = _mm_set1_pd(x0), vy0 = _mm_set1_pd(y0), vm00 = _mm_set1_pd(m00),
+                  vm01 = _mm_set1_pd(2.0 * m01), vm11 = _mm_set1_pd(m11), one = _mm_set1_pd(1.0);
+    __m128d sum = _mm_setzero_pd();
+    for (; first_unpaired + 1 < found; first_unpaired += 2) {
+      const __m128d dx = _mm_sub_pd(_mm_load_pd(px + first_unpaired), vx0);
+      const __m128d dy = _mm_sub_pd(_mm_load_pd(py + first_unpaired), vy0);
+      const __m128d form = _mm_add_pd(_mm_mul_pd(_mm_mul_pd(vm00, dx), dx),
+                                      _mm_add_pd(_mm_mul_pd(_mm_mul_pd(vm01, dx), dy), _mm_mul_pd(_mm_mul_pd(vm11, dy), dy)));
+      const __m128d rho = _mm_sub_pd(_mm_sqrt_pd(_mm_max_pd(form, _mm_setzero_pd())), one);
+      sum = _mm_add_pd(sum, _mm_mul_pd(rho, rho));
+    }
+    residual2 = _mm_cvtsd_f64(sum) + _mm_cvtsd_f64(_mm_unpackhi_pd(sum, sum));
+  }
+#endif
+  for (int i = first_unpaired; i < found; ++i) {
     const double dx = px[i] - x0, dy = py[i] - y0;
     const double rho = std::sqrt(std::max(0.0, m00 * dx * dx + 2.0 * m01 * dx * dy + m11 * dy * dy)) - 1.0;
     residual2 += rho * rho;
