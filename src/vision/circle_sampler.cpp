@@ -41,12 +41,18 @@ bool ellipse_inside(const cv::Mat& grey, double centre_u, double centre_v, const
 
 void sample_ellipse(const cv::Mat& grey, double centre_u, double centre_v, const cv::Matx22d& shape, double radius,
                     const CircleDirections& directions, float* out) {
+  sample_ellipse(grey, centre_u, centre_v, shape, radius, directions.cos.data(), directions.sin.data(),
+                 static_cast<int>(directions.cos.size()), out);
+}
+
+void sample_ellipse(const cv::Mat& grey, double centre_u, double centre_v, const cv::Matx22d& shape, double radius,
+                    const float* direction_x, const float* direction_y, int count, float* out) {
   const std::uint8_t* data = grey.ptr<std::uint8_t>(0);
   const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(grey.step[0]);
   const auto a = static_cast<float>(shape(0, 0) * radius), b = static_cast<float>(shape(0, 1) * radius);
   const auto c = static_cast<float>(shape(1, 0) * radius), d = static_cast<float>(shape(1, 1) * radius);
   const auto cu = static_cast<float>(centre_u), cv = static_cast<float>(centre_v);
-  const int n = static_cast<int>(directions.cos.size());
+  const int n = count;
   auto pixel_quad = [&](int x, int y, float fx, float fy) {
     const std::uint8_t* p = data + static_cast<std::ptrdiff_t>(y) * stride + x;
     const float top = p[0] + (p[1] - p[0]) * fx;
@@ -80,7 +86,7 @@ void sample_ellipse(const cv::Mat& grey, double centre_u, double centre_v, const
     return _mm_insert_epi16(v, word(p3), 6);
   };
   for (int k = 0; k < n; k += 4) {
-    const __m128 dx = _mm_loadu_ps(&directions.cos[k]), dy = _mm_loadu_ps(&directions.sin[k]);
+    const __m128 dx = _mm_loadu_ps(direction_x + k), dy = _mm_loadu_ps(direction_y + k);
     const __m128 u = _mm_add_ps(vcu, _mm_add_ps(_mm_mul_ps(va, dx), _mm_mul_ps(vb, dy)));
     const __m128 v = _mm_add_ps(vcv, _mm_add_ps(_mm_mul_ps(vc, dx), _mm_mul_ps(vd, dy)));
     const __m128i ui = _mm_cvttps_epi32(u), vi = _mm_cvttps_epi32(v);  // floor: coordinates are positive
@@ -108,8 +114,8 @@ void sample_ellipse(const cv::Mat& grey, double centre_u, double centre_v, const
   }
 #else
   for (int k = 0; k < n; ++k) {
-    const float u = cu + a * directions.cos[k] + b * directions.sin[k];
-    const float v = cv + c * directions.cos[k] + d * directions.sin[k];
+    const float u = cu + a * direction_x[k] + b * direction_y[k];
+    const float v = cv + c * direction_x[k] + d * direction_y[k];
     const int x = static_cast<int>(u), y = static_cast<int>(v);
     out[k] = pixel_quad(x, y, u - x, v - y);
   }

@@ -36,4 +36,10 @@ bool ellipse_inside(const cv::Mat& grey, double centre_u, double centre_v, const
 void sample_ellipse(const cv::Mat& grey, double centre_u, double centre_v, const cv::Matx22d& shape, double radius,
                     const CircleDirections& directions, float* out);
 
+/// The same for `count` directions given as two arrays (x = cos a, y = -sin a, as
+/// CircleDirections holds them); `count` must be a multiple of four (pad with zeros,
+/// which read the centre).
+void sample_ellipse(const cv::Mat& grey, double centre_u, double centre_v, const cv::Matx22d& shape, double radius,
+                    const float* direction_x, const float* direction_y, int count, float* out);
+
 }  // namespace rilbed::vision

@@ -166,10 +166,22 @@ Decoder::Decoder(const MarkerFamily& family, const std::vector<int>& ids, Decode
     }
     order_knots(ideal);
     ideals_.push_back(std::move(ideal));
+    std::vector<SpotSlice> spots;
+    for (const auto& sl : slices) {
+      const double middle = deg_to_rad(0.5 * (sl.start_deg + sl.end_deg));
+      spots.push_back({std::cos(middle), std::sin(middle), sl.white});
+    }
+    spot_slices_.push_back(std::move(spots));
   }
   index_of_id_.assign(family.max_id() + 1, -1);
   for (std::size_t i = 0; i < ids.size(); ++i) index_of_id_[ids[i]] = static_cast<int>(i);
   build_key_template(family);
+  {
+    const auto key = family.slices(family.min_id()).front();
+    const double half = deg_to_rad(0.5 * (key.end_deg - key.start_deg));
+    key_half_cos_ = std::cos(half);
+    key_half_sin_ = std::sin(half);
+  }
   decode_by_bits_ = static_cast<int>(ids.size()) > kExhaustiveIds;
 }
 
@@ -659,6 +671,113 @@ CodeMatch Decoder::match_one(const SampledSignal& signal, const Blob& blob, int 
   }
   const auto [lag, value] = refine_peak(p, ideal, peak.first, peak.second);
   return {id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, lag)};
+}
+
+std::optional<double> Decoder::spot_check_heading(const cv::Mat& grey, const Blob& blob, int id,
+                                                  double expected_heading_deg, double black_level,
+                                                  double white_level) const {
+  const int index = id >= 0 && id < static_cast<int>(index_of_id_.size()) ? index_of_id_[id] : -1;
+  if (index < 0) throw std::invalid_argument("ID " + std::to_string(id) + " is not decoded here");
+  const double contrast = white_level - black_level;
+  if (!(contrast >= config_.min_ring_contrast)) return std::nullopt;
+  const double mid = 0.5 * (black_level + white_level), inv_contrast = 1.0 / contrast;
+  // The edges are read on two circles across the code annulus (its inner and outer
+  // sampling radii, in units of the dark disc's radius), which halves their noise; the
+  // slices' colours on the middle one.
+  constexpr double kUnit = 1.0 / MarkerFamily::black_ring_outer_radius;
+  constexpr double kInner = MarkerFamily::sample_radii[0] * kUnit, kOuter = MarkerFamily::sample_radii[2] * kUnit;
+  constexpr double kMiddle = MarkerFamily::sample_radii[1] * kUnit;
+  if (!ellipse_inside(grey, blob.u, blob.v, blob.shape, kOuter)) return std::nullopt;
+  const cv::Matx22d& s = blob.shape;
+  const double det = s(0, 0) * s(1, 1) - s(0, 1) * s(1, 0);
+  if (!(det > 0.0)) return std::nullopt;
+
+  // The bisector last seen, as an angle in this frame's unit-circle frame (the decoder's
+  // samples' frame: direction (cos a, -sin a), counter-clockwise on screen).
+  double he_s = 0.0, he_c = 0.0;
+  fast_sincos(deg_to_rad(expected_heading_deg), he_s, he_c);
+  const double ex = s(1, 1) * he_c + s(0, 1) * he_s, ey = -s(1, 0) * he_c - s(0, 0) * he_s;  // det S^-1 (c, -s)
+  const double expected = fast_atan2(-ey, ex);
+
+  // The balance of the key's edges on a grid of bisectors around the expected one:
+  // grey just inside its counter-clockwise edge minus just inside its clockwise edge.
+  // It is positive while the bisector lies clockwise of the true one (the first read is
+  // still in the white key, the second already in the black guard), crosses zero on it,
+  // and is negative beyond. The grid's steps (at most 0.6 px along the circles, and at
+  // most a third of kTrackReachDeg) are finer than the edges' blur, so it changes sign
+  // between two neighbours, where it is close to linear. It reaches kTrackReachDeg either
+  // way for markers up to about 40 px across, less for larger ones (their turns beyond
+  // it are correlated). All reads are independent: the four-wide sampler takes them at
+  // once.
+  constexpr int kHalfGrid = 3, kGrid = 2 * kHalfGrid + 1, kPadded = (2 * kGrid + 3) & ~3;
+  const double radius_px = std::sqrt(det);
+  const double step = std::min(0.6 / (0.5 * (kInner + kOuter) * radius_px), deg_to_rad(kTrackReachDeg) / kHalfGrid);
+  double gs = 0.0, gc = 0.0, ss = 0.0, sc = 0.0;
+  fast_sincos(expected - kHalfGrid * step, gs, gc);
+  fast_sincos(step, ss, sc);
+  alignas(16) float dx[kPadded] = {}, dy[kPadded] = {}, inner[kPadded], outer[kPadded];
+  double grid_c[kGrid], grid_s[kGrid];
+  const double kc = key_half_cos_, ks = key_half_sin_;
+  for (int j = 0; j < kGrid; ++j) {
+    grid_c[j] = gc;
+    grid_s[j] = gs;
+    dx[j] = static_cast<float>(gc * kc - gs * ks);  // bisector + half the key: counter-clockwise edge
+    dy[j] = static_cast<float>(-(gs * kc + gc * ks));
+    dx[kGrid + j] = static_cast<float>(gc * kc + gs * ks);  // bisector - half the key: clockwise edge
+    dy[kGrid + j] = static_cast<float>(-(gs * kc - gc * ks));
+    const double next_c = gc * sc - gs * ss;
+    gs = gs * sc + gc * ss;
+    gc = next_c;
+  }
+  sample_ellipse(grey, blob.u, blob.v, s, kInner, dx, dy, kPadded, inner);
+  sample_ellipse(grey, blob.u, blob.v, s, kOuter, dx, dy, kPadded, outer);
+  double balance[kGrid], edges[kGrid];
+  for (int j = 0; j < kGrid; ++j) {
+    const double ccw = inner[j] + outer[j], cw = inner[kGrid + j] + outer[kGrid + j];
+    balance[j] = 0.5 * (ccw - cw) * inv_contrast;
+    edges[j] = (0.25 * (ccw + cw) - mid) * inv_contrast;  // the two edges' mean level
+  }
+  // The zero crossing (from positive to negative) nearest the expected bisector.
+  int below = -1;
+  for (int d = 0; d < kHalfGrid && below < 0; ++d) {
+    for (const int j : {kHalfGrid + d, kHalfGrid - d - 1}) {
+      if (balance[j] > 0.0 && balance[j + 1] <= 0.0) {
+        below = j;
+        break;
+      }
+    }
+  }
+  if (below < 0) return std::nullopt;
+  const double t = balance[below] / (balance[below] - balance[below + 1]);
+  // The balance is zero also where both reads are black or both white (a wrong place):
+  // the edges must read near the midpoint there.
+  if (std::abs(edges[below] + t * (edges[below + 1] - edges[below])) > kSpotEdgeBand) return std::nullopt;
+  // The bisector: the grid's direction below the crossing turned by t steps (a short
+  // series: t * step < 0.3 rad, to better than 1e-7).
+  const double x = t * step, x2 = x * x;
+  const double rs = x * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0)));
+  const double rc = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0));
+  const double c = grid_c[below] * rc - grid_s[below] * rs, sn = grid_s[below] * rc + grid_c[below] * rs;
+
+  // Every slice's middle must read its colour.
+  const std::vector<SpotSlice>& slices = spot_slices_[index];
+  constexpr int kMaxSlices = 32;
+  const int count = static_cast<int>(slices.size());
+  if (count > kMaxSlices) return std::nullopt;
+  alignas(16) float sx[kMaxSlices] = {}, sy[kMaxSlices] = {}, levels[kMaxSlices];
+  for (int i = 0; i < count; ++i) {
+    sx[i] = static_cast<float>(c * slices[i].cos - sn * slices[i].sin);
+    sy[i] = static_cast<float>(-(sn * slices[i].cos + c * slices[i].sin));
+  }
+  sample_ellipse(grey, blob.u, blob.v, s, kMiddle, sx, sy, (count + 3) & ~3, levels);
+  for (int i = 0; i < count; ++i) {
+    const double level = (levels[i] - mid) * inv_contrast;
+    if (slices[i].white ? level < kSpotMargin : level > -kSpotMargin) return std::nullopt;
+  }
+  const double du = s(0, 0) * c - s(0, 1) * sn, dv = s(1, 0) * c - s(1, 1) * sn;
+  double heading_deg = rad_to_deg(fast_atan2(-dv, du));
+  if (heading_deg < 0.0) heading_deg += 360.0;
+  return heading_deg >= 360.0 ? heading_deg - 360.0 : heading_deg;
 }
 
 }  // namespace rilbed::vision

@@ -95,6 +95,19 @@ class Decoder {
   CodeMatch match_one(const SampledSignal& signal, const Blob& blob, int id,
                       std::optional<double> expected_heading_deg = std::nullopt) const;
 
+  /// A tracked marker's heading from a few reads, without its whole signal: the key
+  /// slice's bisector is where the grey levels just inside its two edges balance (found
+  /// from the heading last seen, on two circles of the code annulus), and then every
+  /// slice's middle is read and must have the ID's colour by a clear margin. About a
+  /// quarter of sample_code() and match_one() together. `blob` is the marker's disc
+  /// this frame; `black_level` and `white_level` the rings' grey levels (from the edge
+  /// fit). Returns the heading on screen (as CodeMatch::heading_deg), or nothing when
+  /// the marker turned by more than 15 degrees, an edge is not where the balance puts
+  /// it, or a slice does not read its colour: the caller then correlates the whole
+  /// signal. It gives no similarity score.
+  std::optional<double> spot_check_heading(const cv::Mat& grey, const Blob& blob, int id, double expected_heading_deg,
+                                           double black_level, double white_level) const;
+
   const std::vector<int>& ids() const { return ids_; }
   const DecoderConfig& config() const { return config_; }
 
@@ -147,6 +160,20 @@ class Decoder {
   // A tracked marker turns at most this many degrees between frames before its
   // confirmation falls back to the search over every lag.
   static constexpr double kTrackReachDeg = 15.0;
+  // A slice's middle must lie this fraction of the ring contrast beyond the midpoint
+  // grey on its colour's side, and the key's edges within kSpotEdgeBand of it, in a
+  // spot check. Generous (a clean marker reads its slices at about +-0.45 and its edges
+  // near 0), so that only a wrong place, a wrong ID or a damaged marker fails.
+  static constexpr double kSpotMargin = 0.2;
+  static constexpr double kSpotEdgeBand = 0.3;
+  // Per ID (in the order of ids_), its slices' middles relative to the key's bisector
+  // (radians, counter-clockwise) as unit vectors, and their colours.
+  struct SpotSlice {
+    double cos = 1.0, sin = 0.0;
+    bool white = false;
+  };
+  std::vector<std::vector<SpotSlice>> spot_slices_;
+  double key_half_cos_ = 1.0, key_half_sin_ = 0.0;  // half the key slice's width, as a unit vector
   int track_reach_samples_ = 0;  // kTrackReachDeg in samples, rounded up
   // Entries of the running integral past 2n + 2 that local_peak reads for the windows the
   // decoder uses (at most one lag either side, scored as two pairs of lags); a wider

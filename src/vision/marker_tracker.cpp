@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "core/geometry.hpp"
 #include "vision/assignment.hpp"
 
 namespace rilbed::vision {
@@ -159,7 +160,7 @@ std::optional<MarkerDetection> MarkerTracker::confirm(const cv::Mat& grey, const
   decoder_.sample(grey, blob, signal_);
   if (!signal_.usable) return std::nullopt;
   ++stats_.decoded;
-  const CodeMatch m = decoder_.match_one(signal_, blob, track.id, track.heading_deg);
+  const CodeMatch m = decoder_.match_one(signal_, blob, track.id, wrap_deg_360(track.predicted_heading_deg()));
   if (m.score < config_.min_assign_score || m.score < track.score - config_.confirm_drop) return std::nullopt;
   return make_detection(blob, m, true, 0.5 * (signal_.black_level + signal_.white_level));
 }
@@ -185,9 +186,20 @@ std::optional<MarkerDetection> MarkerTracker::confirm_by_edges(const cv::Mat& gr
     fit = fit_disc_edges(grey, predicted, track.threshold_grey, config_.edge_fit);
   }
   if (!fit || fit->white_fraction < decoder_.config().min_white_ring_fraction) return std::nullopt;
+  if (track.frames_since_correlated + 1 < config_.full_confirm_interval_frames) {
+    if (auto heading = confirm_decoder_.spot_check_heading(grey, fit->blob, track.id, wrap_deg_360(track.predicted_heading_deg()),
+                                                          fit->black_level, fit->white_level)) {
+      ++stats_.blobs;
+      ++stats_.edge_fits;
+      MarkerDetection d =
+          make_detection(fit->blob, {track.id, track.score, *heading}, true, 0.5 * (fit->black_level + fit->white_level));
+      d.spot_checked = true;
+      return d;
+    }
+  }
   confirm_decoder_.sample_code(grey, fit->blob, fit->black_level, fit->white_level, signal_);
   if (!signal_.usable) return std::nullopt;
-  const CodeMatch m = confirm_decoder_.match_one(signal_, fit->blob, track.id, track.heading_deg);
+  const CodeMatch m = confirm_decoder_.match_one(signal_, fit->blob, track.id, wrap_deg_360(track.predicted_heading_deg()));
   if (m.score < config_.min_assign_score || m.score < track.score - config_.confirm_drop) return std::nullopt;
   ++stats_.blobs;
   ++stats_.decoded;
@@ -267,8 +279,11 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
   for (const MarkerDetection& d : found) {
     auto it = std::find_if(tracks_.begin(), tracks_.end(), [&](const Track& t) { return t.id == d.id; });
     if (it == tracks_.end()) {
-      tracks_.push_back(
-          {d.id, d.u, d.v, 0.0, 0.0, d.diameter_px, d.threshold_grey, d.score, d.heading_deg, d.disc_shape, 0});
+      // Staggered by ID: of many markers found together, about one in the interval is
+      // correlated in each frame.
+      const int interval = std::max(1, config_.full_confirm_interval_frames);
+      tracks_.push_back({d.id, d.u, d.v, 0.0, 0.0, d.diameter_px, d.threshold_grey, d.score, d.heading_deg,
+                         d.disc_shape, 0, d.id % interval});
       continue;
     }
     const int frames = it->missed;  // frames since the last sighting, >= 1
@@ -277,6 +292,7 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     it->u = d.u;
     it->v = d.v;
     it->diameter_px = d.diameter_px;
+    it->turn_deg = wrap_deg_180(d.heading_deg - it->heading_deg) / frames;
     it->heading_deg = d.heading_deg;
     it->shape = d.disc_shape;
     it->threshold_grey = d.threshold_grey;
@@ -284,6 +300,7 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     // confirmations, so a drifting code cannot ratchet its own bar down.
     it->score = d.tracked ? std::max(d.score, it->score - 0.01) : d.score;
     it->missed = 0;
+    it->frames_since_correlated = d.spot_checked ? it->frames_since_correlated + 1 : 0;
   }
   std::erase_if(tracks_, [&](const Track& t) { return t.missed > config_.max_missed_frames; });
   return found;

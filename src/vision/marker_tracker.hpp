@@ -38,6 +38,10 @@ struct MarkerDetection {
   /// Affine map from the unit circle to the outline of the marker's dark disc (see
   /// Blob::shape), pixels.
   cv::Matx22d disc_shape = cv::Matx22d::eye();
+  /// True when this frame only spot-checked its code (each slice's colour, see
+  /// TrackerConfig::full_confirm_interval_frames): `score` is then the one its last
+  /// correlation gave, at most that many frames ago.
+  bool spot_checked = false;
 };
 
 /// Knobs of the whole pipeline.
@@ -55,6 +59,13 @@ struct TrackerConfig {
   /// sample, but less precisely: on the recorded clips 60 gives 0.8-0.9 degrees RMS and
   /// 120 the full decode's 0.5-0.7, for about a quarter more time per tracked frame.
   int confirm_samples = 60;
+  /// A tracked marker found again by its outline has its whole code correlated (a
+  /// fresh score) at least every this many frames; in the frames between, its heading
+  /// comes from the balance of its key slice's edges and every slice's colour is
+  /// checked (Decoder::spot_check_heading), which costs about a quarter as much. A
+  /// failed check correlates at once. 1 correlates every frame. The tracks' turns are
+  /// staggered by ID, so each frame correlates about the same number of markers.
+  int full_confirm_interval_frames = 8;
   /// Smallest similarity at which an object may take an ID. Lower finds markers in
   /// worse images but lets clutter through more often.
   double min_assign_score = 0.75;
@@ -126,6 +137,12 @@ class MarkerTracker {
     double heading_deg = 0;  // on screen, as last seen
     cv::Matx22d shape = cv::Matx22d::eye();  // the disc's outline, as last seen
     int missed = 0;
+    /// Frames since its code was last correlated (not only spot-checked).
+    int frames_since_correlated = 0;
+    /// Its turn per frame, degrees counter-clockwise on screen.
+    double turn_deg = 0;
+    /// Its heading in the coming frame (constant turn, coasting over misses), degrees.
+    double predicted_heading_deg() const { return heading_deg + turn_deg * (missed + 1.0); }
     /// Where it should be in the coming frame (constant motion, coasting over misses).
     cv::Point2d predicted() const { return {u + du * (missed + 1.0), v + dv * (missed + 1.0)}; }
     /// How far it moves by then, pixels.

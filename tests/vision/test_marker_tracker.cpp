@@ -254,3 +254,64 @@ TEST(MarkerTracker, MarkerAtTheFrameEdge) {
   EXPECT_EQ(d[1].id, 5);
   EXPECT_NEAR(d[1].u, 16.5, 0.2);
 }
+
+// Between correlations a tracked marker is spot-checked: its heading follows from the
+// key's edges, its score is its last correlation's, and it is correlated again at least
+// every full_confirm_interval_frames frames. The heading stays as precise as the
+// correlation's.
+TEST(MarkerTracker, SpotChecksBetweenCorrelations) {
+  const auto preset = scene_preset("nominal");
+  SyntheticCamera camera(preset.camera, MarkerFamily::six_ucp(), preset.conditions, preset.clutter);
+  TrackerConfig config;
+  config.full_confirm_interval_frames = 4;
+  MarkerTracker tracker(MarkerFamily::six_ucp(), {1, 2, 3, 4, 5, 6, 7, 8}, config);
+  cv::RNG rng(5);
+  std::map<int, int> since_correlated;
+  std::map<int, double> last_score;
+  int spot_checked = 0, correlated = 0;
+  for (int f = 0; f < 24; ++f) {
+    const auto robots = robots_at(f / 15.0, 8, preset, 5);
+    const auto found = tracker.process(camera.render(robots, rng));
+    ASSERT_EQ(found.size(), 8u) << "frame " << f;
+    std::map<int, MarkerTruth> truth;
+    for (const auto& t : camera.truth(robots)) truth[t.id] = t;
+    for (const auto& d : found) {
+      EXPECT_NEAR(wrap_deg_180(d.heading_deg - truth[d.id].heading_deg), 0.0, 2.5) << "frame " << f << " id " << d.id;
+      if (d.spot_checked) {
+        ++spot_checked;
+        EXPECT_TRUE(d.tracked);
+        EXPECT_DOUBLE_EQ(d.score, last_score[d.id]) << "frame " << f << " id " << d.id;
+        EXPECT_LT(++since_correlated[d.id], 4) << "frame " << f << " id " << d.id;
+      } else {
+        ++correlated;
+        since_correlated[d.id] = 0;
+        last_score[d.id] = d.score;  // what the track keeps (a fresh decode or a confirmation above the old bar)
+      }
+    }
+  }
+  EXPECT_GE(spot_checked, 8 * 23 * 3 / 4 - 8);  // most tracked markers, about 3 frames in 4
+  EXPECT_GE(correlated, 8 + 8 * 23 / 4 - 8);
+}
+
+// A spot check does not keep an ID on a marker that was swapped for another one.
+TEST(MarkerTracker, ASwappedMarkerIsDecodedAgain) {
+  const auto f = MarkerFamily::six_ucp();
+  MarkerTracker tracker(f, {3, 4, 6});
+  auto frame_with = [&](int id_there) {
+    cv::Mat img(240, 320, CV_8UC1, cv::Scalar(185));
+    render_marker_topdown(f, id_there, 32, 30.0).copyTo(img(cv::Rect(100, 80, 32, 32)));
+    render_marker_topdown(f, 6, 32, 200.0).copyTo(img(cv::Rect(220, 150, 32, 32)));
+    return img;
+  };
+  for (int i = 0; i < 3; ++i) {
+    const auto found = tracker.process(frame_with(3));
+    ASSERT_EQ(found.size(), 2u);
+    EXPECT_EQ(found[0].id, 3);
+  }
+  EXPECT_TRUE(tracker.process(frame_with(3))[0].spot_checked);
+  const auto found = tracker.process(frame_with(4));
+  ASSERT_EQ(found.size(), 2u);
+  EXPECT_EQ(found[0].id, 4);
+  EXPECT_FALSE(found[0].spot_checked);
+  EXPECT_EQ(found[1].id, 6);
+}
