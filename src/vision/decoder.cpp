@@ -703,34 +703,47 @@ std::optional<double> Decoder::spot_check_heading(const cv::Mat& grey, const Blo
   // grey just inside its counter-clockwise edge minus just inside its clockwise edge.
   // It is positive while the bisector lies clockwise of the true one (the first read is
   // still in the white key, the second already in the black guard), crosses zero on it,
-  // and is negative beyond. The grid's steps (at most 0.6 px along the circles, and at
-  // most a third of kTrackReachDeg) are finer than the edges' blur, so it changes sign
-  // between two neighbours, where it is close to linear. It reaches kTrackReachDeg either
-  // way for markers up to about 40 px across, less for larger ones (their turns beyond
-  // it are correlated). All reads are independent: the four-wide sampler takes them at
-  // once.
-  constexpr int kHalfGrid = 3, kGrid = 2 * kHalfGrid + 1, kPadded = (2 * kGrid + 3) & ~3;
+  // and is negative beyond. The grid's steps (0.6 px along the circles, but 4.5 degrees
+  // at least and half of kTrackReachDeg at most: under a pixel for markers up to 70 px
+  // across) are finer than the edges' blur, so it changes sign between two neighbours,
+  // where it is close to linear. The grid reaches two steps either way of the turn the
+  // track predicts, 9 to 15 degrees (beyond it, the caller correlates). All reads are
+  // independent: the four-wide sampler takes them in one go.
+  constexpr int kHalfGrid = 2, kGrid = 2 * kHalfGrid + 1, kEdges = 2 * kGrid, kPadded = (kEdges + 3) & ~3;
   const double radius_px = std::sqrt(det);
-  const double step = std::min(0.6 / (0.5 * (kInner + kOuter) * radius_px), deg_to_rad(kTrackReachDeg) / kHalfGrid);
-  double gs = 0.0, gc = 0.0, ss = 0.0, sc = 0.0;
+  const double step = std::clamp(0.6 / (0.5 * (kInner + kOuter) * radius_px), deg_to_rad(4.5),
+                                 deg_to_rad(kTrackReachDeg) / kHalfGrid);
+  double gs = 0.0, gc = 0.0;
   fast_sincos(expected - kHalfGrid * step, gs, gc);
-  fast_sincos(step, ss, sc);
-  alignas(16) float dx[kPadded] = {}, dy[kPadded] = {}, inner[kPadded], outer[kPadded];
+  // The step as a rotation (a short series: step < 0.14 rad, to better than 1e-12).
+  const double step2 = step * step;
+  const double ss = step * (1.0 - step2 / 6.0 * (1.0 - step2 / 20.0 * (1.0 - step2 / 42.0)));
+  const double sc = 1.0 - step2 / 2.0 * (1.0 - step2 / 12.0 * (1.0 - step2 / 30.0 * (1.0 - step2 / 56.0)));
+  // Directions scaled to the two circles: [inner circle's edges | outer circle's], each
+  // counter-clockwise edges of the grid then clockwise ones; one sampler call at radius 1.
+  alignas(16) float dx[2 * kPadded] = {}, dy[2 * kPadded] = {}, levels_read[2 * kPadded];
   double grid_c[kGrid], grid_s[kGrid];
   const double kc = key_half_cos_, ks = key_half_sin_;
   for (int j = 0; j < kGrid; ++j) {
     grid_c[j] = gc;
     grid_s[j] = gs;
-    dx[j] = static_cast<float>(gc * kc - gs * ks);  // bisector + half the key: counter-clockwise edge
-    dy[j] = static_cast<float>(-(gs * kc + gc * ks));
-    dx[kGrid + j] = static_cast<float>(gc * kc + gs * ks);  // bisector - half the key: clockwise edge
-    dy[kGrid + j] = static_cast<float>(-(gs * kc - gc * ks));
+    const double ccw_x = gc * kc - gs * ks, ccw_y = -(gs * kc + gc * ks);  // bisector + half the key
+    const double cw_x = gc * kc + gs * ks, cw_y = -(gs * kc - gc * ks);    // bisector - half the key
+    dx[j] = static_cast<float>(kInner * ccw_x);
+    dy[j] = static_cast<float>(kInner * ccw_y);
+    dx[kGrid + j] = static_cast<float>(kInner * cw_x);
+    dy[kGrid + j] = static_cast<float>(kInner * cw_y);
+    dx[kPadded + j] = static_cast<float>(kOuter * ccw_x);
+    dy[kPadded + j] = static_cast<float>(kOuter * ccw_y);
+    dx[kPadded + kGrid + j] = static_cast<float>(kOuter * cw_x);
+    dy[kPadded + kGrid + j] = static_cast<float>(kOuter * cw_y);
     const double next_c = gc * sc - gs * ss;
     gs = gs * sc + gc * ss;
     gc = next_c;
   }
-  sample_ellipse(grey, blob.u, blob.v, s, kInner, dx, dy, kPadded, inner);
-  sample_ellipse(grey, blob.u, blob.v, s, kOuter, dx, dy, kPadded, outer);
+  sample_ellipse(grey, blob.u, blob.v, s, 1.0, dx, dy, 2 * kPadded, levels_read);
+  const float* inner = levels_read;
+  const float* outer = levels_read + kPadded;
   double balance[kGrid], edges[kGrid];
   for (int j = 0; j < kGrid; ++j) {
     const double ccw = inner[j] + outer[j], cw = inner[kGrid + j] + outer[kGrid + j];

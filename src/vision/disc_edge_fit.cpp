@@ -189,6 +189,75 @@ void prefetch_disc_area(const cv::Mat& grey, const Blob& predicted, const DiscEd
 
 namespace {
 
+// The rings' levels and the white ring's bright fraction, from the reads beside the
+// crossings.
+void set_levels(DiscEdgeFit& fit, const double* black, const double* white, int levels) {
+  fit.black_level = mean_of(black, levels);
+  fit.white_level = mean_of(white, levels);
+  const double mid = 0.5 * (fit.black_level + fit.white_level);
+  fit.white_fraction =
+      static_cast<double>(std::count_if(white, white + levels, [&](double g) { return g > mid; })) / levels;
+}
+
+// The disc as the predicted outline moved and scaled: the crossings p (pixel offsets
+// from the predicted centre over the radius) satisfy (p - c)^T Q (p - c) = k, with Q the
+// predicted outline's form in those units (p^T Q p = 1 on it). Linear in g = Q c and
+// h = k - c^T Q c: p^T Q p = 2 g^T p + h, three unknowns by least squares.
+std::optional<DiscEdgeFit> fit_centre_and_size(const Blob& predicted, double threshold_grey,
+                                               const DiscEdgeFitConfig& config, double q00, double q01, double q11,
+                                               double radius_px, const double* px, const double* py, int found,
+                                               const double* black, const double* white, int levels) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, sz = 0, sxz = 0, syz = 0;
+  for (int i = 0; i < found; ++i) {
+    const double x = px[i], y = py[i];
+    const double z = q00 * x * x + 2.0 * q01 * x * y + q11 * y * y;
+    sx += x;
+    sy += y;
+    sxx += x * x;
+    sxy += x * y;
+    syy += y * y;
+    sz += z;
+    sxz += x * z;
+    syz += y * z;
+  }
+  // Normal equations for (2 g_x, 2 g_y, h), solved by Cramer's rule.
+  const double n = found;
+  const double a00 = sxx, a01 = sxy, a02 = sx, a11 = syy, a12 = sy, a22 = n;
+  const double c00 = a11 * a22 - a12 * a12, c01 = a02 * a12 - a01 * a22, c02 = a01 * a12 - a02 * a11;
+  const double det = a00 * c00 + a01 * c01 + a02 * c02;
+  if (!(std::abs(det) > 1e-12 * n * n * n)) return std::nullopt;
+  const double c11 = a00 * a22 - a02 * a02, c12 = a01 * a02 - a00 * a12, c22 = a00 * a11 - a01 * a01;
+  const double inv_det = 1.0 / det;
+  const double gx2 = (c00 * sxz + c01 * syz + c02 * sz) * inv_det;
+  const double gy2 = (c01 * sxz + c11 * syz + c12 * sz) * inv_det;
+  const double h = (c02 * sxz + c12 * syz + c22 * sz) * inv_det;
+  // c = Q^-1 g; k = h + g^T c.
+  const double det_q = q00 * q11 - q01 * q01;
+  const double gx = 0.5 * gx2, gy = 0.5 * gy2;
+  const double x0 = (q11 * gx - q01 * gy) / det_q, y0 = (q00 * gy - q01 * gx) / det_q;
+  const double k = h + gx * x0 + gy * y0;
+  if (!(k > 0.0)) return std::nullopt;
+  const double inv_k = 1.0 / k;
+  double residual2 = 0.0;
+  for (int i = 0; i < found; ++i) {
+    const double dx = px[i] - x0, dy = py[i] - y0;
+    const double rho = std::sqrt(std::max(0.0, (q00 * dx * dx + 2.0 * q01 * dx * dy + q11 * dy * dy) * inv_k)) - 1.0;
+    residual2 += rho * rho;
+  }
+  if (residual2 > config.max_residual * config.max_residual * found) return std::nullopt;
+  // The area scales as k (the outline's radius as sqrt(k)).
+  if (std::abs(k - 1.0) > config.max_area_change) return std::nullopt;
+  DiscEdgeFit fit;
+  const double scale = std::sqrt(k);
+  fit.blob.u = predicted.u + radius_px * x0;
+  fit.blob.v = predicted.v + radius_px * y0;
+  fit.blob.shape = predicted.shape * scale;
+  fit.blob.threshold = threshold_grey;
+  fit.blob.filled_area_px = kPi * radius_px * radius_px * k;
+  set_levels(fit, black, white, levels);
+  return fit;
+}
+
 // One fit from `predicted`. When too few crossings are found but enough to say where
 // the disc lies, `shift_px` (if given) receives the prediction's error, estimated from
 // those found.
@@ -307,6 +376,10 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
     return std::nullopt;
   }
   if (levels < 4) return std::nullopt;
+  if (config.keep_shape) {
+    return fit_centre_and_size(predicted, threshold_grey, config, q00 * det_s, q01 * det_s, q11 * det_s, radius_px,
+                               px, py, found, black, white, levels);
+  }
 
   // The normal equations need only the moments of the points up to the fourth order;
   // summed in named accumulators (a loop over a small phi array made the compiler store
@@ -431,11 +504,7 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
   fit.blob.shape = sqrt_spd(cov);
   fit.blob.threshold = threshold_grey;
   fit.blob.filled_area_px = area;
-  fit.black_level = mean_of(black, levels);
-  fit.white_level = mean_of(white, levels);
-  const double mid = 0.5 * (fit.black_level + fit.white_level);
-  fit.white_fraction =
-      static_cast<double>(std::count_if(white, white + levels, [&](double g) { return g > mid; })) / levels;
+  set_levels(fit, black, white, levels);
   return fit;
 }
 

@@ -38,6 +38,12 @@ struct DiscEdgeFitConfig {
   double max_area_change = 0.3;
   /// Largest ratio of the ellipse's axes (as BlobDetectorConfig::max_axis_ratio).
   double max_axis_ratio = 1.8;
+  /// Fit only the centre and the size, keeping the predicted outline's orientation and
+  /// eccentricity: 3 unknowns instead of the ellipse's 5, so fewer crossings pin it
+  /// down and the solve is cheaper. For a marker whose outline was fitted in full a few
+  /// frames ago: its shape changes slowly as it crosses the field (perspective, lens),
+  /// its place every frame.
+  bool keep_shape = false;
 };
 
 /// What the edge fit found.

@@ -176,30 +176,40 @@ Blob MarkerTracker::Track::predicted_disc() const {
 }
 
 std::optional<MarkerDetection> MarkerTracker::confirm_by_edges(const cv::Mat& grey, const Track& track) {
-  Blob predicted = track.predicted_disc();
-  auto fit = fit_disc_edges(grey, predicted, track.threshold_grey, config_.edge_fit);
-  if (!fit && (track.du != 0.0 || track.dv != 0.0)) {
-    // It may have stopped or turned back (a bounce): where it was last is the other
-    // cheap guess before a fill.
-    predicted.u = track.u;
-    predicted.v = track.v;
-    fit = fit_disc_edges(grey, predicted, track.threshold_grey, config_.edge_fit);
-  }
-  if (!fit || fit->white_fraction < decoder_.config().min_white_ring_fraction) return std::nullopt;
+  const double expected_heading = wrap_deg_360(track.predicted_heading_deg());
+  auto fit_near = [&](const DiscEdgeFitConfig& edge_fit) {
+    Blob predicted = track.predicted_disc();
+    auto fit = fit_disc_edges(grey, predicted, track.threshold_grey, edge_fit);
+    if (!fit && (track.du != 0.0 || track.dv != 0.0)) {
+      // It may have stopped or turned back (a bounce): where it was last is the other
+      // cheap guess before a fill.
+      predicted.u = track.u;
+      predicted.v = track.v;
+      fit = fit_disc_edges(grey, predicted, track.threshold_grey, edge_fit);
+    }
+    if (fit && fit->white_fraction < decoder_.config().min_white_ring_fraction) fit.reset();
+    return fit;
+  };
   if (track.frames_since_correlated + 1 < config_.full_confirm_interval_frames) {
-    if (auto heading = confirm_decoder_.spot_check_heading(grey, fit->blob, track.id, wrap_deg_360(track.predicted_heading_deg()),
-                                                          fit->black_level, fit->white_level)) {
-      ++stats_.blobs;
-      ++stats_.edge_fits;
-      MarkerDetection d =
-          make_detection(fit->blob, {track.id, track.score, *heading}, true, 0.5 * (fit->black_level + fit->white_level));
-      d.spot_checked = true;
-      return d;
+    // A spot check: the cheaper fit, the heading from the key's edges, the slices'
+    // colours; the score stays the last correlation's.
+    if (auto fit = fit_near(config_.spot_edge_fit)) {
+      if (auto heading = confirm_decoder_.spot_check_heading(grey, fit->blob, track.id, expected_heading,
+                                                            fit->black_level, fit->white_level)) {
+        ++stats_.blobs;
+        ++stats_.edge_fits;
+        MarkerDetection d = make_detection(fit->blob, {track.id, track.score, *heading}, true,
+                                           0.5 * (fit->black_level + fit->white_level));
+        d.spot_checked = true;
+        return d;
+      }
     }
   }
+  auto fit = fit_near(config_.edge_fit);
+  if (!fit) return std::nullopt;
   confirm_decoder_.sample_code(grey, fit->blob, fit->black_level, fit->white_level, signal_);
   if (!signal_.usable) return std::nullopt;
-  const CodeMatch m = confirm_decoder_.match_one(signal_, fit->blob, track.id, wrap_deg_360(track.predicted_heading_deg()));
+  const CodeMatch m = confirm_decoder_.match_one(signal_, fit->blob, track.id, expected_heading);
   if (m.score < config_.min_assign_score || m.score < track.score - config_.confirm_drop) return std::nullopt;
   ++stats_.blobs;
   ++stats_.decoded;
