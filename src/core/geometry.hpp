@@ -41,6 +41,13 @@ constexpr double rad_to_deg(double rad) { return rad * 180.0 / kPi; }
 
 /// Wraps an angle in degrees into [0, 360).
 inline double wrap_deg_360(double deg) {
+  // Within a turn of the range (most callers) without fmod; the same result as it
+  // (fmod is exact, and so is adding or removing one turn here).
+  if (deg >= 0.0 && deg < 360.0) return deg;
+  if (deg >= -360.0 && deg < 720.0) {
+    const double w = deg < 0.0 ? deg + 360.0 : deg - 360.0;
+    return w >= 360.0 ? w - 360.0 : w;  // a tiny negative plus a turn can round up to 360
+  }
   double w = std::fmod(deg, 360.0);
   if (w < 0.0) w += 360.0;
   if (w >= 360.0) w -= 360.0;  // fmod of a tiny negative can round up to 360

@@ -27,18 +27,6 @@ CircleDirections CircleDirections::make(int count, double phase) {
   return d;
 }
 
-cv::Vec2d ellipse_half_extent(const cv::Matx22d& shape, double radius) {
-  return {radius * (std::abs(shape(0, 0)) + std::abs(shape(0, 1))),
-          radius * (std::abs(shape(1, 0)) + std::abs(shape(1, 1)))};
-}
-
-bool ellipse_inside(const cv::Mat& grey, double centre_u, double centre_v, const cv::Matx22d& shape, double radius,
-                    double margin_px) {
-  const cv::Vec2d half = ellipse_half_extent(shape, radius) + cv::Vec2d(margin_px, margin_px);
-  return centre_u - half[0] >= 0.0 && centre_v - half[1] >= 0.0 && centre_u + half[0] < grey.cols - 1.0 &&
-         centre_v + half[1] < grey.rows - 1.0;
-}
-
 void sample_ellipse(const cv::Mat& grey, double centre_u, double centre_v, const cv::Matx22d& shape, double radius,
                     const CircleDirections& directions, float* out) {
   sample_ellipse(grey, centre_u, centre_v, shape, radius, directions.cos.data(), directions.sin.data(),

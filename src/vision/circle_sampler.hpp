@@ -5,6 +5,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <cmath>
 #include <vector>
 
 namespace rilbed::vision {
@@ -21,13 +22,21 @@ struct CircleDirections {
 
 /// Half-width and half-height, pixels, of the box around the ellipse
 /// centre + radius · shape · (unit circle) (shape as Blob::shape).
-cv::Vec2d ellipse_half_extent(const cv::Matx22d& shape, double radius);
+/// (Inline: every tracked marker asks several times per frame.)
+inline cv::Vec2d ellipse_half_extent(const cv::Matx22d& shape, double radius) {
+  return {radius * (std::abs(shape(0, 0)) + std::abs(shape(0, 1))),
+          radius * (std::abs(shape(1, 0)) + std::abs(shape(1, 1)))};
+}
 
 /// True when the box around that ellipse, widened by `margin_px`, lies inside the image
 /// together with the right and lower neighbours a bilinear read takes: the check
 /// sample_ellipse() leaves to its caller.
-bool ellipse_inside(const cv::Mat& grey, double centre_u, double centre_v, const cv::Matx22d& shape, double radius,
-                    double margin_px = 0.0);
+inline bool ellipse_inside(const cv::Mat& grey, double centre_u, double centre_v, const cv::Matx22d& shape,
+                           double radius, double margin_px = 0.0) {
+  const cv::Vec2d half = ellipse_half_extent(shape, radius) + cv::Vec2d(margin_px, margin_px);
+  return centre_u - half[0] >= 0.0 && centre_v - half[1] >= 0.0 && centre_u + half[0] < grey.cols - 1.0 &&
+         centre_v + half[1] < grey.rows - 1.0;
+}
 
 /// Writes to `out[k]` the bilinear grey level at centre + radius · M · d_k, where M maps
 /// the unit circle onto the ellipse (as Blob::shape) and d_k are the directions. The

@@ -189,6 +189,37 @@ void prefetch_disc_area(const cv::Mat& grey, const Blob& predicted, const DiscEd
 
 namespace {
 
+// Mean square of each crossing's radial distance from the ellipse (p - c)^T m (p - c) = 1,
+// as a fraction of its radius there (the same in every linearly related frame).
+double residual_rms2(const double* px, const double* py, int found, double x0, double y0, double m00, double m01,
+                     double m11) {
+  double residual2 = 0.0;
+  int first_unpaired = 0;
+#if defined(__SSE2__)
+  {
+    // Two crossings per step (a square root each: one instruction for both).
+    const __m128d vx0 = _mm_set1_pd(x0), vy0 = _mm_set1_pd(y0), vm00 = _mm_set1_pd(m00),
+                  vm01 = _mm_set1_pd(2.0 * m01), vm11 = _mm_set1_pd(m11), one = _mm_set1_pd(1.0);
+    __m128d sum = _mm_setzero_pd();
+    for (; first_unpaired + 1 < found; first_unpaired += 2) {
+      const __m128d dx = _mm_sub_pd(_mm_load_pd(px + first_unpaired), vx0);
+      const __m128d dy = _mm_sub_pd(_mm_load_pd(py + first_unpaired), vy0);
+      const __m128d form = _mm_add_pd(_mm_mul_pd(_mm_mul_pd(vm00, dx), dx),
+                                      _mm_add_pd(_mm_mul_pd(_mm_mul_pd(vm01, dx), dy), _mm_mul_pd(_mm_mul_pd(vm11, dy), dy)));
+      const __m128d rho = _mm_sub_pd(_mm_sqrt_pd(_mm_max_pd(form, _mm_setzero_pd())), one);
+      sum = _mm_add_pd(sum, _mm_mul_pd(rho, rho));
+    }
+    residual2 = _mm_cvtsd_f64(sum) + _mm_cvtsd_f64(_mm_unpackhi_pd(sum, sum));
+  }
+#endif
+  for (int i = first_unpaired; i < found; ++i) {
+    const double dx = px[i] - x0, dy = py[i] - y0;
+    const double rho = std::sqrt(std::max(0.0, m00 * dx * dx + 2.0 * m01 * dx * dy + m11 * dy * dy)) - 1.0;
+    residual2 += rho * rho;
+  }
+  return residual2 / found;
+}
+
 // The rings' levels and the white ring's bright fraction, from the reads beside the
 // crossings.
 void set_levels(DiscEdgeFit& fit, const double* black, const double* white, int levels) {
@@ -208,7 +239,31 @@ std::optional<DiscEdgeFit> fit_centre_and_size(const Blob& predicted, double thr
                                                double radius_px, const double* px, const double* py, int found,
                                                const double* black, const double* white, int levels) {
   double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, sz = 0, sxz = 0, syz = 0;
-  for (int i = 0; i < found; ++i) {
+  int first_single = 0;
+#if defined(__SSE2__)
+  {
+    // Two crossings per step, one in each lane; the lanes are added at the end.
+    const __m128d vq00 = _mm_set1_pd(q00), vq01 = _mm_set1_pd(2.0 * q01), vq11 = _mm_set1_pd(q11);
+    __m128d mx = _mm_setzero_pd(), my = mx, mxx = mx, mxy = mx, myy = mx, mz = mx, mxz = mx, myz = mx;
+    for (; first_single + 1 < found; first_single += 2) {
+      const __m128d x = _mm_load_pd(px + first_single), y = _mm_load_pd(py + first_single);
+      const __m128d xx = _mm_mul_pd(x, x), xy = _mm_mul_pd(x, y), yy = _mm_mul_pd(y, y);
+      const __m128d z = _mm_add_pd(_mm_mul_pd(vq00, xx), _mm_add_pd(_mm_mul_pd(vq01, xy), _mm_mul_pd(vq11, yy)));
+      mx = _mm_add_pd(mx, x);
+      my = _mm_add_pd(my, y);
+      mxx = _mm_add_pd(mxx, xx);
+      mxy = _mm_add_pd(mxy, xy);
+      myy = _mm_add_pd(myy, yy);
+      mz = _mm_add_pd(mz, z);
+      mxz = _mm_add_pd(mxz, _mm_mul_pd(x, z));
+      myz = _mm_add_pd(myz, _mm_mul_pd(y, z));
+    }
+    auto lanes = [](__m128d v) { return _mm_cvtsd_f64(v) + _mm_cvtsd_f64(_mm_unpackhi_pd(v, v)); };
+    sx = lanes(mx), sy = lanes(my), sxx = lanes(mxx), sxy = lanes(mxy), syy = lanes(myy);
+    sz = lanes(mz), sxz = lanes(mxz), syz = lanes(myz);
+  }
+#endif
+  for (int i = first_single; i < found; ++i) {
     const double x = px[i], y = py[i];
     const double z = q00 * x * x + 2.0 * q01 * x * y + q11 * y * y;
     sx += x;
@@ -238,13 +293,11 @@ std::optional<DiscEdgeFit> fit_centre_and_size(const Blob& predicted, double thr
   const double k = h + gx * x0 + gy * y0;
   if (!(k > 0.0)) return std::nullopt;
   const double inv_k = 1.0 / k;
-  double residual2 = 0.0;
-  for (int i = 0; i < found; ++i) {
-    const double dx = px[i] - x0, dy = py[i] - y0;
-    const double rho = std::sqrt(std::max(0.0, (q00 * dx * dx + 2.0 * q01 * dx * dy + q11 * dy * dy) * inv_k)) - 1.0;
-    residual2 += rho * rho;
+  // The residual test as fit_from's, with the form Q / k of the fitted outline.
+  if (residual_rms2(px, py, found, x0, y0, q00 * inv_k, q01 * inv_k, q11 * inv_k) >
+      config.max_residual * config.max_residual) {
+    return std::nullopt;
   }
-  if (residual2 > config.max_residual * config.max_residual * found) return std::nullopt;
   // The area scales as k (the outline's radius as sqrt(k)).
   if (std::abs(k - 1.0) > config.max_area_change) return std::nullopt;
   DiscEdgeFit fit;
@@ -459,31 +512,9 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
 
   // RMS of each crossing's distance from the ellipse, radially, as a fraction of the
   // ellipse's radius there (the same in every linearly related frame).
-  double residual2 = 0.0;
-  int first_unpaired = 0;
-#if defined(__SSE2__)
-  {
-    // Two crossings per step (a square root each: one instruction for both).
-    const __m128d vx0 = _mm_set1_pd(x0), vy0 = _mm_set1_pd(y0), vm00 = _mm_set1_pd(m00),
-                  vm01 = _mm_set1_pd(2.0 * m01), vm11 = _mm_set1_pd(m11), one = _mm_set1_pd(1.0);
-    __m128d sum = _mm_setzero_pd();
-    for (; first_unpaired + 1 < found; first_unpaired += 2) {
-      const __m128d dx = _mm_sub_pd(_mm_load_pd(px + first_unpaired), vx0);
-      const __m128d dy = _mm_sub_pd(_mm_load_pd(py + first_unpaired), vy0);
-      const __m128d form = _mm_add_pd(_mm_mul_pd(_mm_mul_pd(vm00, dx), dx),
-                                      _mm_add_pd(_mm_mul_pd(_mm_mul_pd(vm01, dx), dy), _mm_mul_pd(_mm_mul_pd(vm11, dy), dy)));
-      const __m128d rho = _mm_sub_pd(_mm_sqrt_pd(_mm_max_pd(form, _mm_setzero_pd())), one);
-      sum = _mm_add_pd(sum, _mm_mul_pd(rho, rho));
-    }
-    residual2 = _mm_cvtsd_f64(sum) + _mm_cvtsd_f64(_mm_unpackhi_pd(sum, sum));
+  if (residual_rms2(px, py, found, x0, y0, m00, m01, m11) > config.max_residual * config.max_residual) {
+    return std::nullopt;
   }
-#endif
-  for (int i = first_unpaired; i < found; ++i) {
-    const double dx = px[i] - x0, dy = py[i] - y0;
-    const double rho = std::sqrt(std::max(0.0, m00 * dx * dx + 2.0 * m01 * dx * dy + m11 * dy * dy)) - 1.0;
-    residual2 += rho * rho;
-  }
-  if (residual2 > config.max_residual * config.max_residual * found) return std::nullopt;
 
   // Back to pixels: the outline is centre + radius (x0 + m^-1/2 u), so the shape's
   // square is radius² m^-1.

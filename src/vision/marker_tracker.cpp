@@ -221,8 +221,10 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
   const cv::Mat grey = to_grey(frame);
   stats_ = FrameStats{};
   std::vector<Blob> blobs;  // found but not confirmed: decoded against the family
-  std::vector<MarkerDetection> confirmed;
-  std::vector<int> confirmed_ids;
+  std::vector<MarkerDetection>& confirmed = confirmed_;
+  std::vector<int>& confirmed_ids = confirmed_ids_;
+  confirmed.clear();
+  confirmed_ids.clear();
   // Only tracks seen last frame try the edge fit, so only their areas are asked for.
   auto fits = [&](std::size_t i) { return config_.use_edge_fit && i < tracks_.size() && tracks_[i].missed == 0; };
   auto prefetch = [&](std::size_t i) {
@@ -266,8 +268,11 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     append_unique(blobs, near);
   }
   drop_confirmed(blobs, confirmed);
-  std::vector<MarkerDetection> found = assign(grey, blobs, true, confirmed_ids);
-  for (auto& d : found) d.tracked = true;
+  std::vector<MarkerDetection> found;
+  if (!blobs.empty()) {
+    found = assign(grey, blobs, true, confirmed_ids);
+    for (auto& d : found) d.tracked = true;
+  }
   found.insert(found.end(), confirmed.begin(), confirmed.end());
 
   const bool all_found = found.size() == ids_.size();
@@ -281,14 +286,19 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     found.insert(found.end(), confirmed.begin(), confirmed.end());
     stats_.full_search = true;
   }
-  std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
+  auto by_id = [](const auto& a, const auto& b) { return a.id < b.id; };
+  if (!std::is_sorted(found.begin(), found.end(), by_id)) std::sort(found.begin(), found.end(), by_id);
   stats_.fills = detector_.take_fill_count();
 
   // Update the tracks: move the seen ones, coast the others, drop the long-lost.
-  for (Track& t : tracks_) ++t.missed;
+  track_of_id_.assign(family_.max_id() + 1, -1);
+  for (std::size_t i = 0; i < tracks_.size(); ++i) {
+    ++tracks_[i].missed;
+    track_of_id_[tracks_[i].id] = static_cast<int>(i);
+  }
   for (const MarkerDetection& d : found) {
-    auto it = std::find_if(tracks_.begin(), tracks_.end(), [&](const Track& t) { return t.id == d.id; });
-    if (it == tracks_.end()) {
+    const int index = track_of_id_[d.id];
+    if (index < 0) {
       // Staggered by ID: of many markers found together, about one in the interval is
       // correlated in each frame.
       const int interval = std::max(1, config_.full_confirm_interval_frames);
@@ -296,6 +306,7 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
                          d.disc_shape, 0, d.id % interval});
       continue;
     }
+    const auto it = tracks_.begin() + index;
     const int frames = it->missed;  // frames since the last sighting, >= 1
     it->du = (d.u - it->u) / frames;
     it->dv = (d.v - it->v) / frames;
