@@ -377,10 +377,7 @@ void Decoder::prepare_doubled(const SampledSignal& signal, Prepared& p) const {
 }
 
 double Decoder::lag_of_heading(const Blob& blob, double heading_deg) const {
-  double s = 0.0, c = 0.0;
-  fast_sincos(deg_to_rad(heading_deg), s, c);
-  const cv::Vec2d dir = blob.shape.inv() * cv::Vec2d(c, -s);
-  const double lag = fast_atan2(-dir[1], dir[0]) * config_.samples / (2.0 * kPi);
+  const double lag = key_angle_of_heading(blob, heading_deg) * config_.samples / (2.0 * kPi);
   return lag < 0.0 ? lag + config_.samples : lag;
 }
 
@@ -586,7 +583,8 @@ void Decoder::match_all(const SampledSignal& signal, const Blob& blob, std::vect
     if ((family_best - value) / p.norm < kRefineMargin) {
       std::tie(lag, value) = refine_peak(p, ideals_[i], peaks[i].first, value);
     }
-    out.push_back({ideals_[i].id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, lag)});
+    out.push_back({ideals_[i].id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, lag),
+                   2.0 * kPi * lag / n});
   }
 }
 
@@ -630,7 +628,8 @@ void Decoder::match_by_key(const Prepared& p, const Blob& blob, std::vector<Code
     if (id >= static_cast<int>(index_of_id_.size()) || index_of_id_[id] < 0) continue;
     const Ideal& ideal = ideals_[index_of_id_[id]];
     const auto [fine_lag, value] = refine_peak(p, ideal, centre, correlate(p, ideal, centre));
-    out[index_of_id_[id]] = {ideal.id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, fine_lag)};
+    out[index_of_id_[id]] = {ideal.id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, fine_lag),
+                             2.0 * kPi * fine_lag / n};
   }
 }
 
@@ -670,12 +669,20 @@ CodeMatch Decoder::match_one(const SampledSignal& signal, const Blob& blob, int 
     peak = coarse_peak(p, ideal, scratch);
   }
   const auto [lag, value] = refine_peak(p, ideal, peak.first, peak.second);
-  return {id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, lag)};
+  return {id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, lag), 2.0 * kPi * lag / config_.samples};
 }
 
-std::optional<double> Decoder::spot_check_heading(const cv::Mat& grey, const Blob& blob, int id,
-                                                  double expected_heading_deg, double black_level,
-                                                  double white_level) const {
+double Decoder::key_angle_of_heading(const Blob& blob, double heading_deg) const {
+  const cv::Matx22d& s = blob.shape;
+  double he_s = 0.0, he_c = 0.0;
+  fast_sincos(deg_to_rad(heading_deg), he_s, he_c);
+  const double ex = s(1, 1) * he_c + s(0, 1) * he_s, ey = -s(1, 0) * he_c - s(0, 0) * he_s;  // det S^-1 (c, -s)
+  return fast_atan2(-ey, ex);
+}
+
+std::optional<SpotCheck> Decoder::spot_check(const cv::Mat& grey, const Blob& blob, int id,
+                                             double expected_key_angle_rad, double black_level,
+                                             double white_level) const {
   const int index = id >= 0 && id < static_cast<int>(index_of_id_.size()) ? index_of_id_[id] : -1;
   if (index < 0) throw std::invalid_argument("ID " + std::to_string(id) + " is not decoded here");
   const double contrast = white_level - black_level;
@@ -692,12 +699,7 @@ std::optional<double> Decoder::spot_check_heading(const cv::Mat& grey, const Blo
   const double det = s(0, 0) * s(1, 1) - s(0, 1) * s(1, 0);
   if (!(det > 0.0)) return std::nullopt;
 
-  // The bisector last seen, as an angle in this frame's unit-circle frame (the decoder's
-  // samples' frame: direction (cos a, -sin a), counter-clockwise on screen).
-  double he_s = 0.0, he_c = 0.0;
-  fast_sincos(deg_to_rad(expected_heading_deg), he_s, he_c);
-  const double ex = s(1, 1) * he_c + s(0, 1) * he_s, ey = -s(1, 0) * he_c - s(0, 0) * he_s;  // det S^-1 (c, -s)
-  const double expected = fast_atan2(-ey, ex);
+  const double expected = expected_key_angle_rad;
 
   // The balance of the key's edges on a grid of bisectors around the expected one:
   // grey just inside its counter-clockwise edge minus just inside its clockwise edge.
@@ -723,6 +725,7 @@ std::optional<double> Decoder::spot_check_heading(const cv::Mat& grey, const Blo
   // counter-clockwise edges of the grid then clockwise ones; one sampler call at radius 1.
   alignas(16) float dx[2 * kPadded] = {}, dy[2 * kPadded] = {}, levels_read[2 * kPadded];
   double grid_c[kGrid], grid_s[kGrid];
+  auto grid_angle = [&](int j) { return expected + (j - kHalfGrid) * step; };
   const double kc = key_half_cos_, ks = key_half_sin_;
   for (int j = 0; j < kGrid; ++j) {
     grid_c[j] = gc;
@@ -790,7 +793,8 @@ std::optional<double> Decoder::spot_check_heading(const cv::Mat& grey, const Blo
   const double du = s(0, 0) * c - s(0, 1) * sn, dv = s(1, 0) * c - s(1, 1) * sn;
   double heading_deg = rad_to_deg(fast_atan2(-dv, du));
   if (heading_deg < 0.0) heading_deg += 360.0;
-  return heading_deg >= 360.0 ? heading_deg - 360.0 : heading_deg;
+  if (heading_deg >= 360.0) heading_deg -= 360.0;
+  return SpotCheck{heading_deg, grid_angle(below) + x};
 }
 
 }  // namespace rilbed::vision

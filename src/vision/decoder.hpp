@@ -52,6 +52,16 @@ struct CodeMatch {
   /// within 0.1 of the best score (the only ones that can be assigned); others carry
   /// the whole-sample lag's heading.
   double heading_deg = 0.0;
+  /// The same direction as an angle in the unit-circle frame of the blob's shape
+  /// (radians, counter-clockwise on screen as the decoder's samples: the direction is
+  /// shape · (cos a, -sin a)); what a tracker predicts the next frame's key from.
+  double key_angle_rad = 0.0;
+};
+
+/// What a spot check of a tracked marker found (Decoder::spot_check).
+struct SpotCheck {
+  double heading_deg = 0.0;    ///< as CodeMatch::heading_deg
+  double key_angle_rad = 0.0;  ///< as CodeMatch::key_angle_rad
 };
 
 /// Decoder for a fixed family and a fixed set of available IDs; precomputes their ideal
@@ -97,16 +107,21 @@ class Decoder {
 
   /// A tracked marker's heading from a few reads, without its whole signal: the key
   /// slice's bisector is where the grey levels just inside its two edges balance (found
-  /// from the heading last seen, on two circles of the code annulus), and then every
-  /// slice's middle is read and must have the ID's colour by a clear margin. About a
-  /// quarter of sample_code() and match_one() together. `blob` is the marker's disc
-  /// this frame; `black_level` and `white_level` the rings' grey levels (from the edge
-  /// fit). Returns the heading on screen (as CodeMatch::heading_deg), or nothing when
-  /// the marker turned by more than 15 degrees, an edge is not where the balance puts
-  /// it, or a slice does not read its colour: the caller then correlates the whole
-  /// signal. It gives no similarity score.
-  std::optional<double> spot_check_heading(const cv::Mat& grey, const Blob& blob, int id, double expected_heading_deg,
-                                           double black_level, double white_level) const;
+  /// on two circles of the code annulus, near `expected_key_angle_rad`, the bisector
+  /// predicted in the unit-circle frame of `blob`'s shape), and then every slice's middle
+  /// is read and must have the ID's colour by a clear margin. About a quarter of
+  /// sample_code() and match_one() together. `blob` is the marker's disc this frame;
+  /// `black_level` and `white_level` the rings' grey levels (from the edge fit). Returns
+  /// nothing when the marker turned by more than 9 to 15 degrees from the prediction
+  /// (by its size), an edge is not where the balance puts it, or a slice does not read
+  /// its colour: the caller then correlates the whole signal. It gives no similarity
+  /// score. Throws std::invalid_argument for an ID not decoded here.
+  std::optional<SpotCheck> spot_check(const cv::Mat& grey, const Blob& blob, int id, double expected_key_angle_rad,
+                                      double black_level, double white_level) const;
+
+  /// The on-screen heading `heading_deg` as an angle in the unit-circle frame of
+  /// `blob`'s shape (see CodeMatch::key_angle_rad).
+  double key_angle_of_heading(const Blob& blob, double heading_deg) const;
 
   const std::vector<int>& ids() const { return ids_; }
   const DecoderConfig& config() const { return config_; }

@@ -56,8 +56,10 @@ DecoderConfig confirm_config(const TrackerConfig& config) {
 // A detection of `blob` as `match`; the blob's disc scaled to the marker's outer size.
 MarkerDetection make_detection(const Blob& blob, const CodeMatch& match, bool tracked, double threshold_grey) {
   const double disc_d = 2.0 * std::sqrt(std::abs(cv::determinant(blob.shape)));
-  return {match.id, blob.u,  blob.v, match.heading_deg, match.score, disc_d / MarkerFamily::black_ring_outer_radius,
-          tracked,  threshold_grey, blob.shape};
+  MarkerDetection d{match.id, blob.u,  blob.v, match.heading_deg, match.score, disc_d / MarkerFamily::black_ring_outer_radius,
+                    tracked,  threshold_grey, blob.shape};
+  d.key_angle_rad = match.key_angle_rad;
+  return d;
 }
 
 // Blobs at a confirmed marker's place are that marker: drop them.
@@ -194,12 +196,12 @@ std::optional<MarkerDetection> MarkerTracker::confirm_by_edges(const cv::Mat& gr
     // A spot check: the cheaper fit, the heading from the key's edges, the slices'
     // colours; the score stays the last correlation's.
     if (auto fit = fit_near(config_.spot_edge_fit)) {
-      if (auto heading = confirm_decoder_.spot_check_heading(grey, fit->blob, track.id, expected_heading,
-                                                            fit->black_level, fit->white_level)) {
+      if (auto spot = confirm_decoder_.spot_check(grey, fit->blob, track.id, track.predicted_key_angle_rad(),
+                                                   fit->black_level, fit->white_level)) {
         ++stats_.blobs;
         ++stats_.edge_fits;
-        MarkerDetection d = make_detection(fit->blob, {track.id, track.score, *heading}, true,
-                                           0.5 * (fit->black_level + fit->white_level));
+        MarkerDetection d = make_detection(fit->blob, {track.id, track.score, spot->heading_deg, spot->key_angle_rad},
+                                           true, 0.5 * (fit->black_level + fit->white_level));
         d.spot_checked = true;
         return d;
       }
@@ -302,8 +304,9 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
       // Staggered by ID: of many markers found together, about one in the interval is
       // correlated in each frame.
       const int interval = std::max(1, config_.full_confirm_interval_frames);
-      tracks_.push_back({d.id, d.u, d.v, 0.0, 0.0, d.diameter_px, d.threshold_grey, d.score, d.heading_deg,
-                         d.disc_shape, 0, d.id % interval});
+      Track& t = tracks_.emplace_back(Track{d.id, d.u, d.v, 0.0, 0.0, d.diameter_px, d.threshold_grey, d.score,
+                                            d.heading_deg, d.disc_shape, 0, d.id % interval});
+      t.key_angle_rad = d.key_angle_rad;
       continue;
     }
     const auto it = tracks_.begin() + index;
@@ -314,6 +317,12 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     it->v = d.v;
     it->diameter_px = d.diameter_px;
     it->turn_deg = wrap_deg_180(d.heading_deg - it->heading_deg) / frames;
+    // A spot check's angle is in the frame of the track's shape (its fit keeps it), so
+    // the turn there is exact; after a fit of the whole outline the frame moved a little,
+    // and the turn on screen stands in for it.
+    it->key_turn_rad = d.spot_checked ? wrap_rad_pi(d.key_angle_rad - it->key_angle_rad) / frames
+                                      : deg_to_rad(it->turn_deg);
+    it->key_angle_rad = d.key_angle_rad;
     it->heading_deg = d.heading_deg;
     it->shape = d.disc_shape;
     it->threshold_grey = d.threshold_grey;

@@ -38,6 +38,9 @@ struct MarkerDetection {
   /// Affine map from the unit circle to the outline of the marker's dark disc (see
   /// Blob::shape), pixels.
   cv::Matx22d disc_shape = cv::Matx22d::eye();
+  /// The heading as an angle in the unit-circle frame of disc_shape, radians (see
+  /// CodeMatch::key_angle_rad).
+  double key_angle_rad = 0.0;
   /// True when this frame only spot-checked its code (each slice's colour, see
   /// TrackerConfig::full_confirm_interval_frames): `score` is then the one its last
   /// correlation gave, at most that many frames ago.
@@ -73,7 +76,7 @@ struct TrackerConfig {
   /// A tracked marker found again by its outline has its whole code correlated (a
   /// fresh score) at least every this many frames; in the frames between, its heading
   /// comes from the balance of its key slice's edges and every slice's colour is
-  /// checked (Decoder::spot_check_heading), which costs about a quarter as much. A
+  /// checked (Decoder::spot_check), which costs about a quarter as much. A
   /// failed check correlates at once. 1 correlates every frame. The tracks' turns are
   /// staggered by ID, so each frame correlates about the same number of markers.
   int full_confirm_interval_frames = 8;
@@ -154,6 +157,11 @@ class MarkerTracker {
     double turn_deg = 0;
     /// Its heading in the coming frame (constant turn, coasting over misses), degrees.
     double predicted_heading_deg() const { return heading_deg + turn_deg * (missed + 1.0); }
+    /// The heading last seen in the unit-circle frame of `shape` and its turn per frame
+    /// there, radians: the spot check's prediction (its fit keeps the shape).
+    double key_angle_rad = 0;
+    double key_turn_rad = 0;
+    double predicted_key_angle_rad() const { return key_angle_rad + key_turn_rad * (missed + 1.0); }
     /// Where it should be in the coming frame (constant motion, coasting over misses).
     cv::Point2d predicted() const { return {u + du * (missed + 1.0), v + dv * (missed + 1.0)}; }
     /// How far it moves by then, pixels.

@@ -180,10 +180,15 @@ TEST(Decoder, SpotCheckFindsTheHeadingFromTheKeyEdges) {
             const std::string where = std::string(family) + " size " + std::to_string(size) + " id " +
                                       std::to_string(id) + " heading " + std::to_string(heading) + " turned " +
                                       std::to_string(turned);
-            const auto found = decoder.spot_check_heading(img, blobs[0], id, wrap_deg_360(heading - turned),
-                                                          signal.black_level, signal.white_level);
+            const auto found =
+                decoder.spot_check(img, blobs[0], id, decoder.key_angle_of_heading(blobs[0], heading - turned),
+                                   signal.black_level, signal.white_level);
             ASSERT_TRUE(found.has_value()) << where;
-            EXPECT_NEAR(wrap_deg_180(*found - heading), 0.0, size < 32 ? 1.5 : 1.0) << where;
+            EXPECT_NEAR(wrap_deg_180(found->heading_deg - heading), 0.0, size < 32 ? 1.5 : 1.0) << where;
+            // The angle it gives is the heading's in the blob's frame.
+            EXPECT_NEAR(wrap_rad_pi(found->key_angle_rad - decoder.key_angle_of_heading(blobs[0], found->heading_deg)),
+                        0.0, 1e-9)
+                << where;
           }
         }
       }
@@ -208,17 +213,17 @@ TEST(Decoder, SpotCheckRefusesOtherIdsAndNonMarkers) {
         if (other == id) continue;
         for (double turned : {0.0, 5.0, -5.0}) {
           EXPECT_FALSE(decoder
-                           .spot_check_heading(img, blobs[0], other, wrap_deg_360(heading - turned),
-                                               signal.black_level, signal.white_level)
+                           .spot_check(img, blobs[0], other, decoder.key_angle_of_heading(blobs[0], heading - turned),
+                                       signal.black_level, signal.white_level)
                            .has_value())
               << "marker " << id << " checked as " << other << " heading " << heading << " turned " << turned;
         }
       }
       for (double turned : {30.0, -45.0, 90.0, 180.0}) {
-        const auto found = decoder.spot_check_heading(img, blobs[0], id, wrap_deg_360(heading - turned),
-                                                      signal.black_level, signal.white_level);
+        const auto found = decoder.spot_check(img, blobs[0], id, decoder.key_angle_of_heading(blobs[0], heading - turned),
+                                              signal.black_level, signal.white_level);
         if (found) {
-          EXPECT_NEAR(wrap_deg_180(*found - heading), 0.0, 1.0) << "id " << id << " turned " << turned;
+          EXPECT_NEAR(wrap_deg_180(found->heading_deg - heading), 0.0, 1.0) << "id " << id << " turned " << turned;
         }
       }
     }
@@ -229,8 +234,10 @@ TEST(Decoder, SpotCheckRefusesOtherIdsAndNonMarkers) {
   ASSERT_EQ(blobs.size(), 1u);
   for (int id : ids) {
     for (double heading : {0.0, 120.0, 240.0}) {
-      EXPECT_FALSE(decoder.spot_check_heading(disc, blobs[0], id, heading, 28.0, 185.0).has_value()) << id;
+      EXPECT_FALSE(
+          decoder.spot_check(disc, blobs[0], id, decoder.key_angle_of_heading(blobs[0], heading), 28.0, 185.0).has_value())
+          << id;
     }
   }
-  EXPECT_THROW(decoder.spot_check_heading(disc, blobs[0], 9, 0.0, 28.0, 185.0), std::invalid_argument);
+  EXPECT_THROW(decoder.spot_check(disc, blobs[0], 9, 0.0, 28.0, 185.0), std::invalid_argument);
 }
