@@ -166,11 +166,16 @@ Decoder::Decoder(const MarkerFamily& family, const std::vector<int>& ids, Decode
     }
     order_knots(ideal);
     ideals_.push_back(std::move(ideal));
-    std::vector<SpotSlice> spots;
+    SpotSlices spots;
     for (const auto& sl : slices) {
       const double middle = deg_to_rad(0.5 * (sl.start_deg + sl.end_deg));
-      spots.push_back({std::cos(middle), std::sin(middle), sl.white});
+      spots.cos.push_back(static_cast<float>(std::cos(middle)));
+      spots.sin.push_back(static_cast<float>(std::sin(middle)));
+      spots.white.push_back(sl.white);
     }
+    const std::size_t padded = (slices.size() + 3) & ~std::size_t{3};
+    spots.cos.resize(padded, 0.0f);
+    spots.sin.resize(padded, 0.0f);
     spot_slices_.push_back(std::move(spots));
   }
   index_of_id_.assign(family.max_id() + 1, -1);
@@ -776,19 +781,23 @@ std::optional<SpotCheck> Decoder::spot_check(const cv::Mat& grey, const Blob& bl
   const double c = grid_c[below] * rc - grid_s[below] * rs, sn = grid_s[below] * rc + grid_c[below] * rs;
 
   // Every slice's middle must read its colour.
-  const std::vector<SpotSlice>& slices = spot_slices_[index];
-  constexpr int kMaxSlices = 32;
-  const int count = static_cast<int>(slices.size());
-  if (count > kMaxSlices) return std::nullopt;
-  alignas(16) float sx[kMaxSlices] = {}, sy[kMaxSlices] = {}, levels[kMaxSlices];
-  for (int i = 0; i < count; ++i) {
-    sx[i] = static_cast<float>(c * slices[i].cos - sn * slices[i].sin);
-    sy[i] = static_cast<float>(-(sn * slices[i].cos + c * slices[i].sin));
+  const SpotSlices& slices = spot_slices_[index];
+  constexpr int kMaxSlices = 32;  // k_ucp allows at most 14 slices
+  const int padded = static_cast<int>(slices.cos.size());
+  if (padded > kMaxSlices) return std::nullopt;
+  alignas(16) float sx[kMaxSlices], sy[kMaxSlices], levels[kMaxSlices];
+  // The bisector's direction turned by each slice's angle: (x, y) = (cos, -sin) of the
+  // sum, as the sampler's directions.
+  const auto fc = static_cast<float>(c), fs = static_cast<float>(sn);
+  for (int i = 0; i < padded; ++i) {
+    sx[i] = fc * slices.cos[i] - fs * slices.sin[i];
+    sy[i] = -(fs * slices.cos[i] + fc * slices.sin[i]);
   }
-  sample_ellipse(grey, blob.u, blob.v, s, kMiddle, sx, sy, (count + 3) & ~3, levels);
+  sample_ellipse(grey, blob.u, blob.v, s, kMiddle, sx, sy, padded, levels);
+  const double white_from = mid + kSpotMargin * contrast, black_below = mid - kSpotMargin * contrast;
+  const int count = static_cast<int>(slices.white.size());
   for (int i = 0; i < count; ++i) {
-    const double level = (levels[i] - mid) * inv_contrast;
-    if (slices[i].white ? level < kSpotMargin : level > -kSpotMargin) return std::nullopt;
+    if (slices.white[i] ? levels[i] < white_from : levels[i] > black_below) return std::nullopt;
   }
   const double du = s(0, 0) * c - s(0, 1) * sn, dv = s(1, 0) * c - s(1, 1) * sn;
   double heading_deg = rad_to_deg(fast_atan2(-dv, du));

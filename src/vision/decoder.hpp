@@ -182,12 +182,13 @@ class Decoder {
   static constexpr double kSpotMargin = 0.2;
   static constexpr double kSpotEdgeBand = 0.3;
   // Per ID (in the order of ids_), its slices' middles relative to the key's bisector
-  // (radians, counter-clockwise) as unit vectors, and their colours.
-  struct SpotSlice {
-    double cos = 1.0, sin = 0.0;
-    bool white = false;
+  // as unit vectors (cos, sin of the angle counter-clockwise), padded with zeros to a
+  // multiple of four for the four-wide sampler, and their colours.
+  struct SpotSlices {
+    std::vector<float> cos, sin;
+    std::vector<bool> white;
   };
-  std::vector<std::vector<SpotSlice>> spot_slices_;
+  std::vector<SpotSlices> spot_slices_;
   double key_half_cos_ = 1.0, key_half_sin_ = 0.0;  // half the key slice's width, as a unit vector
   int track_reach_samples_ = 0;  // kTrackReachDeg in samples, rounded up
   // Entries of the running integral past 2n + 2 that local_peak reads for the windows the
