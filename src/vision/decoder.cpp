@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
@@ -714,59 +715,66 @@ std::optional<SpotCheck> Decoder::spot_check(const cv::Mat& grey, const Blob& bl
   // at least and half of kTrackReachDeg at most: under a pixel for markers up to 70 px
   // across) are finer than the edges' blur, so it changes sign between two neighbours,
   // where it is close to linear. The grid reaches two steps either way of the turn the
-  // track predicts, 9 to 15 degrees (beyond it, the caller correlates). All reads are
-  // independent: the four-wide sampler takes them in one go.
-  constexpr int kHalfGrid = 2, kGrid = 2 * kHalfGrid + 1, kEdges = 2 * kGrid, kPadded = (kEdges + 3) & ~3;
+  // track predicts, 9 to 15 degrees (beyond it, the caller correlates); the three
+  // bisectors in the middle are read first (a turn as predicted crosses there), the
+  // outer two only when it does not. Each group's reads are independent: the four-wide
+  // sampler takes them in one go.
+  constexpr int kHalfGrid = 2, kGrid = 2 * kHalfGrid + 1;
   const double radius_px = std::sqrt(det);
   const double step = std::clamp(0.6 / (0.5 * (kInner + kOuter) * radius_px), deg_to_rad(4.5),
                                  deg_to_rad(kTrackReachDeg) / kHalfGrid);
-  double gs = 0.0, gc = 0.0;
-  fast_sincos(expected - kHalfGrid * step, gs, gc);
-  // The step as a rotation (a short series: step < 0.14 rad, to better than 1e-12).
-  const double step2 = step * step;
-  const double ss = step * (1.0 - step2 / 6.0 * (1.0 - step2 / 20.0 * (1.0 - step2 / 42.0)));
-  const double sc = 1.0 - step2 / 2.0 * (1.0 - step2 / 12.0 * (1.0 - step2 / 30.0 * (1.0 - step2 / 56.0)));
-  // Directions scaled to the two circles: [inner circle's edges | outer circle's], each
-  // counter-clockwise edges of the grid then clockwise ones; one sampler call at radius 1.
-  alignas(16) float dx[2 * kPadded] = {}, dy[2 * kPadded] = {}, levels_read[2 * kPadded];
   double grid_c[kGrid], grid_s[kGrid];
-  auto grid_angle = [&](int j) { return expected + (j - kHalfGrid) * step; };
-  const double kc = key_half_cos_, ks = key_half_sin_;
-  for (int j = 0; j < kGrid; ++j) {
-    grid_c[j] = gc;
-    grid_s[j] = gs;
-    const double ccw_x = gc * kc - gs * ks, ccw_y = -(gs * kc + gc * ks);  // bisector + half the key
-    const double cw_x = gc * kc + gs * ks, cw_y = -(gs * kc - gc * ks);    // bisector - half the key
-    dx[j] = static_cast<float>(kInner * ccw_x);
-    dy[j] = static_cast<float>(kInner * ccw_y);
-    dx[kGrid + j] = static_cast<float>(kInner * cw_x);
-    dy[kGrid + j] = static_cast<float>(kInner * cw_y);
-    dx[kPadded + j] = static_cast<float>(kOuter * ccw_x);
-    dy[kPadded + j] = static_cast<float>(kOuter * ccw_y);
-    dx[kPadded + kGrid + j] = static_cast<float>(kOuter * cw_x);
-    dy[kPadded + kGrid + j] = static_cast<float>(kOuter * cw_y);
-    const double next_c = gc * sc - gs * ss;
-    gs = gs * sc + gc * ss;
-    gc = next_c;
-  }
-  sample_ellipse(grey, blob.u, blob.v, s, 1.0, dx, dy, 2 * kPadded, levels_read);
-  const float* inner = levels_read;
-  const float* outer = levels_read + kPadded;
-  double balance[kGrid], edges[kGrid];
-  for (int j = 0; j < kGrid; ++j) {
-    const double ccw = inner[j] + outer[j], cw = inner[kGrid + j] + outer[kGrid + j];
-    balance[j] = 0.5 * (ccw - cw) * inv_contrast;
-    edges[j] = (0.25 * (ccw + cw) - mid) * inv_contrast;  // the two edges' mean level
-  }
-  // The zero crossing (from positive to negative) nearest the expected bisector.
-  int below = -1;
-  for (int d = 0; d < kHalfGrid && below < 0; ++d) {
-    for (const int j : {kHalfGrid + d, kHalfGrid - d - 1}) {
-      if (balance[j] > 0.0 && balance[j + 1] <= 0.0) {
-        below = j;
-        break;
-      }
+  fast_sincos(expected, grid_s[kHalfGrid], grid_c[kHalfGrid]);
+  {
+    // The step as a rotation (a short series: step < 0.14 rad, to better than 1e-12).
+    const double step2 = step * step;
+    const double ss = step * (1.0 - step2 / 6.0 * (1.0 - step2 / 20.0 * (1.0 - step2 / 42.0)));
+    const double sc = 1.0 - step2 / 2.0 * (1.0 - step2 / 12.0 * (1.0 - step2 / 30.0 * (1.0 - step2 / 56.0)));
+    for (int j = kHalfGrid + 1; j < kGrid; ++j) {
+      grid_c[j] = grid_c[j - 1] * sc - grid_s[j - 1] * ss;
+      grid_s[j] = grid_s[j - 1] * sc + grid_c[j - 1] * ss;
     }
+    for (int j = kHalfGrid - 1; j >= 0; --j) {
+      grid_c[j] = grid_c[j + 1] * sc + grid_s[j + 1] * ss;
+      grid_s[j] = grid_s[j + 1] * sc - grid_c[j + 1] * ss;
+    }
+  }
+  auto grid_angle = [&](int j) { return expected + (j - kHalfGrid) * step; };
+  double balance[kGrid], edges[kGrid];
+  // Reads both edges of the bisectors `js` on both circles, in one sampler call (4 per
+  // bisector: a multiple of four for any count).
+  auto read_bisectors = [&](std::initializer_list<int> js) {
+    constexpr int kMaxReads = 4 * kGrid;
+    alignas(16) float dx[kMaxReads], dy[kMaxReads], level[kMaxReads];
+    const int count = static_cast<int>(js.size());
+    const double kc = key_half_cos_, ks = key_half_sin_;
+    int k = 0;
+    for (const int j : js) {
+      const double gc = grid_c[j], gs = grid_s[j];
+      const double ccw_x = gc * kc - gs * ks, ccw_y = -(gs * kc + gc * ks);  // bisector + half the key
+      const double cw_x = gc * kc + gs * ks, cw_y = -(gs * kc - gc * ks);    // bisector - half the key
+      dx[k] = static_cast<float>(kInner * ccw_x), dy[k] = static_cast<float>(kInner * ccw_y);
+      dx[count + k] = static_cast<float>(kInner * cw_x), dy[count + k] = static_cast<float>(kInner * cw_y);
+      dx[2 * count + k] = static_cast<float>(kOuter * ccw_x), dy[2 * count + k] = static_cast<float>(kOuter * ccw_y);
+      dx[3 * count + k] = static_cast<float>(kOuter * cw_x), dy[3 * count + k] = static_cast<float>(kOuter * cw_y);
+      ++k;
+    }
+    sample_ellipse(grey, blob.u, blob.v, s, 1.0, dx, dy, 4 * count, level);
+    k = 0;
+    for (const int j : js) {
+      const double ccw = level[k] + level[2 * count + k], cw = level[count + k] + level[3 * count + k];
+      balance[j] = 0.5 * (ccw - cw) * inv_contrast;
+      edges[j] = (0.25 * (ccw + cw) - mid) * inv_contrast;  // the two edges' mean level
+      ++k;
+    }
+  };
+  // The zero crossing (from positive to negative) nearest the expected bisector.
+  auto crossing_between = [&](int j) { return balance[j] > 0.0 && balance[j + 1] <= 0.0; };
+  read_bisectors({kHalfGrid - 1, kHalfGrid, kHalfGrid + 1});
+  int below = crossing_between(kHalfGrid) ? kHalfGrid : crossing_between(kHalfGrid - 1) ? kHalfGrid - 1 : -1;
+  if (below < 0) {
+    read_bisectors({0, kGrid - 1});
+    below = crossing_between(kHalfGrid + 1) ? kHalfGrid + 1 : crossing_between(0) ? 0 : -1;
   }
   if (below < 0) return std::nullopt;
   const double t = balance[below] / (balance[below] - balance[below + 1]);
