@@ -294,10 +294,8 @@ std::optional<DiscEdgeFit> fit_centre_and_size(const Blob& predicted, double thr
   if (!(k > 0.0)) return std::nullopt;
   const double inv_k = 1.0 / k;
   // The residual test as fit_from's, with the form Q / k of the fitted outline.
-  if (residual_rms2(px, py, found, x0, y0, q00 * inv_k, q01 * inv_k, q11 * inv_k) >
-      config.max_residual * config.max_residual) {
-    return std::nullopt;
-  }
+  const double residual2 = residual_rms2(px, py, found, x0, y0, q00 * inv_k, q01 * inv_k, q11 * inv_k);
+  if (residual2 > config.max_residual * config.max_residual) return std::nullopt;
   // The area scales as k (the outline's radius as sqrt(k)).
   if (std::abs(k - 1.0) > config.max_area_change) return std::nullopt;
   DiscEdgeFit fit;
@@ -307,6 +305,7 @@ std::optional<DiscEdgeFit> fit_centre_and_size(const Blob& predicted, double thr
   fit.blob.shape = predicted.shape * scale;
   fit.blob.threshold = threshold_grey;
   fit.blob.filled_area_px = kPi * radius_px * radius_px * k;
+  fit.residual = std::sqrt(residual2);
   set_levels(fit, black, white, levels);
   return fit;
 }
@@ -512,9 +511,8 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
 
   // RMS of each crossing's distance from the ellipse, radially, as a fraction of the
   // ellipse's radius there (the same in every linearly related frame).
-  if (residual_rms2(px, py, found, x0, y0, m00, m01, m11) > config.max_residual * config.max_residual) {
-    return std::nullopt;
-  }
+  const double residual2 = residual_rms2(px, py, found, x0, y0, m00, m01, m11);
+  if (residual2 > config.max_residual * config.max_residual) return std::nullopt;
 
   // Back to pixels: the outline is centre + radius (x0 + m^-1/2 u), so the shape's
   // square is radius² m^-1.
@@ -535,6 +533,7 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
   fit.blob.shape = sqrt_spd(cov);
   fit.blob.threshold = threshold_grey;
   fit.blob.filled_area_px = area;
+  fit.residual = std::sqrt(residual2);
   set_levels(fit, black, white, levels);
   return fit;
 }

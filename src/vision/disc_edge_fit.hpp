@@ -57,6 +57,10 @@ struct DiscEdgeFit {
   double white_level = 0.0;
   /// Fraction of the white-ring reads brighter than the midpoint of the two levels.
   double white_fraction = 0.0;
+  /// RMS distance of the crossings from the fitted outline, as a fraction of its radius
+  /// (at most DiscEdgeFitConfig::max_residual). With keep_shape, a value that grows says
+  /// the shape kept no longer matches the disc's.
+  double residual = 0.0;
 };
 
 /// Fits the outline of the disc predicted by `predicted` (its centre and shape; see

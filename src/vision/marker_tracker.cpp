@@ -178,7 +178,6 @@ Blob MarkerTracker::Track::predicted_disc() const {
 }
 
 std::optional<MarkerDetection> MarkerTracker::confirm_by_edges(const cv::Mat& grey, const Track& track) {
-  const double expected_heading = wrap_deg_360(track.predicted_heading_deg());
   auto fit_near = [&](const DiscEdgeFitConfig& edge_fit) {
     Blob predicted = track.predicted_disc();
     auto fit = fit_disc_edges(grey, predicted, track.threshold_grey, edge_fit);
@@ -192,31 +191,43 @@ std::optional<MarkerDetection> MarkerTracker::confirm_by_edges(const cv::Mat& gr
     if (fit && fit->white_fraction < decoder_.config().min_white_ring_fraction) fit.reset();
     return fit;
   };
-  if (track.frames_since_correlated + 1 < config_.full_confirm_interval_frames) {
-    // A spot check: the cheaper fit, the heading from the key's edges, the slices'
-    // colours; the score stays the last correlation's.
-    if (auto fit = fit_near(config_.spot_edge_fit)) {
-      if (auto spot = confirm_decoder_.spot_check(grey, fit->blob, track.id, track.predicted_key_angle_rad(),
-                                                   fit->black_level, fit->white_level)) {
-        ++stats_.blobs;
-        ++stats_.edge_fits;
-        MarkerDetection d = make_detection(fit->blob, {track.id, track.score, spot->heading_deg, spot->key_angle_rad},
-                                           true, 0.5 * (fit->black_level + fit->white_level));
-        d.spot_checked = true;
-        return d;
-      }
+  // In the frames that only spot-check the code, the outline's centre and size first,
+  // with the shape last fitted; the whole ellipse when that does not fit, or fits so
+  // loosely that the shape has changed, and always in the frames that correlate (the
+  // shape drifts as the marker crosses the field, and the heading is read through it).
+  const bool spot_check = track.frames_since_correlated + 1 < config_.full_confirm_interval_frames;
+  std::optional<DiscEdgeFit> fit;
+  if (spot_check) fit = fit_near(config_.quick_edge_fit);
+  bool same_shape = fit && fit->residual <= config_.shape_refit_residual;
+  if (!same_shape) fit = fit_near(config_.edge_fit);
+  if (!fit) return std::nullopt;
+  const double threshold = 0.5 * (fit->black_level + fit->white_level);
+  if (spot_check) {
+    // A spot check: the heading from the key's edges, the slices' colours; the score
+    // stays the last correlation's. The key's angle predicted in the shape's frame is the
+    // track's while the shape is the one it kept.
+    const double expected_key = same_shape ? track.predicted_key_angle_rad()
+                                           : confirm_decoder_.key_angle_of_heading(
+                                                 fit->blob, wrap_deg_360(track.predicted_heading_deg()));
+    if (auto spot = confirm_decoder_.spot_check(grey, fit->blob, track.id, expected_key, fit->black_level,
+                                                fit->white_level)) {
+      ++stats_.blobs;
+      ++stats_.edge_fits;
+      MarkerDetection d =
+          make_detection(fit->blob, {track.id, track.score, spot->heading_deg, spot->key_angle_rad}, true, threshold);
+      d.spot_checked = true;
+      return d;
     }
   }
-  auto fit = fit_near(config_.edge_fit);
-  if (!fit) return std::nullopt;
   confirm_decoder_.sample_code(grey, fit->blob, fit->black_level, fit->white_level, signal_);
   if (!signal_.usable) return std::nullopt;
-  const CodeMatch m = confirm_decoder_.match_one(signal_, fit->blob, track.id, expected_heading);
+  const CodeMatch m =
+      confirm_decoder_.match_one(signal_, fit->blob, track.id, wrap_deg_360(track.predicted_heading_deg()));
   if (m.score < config_.min_assign_score || m.score < track.score - config_.confirm_drop) return std::nullopt;
   ++stats_.blobs;
   ++stats_.decoded;
   ++stats_.edge_fits;
-  return make_detection(fit->blob, m, true, 0.5 * (fit->black_level + fit->white_level));
+  return make_detection(fit->blob, m, true, threshold);
 }
 
 std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {

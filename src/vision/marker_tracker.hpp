@@ -51,19 +51,25 @@ struct MarkerDetection {
 struct TrackerConfig {
   BlobDetectorConfig blobs;
   DecoderConfig decoder;
-  /// How a tracked marker is re-found from its outline before any fill.
-  DiscEdgeFitConfig edge_fit;
-  /// The same in the frames where its code is only spot-checked (see
-  /// full_confirm_interval_frames): by default the centre and size only, from 2 rows
-  /// and 2 columns, at about half the cost; the outline's shape is fitted in full in the
-  /// frames that correlate. On the benchmark's 32 px markers the centre stays within
-  /// about 0.03 px RMS of the truth.
-  DiscEdgeFitConfig spot_edge_fit = [] {
+  /// How a tracked marker is re-found from its outline before any fill. In the frames
+  /// that only spot-check its code (see full_confirm_interval_frames) `quick_edge_fit`
+  /// comes first: the centre and size only (2 rows and 2 columns, the shape kept from the
+  /// last full fit; on the benchmark's 32 px markers the centre stays within about
+  /// 0.03 px RMS of the truth, at about half the cost). `edge_fit`, the whole ellipse,
+  /// follows when the quick fit fails or its residual exceeds `shape_refit_residual`
+  /// (the shape changed), and fits every frame that correlates the code: the shape drifts
+  /// as the marker crosses the field (lens, perspective), and the heading is read
+  /// through it.
+  DiscEdgeFitConfig quick_edge_fit = [] {
     DiscEdgeFitConfig c;
     c.lines = 2;
     c.keep_shape = true;
     return c;
   }();
+  DiscEdgeFitConfig edge_fit;
+  /// See quick_edge_fit; a fraction of the radius (DiscEdgeFit::residual). A clean disc
+  /// whose shape is as kept fits within about 0.01; lower refits the shape more often.
+  double shape_refit_residual = 0.02;
   /// Re-find tracked markers by the edge fit first (the fill remains the fallback).
   /// Off, every tracked marker costs a fill of its disc: several times slower.
   bool use_edge_fit = true;
