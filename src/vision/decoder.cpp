@@ -172,7 +172,8 @@ Decoder::Decoder(const MarkerFamily& family, const std::vector<int>& ids, Decode
       const double middle = deg_to_rad(0.5 * (sl.start_deg + sl.end_deg));
       spots.cos.push_back(static_cast<float>(std::cos(middle)));
       spots.sin.push_back(static_cast<float>(std::sin(middle)));
-      spots.white.push_back(sl.white);
+      if (sl.white) spots.white |= std::uint32_t{1} << spots.count;
+      ++spots.count;
     }
     const std::size_t padded = (slices.size() + 3) & ~std::size_t{3};
     spots.cos.resize(padded, 0.0f);
@@ -803,9 +804,9 @@ std::optional<SpotCheck> Decoder::spot_check(const cv::Mat& grey, const Blob& bl
   }
   sample_ellipse(grey, blob.u, blob.v, s, kMiddle, sx, sy, padded, levels);
   const double white_from = mid + kSpotMargin * contrast, black_below = mid - kSpotMargin * contrast;
-  const int count = static_cast<int>(slices.white.size());
-  for (int i = 0; i < count; ++i) {
-    if (slices.white[i] ? levels[i] < white_from : levels[i] > black_below) return std::nullopt;
+  for (int i = 0; i < slices.count; ++i) {
+    const bool white = (slices.white >> i) & 1u;
+    if (white ? levels[i] < white_from : levels[i] > black_below) return std::nullopt;
   }
   const double du = s(0, 0) * c - s(0, 1) * sn, dv = s(1, 0) * c - s(1, 1) * sn;
   double heading_deg = rad_to_deg(fast_atan2(-dv, du));

@@ -5,6 +5,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <cstdint>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -186,7 +187,8 @@ class Decoder {
   // multiple of four for the four-wide sampler, and their colours.
   struct SpotSlices {
     std::vector<float> cos, sin;
-    std::vector<bool> white;
+    std::uint32_t white = 0;  // bit i: slice i is white
+    int count = 0;
   };
   std::vector<SpotSlices> spot_slices_;
   double key_half_cos_ = 1.0, key_half_sin_ = 0.0;  // half the key slice's width, as a unit vector
