@@ -172,7 +172,7 @@ Decoder::Decoder(const MarkerFamily& family, const std::vector<int>& ids, Decode
       const double middle = deg_to_rad(0.5 * (sl.start_deg + sl.end_deg));
       spots.cos.push_back(static_cast<float>(std::cos(middle)));
       spots.sin.push_back(static_cast<float>(std::sin(middle)));
-      if (sl.white) spots.white |= std::uint32_t{1} << spots.count;
+      spots.sign.push_back(sl.white ? 1.0f : -1.0f);
       ++spots.count;
     }
     const std::size_t padded = (slices.size() + 3) & ~std::size_t{3};
@@ -803,11 +803,13 @@ std::optional<SpotCheck> Decoder::spot_check(const cv::Mat& grey, const Blob& bl
     sy[i] = -(fs * slices.cos[i] + fc * slices.sin[i]);
   }
   sample_ellipse(grey, blob.u, blob.v, s, kMiddle, sx, sy, padded, levels);
-  const double white_from = mid + kSpotMargin * contrast, black_below = mid - kSpotMargin * contrast;
-  for (int i = 0; i < slices.count; ++i) {
-    const bool white = (slices.white >> i) & 1u;
-    if (white ? levels[i] < white_from : levels[i] > black_below) return std::nullopt;
-  }
+  // Each slice's level beyond the midpoint towards its colour (a sign per slice), the
+  // least of them against the margin: one branch for all (which slices are white
+  // differs from marker to marker, and a branch per slice mispredicted).
+  const auto fmid = static_cast<float>(mid);
+  float least = std::numeric_limits<float>::max();
+  for (int i = 0; i < slices.count; ++i) least = std::min(least, (levels[i] - fmid) * slices.sign[i]);
+  if (!(least >= static_cast<float>(kSpotMargin * contrast))) return std::nullopt;
   const double du = s(0, 0) * c - s(0, 1) * sn, dv = s(1, 0) * c - s(1, 1) * sn;
   double heading_deg = rad_to_deg(fast_atan2(-dv, du));
   if (heading_deg < 0.0) heading_deg += 360.0;

@@ -184,10 +184,10 @@ class Decoder {
   static constexpr double kSpotEdgeBand = 0.3;
   // Per ID (in the order of ids_), its slices' middles relative to the key's bisector
   // as unit vectors (cos, sin of the angle counter-clockwise), padded with zeros to a
-  // multiple of four for the four-wide sampler, and their colours.
+  // multiple of four for the four-wide sampler, and their colours as signs.
   struct SpotSlices {
     std::vector<float> cos, sin;
-    std::uint32_t white = 0;  // bit i: slice i is white
+    std::vector<float> sign;  // +1 for a white slice, -1 for a black one
     int count = 0;
   };
   std::vector<SpotSlices> spot_slices_;
