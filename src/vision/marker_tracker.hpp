@@ -79,13 +79,15 @@ struct TrackerConfig {
   /// sample, but less precisely: on the recorded clips 60 gives 0.8-0.9 degrees RMS and
   /// 120 the full decode's 0.5-0.7, for about a quarter more time per tracked frame.
   int confirm_samples = 60;
-  /// A tracked marker found again by its outline has its whole code correlated (a
-  /// fresh score) at least every this many frames; in the frames between, its heading
-  /// comes from the balance of its key slice's edges and every slice's colour is
-  /// checked (Decoder::spot_check), which costs about a quarter as much. A
-  /// failed check correlates at once. 1 correlates every frame. The tracks' turns are
-  /// staggered by ID, so each frame correlates about the same number of markers.
-  int full_confirm_interval_frames = 8;
+  /// A tracked marker found again by its outline is spot-checked every frame: its
+  /// heading from the balance of its key slice's edges, every slice's colour checked
+  /// (Decoder::spot_check), at about a quarter of the cost of correlating its code. Its
+  /// whole code is correlated (a fresh score, and the whole outline refitted) at least
+  /// every this many frames, and at once when a spot check fails. 1 correlates every
+  /// frame. The tracks' turns are staggered by ID, so each frame correlates about the
+  /// same number of markers. Larger costs less and keeps a score (and a shape) longer;
+  /// the heading does not suffer (the spot check's is the more precise).
+  int full_confirm_interval_frames = 16;
   /// Smallest similarity at which an object may take an ID. Lower finds markers in
   /// worse images but lets clutter through more often.
   double min_assign_score = 0.75;
