@@ -241,9 +241,11 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
   const cv::Mat grey = to_grey(frame);
   stats_ = FrameStats{};
   std::vector<Blob> blobs;  // found but not confirmed: decoded against the family
-  std::vector<MarkerDetection>& confirmed = confirmed_;
+  // The markers confirmed near their tracks go straight into the result (its first
+  // `confirmed` entries); those decoded from blobs follow.
+  std::vector<MarkerDetection> found;
+  found.reserve(tracks_.size() + 1);
   std::vector<int>& confirmed_ids = confirmed_ids_;
-  confirmed.clear();
   confirmed_ids.clear();
   // Only tracks seen last frame try the edge fit, so only their areas are asked for.
   auto fits = [&](std::size_t i) { return config_.use_edge_fit && i < tracks_.size() && tracks_[i].missed == 0; };
@@ -266,7 +268,7 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     // The cheap way first: the outline where the prediction puts it.
     if (config_.use_edge_fit && t.missed == 0) {
       if (auto d = confirm_by_edges(grey, t)) {
-        confirmed.push_back(*d);
+        found.push_back(std::move(*d));
         confirmed_ids.push_back(t.id);
         continue;
       }
@@ -280,30 +282,31 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     if (near.size() == 1 && t.missed == 0) {
       ++stats_.blobs;
       if (auto d = confirm(grey, t, near[0])) {
-        confirmed.push_back(*d);
+        found.push_back(std::move(*d));
         confirmed_ids.push_back(t.id);
         continue;
       }
     }
     append_unique(blobs, near);
   }
-  drop_confirmed(blobs, confirmed);
-  std::vector<MarkerDetection> found;
+  const std::size_t confirmed = found.size();
+  drop_confirmed(blobs, found);
   if (!blobs.empty()) {
-    found = assign(grey, blobs, true, confirmed_ids);
-    for (auto& d : found) d.tracked = true;
+    for (MarkerDetection& d : assign(grey, blobs, true, confirmed_ids)) {
+      d.tracked = true;
+      found.push_back(std::move(d));
+    }
   }
-  found.insert(found.end(), confirmed.begin(), confirmed.end());
 
   const bool all_found = found.size() == ids_.size();
   ++frames_since_full_;
   if (tracks_.empty() || (!all_found && frames_since_full_ >= config_.full_search_interval_frames)) {
     frames_since_full_ = 0;
     std::vector<Blob> more = detector_.detect(grey);
-    drop_confirmed(more, confirmed);
+    found.resize(confirmed);  // the blobs are assigned again, with the new ones
+    drop_confirmed(more, found);
     append_unique(blobs, more);
-    found = assign(grey, blobs, true, confirmed_ids);
-    found.insert(found.end(), confirmed.begin(), confirmed.end());
+    for (MarkerDetection& d : assign(grey, blobs, true, confirmed_ids)) found.push_back(std::move(d));
     stats_.full_search = true;
   }
   auto by_id = [](const auto& a, const auto& b) { return a.id < b.id; };

@@ -199,9 +199,7 @@ class MarkerTracker {
   Decoder confirm_decoder_;  // the listed IDs only, at confirm_samples: the edge-fit confirmation
   std::vector<Track> tracks_;
   std::vector<int> track_of_id_;  // per ID, its index in tracks_ or -1 (rebuilt per frame)
-  // process()'s buffers, kept between frames (no allocation per frame once grown).
-  std::vector<MarkerDetection> confirmed_;
-  std::vector<int> confirmed_ids_;
+  std::vector<int> confirmed_ids_;  // process()'s, kept between frames (no allocation per frame)
   FrameStats stats_;
   int frames_since_full_ = 0;
   cv::Mat grey_buffer_;
