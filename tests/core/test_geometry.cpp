@@ -67,3 +67,19 @@ TEST(FastTrig, Atan2MatchesTheLibraryInEveryOctant) {
   }
   EXPECT_EQ(fast_atan2(0.0, 0.0), 0.0);
 }
+
+// wrap_deg_360 wraps within a turn of its range without fmod, and must give exactly
+// what fmod gives, at the boundaries too.
+TEST(Geometry, WrapDeg360MatchesFmodExactly) {
+  auto reference = [](double deg) {
+    double w = std::fmod(deg, 360.0);
+    if (w < 0.0) w += 360.0;
+    if (w >= 360.0) w -= 360.0;
+    return w;
+  };
+  for (double deg : {-720.0, -360.0, -359.999999, -1e-17, -0.0, 0.0, 1e-300, 359.99999999999994, 360.0, 400.5, 719.9999,
+                     720.0, 1080.25, -1e-9, 12345.678, -12345.678}) {
+    EXPECT_EQ(wrap_deg_360(deg), reference(deg)) << deg;
+  }
+  for (double deg = -1000.0; deg < 1000.0; deg += 0.37) EXPECT_EQ(wrap_deg_360(deg), reference(deg)) << deg;
+}

@@ -176,6 +176,11 @@ TEST(Decoder, SpotCheckFindsTheHeadingFromTheKeyEdges) {
           ASSERT_EQ(blobs.size(), 1u);
           const auto signal = decoder.sample(img, blobs[0]);
           ASSERT_TRUE(signal.usable);
+          // A correlation's key angle is its heading's in the blob's frame too.
+          const CodeMatch correlated = decoder.match_one(signal, blobs[0], id);
+          EXPECT_NEAR(wrap_rad_pi(correlated.key_angle_rad -
+                                  decoder.key_angle_of_heading(blobs[0], correlated.heading_deg)),
+                      0.0, 1e-9);
           for (double turned : {0.0, 4.0, -4.0, 8.0, -8.0}) {
             const std::string where = std::string(family) + " size " + std::to_string(size) + " id " +
                                       std::to_string(id) + " heading " + std::to_string(heading) + " turned " +

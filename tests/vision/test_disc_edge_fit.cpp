@@ -130,3 +130,47 @@ TEST(DiscEdgeFit, LoadDiscAreaReadsTheAreaOnly) {
     prefetch_disc_area(img, disc_at(p, 12.0));
   }
 }
+
+// Keeping the shape, 2 rows and 2 columns find the centre and the size of a disc from a
+// prediction off by up to two pixels and by 5 % in size, about as well as the whole
+// ellipse's fit; the residual it reports stays small for a disc of the kept shape and
+// grows for one whose shape changed (the tracker then fits the whole ellipse).
+TEST(DiscEdgeFit, KeepingTheShapeFitsCentreAndSize) {
+  DiscEdgeFitConfig quick;
+  quick.lines = 2;
+  quick.keep_shape = true;
+  for (double offset : {0.0, 0.375, 0.75}) {
+    cv::Point2d truth;
+    const cv::Mat img = marker_image(offset, 40.0, truth);
+    // The dark disc of a 32 px marker: radius 0.78 * 16 px.
+    const double radius = 0.78 * 16.0;
+    for (const cv::Point2d error : {cv::Point2d(0, 0), cv::Point2d(1.5, -1.0), cv::Point2d(-2.0, 0.5)}) {
+      for (double size_error : {0.95, 1.0, 1.05}) {
+        const auto fit = fit_disc_edges(img, disc_at(truth + error, radius * size_error), 110.0, quick);
+        ASSERT_TRUE(fit.has_value()) << offset << " " << error << " " << size_error;
+        EXPECT_NEAR(fit->blob.u, truth.x, 0.1) << offset << " " << error << " " << size_error;
+        EXPECT_NEAR(fit->blob.v, truth.y, 0.1) << offset << " " << error << " " << size_error;
+        EXPECT_NEAR(std::sqrt(cv::determinant(fit->blob.shape)), radius, 0.3);
+        // The shape is the prediction's, scaled: still a circle.
+        EXPECT_NEAR(fit->blob.shape(0, 1), 0.0, 1e-12);
+        EXPECT_NEAR(fit->blob.shape(0, 0), fit->blob.shape(1, 1), 1e-12);
+        EXPECT_LT(fit->residual, 0.02);
+        EXPECT_GT(fit->black_level, 0.0);
+        EXPECT_GT(fit->white_level, fit->black_level + 50.0);
+      }
+    }
+  }
+  // An ellipse of axes 15 and 10 px predicted as a circle: the kept shape does not fit
+  // it (refused, or a residual the tracker refits on), while the whole fit does.
+  cv::Mat big(200 * kScale, 200 * kScale, CV_8UC1, cv::Scalar(200));
+  const cv::Point2d c(100.3, 90.7);
+  cv::ellipse(big, {{float(c.x * kScale + 3.5), float(c.y * kScale + 3.5)}, {30.f * kScale, 20.f * kScale}, 30.f},
+              cv::Scalar(30), cv::FILLED);
+  cv::Mat img;
+  cv::resize(big, img, cv::Size(200, 200), 0, 0, cv::INTER_AREA);
+  const auto kept = fit_disc_edges(img, disc_at(c, 12.2), 115.0, quick);
+  EXPECT_TRUE(!kept.has_value() || kept->residual > 0.02);
+  const auto whole = fit_disc_edges(img, disc_at(c, 12.2), 115.0);
+  ASSERT_TRUE(whole.has_value());
+  EXPECT_LT(whole->residual, 0.02);
+}

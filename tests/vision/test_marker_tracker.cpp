@@ -315,3 +315,40 @@ TEST(MarkerTracker, ASwappedMarkerIsDecodedAgain) {
   EXPECT_FALSE(found[0].spot_checked);
   EXPECT_EQ(found[1].id, 6);
 }
+
+// A marker whose outline stretches from frame to frame (it moves to where the lens or the
+// perspective draws it otherwise) keeps being found, and the disc's shape follows it:
+// the quick fit keeps the shape only while it still fits, and the whole outline is
+// refitted when it does not, or when the code is correlated.
+TEST(MarkerTracker, TheShapeFollowsAStretchingMarker) {
+  const auto f = MarkerFamily::six_ucp();
+  MarkerTracker tracker(f, {3, 6});
+  constexpr int kScale = 4;
+  auto frame_with = [&](double stretch) {
+    cv::Mat big(240 * kScale, 320 * kScale, CV_8UC1, cv::Scalar(185));
+    render_marker_topdown(f, 3, 32 * kScale, 30.0, 185.0, 1).copyTo(big(cv::Rect(100 * kScale, 80 * kScale, 32 * kScale, 32 * kScale)));
+    render_marker_topdown(f, 6, 32 * kScale, 200.0, 185.0, 1).copyTo(big(cv::Rect(220 * kScale, 150 * kScale, 32 * kScale, 32 * kScale)));
+    // Stretched along u about marker 3's centre.
+    const double cx = (116.0) * kScale;
+    const cv::Matx23d warp(stretch, 0, cx * (1.0 - stretch), 0, 1, 0);
+    cv::Mat warped, img;
+    cv::warpAffine(big, warped, warp, big.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    cv::resize(warped, img, cv::Size(320, 240), 0, 0, cv::INTER_AREA);
+    return img;
+  };
+  const double disc_radius = 0.78 * 16.0;
+  for (int i = 0; i <= 30; ++i) {
+    const double stretch = 1.0 + 0.01 * i;  // up to 1.3 wide
+    const auto found = tracker.process(frame_with(stretch));
+    ASSERT_EQ(found.size(), 2u) << "frame " << i;
+    ASSERT_EQ(found[0].id, 3);
+    // The outline's axes: stretch * r along u, r along v.
+    const cv::Matx22d& s = found[0].disc_shape;
+    const double along_u = std::hypot(s(0, 0), s(1, 0)), along_v = std::hypot(s(0, 1), s(1, 1));
+    EXPECT_NEAR(along_u / disc_radius, stretch, 0.04) << "frame " << i;
+    EXPECT_NEAR(along_v / disc_radius, 1.0, 0.04) << "frame " << i;
+    // The heading seen on screen: the forward direction (cos 30, -sin 30) stretched.
+    const double expected = std::atan2(std::sin(kPi / 6), stretch * std::cos(kPi / 6)) * 180.0 / kPi;
+    EXPECT_NEAR(wrap_deg_180(found[0].heading_deg - expected), 0.0, 1.5) << "frame " << i;
+  }
+}
