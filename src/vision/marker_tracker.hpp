@@ -26,7 +26,8 @@ struct MarkerDetection {
   /// counter-clockwise on screen from +u, i.e. atan2(-dv, du), in [0, 360).
   double heading_deg = 0.0;
   /// Circular cross-covariance of the sampled signal with the ID's ideal signal, in
-  /// [-1, 1]; 1 is a perfect match.
+  /// [-1, 1]; 1 is a perfect match. For a spot-checked marker (see spot_checked) the
+  /// one of its last correlation.
   double score = 0.0;
   /// Diameter of the marker's dark disc scaled to the marker's outer diameter, pixels
   /// (the geometric mean of the ellipse axes).
@@ -66,6 +67,7 @@ struct TrackerConfig {
     c.keep_shape = true;
     return c;
   }();
+  /// The whole ellipse's fit (see quick_edge_fit).
   DiscEdgeFitConfig edge_fit;
   /// See quick_edge_fit; a fraction of the radius (DiscEdgeFit::residual). A clean disc
   /// whose shape is as kept fits within about 0.01; lower refits the shape more often.
@@ -73,11 +75,12 @@ struct TrackerConfig {
   /// Re-find tracked markers by the edge fit first (the fill remains the fallback).
   /// Off, every tracked marker costs a fill of its disc: several times slower.
   bool use_edge_fit = true;
-  /// Samples around the circle when a marker re-found by the edge fit is confirmed
-  /// against its own ID. Fewer than the full decode's (decoder.samples) since one ID is
-  /// checked, not told apart from the family; the heading is still refined below a
-  /// sample, but less precisely: on the recorded clips 60 gives 0.8-0.9 degrees RMS and
-  /// 120 the full decode's 0.5-0.7, for about a quarter more time per tracked frame.
+  /// Samples around the circle when a tracked marker's code is correlated against its
+  /// own ID (see full_confirm_interval_frames). Fewer than the full decode's
+  /// (decoder.samples) since one ID is checked, not told apart from the family. The
+  /// correlation's heading is used only when the spot check fails: on the recorded clips
+  /// 60 samples give 0.8-0.9 degrees RMS, 120 the full decode's 0.5-0.7, the spot check
+  /// 0.4-0.7.
   int confirm_samples = 60;
   /// A tracked marker found again by its outline is spot-checked every frame: its
   /// heading from the balance of its key slice's edges, every slice's colour checked
