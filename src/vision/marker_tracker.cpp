@@ -198,7 +198,7 @@ std::optional<MarkerDetection> MarkerTracker::confirm_by_edges(const cv::Mat& gr
   const bool spot_check = track.frames_since_correlated + 1 < config_.full_confirm_interval_frames;
   std::optional<DiscEdgeFit> fit;
   if (spot_check) fit = fit_near(config_.quick_edge_fit);
-  bool same_shape = fit && fit->residual <= config_.shape_refit_residual;
+  const bool same_shape = fit && fit->residual <= config_.shape_refit_residual;
   if (!same_shape) fit = fit_near(config_.edge_fit);
   if (!fit) return std::nullopt;
   const double threshold = 0.5 * (fit->black_level + fit->white_level);
