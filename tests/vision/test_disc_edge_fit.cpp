@@ -30,6 +30,17 @@ cv::Mat marker_image(double offset, double heading_deg, cv::Point2d& centre) {
   return img;
 }
 
+// A dark ellipse of axes 15 and 10 px, tilted by 30 degrees, centred at `c` on a light
+// floor, area-sampled (a disc seen by a tilted camera).
+cv::Mat tilted_ellipse_image(cv::Point2d c) {
+  cv::Mat big(200 * kScale, 200 * kScale, CV_8UC1, cv::Scalar(200));
+  cv::ellipse(big, {{float(c.x * kScale + 3.5), float(c.y * kScale + 3.5)}, {30.f * kScale, 20.f * kScale}, 30.f},
+              cv::Scalar(30), cv::FILLED);
+  cv::Mat img;
+  cv::resize(big, img, cv::Size(200, 200), 0, 0, cv::INTER_AREA);
+  return img;
+}
+
 Blob disc_at(cv::Point2d p, double radius_px) {
   Blob b;
   b.u = p.x;
@@ -81,12 +92,8 @@ TEST(DiscEdgeFit, FollowsADiscBeyondItsReach) {
 
 // The fit follows an ellipse (a tilted view) as well as a circle.
 TEST(DiscEdgeFit, FitsATiltedEllipse) {
-  cv::Mat big(200 * kScale, 200 * kScale, CV_8UC1, cv::Scalar(200));
   const cv::Point2d c(100.3, 90.7);
-  cv::ellipse(big, {{float(c.x * kScale + 3.5), float(c.y * kScale + 3.5)}, {30.f * kScale, 20.f * kScale}, 30.f},
-              cv::Scalar(30), cv::FILLED);
-  cv::Mat img;
-  cv::resize(big, img, cv::Size(200, 200), 0, 0, cv::INTER_AREA);
+  const cv::Mat img = tilted_ellipse_image(c);
   const auto fit = fit_disc_edges(img, disc_at(c + cv::Point2d(1, 1), 12.5), 115.0);
   ASSERT_TRUE(fit.has_value());
   EXPECT_NEAR(fit->blob.u, c.x, 0.05);
@@ -162,12 +169,8 @@ TEST(DiscEdgeFit, KeepingTheShapeFitsCentreAndSize) {
   }
   // An ellipse of axes 15 and 10 px predicted as a circle: the kept shape does not fit
   // it (refused, or a residual the tracker refits on), while the whole fit does.
-  cv::Mat big(200 * kScale, 200 * kScale, CV_8UC1, cv::Scalar(200));
   const cv::Point2d c(100.3, 90.7);
-  cv::ellipse(big, {{float(c.x * kScale + 3.5), float(c.y * kScale + 3.5)}, {30.f * kScale, 20.f * kScale}, 30.f},
-              cv::Scalar(30), cv::FILLED);
-  cv::Mat img;
-  cv::resize(big, img, cv::Size(200, 200), 0, 0, cv::INTER_AREA);
+  const cv::Mat img = tilted_ellipse_image(c);
   const auto kept = fit_disc_edges(img, disc_at(c, 12.2), 115.0, quick);
   EXPECT_TRUE(!kept.has_value() || kept->residual > 0.02);
   const auto whole = fit_disc_edges(img, disc_at(c, 12.2), 115.0);
