@@ -108,6 +108,16 @@ double doubled_integral_at(const double* c, double t) {
   return c[k] + (s - k) * (c[k + 1] - c[k]);
 }
 
+// The on-screen heading, degrees in [0, 360), of the direction at angle a (cos a = c,
+// sin a = s) in the unit-circle frame of `shape`: shape · (c, -s), as the samples lie.
+double screen_heading_deg(const cv::Matx22d& shape, double c, double s) {
+  const double du = shape(0, 0) * c - shape(0, 1) * s, dv = shape(1, 0) * c - shape(1, 1) * s;
+  // Within [-180, 180]: one turn added at most (no fmod, as wrap_deg_360 needs).
+  double heading_deg = rad_to_deg(fast_atan2(-dv, du));
+  if (heading_deg < 0.0) heading_deg += 360.0;
+  return heading_deg >= 360.0 ? heading_deg - 360.0 : heading_deg;
+}
+
 // t wrapped once into [0, n).
 double wrap_samples(double t, double n) {
   while (t < 0.0) t += n;
@@ -315,11 +325,7 @@ double Decoder::heading_on_screen(const Blob& blob, double lag) const {
   // and the library's took a tenth of a tracked marker's time.
   double s = 0.0, c = 0.0;
   fast_sincos(2.0 * kPi * lag / config_.samples, s, c);
-  const cv::Vec2d dir = blob.shape * cv::Vec2d(c, -s);
-  // Within [-180, 180]: one turn added at most (no fmod, as wrap_deg_360 needs).
-  double heading_deg = rad_to_deg(fast_atan2(-dir[1], dir[0]));
-  if (heading_deg < 0.0) heading_deg += 360.0;
-  return heading_deg >= 360.0 ? heading_deg - 360.0 : heading_deg;
+  return screen_heading_deg(blob.shape, c, s);
 }
 
 void Decoder::prepare(const SampledSignal& signal, Prepared& p) const {
@@ -810,11 +816,7 @@ std::optional<SpotCheck> Decoder::spot_check(const cv::Mat& grey, const Blob& bl
   float least = std::numeric_limits<float>::max();
   for (int i = 0; i < slices.count; ++i) least = std::min(least, (levels[i] - fmid) * slices.sign[i]);
   if (!(least >= static_cast<float>(kSpotMargin * contrast))) return std::nullopt;
-  const double du = s(0, 0) * c - s(0, 1) * sn, dv = s(1, 0) * c - s(1, 1) * sn;
-  double heading_deg = rad_to_deg(fast_atan2(-dv, du));
-  if (heading_deg < 0.0) heading_deg += 360.0;
-  if (heading_deg >= 360.0) heading_deg -= 360.0;
-  return SpotCheck{heading_deg, grid_angle(below) + x};
+  return SpotCheck{screen_heading_deg(s, c, sn), grid_angle(below) + x};
 }
 
 }  // namespace rilbed::vision

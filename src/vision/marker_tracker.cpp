@@ -162,7 +162,7 @@ std::optional<MarkerDetection> MarkerTracker::confirm(const cv::Mat& grey, const
   decoder_.sample(grey, blob, signal_);
   if (!signal_.usable) return std::nullopt;
   ++stats_.decoded;
-  const CodeMatch m = decoder_.match_one(signal_, blob, track.id, wrap_deg_360(track.predicted_heading_deg()));
+  const CodeMatch m = decoder_.match_one(signal_, blob, track.id, track.predicted_heading_deg());
   if (m.score < config_.min_assign_score || m.score < track.score - config_.confirm_drop) return std::nullopt;
   return make_detection(blob, m, true, 0.5 * (signal_.black_level + signal_.white_level));
 }
@@ -207,7 +207,7 @@ std::optional<MarkerDetection> MarkerTracker::confirm_by_edges(const cv::Mat& gr
   // kept.
   const double expected_key = same_shape ? track.predicted_key_angle_rad()
                                          : confirm_decoder_.key_angle_of_heading(
-                                               fit->blob, wrap_deg_360(track.predicted_heading_deg()));
+                                               fit->blob, track.predicted_heading_deg());
   const auto spot =
       confirm_decoder_.spot_check(grey, fit->blob, track.id, expected_key, fit->black_level, fit->white_level);
   if (spot && spot_check) {
@@ -222,7 +222,7 @@ std::optional<MarkerDetection> MarkerTracker::confirm_by_edges(const cv::Mat& gr
   // The whole code correlated: a fresh score (and the heading, if the spot check failed).
   confirm_decoder_.sample_code(grey, fit->blob, fit->black_level, fit->white_level, signal_);
   if (!signal_.usable) return std::nullopt;
-  CodeMatch m = confirm_decoder_.match_one(signal_, fit->blob, track.id, wrap_deg_360(track.predicted_heading_deg()));
+  CodeMatch m = confirm_decoder_.match_one(signal_, fit->blob, track.id, track.predicted_heading_deg());
   if (m.score < config_.min_assign_score || m.score < track.score - config_.confirm_drop) return std::nullopt;
   if (spot) {
     // The key's edges place the heading more precisely than the correlation of a

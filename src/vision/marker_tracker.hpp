@@ -9,6 +9,7 @@
 #include <optional>
 #include <vector>
 
+#include "core/geometry.hpp"
 #include "vision/blob_detector.hpp"
 #include "vision/decoder.hpp"
 #include "vision/disc_edge_fit.hpp"
@@ -166,8 +167,9 @@ class MarkerTracker {
     int frames_since_correlated = 0;
     /// Its turn per frame, degrees counter-clockwise on screen.
     double turn_deg = 0;
-    /// Its heading in the coming frame (constant turn, coasting over misses), degrees.
-    double predicted_heading_deg() const { return heading_deg + turn_deg * (missed + 1.0); }
+    /// Its heading in the coming frame (constant turn, coasting over misses), degrees in
+    /// [0, 360).
+    double predicted_heading_deg() const { return wrap_deg_360(heading_deg + turn_deg * (missed + 1.0)); }
     /// The heading last seen in the unit-circle frame of `shape` and its turn per frame
     /// there, radians: the spot check's prediction (its fit keeps the shape).
     double key_angle_rad = 0;
