@@ -31,7 +31,29 @@ struct EmulatorArgs {
   std::string pose = "0,0,0";
   std::string stable_path;
   std::uint64_t seed = 1;
+  // How the firmware words its replies (ReplyStyle), and its versions text.
+  std::string versions;
+  bool upper_case = false;
+  std::string line_end = "crlf";
+  std::string extra_fields;
+  int trailing_spaces = 0;
+  bool spaces_after_commas = false;
+  bool echo = false;
 };
+
+// `--versions TEXT`: for a Khepera the text after "b," (its first field the BIOS, the rest
+// the protocol version); for an e-puck the text after "v,".
+links::FirmwareVersions versions_from_text(const links::RobotModel& model, const std::string& text) {
+  links::FirmwareVersions v;
+  if (!model.bios_protocol_versions) {
+    v.text = text;
+    return v;
+  }
+  const std::size_t comma = text.find(',');
+  v.bios = text.substr(0, comma);
+  if (comma != std::string::npos) v.protocol = text.substr(comma + 1);
+  return v;
+}
 
 // "x,y,theta_deg" (metres, metres, degrees).
 std::optional<Pose2> parse_pose(const std::string& text) {
@@ -63,6 +85,13 @@ int emulator_command(const EmulatorArgs& args) {
   config.faults.corrupt_probability = args.corrupt;
   config.faults.disconnect_after_s = args.disconnect_after_s;
   config.faults.replug_after_s = args.replug_after_s;
+  if (!args.versions.empty()) config.versions = versions_from_text(*model, args.versions);
+  config.style.upper_case_letter = args.upper_case;
+  config.style.line_end = args.line_end == "lf" ? "\n" : args.line_end == "cr" ? "\r" : "\r\n";
+  config.style.extra_fields = args.extra_fields;
+  config.style.trailing_spaces = args.trailing_spaces;
+  config.style.spaces_after_commas = args.spaces_after_commas;
+  config.style.echo = args.echo;
 
   // Blocked before the emulator's thread exists (it inherits the mask); the main thread
   // takes them with sigwait.
@@ -126,6 +155,17 @@ void add_khepera_emu_command(CLI::App& app) {
   cmd->add_option("--link", args->stable_path,
                   "Keep a symlink here to the current pty (survives a replug; printed instead of the pty)");
   cmd->add_option("--seed", args->seed, "Seed of the fault dice")->default_val(1);
+  // Firmware that words its replies differently (other BIOS versions, independent peers).
+  cmd->add_option("--versions", args->versions,
+                  "What the versions reply carries after its letter (Khepera: BIOS,protocol, any text, e.g. 5.02,5.01)");
+  cmd->add_flag("--upper-case", args->upper_case, "Reply letters in upper case (N,... instead of n,...)");
+  cmd->add_option("--line-end", args->line_end, "What ends a reply")->check(CLI::IsMember({"crlf", "lf", "cr"}))
+      ->default_val("crlf");
+  cmd->add_option("--extra-fields", args->extra_fields, "Text appended to every reply's fields (e.g. ,0,ok)");
+  cmd->add_option("--trailing-spaces", args->trailing_spaces, "Spaces before each reply's line end")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--spaces-after-commas", args->spaces_after_commas, "A space after every comma of a reply");
+  cmd->add_flag("--echo", args->echo, "Echo every command line before its reply");
   cmd->callback([args] { exit_code() = emulator_command(*args); });
 }
 

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -105,6 +106,16 @@ void check_faults(const EmulatorFaults& f) {
   if (!(f.disconnect_after_s >= 0.0) || !(f.replug_after_s >= 0.0)) {
     throw std::invalid_argument("emulated Khepera: disconnect and replug times must be >= 0 s");
   }
+}
+
+void check_style(const ReplyStyle& style) {
+  if (style.line_end.empty() || style.line_end.find_first_not_of("\r\n") != std::string::npos) {
+    throw std::invalid_argument("emulated Khepera: a reply's line end must be CR, LF or both");
+  }
+  if (style.extra_fields.find_first_of("\r\n") != std::string::npos) {
+    throw std::invalid_argument("emulated Khepera: extra reply fields must not end the line");
+  }
+  if (style.trailing_spaces < 0) throw std::invalid_argument("emulated Khepera: trailing spaces must be >= 0");
 }
 
 // A reply waiting for its moment (the fault's reply delay).
@@ -264,30 +275,49 @@ struct KheperaEmulator::State {
   std::string corrupt(std::string reply) {
     std::string body = reply.substr(0, reply.size() - 2);  // without CR LF
     const std::size_t last_comma = body.rfind(',');
-    switch (std::uniform_int_distribution<int>(0, 2)(rng)) {
+    // An acknowledgement carries no value to spoil (whatever follows its letter is
+    // ignored), so only its letter can be wrong.
+    const int how = last_comma == std::string::npos ? 0 : std::uniform_int_distribution<int>(0, 2)(rng);
+    switch (how) {
       case 0:  // wrong letter
         body[0] = body[0] == 'a' ? 'b' : static_cast<char>(body[0] - 1);
         break;
-      case 1:  // a value missing (or one too many on an acknowledgement)
-        if (last_comma == std::string::npos) body += ",1";
-        else body.erase(last_comma);
+      case 1:  // the last value missing
+        body.erase(last_comma);
         break;
       default:  // a value that is not a number
-        if (last_comma == std::string::npos) body += ",x";
-        else body = body.substr(0, last_comma + 1) + "x1";
+        body = body.substr(0, last_comma + 1) + "x1";
         break;
     }
     return body + "\r\n";
   }
 
+  // A K-Team reply ("n,1,2\r\n") in the configured style.
+  std::string styled(const std::string& reply) const {
+    const ReplyStyle& style = config.style;
+    std::string body = reply.substr(0, reply.size() - 2);  // without CR LF
+    if (style.upper_case_letter && !body.empty()) body[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(body[0])));
+    if (style.spaces_after_commas) {
+      std::string spaced;
+      for (const char c : body) spaced += c == ',' ? std::string(", ") : std::string(1, c);
+      body = std::move(spaced);
+    }
+    return body + style.extra_fields + std::string(static_cast<std::size_t>(style.trailing_spaces), ' ') + style.line_end;
+  }
+
+  void queue_locked(Clock::time_point due, std::string bytes) {
+    if (!outbox.empty()) due = std::max(due, outbox.back().due);  // replies keep their order
+    outbox.push_back({due, std::move(bytes)});
+  }
+
   void handle_line_locked(const std::string& line, Clock::time_point now) {
+    if (config.style.echo) queue_locked(now, line + config.style.line_end);
     std::string reply = answer_locked(line, now);
     if (roll(faults.drop_probability)) return;
     if (roll(faults.corrupt_probability)) reply = corrupt(std::move(reply));
+    reply = styled(reply);
     if (roll(faults.garbage_probability)) reply = garbage() + reply;
-    Clock::time_point due = now + std::chrono::milliseconds(faults.reply_delay_ms);
-    if (!outbox.empty()) due = std::max(due, outbox.back().due);  // replies keep their order
-    outbox.push_back({due, std::move(reply)});
+    queue_locked(now + std::chrono::milliseconds(faults.reply_delay_ms), std::move(reply));
   }
 
   void send_due_locked(Clock::time_point now) {
@@ -304,6 +334,7 @@ struct KheperaEmulator::State {
 KheperaEmulator::KheperaEmulator(EmulatorConfig config) : state_(std::make_unique<State>(std::move(config))) {
   State& s = *state_;
   check_faults(s.faults);
+  check_style(s.config.style);
   s.pose = s.config.initial_pose;
   s.proximity = s.config.proximity;
   s.ambient = s.config.ambient;
@@ -454,6 +485,12 @@ std::uint64_t KheperaEmulator::bad_commands() const {
 void KheperaEmulator::set_proximity(const environment::ProximityValues& values) {
   std::lock_guard lock(state_->mutex);
   state_->proximity = values;
+}
+
+void KheperaEmulator::place(const Pose2& pose) {
+  std::lock_guard lock(state_->mutex);
+  state_->integrate_locked(Clock::now());
+  state_->pose = pose;
 }
 
 void KheperaEmulator::set_ambient(const environment::ProximityValues& values) {

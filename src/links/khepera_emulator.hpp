@@ -46,6 +46,18 @@ struct EmulatorFaults {
   double replug_after_s = 0.0;
 };
 
+/// How the emulated firmware words its replies: K-Team's style by default. The other
+/// settings play firmware that differs (other BIOS versions, independent peers), to try
+/// the link's tolerance against real bytes on a real tty.
+struct ReplyStyle {
+  bool upper_case_letter = false;    ///< "N,1,..." instead of "n,1,..."
+  std::string line_end = "\r\n";     ///< what ends a reply: "\r\n", "\n" or "\r"
+  std::string extra_fields;          ///< appended after the reply's own fields, e.g. ",0,ok"
+  int trailing_spaces = 0;           ///< spaces before the line end
+  bool spaces_after_commas = false;  ///< "n, 1, 2, ..."
+  bool echo = false;                 ///< echo each command line, at once, before its reply
+};
+
 /// How an emulator starts.
 struct EmulatorConfig {
   /// Which firmware to speak (letters, ranges, units, see RobotModel).
@@ -56,8 +68,10 @@ struct EmulatorConfig {
   environment::ProximityValues proximity{};
   /// Ambient light values reported by `O` (Khepera: about 500 in an ordinary room).
   environment::ProximityValues ambient = {500, 500, 500, 500, 500, 500, 500, 500};
-  /// Versions reported by `B` (Khepera) or `V` (e-puck text).
-  FirmwareVersions versions{5, 4, "rilbed emulated e-puck"};
+  /// Versions reported by `B` (Khepera: bios and protocol, any text) or `V` (e-puck: text).
+  FirmwareVersions versions{"5", "4", "rilbed emulated e-puck"};
+  /// How replies are worded.
+  ReplyStyle style;
   EmulatorFaults faults;
   /// Seed of the fault dice, so a faulty run can be repeated.
   std::uint64_t seed = 1;
@@ -97,6 +111,9 @@ class KheperaEmulator {
 
   /// Sets what `N` reports from now on (e.g. virtual readings computed by the world).
   void set_proximity(const environment::ProximityValues& values);
+  /// Puts the robot at `pose` (field frame) now, as a hand placing it: the wheels keep
+  /// their speeds and the counters are unchanged.
+  void place(const Pose2& pose);
   /// Sets what `O` reports from now on.
   void set_ambient(const environment::ProximityValues& values);
   /// Changes the faults from now on (a disconnect_after_s counts from the start).

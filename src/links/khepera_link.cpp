@@ -366,6 +366,12 @@ struct KheperaLink::Impl {
       return;
     }
     const CommandKind kind = in_flight->job.command.kind;
+    if (is_echo_of(config.model, in_flight->job.command, line)) {
+      // Our own command coming back (a firmware or terminal server that echoes): never
+      // its reply, however much it looks like one.
+      count([](LinkCounters& c) { ++c.echoed_lines; });
+      return;
+    }
     Result<Reply> reply = decode_reply(config.model, kind, line);
     if (reply) {
       reply_timer.cancel();

@@ -15,6 +15,10 @@
 // failed, one queued request goes before the speeds are tried again, so a dead robot
 // cannot starve the rest.
 //
+// Replies are read tolerantly (see khepera_protocol.hpp): an exact echo of the command in
+// flight is skipped, the reply letter may be either case, fields rilbed does not compute
+// with are kept as text or ignored.
+//
 // Errors: a reply that does not decode counts as bad and the command is retried at once if
 // the line looked like its reply (right letter), otherwise the line is counted as stray
 // and ignored (garbage, a late reply to an earlier attempt). No reply within
@@ -94,6 +98,7 @@ struct LinkCounters {
   std::uint64_t replies_ok = 0;       ///< replies that passed the checks
   std::uint64_t bad_replies = 0;      ///< lines shaped like the awaited reply that failed the checks
   std::uint64_t stray_lines = 0;      ///< lines that answered nothing in flight (garbage, late replies)
+  std::uint64_t echoed_lines = 0;     ///< exact echoes of the command in flight, skipped
   std::uint64_t timeouts = 0;         ///< attempts without a reply in time
   std::uint64_t retries = 0;          ///< attempts beyond the first
   std::uint64_t failed_commands = 0;  ///< commands given up after their retries

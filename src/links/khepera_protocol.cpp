@@ -31,7 +31,7 @@ RobotModel make_khepera2() {
   m.letters[index_of(CommandKind::kReadProximity)] = 'N';
   m.letters[index_of(CommandKind::kReadAmbient)] = 'O';
   m.letters[index_of(CommandKind::kSetLed)] = 'L';
-  m.numeric_versions = true;
+  m.bios_protocol_versions = true;
   m.max_speed_units = 127;
   m.max_sensor_value = 1023;
   m.led_count = 2;
@@ -48,7 +48,7 @@ RobotModel make_epuck() {
   m.letters[index_of(CommandKind::kReadVersions)] = 'V';
   m.letters[index_of(CommandKind::kSetCounters)] = 'P';
   m.letters[index_of(CommandKind::kReadCounters)] = 'Q';
-  m.numeric_versions = false;
+  m.bios_protocol_versions = false;
   m.max_speed_units = 1000;
   m.max_sensor_value = 4095;
   m.led_count = 8;
@@ -65,6 +65,17 @@ std::string_view strip_terminator(std::string_view line) {
   return line;
 }
 
+bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
+// Without line ends, spaces and tabs at either end.
+std::string_view trim(std::string_view text) {
+  while (!text.empty() && is_blank(text.front())) text.remove_prefix(1);
+  while (!text.empty() && is_blank(text.back())) text.remove_suffix(1);
+  return text;
+}
+
+char lower(char c) { return static_cast<char>(std::tolower(static_cast<unsigned char>(c))); }
+
 std::vector<std::string_view> split_fields(std::string_view text) {
   std::vector<std::string_view> fields;
   std::size_t start = 0;
@@ -79,9 +90,10 @@ std::vector<std::string_view> split_fields(std::string_view text) {
   }
 }
 
-// Strict integer syntax: an optional '-', then one or more digits, nothing else.
-// from_chars alone would accept a prefix ("12x") and reject nothing of the rest.
-std::optional<std::int64_t> parse_integer(std::string_view field) {
+// Integer syntax: an optional sign, then one or more digits, nothing else (the caller
+// trims blanks). from_chars alone would accept a prefix ("12x").
+std::optional<std::int64_t> parse_integer(std::string_view field, bool allow_plus) {
+  if (allow_plus && field.size() > 1 && field.front() == '+') field.remove_prefix(1);
   if (field.empty()) return std::nullopt;
   const std::size_t digits_from = field.front() == '-' ? 1 : 0;
   if (digits_from == field.size()) return std::nullopt;
@@ -94,10 +106,10 @@ std::optional<std::int64_t> parse_integer(std::string_view field) {
   return value;
 }
 
-// The fields after the letter of a `x,a,b,...` line, checked for count, syntax and range.
-// `what` names the line in the failure ("reply \"n,...\" to N").
-Result<std::vector<std::int64_t>> parse_values(std::string_view after_letter, std::size_t expected_count,
-                                               std::int64_t min, std::int64_t max, const std::string& what) {
+// The strict form commands take (the emulator plays K-Team's firmware): exactly
+// `expected_count` integers after the letter, no blanks, no sign but '-'.
+Result<std::vector<std::int64_t>> parse_command_values(std::string_view after_letter, std::size_t expected_count,
+                                                       std::int64_t min, std::int64_t max, const std::string& what) {
   std::vector<std::int64_t> values;
   if (expected_count == 0) {
     if (!after_letter.empty()) return Failure{what + ": expected no values after the letter"};
@@ -112,7 +124,7 @@ Result<std::vector<std::int64_t>> parse_values(std::string_view after_letter, st
                    std::to_string(expected_count)};
   }
   for (std::size_t i = 0; i < fields.size(); ++i) {
-    const std::optional<std::int64_t> value = parse_integer(fields[i]);
+    const std::optional<std::int64_t> value = parse_integer(fields[i], false);
     if (!value) return Failure{what + ": value " + std::to_string(i + 1) + " " + printable(fields[i]) + " is not an integer"};
     if (*value < min || *value > max) {
       return Failure{what + ": value " + std::to_string(i + 1) + " = " + std::to_string(*value) + " is outside " +
@@ -121,6 +133,74 @@ Result<std::vector<std::int64_t>> parse_values(std::string_view after_letter, st
     values.push_back(*value);
   }
   return values;
+}
+
+// The name of a reply's computed field `index` (0-based), for messages.
+std::string field_name(CommandKind kind, std::size_t index) {
+  switch (kind) {
+    case CommandKind::kReadSpeeds: return index == 0 ? "left speed" : "right speed";
+    case CommandKind::kReadCounters: return index == 0 ? "left counter" : "right counter";
+    case CommandKind::kReadProximity: return "proximity sensor " + std::to_string(index);
+    case CommandKind::kReadAmbient: return "ambient sensor " + std::to_string(index);
+    default: return "value " + std::to_string(index + 1);
+  }
+}
+
+// The first `expected_count` fields of a reply (after its letter), each trimmed, an
+// integer and in range; fields beyond them are ignored. `what` names the line and
+// command in the failure.
+Result<std::vector<std::int64_t>> parse_reply_values(CommandKind kind, std::string_view after_letter,
+                                                     std::size_t expected_count, std::int64_t min, std::int64_t max,
+                                                     const std::string& what) {
+  std::vector<std::int64_t> values;
+  if (expected_count == 0) return values;
+  const std::vector<std::string_view> fields =
+      after_letter.empty() ? std::vector<std::string_view>{} : split_fields(after_letter.substr(1));
+  for (std::size_t i = 0; i < expected_count; ++i) {
+    const std::string label = "field " + std::to_string(i + 1) + " (" + field_name(kind, i) + ")";
+    if (i >= fields.size()) {
+      return Failure{what + ": " + label + " is missing (" + std::to_string(fields.size()) + " of " +
+                     std::to_string(expected_count) + " values)"};
+    }
+    const std::string_view field = trim(fields[i]);
+    const std::optional<std::int64_t> value = parse_integer(field, true);
+    if (!value) return Failure{what + ": " + label + " " + printable(field) + " is not an integer"};
+    if (*value < min || *value > max) {
+      return Failure{what + ": " + label + " = " + std::to_string(*value) + " is outside " + std::to_string(min) + ".." +
+                     std::to_string(max)};
+    }
+    values.push_back(*value);
+  }
+  return values;
+}
+
+// What follows a reply's letter without its leading comma, trimmed.
+std::string_view after_comma(std::string_view after_letter) {
+  after_letter = trim(after_letter);
+  if (!after_letter.empty() && after_letter.front() == ',') after_letter.remove_prefix(1);
+  return trim(after_letter);
+}
+
+// Khepera versions: "b,<bios>,<protocol>" kept as text; whatever the fields hold.
+FirmwareVersions bios_protocol_versions(std::string_view after_letter) {
+  FirmwareVersions v;
+  const std::string_view text = after_comma(after_letter);
+  const std::size_t comma = text.find(',');
+  v.bios = std::string(trim(text.substr(0, comma)));
+  std::string_view more;  // fields beyond the two
+  if (comma != std::string_view::npos) {
+    const std::string_view after = text.substr(comma + 1);
+    const std::size_t next = after.find(',');
+    v.protocol = std::string(trim(after.substr(0, next)));
+    if (next != std::string_view::npos) more = trim(after.substr(next + 1));
+  }
+  if (v.bios.empty() || v.protocol.empty()) {
+    v.text = std::string(text);
+  } else {
+    v.text = "bios " + v.bios + ", protocol " + v.protocol;
+    if (!more.empty()) v.text += " (" + std::string(more) + ")";
+  }
+  return v;
 }
 
 // How many values a command or its reply carries, and their range, per kind.
@@ -141,7 +221,6 @@ Shape command_shape(const RobotModel& model, CommandKind kind) {
 
 Shape reply_shape(const RobotModel& model, CommandKind kind) {
   switch (kind) {
-    case CommandKind::kReadVersions: return {2, 0, kInt32Max};
     case CommandKind::kReadSpeeds: return {2, -model.max_speed_units, model.max_speed_units};
     case CommandKind::kReadCounters: return {2, kInt32Min, kInt32Max};
     case CommandKind::kReadProximity:
@@ -256,7 +335,7 @@ Result<Command> decode_command(const RobotModel& model, std::string_view line) {
   for (const CommandKind kind : kAllKinds) {
     if (line.front() != model.command_letter(kind)) continue;
     const Shape shape = command_shape(model, kind);
-    auto values = parse_values(line.substr(1), shape.count, shape.min, shape.max, what);
+    auto values = parse_command_values(line.substr(1), shape.count, shape.min, shape.max, what);
     if (!values) return Failure{values.error()};
     Command command{kind};
     if (shape.count == 2) {
@@ -271,52 +350,69 @@ Result<Command> decode_command(const RobotModel& model, std::string_view line) {
   return Failure{what + ": unknown command letter"};
 }
 
+namespace {
+
+// Whether `line` (trimmed) starts with `letter` in either case, followed by nothing, a
+// comma or a blank: the shape of a reply with that letter.
+bool starts_with_reply_letter(std::string_view line, char letter) {
+  if (line.empty() || lower(line.front()) != letter) return false;
+  return line.size() == 1 || line[1] == ',' || is_blank(line[1]);
+}
+
+}  // namespace
+
 bool looks_like_reply_to(const RobotModel& model, CommandKind expected, std::string_view line) {
-  line = strip_terminator(line);
-  if (line.empty()) return false;
-  const char letter = line.front();
-  if (letter != model.reply_letter(expected) && letter != 'z') return false;
-  return line.size() == 1 || line[1] == ',';
+  line = trim(line);
+  return starts_with_reply_letter(line, model.reply_letter(expected)) || starts_with_reply_letter(line, 'z');
+}
+
+bool is_echo_of(const RobotModel& model, const Command& command, std::string_view line) {
+  const Result<EncodedCommand> encoded = encode_command(model, command);
+  return encoded.ok() && !trim(line).empty() && trim(line) == trim(encoded->bytes);
 }
 
 Result<Reply> decode_reply(const RobotModel& model, CommandKind expected, std::string_view line) {
-  line = strip_terminator(line);
+  line = trim(line);
   const char expected_letter = model.reply_letter(expected);
-  const std::string what =
-      "reply " + printable(line) + " to " + std::string(1, model.command_letter(expected)) + " (" +
-      std::string(command_kind_name(expected)) + ")";
-  if (line.empty()) return Failure{"empty reply to " + std::string(1, model.command_letter(expected))};
-  if (line.front() == 'z' && expected_letter != 'z' && (line.size() == 1 || line[1] == ',')) {
+  const std::string command_text =
+      std::string(1, model.command_letter(expected)) + " (" + std::string(command_kind_name(expected)) + ")";
+  const std::string what = "reply " + printable(line) + " to " + command_text;
+  if (line.empty()) return Failure{"empty reply to " + command_text};
+  if (expected_letter != 'z' && starts_with_reply_letter(line, 'z')) {
     return Failure{what + ": the robot reports a protocol error"};
   }
-  if (line.front() != expected_letter) {
+  if (lower(line.front()) != expected_letter) {
     return Failure{what + ": starts with " + printable(line.substr(0, 1)) + ", expected \"" +
                    std::string(1, expected_letter) + "\""};
   }
+  if (!starts_with_reply_letter(line, expected_letter)) {
+    return Failure{what + ": expected a comma after the letter \"" + std::string(1, expected_letter) + "\""};
+  }
   Reply reply;
   reply.kind = expected;
-  const std::string_view rest = line.substr(1);
-  if (expected == CommandKind::kReadVersions && !model.numeric_versions) {
-    // e-puck: "v,<free text>"; the text is whatever printable ASCII follows.
-    if (rest.size() < 2 || rest.front() != ',') return Failure{what + ": expected a version text after \"v,\""};
-    for (const char c : rest) {
-      if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) {
-        return Failure{what + ": the version text has a control byte"};
+  // What follows the letter: nothing, or a comma and the fields (blanks before it ignored).
+  const std::string_view rest = trim(line.substr(1));
+  const Shape shape = reply_shape(model, expected);
+  if (shape.count > 0 && !rest.empty() && rest.front() != ',') {
+    return Failure{what + ": expected a comma before the values"};
+  }
+  if (expected == CommandKind::kReadVersions) {
+    // Shown, never computed with: kept as text, whatever it holds.
+    if (model.bios_protocol_versions) {
+      reply.versions = bios_protocol_versions(rest);
+    } else {
+      std::string text(after_comma(rest));
+      for (char& c : text) {
+        if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) c = '?';
       }
+      reply.versions.text = std::move(text);
     }
-    reply.versions.text = std::string(rest.substr(1));
     return reply;
   }
-  const Shape shape = reply_shape(model, expected);
-  auto values = parse_values(rest, shape.count, shape.min, shape.max, what);
+  auto values = parse_reply_values(expected, rest, shape.count, shape.min, shape.max, what);
   if (!values) return Failure{values.error()};
   const std::vector<std::int64_t>& v = values.value();
   switch (expected) {
-    case CommandKind::kReadVersions:
-      reply.versions.bios = static_cast<int>(v[0]);
-      reply.versions.protocol = static_cast<int>(v[1]);
-      reply.versions.text = "bios " + std::to_string(v[0]) + ", protocol " + std::to_string(v[1]);
-      break;
     case CommandKind::kReadSpeeds:
     case CommandKind::kReadCounters:
       reply.wheels = {v[0], v[1]};
@@ -326,7 +422,7 @@ Result<Reply> decode_reply(const RobotModel& model, CommandKind expected, std::s
       for (std::size_t i = 0; i < reply.sensors.size(); ++i) reply.sensors[i] = static_cast<int>(v[i]);
       break;
     default:
-      break;
+      break;  // acknowledgements: whatever follows the letter is ignored
   }
   return reply;
 }
@@ -335,8 +431,8 @@ std::string encode_reply(const RobotModel& model, const Reply& reply) {
   std::string bytes(1, model.reply_letter(reply.kind));
   switch (reply.kind) {
     case CommandKind::kReadVersions:
-      if (model.numeric_versions) {
-        bytes += ',' + std::to_string(reply.versions.bios) + ',' + std::to_string(reply.versions.protocol);
+      if (model.bios_protocol_versions) {
+        bytes += ',' + reply.versions.bios + ',' + reply.versions.protocol;
       } else {
         bytes += ',' + reply.versions.text;
       }

@@ -1,11 +1,25 @@
-// The Khepera serial protocol as bytes: commands encoded, replies decoded with strict
-// checks, per-model letters and ranges, and the line assembler that cuts a byte stream
-// into lines and resynchronises after noise. Pure functions and plain values: no I/O, no
-// threads, no exceptions for bad bytes (a bad reply is a Result holding the reason).
+// The Khepera serial protocol as bytes: commands encoded, replies decoded, per-model
+// letters and ranges, and the line assembler that cuts a byte stream into lines and
+// resynchronises after noise. Pure functions and plain values: no I/O, no threads, no
+// exceptions for bad bytes (a bad reply is a Result holding the reason).
 //
-// Khepera II (K-Team firmware), see DESIGN.md "Khepera serial protocol": one command per
-// line, an upper-case letter and comma-separated integers, ended by CR; the reply starts
-// with the same letter in lower case and ends with CR LF.
+// Khepera II (K-Team firmware), see ARCHITECTURE.md "Khepera serial protocol": one command
+// per line, an upper-case letter and comma-separated integers, ended by CR; the reply
+// starts with the same letter in lower case and ends with CR LF.
+//
+// Replies are read tolerantly, because firmware differs between robots and BIOS versions
+// and independent peers (other emulators, other boards) answer in their own ways:
+//   - the reply letter may be upper or lower case, the line may end in CR LF, LF or CR,
+//     and spaces or tabs around the line and around each field are ignored;
+//   - fields after the ones rilbed computes with are ignored (`d,0` acknowledges `D`;
+//     `n` with ten values gives the first eight);
+//   - fields rilbed only shows (the versions of `B`/`V`) are kept as text, whatever they
+//     hold (`b,5.02,5.01`, `b,K2 BIOS`);
+//   - only a field rilbed computes with (a speed, a counter, a sensor value) that is
+//     missing, not an integer or out of range makes the reply bad; the reason names the
+//     command and the field.
+// The link skips an exact echo of its command (some firmware and terminal servers echo
+// what they receive) before a line is decoded as a reply.
 //
 // e-puck (GCtronic "advanced sercom" / BTcom, ASCII mode): the same framing and the same
 // D, E, N, O, L letters, but
@@ -14,9 +28,8 @@
 //     Khepera's `G` and `H` mean IR receiver and help on the e-puck),
 //   - speeds are motor steps per second, +-1000; sensors are 12-bit (0..4095); 8 LEDs;
 //   - 115200 baud.
-// Those letters come from GCtronic's published command table; a firmware that differs
-// (e.g. one answering `N` with 10 values) is rejected by the checks, and RobotModel's
-// letter table is a plain value a caller can change.
+// Those letters come from GCtronic's published command table; RobotModel's letter table
+// is a plain value a caller can change for a firmware that differs.
 #pragma once
 
 #include <array>
@@ -125,8 +138,9 @@ struct RobotModel {
   /// Upper-case command letter per CommandKind (index = static_cast<size_t>(kind)); the
   /// reply letter is its lower case.
   std::array<char, kCommandKindCount> letters{};
-  /// true: versions reply `b,<bios>,<protocol>` (two integers); false: `v,<free text>`.
-  bool numeric_versions = true;
+  /// true: the versions reply is `b,<bios>,<protocol>` (Khepera); false: `v,<free text>`
+  /// (e-puck). Either way the versions are kept as text.
+  bool bios_protocol_versions = true;
   /// Largest wheel speed magnitude the firmware takes, in its units.
   int max_speed_units = 127;
   /// Largest proximity or ambient value (sensors report 0..this).
@@ -171,17 +185,21 @@ struct EncodedCommand {
 /// integers, an LED number outside 0..led_count-1 or an LED action outside 0..2 fail.
 Result<EncodedCommand> encode_command(const RobotModel& model, const Command& command);
 
-/// Decodes one command line (terminator optional) as a robot's firmware would, with the
-/// same strictness as decode_reply. Used by the emulator.
+/// Decodes one command line (terminator optional) as K-Team's firmware does: the letter,
+/// then exactly the integers the command takes. Used by the emulator.
 Result<Command> decode_command(const RobotModel& model, std::string_view line);
 
 // ---------------------------------------------------------------- replies
 
-/// Firmware versions as `B` (Khepera) or `V` (e-puck) reports them.
+/// Firmware versions as `B` (Khepera) or `V` (e-puck) reports them. rilbed only shows
+/// them, so they are text, whatever the firmware puts there ("5", "5.02", "K2-BIOS").
 struct FirmwareVersions {
-  int bios = 0;      ///< Khepera: BIOS version; e-puck: 0
-  int protocol = 0;  ///< Khepera: protocol version; e-puck: 0
-  std::string text;  ///< e-puck: the free text after "v,"; Khepera: "bios B, protocol P"
+  std::string bios;      ///< Khepera: the first field after "b,"; e-puck: empty
+  std::string protocol;  ///< Khepera: the second field; e-puck: empty
+  /// For people: Khepera "bios B, protocol P", with any further fields in brackets after
+  /// it (or the whole text after "b," when there are not two fields); e-puck: the free
+  /// text after "v,".
+  std::string text;
   bool operator==(const FirmwareVersions&) const = default;
 };
 
@@ -206,21 +224,27 @@ struct Reply {
   bool operator==(const Reply&) const = default;
 };
 
-/// Decodes `line` as the reply to a command of kind `expected`. The line may still carry
-/// its CR LF (or LF, or CR). Checks, in order: not empty; the firmware's `z` (protocol
-/// error) reply; the reply letter; the field count; each field's integer syntax (an
-/// optional '-', then digits; nothing else, no spaces); each value's range (sensors
-/// 0..max_sensor_value, speeds +-max_speed_units, counters 32-bit, versions >= 0). The
-/// failure reason quotes the line with control bytes escaped.
+/// Decodes `line` as the reply to a command of kind `expected`, tolerantly (see the file
+/// comment). The line may still carry its CR LF (or LF, or CR). Checks, in order: not
+/// empty; the firmware's `z` (protocol error) reply; the reply letter (either case); then,
+/// for the fields rilbed computes with, each one present, an integer (an optional sign,
+/// then digits), and in range (sensors 0..max_sensor_value, speeds +-max_speed_units,
+/// counters 32-bit). The failure reason quotes the line with control bytes escaped and
+/// names the command and the field ("field 4 (proximity sensor 3)").
 Result<Reply> decode_reply(const RobotModel& model, CommandKind expected, std::string_view line);
 
-/// Whether `line` is shaped like a reply to `expected` (its letter alone, or its letter
-/// and a comma), or like the firmware's `z` error, whatever follows. The link uses it to
-/// tell a corrupted reply to its command (retry at once) from a stray line (ignored).
+/// Whether `line` is shaped like a reply to `expected` (its letter in either case alone,
+/// or followed by a comma, space or tab), or like the firmware's `z` error, whatever
+/// follows. The link uses it to tell a corrupted reply to its command (retry at once)
+/// from a stray line (ignored).
 bool looks_like_reply_to(const RobotModel& model, CommandKind expected, std::string_view line);
 
 /// Encodes `reply` as the firmware sends it ("n,0,0,...,0\r\n"). Used by the emulator.
 std::string encode_reply(const RobotModel& model, const Reply& reply);
+
+/// Whether `line` (terminator optional, surrounding spaces ignored) is exactly the
+/// encoded `command`: an echo of it, never its reply.
+bool is_echo_of(const RobotModel& model, const Command& command, std::string_view line);
 
 /// The firmware's reply to a line it does not understand (Khepera: "z,Protocol error").
 inline constexpr std::string_view kProtocolErrorReply = "z,Protocol error\r\n";

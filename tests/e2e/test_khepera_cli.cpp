@@ -172,6 +172,24 @@ TEST(KheperaCli, InfoPrintsVersionsProximityAndCounters) {
   EXPECT_NE(rest.find("last speed 0 0"), std::string::npos) << rest;
 }
 
+// A peer whose firmware words its replies otherwise (the report that opened issue 15: a
+// Khepera answering `b,5.02,5.01`), with every other difference too: the real binary
+// talks to it as to K-Team's firmware.
+TEST(KheperaCli, WorksWithARobotWhoseFirmwareDiffers) {
+  Emulator emulator({"--versions", "5.02,5.01", "--upper-case", "--line-end", "lf", "--extra-fields", ",0,ok",
+                     "--trailing-spaces", "2", "--spaces-after-commas", "--echo"});
+  ASSERT_EQ(emulator.device.rfind("/dev/pts/", 0), 0u) << emulator.device << emulator.process.err();
+  CommandResult r = run_rilbed("khepera --port " + emulator.device + " info");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("versions: bios 5.02, protocol 5.01 (0,ok)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("proximity: 0 0 0 0 0 0 0 0"), std::string::npos) << r.out;
+  r = run_rilbed("khepera --port " + emulator.device + " drive 10 10 --for 0.3");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("stopped"), std::string::npos) << r.out;
+  const std::string rest = emulator.finish();
+  EXPECT_NE(rest.find("last speed 0 0"), std::string::npos) << rest;
+}
+
 TEST(KheperaCli, DriveMovesTheRobotThenStopsIt) {
   Emulator emulator({"--pose", "0.1,0.2,90"});
   ASSERT_FALSE(emulator.device.empty()) << emulator.process.err();

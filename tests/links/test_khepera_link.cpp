@@ -49,8 +49,8 @@ TEST(KheperaLink, InfoRoundTrip) {
   ASSERT_EQ(link.start(), std::nullopt);
   // The handshake reads the versions by itself.
   ASSERT_TRUE(eventually([&] { return link.versions().has_value(); })) << log.text();
-  EXPECT_EQ(link.versions()->bios, 5);
-  EXPECT_EQ(link.versions()->protocol, 4);
+  EXPECT_EQ(link.versions()->bios, "5");
+  EXPECT_EQ(link.versions()->protocol, "4");
   EXPECT_EQ(link.state(), LinkState::kOk);
 
   const Result<Reply> proximity = link.query(Command::read_proximity(), kQueryTimeout);
@@ -386,3 +386,87 @@ TEST(KheperaLink, RejectsABadConfig) {
   EXPECT_FALSE(never_started.stop());
   EXPECT_EQ(never_started.state(), LinkState::kStopped);
 }
+
+// The link against peers whose replies differ from K-Team's firmware in one way each, and
+// in all of them at once: versions that are not integers, extra fields, trailing spaces,
+// LF or CR line ends, upper-case letters, spaces after commas, an echo of every command.
+// Each must work as K-Team's does: the handshake, every reading, speeds acknowledged, and
+// not one reply counted bad.
+struct PeerCase {
+  const char* name;
+  ReplyStyle style;
+  FirmwareVersions versions;
+};
+
+class KheperaLinkWithOtherFirmware : public ::testing::TestWithParam<PeerCase> {};
+
+TEST_P(KheperaLinkWithOtherFirmware, WorksAsWithKTeamFirmware) {
+  const PeerCase& peer = GetParam();
+  EmulatorConfig emulated;
+  emulated.style = peer.style;
+  emulated.versions = peer.versions;
+  emulated.proximity = {1, 2, 3, 4, 5, 6, 7, 1023};
+  KheperaEmulator emulator(emulated);
+  LogSink log;
+  LinkConfig config = config_for(emulator, log);
+  config.counters_period_ms = 40;
+  KheperaLink link(config);
+  ASSERT_EQ(link.start(), std::nullopt);
+  ASSERT_TRUE(eventually([&] { return link.versions().has_value(); })) << log.text();
+  EXPECT_EQ(link.versions()->bios, peer.versions.bios);
+  EXPECT_EQ(link.versions()->protocol, peer.versions.protocol);
+  const Result<Reply> proximity = link.query(Command::read_proximity(), kQueryTimeout);
+  ASSERT_TRUE(proximity.ok()) << proximity.error() << "\n" << log.text();
+  EXPECT_EQ(proximity->sensors, emulated.proximity);
+  ASSERT_TRUE(link.query(Command::set_counters(-300, 400), kQueryTimeout).ok()) << log.text();
+  const Result<Reply> counters = link.query(Command::read_counters(), kQueryTimeout);
+  ASSERT_TRUE(counters.ok()) << counters.error();
+  EXPECT_EQ(counters->wheels, (WheelPair{-300, 400}));
+  link.set_speeds(12, -7);
+  ASSERT_TRUE(eventually([&] { return link.acknowledged_speeds() == WheelSpeeds{12, -7}; })) << log.text();
+  const Result<Reply> speeds = link.query(Command::read_speeds(), kQueryTimeout);
+  ASSERT_TRUE(speeds.ok()) << speeds.error();
+  EXPECT_EQ(speeds->wheels, (WheelPair{12, -7}));
+  EXPECT_TRUE(link.stop()) << log.text();
+  EXPECT_EQ(emulator.last_speeds(), (WheelSpeeds{0, 0}));
+  const LinkCounters c = link.status().counters;
+  EXPECT_EQ(c.bad_replies, 0u) << log.text();
+  EXPECT_EQ(c.timeouts, 0u) << log.text();
+  EXPECT_EQ(c.failed_commands, 0u);
+  if (peer.style.echo) {
+    EXPECT_GE(c.echoed_lines, 6u);  // the handshake, four queries, the speeds and the stop
+  } else {
+    EXPECT_EQ(c.echoed_lines, 0u);
+  }
+}
+
+namespace {
+
+ReplyStyle style_with(void (*change)(ReplyStyle&)) {
+  ReplyStyle style;
+  change(style);
+  return style;
+}
+
+const FirmwareVersions kKTeam{"5", "4", ""};
+const FirmwareVersions kDotted{"5.02", "5.01", ""};
+
+}  // namespace
+
+INSTANTIATE_TEST_SUITE_P(
+    Peers, KheperaLinkWithOtherFirmware,
+    ::testing::Values(
+        PeerCase{"KTeam", {}, kKTeam}, PeerCase{"DottedVersions", {}, kDotted},
+        PeerCase{"TextVersions", {}, {"K2 BIOS", "rev C", ""}},
+        PeerCase{"ExtraFields", style_with([](ReplyStyle& s) { s.extra_fields = ",0,ok"; }), kKTeam},
+        PeerCase{"TrailingSpaces", style_with([](ReplyStyle& s) { s.trailing_spaces = 3; }), kKTeam},
+        PeerCase{"LfOnly", style_with([](ReplyStyle& s) { s.line_end = "\n"; }), kKTeam},
+        PeerCase{"CrOnly", style_with([](ReplyStyle& s) { s.line_end = "\r"; }), kKTeam},
+        PeerCase{"UpperCase", style_with([](ReplyStyle& s) { s.upper_case_letter = true; }), kKTeam},
+        PeerCase{"SpacesAfterCommas", style_with([](ReplyStyle& s) { s.spaces_after_commas = true; }), kKTeam},
+        PeerCase{"Echo", style_with([](ReplyStyle& s) { s.echo = true; }), kKTeam},
+        PeerCase{"AllAtOnce", style_with([](ReplyStyle& s) {
+                   s = {true, "\n", ",9,x", 2, true, true};
+                 }),
+                 kDotted}),
+    [](const ::testing::TestParamInfo<PeerCase>& info) { return std::string(info.param.name); });

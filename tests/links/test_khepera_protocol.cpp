@@ -88,9 +88,12 @@ TEST(KheperaProtocol, EpuckUsesItsOwnLetters) {
   r = decode_reply(e, CommandKind::kReadProximity, "n,4095,0,0,0,0,0,0,3000\r\n");
   ASSERT_TRUE(r.ok()) << r.error();
   EXPECT_EQ(r->sensors[0], 4095);
-  // A Khepera's reply to B is not an e-puck's reply to V.
+  // A Khepera's reply to B is not an e-puck's reply to V; an empty version text is still
+  // a reply (rilbed only shows it).
   EXPECT_FALSE(decode_reply(e, CommandKind::kReadVersions, "b,5,4\r\n").ok());
-  EXPECT_FALSE(decode_reply(e, CommandKind::kReadVersions, "v,\r\n").ok());
+  r = decode_reply(e, CommandKind::kReadVersions, "v,\r\n");
+  ASSERT_TRUE(r.ok()) << r.error();
+  EXPECT_EQ(r->versions.text, "");
 }
 
 TEST(KheperaProtocol, FindsModelsByName) {
@@ -105,8 +108,8 @@ TEST(KheperaProtocol, DecodesEveryKheperaReply) {
   const RobotModel& k = khepera2_model();
   Result<Reply> r = decode_reply(k, CommandKind::kReadVersions, "b,5,4\r\n");
   ASSERT_TRUE(r.ok()) << r.error();
-  EXPECT_EQ(r->versions.bios, 5);
-  EXPECT_EQ(r->versions.protocol, 4);
+  EXPECT_EQ(r->versions.bios, "5");
+  EXPECT_EQ(r->versions.protocol, "4");
   EXPECT_EQ(r->versions.text, "bios 5, protocol 4");
 
   for (const CommandKind ack : {CommandKind::kSetSpeeds, CommandKind::kSetCounters, CommandKind::kSetLed}) {
@@ -133,6 +136,63 @@ TEST(KheperaProtocol, DecodesEveryKheperaReply) {
   EXPECT_EQ(r->sensors[7], 507);
 }
 
+// Firmware differs between robots and BIOS versions, and independent peers answer in
+// their own ways: every one of these is a good reply (ARCHITECTURE.md, "tolerant link").
+TEST(KheperaProtocol, AcceptsRepliesOfOtherFirmware) {
+  const RobotModel& k = khepera2_model();
+  struct VersionCase {
+    std::string line, bios, protocol, text;
+  };
+  for (const VersionCase& c : std::vector<VersionCase>{
+           {"b,5.02,5.01\r\n", "5.02", "5.01", "bios 5.02, protocol 5.01"},
+           {"B,5.02,5.01\n", "5.02", "5.01", "bios 5.02, protocol 5.01"},
+           {"b, 5 , 4  ", "5", "4", "bios 5, protocol 4"},
+           {"b,K2 BIOS v5", "K2 BIOS v5", "", "K2 BIOS v5"},
+           {"b,,4", "", "4", ",4"},
+           {"b,5,4,2019-03, rev C", "5", "4", "bios 5, protocol 4 (2019-03, rev C)"},
+           {"b", "", "", ""},
+           {"b,-1,x", "-1", "x", "bios -1, protocol x"}}) {
+    const Result<Reply> r = decode_reply(k, CommandKind::kReadVersions, c.line);
+    ASSERT_TRUE(r.ok()) << printable(c.line) << ": " << r.error();
+    EXPECT_EQ(r->versions.bios, c.bios) << printable(c.line);
+    EXPECT_EQ(r->versions.protocol, c.protocol) << printable(c.line);
+    EXPECT_EQ(r->versions.text, c.text) << printable(c.line);
+  }
+  const SensorArray eight = {1, 2, 3, 4, 5, 6, 7, 8};
+  for (const char* line : {"n,1,2,3,4,5,6,7,8,9,10\r\n", "n,1,2,3,4,5,6,7,8   \r\n", "N,1,2,3,4,5,6,7,8\r\n",
+                           "n, 1, 2, 3, 4, 5, 6, 7, 8\n", "  n,1,2,3,4,5,6,7,8 \t\r", "n ,1,2,3,4,5,6,7,8",
+                           "n,+1,2,3,4,5,6,7,8,ok", "n,1,2,3,4,5,6,7,8,\r\n"}) {
+    const Result<Reply> r = decode_reply(k, CommandKind::kReadProximity, line);
+    ASSERT_TRUE(r.ok()) << printable(line) << ": " << r.error();
+    EXPECT_EQ(r->sensors, eight) << printable(line);
+  }
+  for (const char* line : {"d", "D", "d,0", "d,10,-10", "d OK", "d\n", " D \r\n"}) {
+    EXPECT_TRUE(decode_reply(k, CommandKind::kSetSpeeds, line).ok()) << printable(line);
+  }
+  for (const char* line : {"h,1,-2,extra,fields", "H,1,-2", "\th,1,-2\t", "h,  1,-2  ,  "}) {
+    const Result<Reply> r = decode_reply(k, CommandKind::kReadCounters, line);
+    ASSERT_TRUE(r.ok()) << printable(line) << ": " << r.error();
+    EXPECT_EQ(r->wheels, (WheelPair{1, -2})) << printable(line);
+  }
+  const Result<Reply> speeds = decode_reply(k, CommandKind::kReadSpeeds, "E,+5,-5,0\n");
+  ASSERT_TRUE(speeds.ok()) << speeds.error();
+  EXPECT_EQ(speeds->wheels, (WheelPair{5, -5}));
+}
+
+TEST(KheperaProtocol, TellsAnEchoOfTheCommandFromItsReply) {
+  const RobotModel& k = khepera2_model();
+  EXPECT_TRUE(is_echo_of(k, Command::set_speeds(10, -10), "D,10,-10"));
+  EXPECT_TRUE(is_echo_of(k, Command::set_speeds(10, -10), "D,10,-10\r\n"));
+  EXPECT_TRUE(is_echo_of(k, Command::read_proximity(), " N \r"));
+  EXPECT_TRUE(is_echo_of(k, Command::read_versions(), "B"));
+  EXPECT_FALSE(is_echo_of(k, Command::set_speeds(10, -10), "D,10,-11"));
+  EXPECT_FALSE(is_echo_of(k, Command::set_speeds(10, -10), "d"));
+  EXPECT_FALSE(is_echo_of(k, Command::read_proximity(), "n"));
+  EXPECT_FALSE(is_echo_of(k, Command::read_proximity(), "N,1,2,3,4,5,6,7,8"));
+  EXPECT_FALSE(is_echo_of(k, Command::read_proximity(), ""));
+  EXPECT_FALSE(is_echo_of(epuck_model(), Command::read_versions(), "B"));
+}
+
 TEST(KheperaProtocol, AcceptsAnyLineEnd) {
   const RobotModel& k = khepera2_model();
   for (const char* line : {"h,1,2\r\n", "h,1,2\n", "h,1,2\r", "h,1,2", "h,1,2\n\r"}) {
@@ -151,36 +211,35 @@ TEST(KheperaProtocol, RejectsMalformedRepliesWithAReason) {
   const std::vector<Case> cases = {
       {CommandKind::kReadProximity, "", "empty reply"},
       {CommandKind::kReadProximity, "\r\n", "empty reply"},
+      {CommandKind::kReadProximity, " \t \r\n", "empty reply"},
       {CommandKind::kReadProximity, "o,1,2,3,4,5,6,7,8", "expected \"n\""},
-      {CommandKind::kReadProximity, "N,1,2,3,4,5,6,7,8", "expected \"n\""},
-      {CommandKind::kReadProximity, "n,1,2,3,4,5,6,7", "has 7 values, expected 8"},
-      {CommandKind::kReadProximity, "n,1,2,3,4,5,6,7,8,9", "has 9 values, expected 8"},
-      {CommandKind::kReadProximity, "n", "expected 8 comma-separated values"},
-      {CommandKind::kReadProximity, "n1,2,3,4,5,6,7,8", "expected 8 comma-separated values"},
-      {CommandKind::kReadProximity, "nn,1,2,3,4,5,6,7,8", "expected 8 comma-separated values"},
-      {CommandKind::kReadProximity, "n,1,2,3,a,5,6,7,8", "value 4 \"a\" is not an integer"},
-      {CommandKind::kReadProximity, "n,1,2,3,,5,6,7,8", "value 4 \"\" is not an integer"},
-      {CommandKind::kReadProximity, "n,1,2,3, 4,5,6,7,8", "value 4 \" 4\" is not an integer"},
-      {CommandKind::kReadProximity, "n,1,2,3,+4,5,6,7,8", "is not an integer"},
+      {CommandKind::kReadProximity, "n,1,2,3,4,5,6,7", "field 8 (proximity sensor 7) is missing (7 of 8 values)"},
+      {CommandKind::kReadProximity, "n", "field 1 (proximity sensor 0) is missing (0 of 8 values)"},
+      {CommandKind::kReadProximity, "n1,2,3,4,5,6,7,8", "expected a comma after the letter"},
+      {CommandKind::kReadProximity, "nn,1,2,3,4,5,6,7,8", "expected a comma after the letter"},
+      {CommandKind::kReadProximity, "n 1,2,3,4,5,6,7,8", "expected a comma before the values"},
+      {CommandKind::kReadProximity, "n,1,2,3,a,5,6,7,8", "field 4 (proximity sensor 3) \"a\" is not an integer"},
+      {CommandKind::kReadProximity, "n,1,2,3,,5,6,7,8", "field 4 (proximity sensor 3) \"\" is not an integer"},
+      {CommandKind::kReadProximity, "n,1,2,3,4 4,5,6,7,8", "field 4 (proximity sensor 3) \"4 4\" is not an integer"},
       {CommandKind::kReadProximity, "n,1,2,3,4-,5,6,7,8", "is not an integer"},
       {CommandKind::kReadProximity, "n,1,2,3,-,5,6,7,8", "is not an integer"},
+      {CommandKind::kReadProximity, "n,1,2,3,+,5,6,7,8", "is not an integer"},
       {CommandKind::kReadProximity, "n,1,2,3,4.5,5,6,7,8", "is not an integer"},
-      {CommandKind::kReadProximity, "n,1,2,3,4,5,6,7,1024", "value 8 = 1024 is outside 0..1023"},
-      {CommandKind::kReadProximity, "n,-1,2,3,4,5,6,7,8", "value 1 = -1 is outside 0..1023"},
-      {CommandKind::kReadAmbient, "o,1,2,3,4,5,6,7,99999", "is outside 0..1023"},
-      {CommandKind::kReadSpeeds, "e,128,0", "value 1 = 128 is outside -127..127"},
-      {CommandKind::kReadSpeeds, "e,0,-128", "value 2 = -128 is outside -127..127"},
-      {CommandKind::kReadCounters, "h,2147483648,0", "is outside"},
+      {CommandKind::kReadProximity, "n,1,2,3,4,5,6,7,1024", "field 8 (proximity sensor 7) = 1024 is outside 0..1023"},
+      {CommandKind::kReadProximity, "n,-1,2,3,4,5,6,7,8", "field 1 (proximity sensor 0) = -1 is outside 0..1023"},
+      {CommandKind::kReadAmbient, "o,1,2,3,4,5,6,7,99999", "field 8 (ambient sensor 7) = 99999 is outside 0..1023"},
+      {CommandKind::kReadSpeeds, "e,128,0", "field 1 (left speed) = 128 is outside -127..127"},
+      {CommandKind::kReadSpeeds, "e,0,-128", "field 2 (right speed) = -128 is outside -127..127"},
+      {CommandKind::kReadCounters, "h,2147483648,0", "field 1 (left counter) = 2147483648 is outside"},
       {CommandKind::kReadCounters, "h,99999999999999999999999,0", "is not an integer"},
-      {CommandKind::kReadCounters, "h", "expected 2 comma-separated values"},
-      {CommandKind::kReadCounters, "h,1", "has 1 values, expected 2"},
-      {CommandKind::kReadVersions, "b,5", "has 1 values, expected 2"},
-      {CommandKind::kReadVersions, "b,-5,4", "is outside"},
-      {CommandKind::kSetSpeeds, "d,1", "expected no values"},
-      {CommandKind::kSetSpeeds, "d,", "expected no values"},
+      {CommandKind::kReadCounters, "h", "field 1 (left counter) is missing"},
+      {CommandKind::kReadCounters, "h,1", "field 2 (right counter) is missing (1 of 2 values)"},
+      {CommandKind::kReadCounters, "h,1,x2", "field 2 (right counter) \"x2\" is not an integer"},
+      {CommandKind::kSetSpeeds, "dx", "expected a comma after the letter"},
       {CommandKind::kSetSpeeds, "e", "expected \"d\""},
       {CommandKind::kSetLed, "z,Protocol error", "protocol error"},
       {CommandKind::kReadProximity, "z,Protocol error", "protocol error"},
+      {CommandKind::kReadProximity, "Z", "protocol error"},
       {CommandKind::kReadProximity, std::string("\xff\xfe\x01garbage", 10), "expected \"n\""},
       {CommandKind::kReadProximity, std::string("n,1,2\0,3,4,5,6,7,8", 18), "is not an integer"},
   };
@@ -197,6 +256,7 @@ TEST(KheperaProtocol, ReasonsQuoteTheLineWithControlBytesEscaped) {
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.error().find("\"h,1,\\x01\\0\""), std::string::npos) << r.error();
   EXPECT_NE(r.error().find("to H (read counters)"), std::string::npos) << r.error();
+  EXPECT_NE(r.error().find("field 2 (right counter)"), std::string::npos) << r.error();
   EXPECT_EQ(printable("a\r\n\"b\\"), "\"a\\r\\n\\\"b\\\\\"");
   EXPECT_EQ(printable("abcdef", 3), "\"abc...\"");
 }
@@ -210,6 +270,11 @@ TEST(KheperaProtocol, TellsAReplyShapedLineFromAStrayOne) {
   EXPECT_FALSE(looks_like_reply_to(k, CommandKind::kReadProximity, "nx"));
   EXPECT_FALSE(looks_like_reply_to(k, CommandKind::kReadProximity, "h,1,2"));
   EXPECT_FALSE(looks_like_reply_to(k, CommandKind::kReadProximity, ""));
+  // Other firmware: either case, blanks around the line.
+  EXPECT_TRUE(looks_like_reply_to(k, CommandKind::kReadProximity, "N,1,2,3,4,5,6,7,8"));
+  EXPECT_TRUE(looks_like_reply_to(k, CommandKind::kReadProximity, "  n ,1"));
+  EXPECT_TRUE(looks_like_reply_to(k, CommandKind::kSetSpeeds, "Z,Protocol error"));
+  EXPECT_FALSE(looks_like_reply_to(k, CommandKind::kReadProximity, "No such thing"));
 }
 
 TEST(KheperaProtocol, RepliesEncodedByTheEmulatorDecodeToThemselves) {
@@ -217,7 +282,8 @@ TEST(KheperaProtocol, RepliesEncodedByTheEmulatorDecodeToThemselves) {
     std::vector<Reply> replies;
     Reply r;
     r.kind = CommandKind::kReadVersions;
-    r.versions = model->numeric_versions ? FirmwareVersions{5, 4, "bios 5, protocol 4"} : FirmwareVersions{0, 0, "emulated"};
+    r.versions = model->bios_protocol_versions ? FirmwareVersions{"5.02", "5.01", "bios 5.02, protocol 5.01"}
+                                               : FirmwareVersions{"", "", "emulated"};
     replies.push_back(r);
     for (const CommandKind ack : {CommandKind::kSetSpeeds, CommandKind::kSetCounters, CommandKind::kSetLed}) {
       replies.push_back(Reply{ack});
