@@ -82,4 +82,42 @@ class BeaconHomingController final : public Controller {
   BeaconHomingConfig config_;
 };
 
+/// Knobs of going to a pose (placing a real robot at a run's start pose).
+struct GoToPoseConfig {
+  Pose2 target;                     ///< where to end, field frame
+  double speed_mps = 0.04;          ///< top speed: slow, so the camera keeps up and a bump is harmless
+  double position_tolerance_m = 0.01;   ///< close enough (the camera's error is far below this)
+  double heading_tolerance_rad = 0.07;  ///< about 4 degrees
+  /// Another robot nearer than this, ahead of it, makes it yield (a higher ID waits for a
+  /// lower one; the lower one steers around it), metres between centres.
+  double yield_distance_m = 0.13;
+  /// Robots nearer than this push its course away (as the convoy's repulsion), metres.
+  double repulse_radius_m = 0.12;
+  /// Waiting longer than this for another robot, it steers around it too, seconds.
+  double patience_s = 3.0;
+  SteeringConfig steering;
+};
+
+/// Drives to a pose slowly: turns towards the target, drives there avoiding the other
+/// robots of the team (repulsion, and yielding by ID when one is ahead), then turns on
+/// the spot to the target heading, and holds. Stands still while its pose is unknown.
+/// done() once it is within both tolerances (it starts again if pushed away by more than
+/// twice the position tolerance). Behaviours: "wait", "place", "yield", "align", "placed".
+class GoToPoseController final : public Controller {
+ public:
+  explicit GoToPoseController(GoToPoseConfig config);
+  ControlOutput step(const ControlInput& input) override;
+  bool wants_team() const override { return true; }
+  bool done() const override { return placed_; }
+
+ private:
+  // The nearest other robot ahead of `self` within the yield distance, if any.
+  const TeamMessage* blocker(const ControlInput& input, const Pose2& self) const;
+  Vec2 repulsion(const ControlInput& input, const Pose2& self) const;
+
+  GoToPoseConfig config_;
+  bool placed_ = false;
+  std::optional<TimeUs> waiting_since_us_;
+};
+
 }  // namespace rilbed::agents

@@ -85,6 +85,9 @@ class Controller {
   /// Whether it reads ControlInput::team. Only such agents are sent the team broadcast,
   /// which costs a copy of every member's message per agent.
   virtual bool wants_team() const { return false; }
+  /// Whether it has reached its goal (a controller with a goal, e.g. going to a pose);
+  /// a run with RunOptions::stop_when_done ends once every controller is done.
+  virtual bool done() const { return false; }
 };
 
 }  // namespace rilbed::agents

@@ -57,6 +57,9 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   Body& body() const { return body_; }
   /// Whether its controller reads the team broadcast.
   bool wants_team() const { return controller_ && controller_->wants_team(); }
+  /// Whether it has no goal left: no controller (it stands still or is commanded), or
+  /// its controller is done.
+  bool done() const { return !controller_ || controller_->done(); }
   /// The active behaviour (a static string), "idle" before the first step.
   std::string_view behaviour() const { return state_.last.behaviour; }
   const WheelCommand& wheels() const { return state_.last.wheels; }

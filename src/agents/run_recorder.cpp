@@ -1,6 +1,9 @@
 #include "agents/run_recorder.hpp"
 
+#include <cmath>
 #include <cstdio>
+#include <ostream>
+#include <string>
 #include <stdexcept>
 
 namespace rilbed::agents {
@@ -18,6 +21,28 @@ const char* colour(int index) {
   static const char* kColours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
                                    "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
   return kColours[static_cast<std::size_t>(index) % 10];
+}
+
+// The legend under the field: what a virtual and a real robot look like, and the start.
+void write_legend(std::ostream& svg, double x, double top) {
+  const double mid = top + 11.0;
+  auto num = [](double v) { return format("%.1f", v); };
+  svg << "<g class=\"legend\">\n";
+  svg << "<circle r=\"8\" fill=\"#888\" fill-opacity=\"0.35\" stroke=\"#888\" cx=\"" << num(x + 8) << "\" cy=\"" << num(mid)
+      << "\"/>\n";
+  svg << "<line stroke=\"#888\" stroke-width=\"1.5\" x1=\"" << num(x + 20) << "\" y1=\"" << num(mid) << "\" x2=\""
+      << num(x + 44) << "\" y2=\"" << num(mid) << "\"/>\n";
+  svg << "<text x=\"" << num(x + 50) << "\" y=\"" << num(mid + 4) << "\">virtual robot</text>\n";
+  const double rx = x + 150;
+  svg << "<rect width=\"16\" height=\"16\" x=\"" << num(rx) << "\" y=\"" << num(mid - 8)
+      << "\" fill=\"#888\" fill-opacity=\"0.35\" stroke=\"#000\" stroke-width=\"2\"/>\n";
+  svg << "<line stroke=\"#888\" stroke-width=\"1.5\" stroke-dasharray=\"6,3\" x1=\"" << num(rx + 20) << "\" y1=\"" << num(mid)
+      << "\" x2=\"" << num(rx + 44) << "\" y2=\"" << num(mid) << "\"/>\n";
+  svg << "<text x=\"" << num(rx + 50) << "\" y=\"" << num(mid + 4) << "\">real robot (as the camera saw it)</text>\n";
+  const double sx = rx + 260;
+  svg << "<circle r=\"3\" fill=\"none\" stroke=\"#888\" cx=\"" << num(sx + 8) << "\" cy=\"" << num(mid) << "\"/>\n";
+  svg << "<text x=\"" << num(sx + 16) << "\" y=\"" << num(mid + 4) << "\">start (the last pose shows the heading)</text>\n";
+  svg << "</g>\n";
 }
 
 }  // namespace
@@ -86,7 +111,8 @@ void RunRecorder::finish(const nlohmann::json& summary) {
 void RunRecorder::write_svg() const {
   // 500 pixels per metre; y flipped so that the field's +y is up on screen.
   const double scale = 500.0, margin = 20.0;
-  const double w = field_.width_m * scale + 2 * margin, h = field_.height_m * scale + 2 * margin;
+  const double legend_h = 28.0;
+  const double w = field_.width_m * scale + 2 * margin, h = field_.height_m * scale + 2 * margin + legend_h;
   // Screen coordinates of a field point, as text.
   struct Screen {
     std::string x, y;
@@ -118,10 +144,13 @@ void RunRecorder::write_svg() const {
     const Screen s = screen(b);
     svg << "<circle r=\"6\" fill=\"#fc0\" stroke=\"#a80\" cx=\"" << s.x << "\" cy=\"" << s.y << "\"/>\n";
   }
+  const double body_r = 0.0275 * scale;  // a Khepera is 55 mm across
   int index = 0;
   for (const auto& [id, path] : paths_) {
     const char* c = colour(index++);
-    svg << "<polyline fill=\"none\" stroke=\"" << c << "\" stroke-width=\"1.5\" points=\"";
+    const bool real = field_.real_robot_ids.contains(id);
+    svg << "<polyline fill=\"none\" stroke=\"" << c << "\" stroke-width=\"1.5\""
+        << (real ? " stroke-dasharray=\"6,3\"" : "") << " points=\"";
     for (const Vec2& p : path) svg << px(p) << ' ';
     svg << "\"/>\n";
     if (!path.empty()) {
@@ -135,12 +164,19 @@ void RunRecorder::write_svg() const {
       const Screen nose = screen(p.position_m + Vec2{std::cos(p.heading_rad), std::sin(p.heading_rad)} * 0.0275);
       const std::string& cx = centre.x;
       const std::string& cy = centre.y;
-      svg << "<circle r=\"" << format("%.1f", 0.0275 * scale) << "\" fill=\"" << c << "\" fill-opacity=\"0.35\" stroke=\"" << c
-          << "\" cx=\"" << cx << "\" cy=\"" << cy << "\"/>\n";
+      if (real) {
+        svg << "<rect class=\"real\" width=\"" << format("%.1f", 2 * body_r) << "\" height=\"" << format("%.1f", 2 * body_r)
+            << "\" x=\"" << format("%.1f", std::stod(cx) - body_r) << "\" y=\"" << format("%.1f", std::stod(cy) - body_r)
+            << "\" fill=\"" << c << "\" fill-opacity=\"0.35\" stroke=\"#000\" stroke-width=\"2\"/>\n";
+      } else {
+        svg << "<circle class=\"virtual\" r=\"" << format("%.1f", body_r) << "\" fill=\"" << c
+            << "\" fill-opacity=\"0.35\" stroke=\"" << c << "\" cx=\"" << cx << "\" cy=\"" << cy << "\"/>\n";
+      }
       svg << "<line stroke=\"#000\" x1=\"" << cx << "\" y1=\"" << cy << "\" x2=\"" << nose.x << "\" y2=\"" << nose.y << "\"/>\n";
       svg << "<text x=\"" << cx << "\" y=\"" << cy << "\" dy=\"4\" text-anchor=\"middle\">" << id << "</text>\n";
     }
   }
+  write_legend(svg, margin, h - legend_h + 4.0);
   svg << "</svg>\n";
 }
 

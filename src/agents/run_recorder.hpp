@@ -8,6 +8,7 @@
 #include <fstream>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -46,9 +47,14 @@ struct FieldDrawing {
   std::vector<std::vector<Vec2>> obstacles;               ///< closed polygons
   std::vector<std::pair<std::vector<Vec2>, double>> tracks;  ///< polylines with their width
   std::vector<Vec2> beacons;
+  /// Robots that are real (drawn apart from virtual ones, with a legend).
+  std::set<int> real_robot_ids;
 };
 
-/// Writes one run's folder. Not thread-safe.
+/// Writes one run's folder. Not thread-safe. The picture shows each robot's path (solid
+/// for a virtual robot, dashed for a real one), its start (a small circle) and its last
+/// pose (a disc for a virtual robot, a square for a real one, with its heading), and a
+/// legend below the field.
 class RunRecorder {
  public:
   /// Creates `dir` (and parents) and opens the two CSV files with their headers. Throws

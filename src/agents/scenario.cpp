@@ -263,7 +263,8 @@ std::vector<RobotSpec> read_robots(const Reader& top) {
     if (r.has("link")) {
       if (base.kind != environment::RobotKind::Real) r.fail_key("link", "only a robot of kind real has a link");
       const Reader l = r.child("link");
-      l.allow({"port", "baud", "model", "emulate", "faults", "reply_timeout_ms", "retries", "counters_period_ms"});
+      l.allow({"port", "baud", "model", "emulate", "placement", "faults", "reply_timeout_ms", "retries",
+               "counters_period_ms"});
       LinkSpec link;
       link.port = l.text("port", "");
       link.baud = l.integer("baud", link.baud);
@@ -276,6 +277,15 @@ std::vector<RobotSpec> read_robots(const Reader& top) {
       link.counters_period_ms = l.integer("counters_period_ms", link.counters_period_ms);
       if (link.counters_period_ms < 0) l.fail_key("counters_period_ms", "must not be negative");
       if (link.port.empty() == !link.emulate) l.fail(r.get("link"), "give either `port` or `emulate: true`");
+      const std::string placement = l.text("placement", link.emulate ? "teleport" : "drive");
+      if (placement == "drive") {
+        link.placement = Placement::kDrive;
+      } else if (placement == "teleport") {
+        if (!link.emulate) l.fail_key("placement", "only an emulated robot can be put in place by rilbed (a real one is driven there)");
+        link.placement = Placement::kTeleport;
+      } else {
+        l.fail_key("placement", "is drive or teleport, not '" + placement + "'");
+      }
       if (l.has("faults")) {
         if (!link.emulate) l.fail_key("faults", "only an emulated robot injects faults");
         const Reader f = l.child("faults");
@@ -504,6 +514,14 @@ std::vector<Pose2> draw_initial_poses(const Scenario& scenario, std::mt19937_64&
     }
   }
   return poses;
+}
+
+std::vector<int> real_robot_ids(const Scenario& scenario) {
+  std::vector<int> ids;
+  for (const RobotSpec& r : scenario.robots) {
+    if (r.kind == environment::RobotKind::Real) ids.push_back(r.id);
+  }
+  return ids;
 }
 
 }  // namespace rilbed::agents

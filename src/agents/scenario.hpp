@@ -32,12 +32,18 @@ class ScenarioError : public std::runtime_error {
 /// Who decides for the convoy (paper 001 §5).
 enum class ConvoyMode { kDistributed, kCentral };
 
+/// How a real robot gets to a run's start pose (before each run of a batch, and before a
+/// single run): a real robot is driven there slowly under the camera; an emulated one is
+/// put there, as a hand would, unless it is to try the driving.
+enum class Placement { kTeleport, kDrive };
+
 /// How a real robot is reached (used by runs with real robots).
 struct LinkSpec {
   std::string port;            ///< serial device, e.g. /dev/ttyUSB0; empty when emulated
-  int baud = 38400;
+  int baud = 0;                ///< 0: the model's own (Khepera 38400, e-puck 115200)
   std::string model = "khepera2";  ///< protocol variant: khepera2 | epuck
   bool emulate = false;        ///< start an emulated Khepera on a pseudo-terminal instead
+  Placement placement = Placement::kDrive;  ///< `placement:` (emulated robots: teleport by default)
   int reply_timeout_ms = 250;  ///< how long one command waits for its reply
   int retries = 3;             ///< further attempts before a command fails
   int counters_period_ms = 200;  ///< read the wheel counters (`H`) this often (0: never)
@@ -102,6 +108,9 @@ struct Scenario {
   double geofence_margin_m = 0.0;
   std::vector<RobotSpec> robots;    ///< sorted by ID
 };
+
+/// The IDs of the scenario's real robots, in ID order.
+std::vector<int> real_robot_ids(const Scenario& scenario);
 
 /// Reads and checks a scenario file. Throws ScenarioError.
 Scenario load_scenario(const std::filesystem::path& path);

@@ -12,6 +12,7 @@
 #include "agents/c_controller.hpp"
 #include "agents/convoy.hpp"
 #include "agents/run_models.hpp"
+#include "core/id_list.hpp"
 #include "sim/clock.hpp"
 #include "sim/coordinator.hpp"
 #include "sim/coupled.hpp"
@@ -238,8 +239,13 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     if (s_.recorder) s_.recorder->add_samples(samples_);
     if (s_.options->keep_in_memory) r.trajectory.insert(r.trajectory.end(), samples_.begin(), samples_.end());
     if (!s_.convoy_ids.empty()) check_formation(t);
+    if (s_.options->stop_when_done &&
+        std::all_of(s_.agents.begin(), s_.agents.end(), [](const AgentModel* a) { return a->done(); })) {
+      end("done");
+    }
     if (s_.options->on_status && t >= next_status_us_) {
-      next_status_us_ = t + 1'000'000;
+      // Once per simulated second: the first sample at or after each whole second.
+      next_status_us_ = (t / 1'000'000 + 1) * 1'000'000;
       std::ostringstream line;
       line << "t=" << std::fixed;
       line.precision(1);
@@ -357,6 +363,17 @@ std::unique_ptr<Controller> make_controller(const Scenario& scenario, const Robo
     c.speed_mps = param(spec, "speed_mps", c.speed_mps, used);
     if (!spec.sensors.beacon_finder) throw ScenarioError(where + ": beacon_homing needs `sensors: beacon_finder:`");
     controller = std::make_unique<BeaconHomingController>(c);
+  } else if (name == "goto") {
+    GoToPoseConfig c;
+    c.target = Pose2{{param(spec, "x_m", 0.0, used), param(spec, "y_m", 0.0, used)},
+                     deg_to_rad(param(spec, "theta_deg", 0.0, used))};
+    if (!spec.controller.params.contains("x_m") || !spec.controller.params.contains("y_m")) {
+      throw ScenarioError(where + ": goto needs params x_m and y_m (and theta_deg)");
+    }
+    c.speed_mps = param(spec, "speed_mps", c.speed_mps, used);
+    c.position_tolerance_m = param(spec, "tolerance_m", c.position_tolerance_m, used);
+    c.heading_tolerance_rad = deg_to_rad(param(spec, "tolerance_deg", rad_to_deg(c.heading_tolerance_rad), used));
+    controller = std::make_unique<GoToPoseController>(c);
   } else if (name.rfind("c:", 0) == 0) {
     const rilbed_c_controller* c = find_c_controller(name.substr(2));
     if (!c) {
@@ -367,12 +384,18 @@ std::unique_ptr<Controller> make_controller(const Scenario& scenario, const Robo
     controller = std::make_unique<CControllerAdapter>(*c);
   } else if (name != "none") {
     throw ScenarioError(where + ": unknown controller '" + name +
-                        "' (convoy, wander, track_follow, beacon_homing, c:<name>, none)");
+                        "' (convoy, wander, track_follow, beacon_homing, goto, c:<name>, none)");
   }
   for (const auto& [key, value] : spec.controller.params) {
     if (!used.contains(key)) throw ScenarioError(where + ": controller " + name + " has no parameter '" + key + "'");
   }
   return controller;
+}
+
+std::vector<Pose2> start_poses(const Scenario& scenario, std::uint64_t seed) {
+  std::seed_seq pose_seed{seed, std::uint64_t{0x706f736573}};
+  std::mt19937_64 pose_rng(pose_seed);
+  return draw_initial_poses(scenario, pose_rng);
 }
 
 RunResult run_scenario(const Scenario& scenario, const RunOptions& options, const RealBodyFactory& real_bodies) {
@@ -381,9 +404,8 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   result.seed = options.seed;
   // Separate streams for the initial poses and for the run's noise, both from the seed,
   // so that changing a sensor's noise does not move the starting poses.
-  std::seed_seq pose_seed{options.seed, std::uint64_t{0x706f736573}};
   std::seed_seq noise_seed{options.seed, std::uint64_t{0x6e6f697365}};
-  std::mt19937_64 pose_rng(pose_seed), noise_rng(noise_seed);
+  std::mt19937_64 noise_rng(noise_seed);
 
   // The convoy: robots with the convoy controller, numbered 1..N.
   std::vector<int> convoy_ids;
@@ -398,19 +420,14 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   }
 
   result.convoy_size = static_cast<int>(convoy_ids.size());
-  std::string real_list;
-  for (const RobotSpec& r : scenario.robots) {
-    if (r.kind != environment::RobotKind::Real) continue;
-    if (!real_list.empty()) real_list += ", ";
-    real_list += std::to_string(r.id);
-  }
-  if (!real_list.empty() && (!options.realtime || options.rt_factor != 1.0)) {
-    throw ScenarioError(scenario.source.string() + ": robots " + real_list +
-                        " are real and move in wall-clock time: run with --realtime and a factor of 1");
+  const std::vector<int> real_ids = real_robot_ids(scenario);
+  if (!real_ids.empty() && (!options.realtime || options.rt_factor != 1.0)) {
+    throw ScenarioError(scenario.source.string() + ": robots " + id_list_text(real_ids) +
+                        " are real and move in wall-clock time: they run in real time at a factor of 1");
   }
   environment::World world(scenario.map);
   for (const auto& m : scenario.moving_obstacles) world.add_moving_obstacle(m);
-  const std::vector<Pose2> poses = draw_initial_poses(scenario, pose_rng);
+  const std::vector<Pose2> poses = start_poses(scenario, options.seed);
   // The camera is checked (its calibration, device or footage) before any real robot's
   // link is opened, so that a bad camera never leaves a robot started.
   std::shared_ptr<VisionModel> camera = scenario.camera ? make_camera(scenario, options, world) : nullptr;
@@ -474,6 +491,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
       drawing.tracks.emplace_back(points, t.width_m);
     }
     for (const auto& b : scenario.map.beacons) drawing.beacons.push_back(b.position_m);
+    drawing.real_robot_ids = {real_ids.begin(), real_ids.end()};
     recorder = std::make_unique<RunRecorder>(*options.out_dir, drawing);
   }
   const double duration_s = options.duration_s.value_or(scenario.duration_s);
@@ -513,6 +531,9 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   if (result.ended_by.empty()) result.ended_by = "duration";
   result.simulated_s = us_to_seconds(std::min(coordinator.now_us(), end_us));
   result.formed = monitor.formed();
+  for (const AgentModel* a : agents) {
+    if (!a->done()) result.not_done.push_back(a->body().id());
+  }
   if (const auto t = monitor.formation_time_us()) result.formation_time_s = us_to_seconds(*t);
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   if (recorder) {
@@ -521,6 +542,8 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
     summary["mode"] = scenario.mode == ConvoyMode::kCentral ? "central" : "distributed";
     summary["robots"] = scenario.robots.size();
     summary["realtime"] = options.realtime;
+    summary["real_robots"] = real_ids;
+    summary["virtual_stand_ins"] = options.virtual_stand_ins;
     if (options.realtime) summary["rt_factor"] = options.rt_factor;
     if (!result.formed && !convoy_ids.empty()) recorder->add_event({coordinator.now_us(), "note", 0, 0, "the convoy did not form"});
     recorder->finish(summary);

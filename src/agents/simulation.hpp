@@ -35,6 +35,7 @@ struct RunOptions {
   bool realtime = false;             ///< pace to the wall clock (else as fast as possible)
   double rt_factor = 1.0;            ///< simulated seconds per wall second when realtime
   bool stop_when_formed = false;     ///< end after_formed_s after the convoy formed
+  bool stop_when_done = false;       ///< end once every agent is done (Controller::done)
   double after_formed_s = 5.0;
   std::optional<std::filesystem::path> out_dir;  ///< write the run folder here
   /// Set from another thread or a signal handler (it is only read) to end the run early.
@@ -46,6 +47,9 @@ struct RunOptions {
   /// With `camera: {emulate: true}`: the markers of the emulated real robots at their true
   /// poses now (the links layer reads them from its emulators). Called on the run's thread.
   std::function<std::vector<vision::SceneMarker>()> emulated_markers;
+  /// The scenario's real robots that this run simulates instead (`--all-virtual`): written
+  /// to summary.json, so that `rilbed compare` knows which robots the comparison is about.
+  std::vector<int> virtual_stand_ins;
 };
 
 /// What a run came to.
@@ -61,7 +65,8 @@ struct RunResult {
   double wall_s = 0.0;                      ///< the whole call, building the world included
   double run_wall_s = 0.0;                  ///< the DEVS run alone (what sim-bench reports)
   double run_cpu_s = 0.0;                   ///< the calling thread's CPU time in the DEVS run
-  std::string ended_by;                     ///< "duration", "formed" or "interrupt"
+  std::string ended_by;                     ///< "duration", "formed", "done" or "interrupt"
+  std::vector<int> not_done;                ///< with stop_when_done: the robots whose agent was not done at the end
   std::vector<TrajectorySample> trajectory; ///< with keep_in_memory only
   /// summary.json's content.
   nlohmann::json summary() const;
@@ -74,6 +79,11 @@ using RealBodyFactory = std::function<std::unique_ptr<Body>(const RobotSpec&, en
 /// Makes the controller named in `spec` (nullptr for a commanded convoy agent in central
 /// mode, or "none"). Throws ScenarioError for an unknown name or parameter.
 std::unique_ptr<Controller> make_controller(const Scenario& scenario, const RobotSpec& spec);
+
+/// The robots' start poses of a run with `seed` (in scenario.robots' order): fixed poses
+/// as given, the others drawn from the seed (draw_initial_poses), exactly as
+/// run_scenario() places them. Real robots are placed there before a run (RealRobots).
+std::vector<Pose2> start_poses(const Scenario& scenario, std::uint64_t seed);
 
 /// Runs `scenario` once with `options`. Throws ScenarioError for a scenario the run cannot
 /// use (e.g. convoy IDs not 1..N, real robots without a factory) and std::runtime_error

@@ -8,6 +8,9 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <limits>
+#include <map>
+#include <stdexcept>
 #include <mutex>
 #include <thread>
 
@@ -16,7 +19,9 @@
 #include "agents/scenario.hpp"
 #include "agents/simulation.hpp"
 #include "app/commands.hpp"
+#include "core/id_list.hpp"
 #include "core/statistics.hpp"
+#include "links/placement.hpp"
 #include "links/real_robots.hpp"
 
 namespace rilbed::app {
@@ -29,6 +34,37 @@ std::atomic<bool> interrupted{false};
 static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler needs a lock-free flag");
 
 extern "C" void on_signal(int) { interrupted.store(true); }
+
+// Set when a batch cannot go on (its real robots could not be placed): the seeds left are
+// not run.
+std::atomic<bool> batch_aborted{false};
+
+void log_to_spdlog(links::LogLevel level, const std::string& message) {
+  if (level == links::LogLevel::kError) spdlog::error("{}", message);
+  else if (level == links::LogLevel::kWarning) spdlog::warn("{}", message);
+  else if (level == links::LogLevel::kInfo) spdlog::info("{}", message);
+}
+
+void print_emulated_last_speeds(const links::RealRobots& real) {
+  for (const auto& [id, emulator] : real.emulators()) {
+    const auto speeds = emulator->last_speeds();
+    std::printf("robot %d (emulated): last speed %d %d\n", id, speeds.left_units, speeds.right_units);
+  }
+}
+
+// The operator, on the terminal: reads a line from standard input once the robots are in
+// place; "q" (or the end of input: nobody there) gives up.
+bool ask_operator_on_stdin(const std::string& message) {
+  std::fprintf(stderr, "%s\nPlace them, then press Enter (q and Enter to give up): ", message.c_str());
+  std::fflush(stderr);
+  std::string answer;
+  if (!std::getline(std::cin, answer)) {
+    std::fprintf(stderr, "\n");
+    spdlog::error("no operator answered (standard input is closed)");
+    return false;
+  }
+  return answer != "q" && answer != "Q";
+}
 
 struct RunArgs {
   std::string scenario;
@@ -44,7 +80,34 @@ struct RunArgs {
   bool quiet = false;
   std::string mode;  // overrides the scenario's
   bool all_virtual = false;
+  bool no_place = false;      // real robots start where they stand
+  double place_timeout_s = 90.0;
 };
+
+// Puts the real robots at the start poses of `seed` (links::place_real_robots), reports
+// what it did, and throws when they could not be placed (the batch then ends).
+void place_or_throw(links::RealRobots& real, const agents::Scenario& scenario, std::uint64_t seed, const RunArgs& args) {
+  const std::vector<Pose2> poses = agents::start_poses(scenario, seed);
+  std::map<int, Pose2> targets;
+  for (std::size_t i = 0; i < scenario.robots.size(); ++i) {
+    if (scenario.robots[i].kind == environment::RobotKind::Real) targets[scenario.robots[i].id] = poses[i];
+  }
+  links::PlacementOptions o;
+  o.timeout_s = args.place_timeout_s;
+  o.ask_operator = ask_operator_on_stdin;
+  o.interrupt = &interrupted;
+  o.log = log_to_spdlog;
+  const links::PlacementResult r = links::place_real_robots(real, targets, o);
+  if (!r.ok) {
+    batch_aborted.store(true);
+    throw std::runtime_error("seed " + std::to_string(seed) + ": " + r.error);
+  }
+  if (!r.offset_m.empty()) {
+    std::string offsets;
+    for (const auto& [id, d] : r.offset_m) offsets += fmt::format("{}robot {}: {:.1f} mm", offsets.empty() ? "" : ", ", id, d * 1000.0);
+    spdlog::info("seed {}: real robots placed in {:.1f} s (distance from the start pose: {})", seed, r.wall_s, offsets);
+  }
+}
 
 void print_result(const agents::RunResult& r) {
   char formed[64] = "no convoy";
@@ -55,7 +118,11 @@ void print_result(const agents::RunResult& r) {
               r.simulated_s, r.wall_s, r.ended_by.c_str());
 }
 
-int run_batch(const agents::Scenario& scenario, const RunArgs& args, agents::RunOptions base) {
+// Runs one seed of a batch (its options already hold the seed and out_dir).
+using SeedRunner = std::function<agents::RunResult(const agents::RunOptions&)>;
+
+int run_batch(const agents::Scenario& scenario, const RunArgs& args, agents::RunOptions base, const SeedRunner& run_seed,
+              int max_jobs) {
   const int n = args.seeds;
   std::vector<agents::RunResult> results(n);
   std::vector<std::string> errors(n);
@@ -63,12 +130,12 @@ int run_batch(const agents::Scenario& scenario, const RunArgs& args, agents::Run
   std::mutex print_mutex;
   const auto wall_start = std::chrono::steady_clock::now();
   auto worker = [&] {
-    for (int i = next++; i < n && !interrupted.load(); i = next++) {
+    for (int i = next++; i < n && !interrupted.load() && !batch_aborted.load(); i = next++) {
       agents::RunOptions o = base;
       o.seed = args.seed + static_cast<std::uint64_t>(i);
       if (!args.out.empty()) o.out_dir = std::filesystem::path(args.out) / ("seed_" + std::to_string(o.seed));
       try {
-        results[i] = agents::run_scenario(scenario, o);
+        results[i] = run_seed(o);
       } catch (const std::exception& e) {
         errors[i] = e.what();
         results[i].seed = o.seed;
@@ -78,7 +145,7 @@ int run_batch(const agents::Scenario& scenario, const RunArgs& args, agents::Run
       if (!args.quiet) print_result(results[i]);
     }
   };
-  const int jobs = std::max(1, args.jobs > 0 ? args.jobs : static_cast<int>(std::thread::hardware_concurrency()));
+  const int jobs = std::clamp(args.jobs > 0 ? args.jobs : static_cast<int>(std::thread::hardware_concurrency()), 1, max_jobs);
   std::vector<std::thread> threads;
   for (int j = 0; j < std::min(jobs, n); ++j) threads.emplace_back(worker);
   for (auto& t : threads) t.join();
@@ -145,19 +212,30 @@ int run_command(const RunArgs& args) {
     spdlog::error("{}", e.what());
     return kExitFailure;
   }
+  std::vector<int> stand_ins;  // real robots this run simulates (--all-virtual)
   if (args.all_virtual) {
     // The same robots, poses and controllers, every one virtual: the simulation half of a
     // sim-to-real comparison (`rilbed compare`).
     for (agents::RobotSpec& r : scenario.robots) {
+      if (r.kind == environment::RobotKind::Real) stand_ins.push_back(r.id);
       r.kind = environment::RobotKind::Virtual;
       r.link.reset();
     }
     scenario.camera.reset();
   }
+  const std::vector<int> real_ids = agents::real_robot_ids(scenario);
+  if (!real_ids.empty() && args.fast) {
+    // Safe default: real robots move in wall-clock time, whatever the simulation's clock.
+    spdlog::error("{}: robots {} are real and move in wall-clock time, so --fast cannot run them: leave --fast out "
+                  "(runs with real robots are real time), or add --all-virtual to run them as virtual robots",
+                  args.scenario, id_list_text(real_ids));
+    return kExitUsage;
+  }
   if (args.mode == "central") scenario.mode = agents::ConvoyMode::kCentral;
   if (args.mode == "distributed") scenario.mode = agents::ConvoyMode::kDistributed;
   agents::RunOptions options;
-  options.realtime = args.realtime;
+  options.realtime = args.realtime || !real_ids.empty();
+  options.virtual_stand_ins = stand_ins;
   options.rt_factor = args.rt_factor;
   options.duration_s = args.duration_s;
   options.stop_when_formed = args.stop_when_formed;
@@ -165,37 +243,45 @@ int run_command(const RunArgs& args) {
   options.interrupt = &interrupted;
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  if (args.seeds > 0) return run_batch(scenario, args, options);
+  if (real_ids.empty()) {
+    if (args.seeds > 0) {
+      return run_batch(scenario, args, options, [&](const agents::RunOptions& o) { return agents::run_scenario(scenario, o); },
+                       std::numeric_limits<int>::max());
+    }
+  }
   if (!args.out.empty()) options.out_dir = args.out;
-  if (args.realtime && !args.quiet) {
+  if (options.realtime && !args.quiet && args.seeds == 0) {
     options.on_status = [](const std::string& line) {
       std::printf("%s\n", line.c_str());
       std::fflush(stdout);
     };
   }
-  // Real robots: their links (and emulators) live until the run has stopped them.
+  // Real robots: their links (and emulators) stay open from run to run of a batch, and
+  // live until every run has stopped them.
   std::unique_ptr<links::RealRobots> real;
   agents::RealBodyFactory real_bodies;
-  const bool has_real = std::any_of(scenario.robots.begin(), scenario.robots.end(),
-                                    [](const agents::RobotSpec& r) { return r.kind == environment::RobotKind::Real; });
-  if (has_real) {
-    real = std::make_unique<links::RealRobots>(scenario, [](links::LogLevel level, const std::string& message) {
-      if (level == links::LogLevel::kError) spdlog::error("{}", message);
-      else if (level == links::LogLevel::kWarning) spdlog::warn("{}", message);
-      else if (level == links::LogLevel::kInfo) spdlog::info("{}", message);
-    });
+  SeedRunner run_seed = [&](const agents::RunOptions& o) { return agents::run_scenario(scenario, o, real_bodies); };
+  if (!real_ids.empty()) {
+    real = std::make_unique<links::RealRobots>(scenario, log_to_spdlog);
     real_bodies = real->body_factory();
     options.emulated_markers = [&real] { return real->emulated_markers(); };
+    // Before each run, every real robot goes to the run's start pose (as its all-virtual
+    // twin starts): emulated ones are put there, physical ones driven there.
+    run_seed = [&](const agents::RunOptions& o) {
+      if (!args.no_place) place_or_throw(*real, scenario, o.seed, args);
+      return agents::run_scenario(scenario, o, real_bodies);
+    };
+    if (args.seeds > 0) {
+      // One after another: the robots are the same ones.
+      const int status = run_batch(scenario, args, options, run_seed, 1);
+      print_emulated_last_speeds(*real);
+      return status;
+    }
   }
   try {
-    const agents::RunResult r = agents::run_scenario(scenario, options, real_bodies);
+    const agents::RunResult r = run_seed(options);
     print_result(r);
-    if (real) {
-      for (const auto& [id, emulator] : real->emulators()) {
-        const auto speeds = emulator->last_speeds();
-        std::printf("robot %d (emulated): last speed %d %d\n", id, speeds.left_units, speeds.right_units);
-      }
-    }
+    if (real) print_emulated_last_speeds(*real);
     if (!args.out.empty()) std::printf("run folder: %s\n", args.out.c_str());
   } catch (const agents::ScenarioError& e) {
     spdlog::error("{}", e.what());
@@ -213,8 +299,9 @@ void add_run_command(CLI::App& app) {
   auto args = std::make_shared<RunArgs>();
   CLI::App* cmd = app.add_subcommand("run", "Run a scenario (simulation; robot-in-the-loop when it has real robots)");
   cmd->add_option("scenario", args->scenario, "Scenario file (YAML, see scenarios/README.md)")->required()->check(CLI::ExistingFile);
-  auto* fast = cmd->add_flag("--fast", args->fast, "As fast as the CPU allows (the default)");
-  auto* realtime = cmd->add_flag("--realtime", args->realtime, "Paced to the wall clock");
+  auto* fast = cmd->add_flag("--fast", args->fast,
+                             "As fast as the CPU allows (the default without real robots; an error with them)");
+  auto* realtime = cmd->add_flag("--realtime", args->realtime, "Paced to the wall clock (the default with real robots)");
   fast->excludes(realtime);
   cmd->add_option("--rt-factor", args->rt_factor, "With --realtime: simulated seconds per wall second")
       ->check(CLI::PositiveNumber)->needs(realtime);
@@ -230,6 +317,12 @@ void add_run_command(CLI::App& app) {
       ->check(CLI::IsMember({"central", "distributed"}));
   cmd->add_flag("--all-virtual", args->all_virtual,
                 "Make every real robot virtual (same poses and controllers): the simulation half of a sim-to-real comparison");
+  cmd->add_flag("--no-place", args->no_place,
+                "Real robots start where they stand (default: before each run they are driven, or put if emulated, "
+                "to the run's start poses)");
+  cmd->add_option("--place-timeout", args->place_timeout_s,
+                  "Seconds the real robots get to drive to their start poses before the operator is asked")
+      ->check(CLI::PositiveNumber)->default_val(90);
   cmd->add_flag("--quiet", args->quiet, "No per-second status (realtime) or per-run lines (batch)");
   cmd->callback([args] { exit_code() = run_command(*args); });
 }

@@ -54,4 +54,13 @@ IdListResult parse_id_list(std::string_view text, int min_id, int max_id) {
   return result;
 }
 
+std::string id_list_text(const std::vector<int>& ids) {
+  std::string text;
+  for (const int id : ids) {
+    if (!text.empty()) text += ", ";
+    text += std::to_string(id);
+  }
+  return text;
+}
+
 }  // namespace rilbed

@@ -20,4 +20,7 @@ struct IdListResult {
 /// Every ID must lie in [min_id, max_id]. Whitespace around items is ignored.
 IdListResult parse_id_list(std::string_view text, int min_id, int max_id);
 
+/// IDs as people read them: "4, 5, 7" (in the order given; empty for none).
+std::string id_list_text(const std::vector<int>& ids);
+
 }  // namespace rilbed

@@ -540,6 +540,22 @@ bool KheperaLink::stop(std::optional<int> timeout_ms) {
   return acknowledged;
 }
 
+bool KheperaLink::halt(std::optional<int> timeout_ms) {
+  Impl& m = *impl_;
+  std::unique_lock lock(m.mutex);
+  if (!m.started || m.stop_result || m.stopping) return false;
+  m.wished = WheelSpeeds{};
+  m.wish_pending = true;
+  const std::uint64_t halt_serial = ++m.wish_serial;
+  lock.unlock();
+  m.kick();
+  const auto wait = std::chrono::milliseconds(timeout_ms.value_or(2 * m.command_budget_ms() + 100));
+  lock.lock();
+  return m.changed.wait_for(lock, wait, [&] {
+    return m.acknowledged_wish_serial >= halt_serial || m.status.state == LinkState::kLost;
+  }) && m.acknowledged_wish_serial >= halt_serial;
+}
+
 void KheperaLink::set_speeds(int left_units, int right_units) {
   Impl& m = *impl_;
   {

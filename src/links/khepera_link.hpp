@@ -148,6 +148,12 @@ class KheperaLink {
   /// never started). Later calls return the first call's result at once.
   bool stop(std::optional<int> timeout_ms = std::nullopt);
 
+  /// Stops the robot (`D,0,0`) and waits up to `timeout_ms` (default as stop()) for it to
+  /// acknowledge, keeping the link open: between the runs of a batch. Returns whether the
+  /// robot acknowledged (false if the link is not running, lost, or the robot did not
+  /// answer). Later set_speeds() calls drive it again.
+  bool halt(std::optional<int> timeout_ms = std::nullopt);
+
   /// Wishes wheel speeds, in the model's units (Khepera: +-127, 8 mm/s per unit); values
   /// beyond the range are clamped when sent (counted in clamped_speeds). Never blocks on
   /// the line; the latest wish is sent when the line is free.

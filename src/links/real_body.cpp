@@ -6,7 +6,7 @@
 
 namespace rilbed::links {
 
-RealBody::RealBody(int id, environment::World& world, std::unique_ptr<KheperaLink> link, RealBodyConfig config,
+RealBody::RealBody(int id, environment::World& world, std::shared_ptr<KheperaLink> link, RealBodyConfig config,
                    std::mt19937_64& rng)
     : id_(id), world_(world), link_(std::move(link)), config_(config), rng_(rng) {
   if (!link_) throw std::invalid_argument("robot " + std::to_string(id) + ": no link");
@@ -17,7 +17,7 @@ RealBody::RealBody(int id, environment::World& world, std::unique_ptr<KheperaLin
   link_->request_proximity();
 }
 
-RealBody::~RealBody() { link_->stop(); }
+RealBody::~RealBody() { link_->halt(); }
 
 environment::SensorReadings RealBody::sense(TimeUs t_us) {
   // Virtual sensors at the camera's pose: walls, obstacles and every robot, virtual or real.

@@ -6,8 +6,10 @@
 // healthy (lost, unresponsive, or not yet answering), while the camera has not
 // seen it for lost_timeout_ms, and when a command would take its centre further beyond
 // the geofence (geofence_margin_m inside the field's edge; turning on the spot and
-// driving back in stay allowed); stop() and the destructor stop it too (the link's own
-// stop waits for the robot to acknowledge, within the link's retry budget).
+// driving back in stay allowed); stop() and the destructor stop it too (the destructor
+// waits for the robot to acknowledge, within the link's retry budget). The link may be
+// shared with whoever keeps it open between runs (RealRobots in a batch); the last owner
+// closes it, with a stop of its own.
 #pragma once
 
 #include <memory>
@@ -35,9 +37,10 @@ class RealBody final : public agents::Body {
  public:
   /// `world` and `rng` must outlive the body; the robot `id` must be in the world as a
   /// real robot. `link` must be started.
-  RealBody(int id, environment::World& world, std::unique_ptr<KheperaLink> link, RealBodyConfig config,
+  RealBody(int id, environment::World& world, std::shared_ptr<KheperaLink> link, RealBodyConfig config,
            std::mt19937_64& rng);
-  /// Stops the robot (the link's stop, acknowledged if the line allows).
+  /// Stops the robot and waits for its acknowledgement if the line allows (the link stays
+  /// open for its other owners; it closes, with another stop, when the last one lets go).
   ~RealBody() override;
   RealBody(const RealBody&) = delete;
   RealBody& operator=(const RealBody&) = delete;
@@ -62,7 +65,7 @@ class RealBody final : public agents::Body {
 
   int id_;
   environment::World& world_;
-  std::unique_ptr<KheperaLink> link_;
+  std::shared_ptr<KheperaLink> link_;
   RealBodyConfig config_;
   std::mt19937_64& rng_;
   std::string held_by_;

@@ -13,61 +13,88 @@ const RobotModel& model_named(const std::string& name, const std::string& where)
   throw agents::ScenarioError(where + ": unknown robot model '" + name + "' (khepera2, epuck)");
 }
 
+EmulatorConfig emulator_config(const agents::RobotSpec& spec, const RobotModel& model, const Pose2& pose) {
+  EmulatorConfig emu;
+  emu.model = model;
+  emu.initial_pose = pose;
+  emu.seed = static_cast<std::uint64_t>(spec.id);
+  const auto& f = spec.link->faults;
+  emu.faults.reply_delay_ms = f.reply_delay_ms;
+  emu.faults.drop_probability = f.drop;
+  emu.faults.garbage_probability = f.garbage;
+  emu.faults.corrupt_probability = f.corrupt;
+  emu.faults.disconnect_after_s = f.disconnect_after_s;
+  emu.faults.replug_after_s = f.replug_after_s;
+  return emu;
+}
+
 }  // namespace
 
 RealRobots::RealRobots(const agents::Scenario& scenario, LogCallback log) : scenario_(scenario), log_(std::move(log)) {}
 
-RealRobots::~RealRobots() = default;
+RealRobots::~RealRobots() {
+  std::map<int, std::shared_ptr<KheperaLink>> links;
+  {
+    std::lock_guard lock(mutex_);
+    links = std::move(links_);
+  }
+  for (auto& [id, link] : links) link->stop();
+}
+
+std::shared_ptr<KheperaLink> RealRobots::connect(const agents::RobotSpec& spec, const Pose2& pose_if_new) {
+  {
+    std::lock_guard lock(mutex_);
+    if (const auto it = links_.find(spec.id); it != links_.end()) return it->second;
+  }
+  const std::string where = scenario_.source.string() + ":" + std::to_string(spec.line) + ": robot " + std::to_string(spec.id);
+  if (!spec.link) throw agents::ScenarioError(where + ": a real robot needs a link");
+  LinkConfig config;
+  config.model = model_named(spec.link->model, where);
+  config.baud = static_cast<unsigned>(spec.link->baud);
+  // Messages name the robot as well as the port (the link names the port).
+  if (log_) {
+    config.log = [log = log_, id = spec.id](LogLevel level, const std::string& message) {
+      log(level, "robot " + std::to_string(id) + ": " + message);
+    };
+  }
+  config.reply_timeout_ms = spec.link->reply_timeout_ms;
+  config.retries = spec.link->retries;
+  // Proximity is read once per control step (RealBody::sense asks for the next one);
+  // the wheel counters at their own rate.
+  config.counters_period_ms = spec.link->counters_period_ms;
+  if (spec.link->emulate) {
+    auto emulator = std::make_unique<KheperaEmulator>(emulator_config(spec, config.model, pose_if_new));
+    config.port = emulator->device_path();
+    std::lock_guard lock(mutex_);
+    emulators_[spec.id] = std::move(emulator);
+  } else {
+    config.port = spec.link->port;
+  }
+  std::shared_ptr<KheperaLink> link;
+  try {
+    link = std::make_shared<KheperaLink>(config);
+  } catch (const std::invalid_argument& e) {
+    throw agents::ScenarioError(where + ": " + e.what());
+  }
+  if (const auto error = link->start()) throw agents::ScenarioError(where + ": " + *error);
+  // The robot must answer before a run relies on it.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  while (link->state() != LinkState::kOk && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  if (link->state() != LinkState::kOk) {
+    const std::string why = link->status().last_error;
+    link->stop(200);
+    throw agents::ScenarioError(where + ": " + config.port + " does not answer" + (why.empty() ? "" : ": " + why));
+  }
+  std::lock_guard lock(mutex_);
+  links_[spec.id] = link;
+  return link;
+}
 
 agents::RealBodyFactory RealRobots::body_factory() {
   return [this](const agents::RobotSpec& spec, environment::World& world, std::mt19937_64& rng) -> std::unique_ptr<agents::Body> {
-    const std::string where = scenario_.source.string() + ":" + std::to_string(spec.line) + ": robot " + std::to_string(spec.id);
-    if (!spec.link) throw agents::ScenarioError(where + ": a real robot needs a link");
-    LinkConfig config;
-    config.model = model_named(spec.link->model, where);
-    config.baud = static_cast<unsigned>(spec.link->baud);
-    // Messages name the robot as well as the port (the link names the port).
-    if (log_) {
-      config.log = [log = log_, id = spec.id](LogLevel level, const std::string& message) {
-        log(level, "robot " + std::to_string(id) + ": " + message);
-      };
-    }
-    config.reply_timeout_ms = spec.link->reply_timeout_ms;
-    config.retries = spec.link->retries;
-    // Proximity is read once per control step (RealBody::sense asks for the next one);
-    // the wheel counters at their own rate.
-    config.counters_period_ms = spec.link->counters_period_ms;
-    if (spec.link->emulate) {
-      EmulatorConfig emu;
-      emu.model = config.model;
-      emu.initial_pose = world.robot(spec.id).pose;
-      emu.seed = static_cast<std::uint64_t>(spec.id);
-      const auto& f = spec.link->faults;
-      emu.faults.reply_delay_ms = f.reply_delay_ms;
-      emu.faults.drop_probability = f.drop;
-      emu.faults.garbage_probability = f.garbage;
-      emu.faults.corrupt_probability = f.corrupt;
-      emu.faults.disconnect_after_s = f.disconnect_after_s;
-      emu.faults.replug_after_s = f.replug_after_s;
-      auto emulator = std::make_unique<KheperaEmulator>(emu);
-      config.port = emulator->device_path();
-      std::lock_guard lock(mutex_);
-      emulators_[spec.id] = std::move(emulator);
-    } else {
-      config.port = spec.link->port;
-    }
-    auto link = std::make_unique<KheperaLink>(config);
-    if (const auto error = link->start()) throw agents::ScenarioError(where + ": " + *error);
-    // The robot must answer before the run relies on it.
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
-    while (link->state() != LinkState::kOk && std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    if (link->state() != LinkState::kOk) {
-      const std::string why = link->status().last_error;
-      link->stop(200);
-      throw agents::ScenarioError(where + ": " + config.port + " does not answer" + (why.empty() ? "" : ": " + why));
-    }
+    std::shared_ptr<KheperaLink> link = connect(spec, world.robot(spec.id).pose);
     RealBodyConfig body;
     body.lost_timeout_ms = scenario_.lost_timeout_ms;
     body.geofence_margin_m = scenario_.geofence_margin_m;
@@ -90,6 +117,12 @@ std::map<int, const KheperaEmulator*> RealRobots::emulators() const {
   std::map<int, const KheperaEmulator*> out;
   for (const auto& [id, e] : emulators_) out[id] = e.get();
   return out;
+}
+
+KheperaEmulator* RealRobots::emulator(int id) {
+  std::lock_guard lock(mutex_);
+  const auto it = emulators_.find(id);
+  return it == emulators_.end() ? nullptr : it->second.get();
 }
 
 }  // namespace rilbed::links

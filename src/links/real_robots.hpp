@@ -1,7 +1,9 @@
-// The real robots of one run: a serial link per robot, and for `link: {emulate: true}`
-// an emulated Khepera on a pseudo-terminal that the link reaches through the same serial
-// code. Supplies the run with real bodies and the emulated camera with the emulated
-// robots' true poses.
+// The real robots of a run, or of a batch of runs: a serial link per robot, and for
+// `link: {emulate: true}` an emulated Khepera on a pseudo-terminal that the link reaches
+// through the same serial code. The links stay open from one run of a batch to the next
+// (each run's bodies share them); the robots are stopped at the end of every run and
+// again when this object goes. Supplies the runs with real bodies and the emulated camera
+// with the emulated robots' true poses.
 #pragma once
 
 #include <functional>
@@ -19,30 +21,42 @@
 
 namespace rilbed::links {
 
-/// Owns the emulators of a run (they must outlive the bodies, which the run owns).
-/// Construct before run_scenario(), keep until it returns.
+/// Owns the links and emulators of one or more runs (they must outlive the bodies, which
+/// each run owns). Construct before the first run_scenario(), keep until the last returns.
 class RealRobots {
  public:
-  /// `log` receives every link's and emulator's messages (may be empty).
+  /// `scenario` must outlive this object. `log` receives every link's and emulator's
+  /// messages (may be empty).
   RealRobots(const agents::Scenario& scenario, LogCallback log);
+  /// Stops every robot (acknowledged if its line allows) and closes the links, then the
+  /// emulators.
   ~RealRobots();
   RealRobots(const RealRobots&) = delete;
   RealRobots& operator=(const RealRobots&) = delete;
 
-  /// Makes a robot's body: starts its emulator if it is emulated (at the world's initial
-  /// pose for it), opens its link and waits up to 2 s for the robot to answer. Throws
-  /// agents::ScenarioError naming the robot and port when the port cannot be opened.
+  /// Opens robot `spec.id`'s link if it is not open yet: starts its emulator first if it
+  /// is emulated (at `pose_if_new`, its true pose from then on), and waits up to 2 s for
+  /// the robot to answer. Returns the link. Throws agents::ScenarioError naming the robot
+  /// and port when the port cannot be opened or the robot does not answer.
+  std::shared_ptr<KheperaLink> connect(const agents::RobotSpec& spec, const Pose2& pose_if_new);
+  /// Makes a robot's body over its link (connect() at the world's initial pose for it).
   agents::RealBodyFactory body_factory();
   /// The emulated robots' markers at their true poses now (for the emulated camera).
   std::vector<vision::SceneMarker> emulated_markers() const;
   /// The emulators, by robot ID (for tests and reports: their last commanded speeds).
   std::map<int, const KheperaEmulator*> emulators() const;
+  /// Robot `id`'s emulator, or nullptr (not emulated, or not connected yet).
+  KheperaEmulator* emulator(int id);
+  /// The scenario the robots belong to.
+  const agents::Scenario& scenario() const { return scenario_; }
 
  private:
   const agents::Scenario& scenario_;
   LogCallback log_;
   mutable std::mutex mutex_;
+  // Declared before the links: the links close (and stop their robots) first.
   std::map<int, std::unique_ptr<KheperaEmulator>> emulators_;
+  std::map<int, std::shared_ptr<KheperaLink>> links_;
 };
 
 }  // namespace rilbed::links

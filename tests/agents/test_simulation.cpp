@@ -166,6 +166,30 @@ TEST(Simulation, BeaconHomersReachTheBeacon) {
   EXPECT_GE(arrived, 3) << "robots within 0.35 m of beacon 2 at the end";
 }
 
+TEST(Simulation, StatusLineOncePerSimulatedSecond) {
+  // Control periods that divide a second and ones that do not: one status line per
+  // simulated second, never the same time twice, each within a control period of its
+  // whole second.
+  for (const TimeUs period_us : {TimeUs{100'000}, TimeUs{150'000}, TimeUs{70'000}, TimeUs{250'000}}) {
+    Scenario s = shipped("convoy_sim");
+    s.control_period_us = period_us;
+    s.broadcast_period_us = period_us;
+    std::vector<std::string> lines;
+    RunOptions o;
+    o.duration_s = 12.0;
+    o.on_status = [&](const std::string& line) { lines.push_back(line); };
+    run_scenario(s, o);
+    ASSERT_EQ(lines.size(), 12u) << "period " << period_us << " us";
+    for (std::size_t k = 0; k < lines.size(); ++k) {
+      ASSERT_EQ(lines[k].rfind("t=", 0), 0u) << lines[k];
+      const double t_s = std::stod(lines[k].substr(2));
+      EXPECT_GE(t_s, static_cast<double>(k) - 0.05) << lines[k];
+      EXPECT_LT(t_s, static_cast<double>(k) + us_to_seconds(period_us) + 0.05) << lines[k];
+      if (k > 0) EXPECT_NE(lines[k].substr(0, lines[k].find(' ')), lines[k - 1].substr(0, lines[k - 1].find(' ')));
+    }
+  }
+}
+
 TEST(Simulation, RealTimeRunsAtTheRequestedPace) {
   RunOptions o;
   o.realtime = true;
@@ -194,7 +218,10 @@ TEST(Simulation, ConvoyIdsMustBeOneToN) {
   EXPECT_THROW(run_scenario(s, RunOptions{}), ScenarioError);
   Scenario real = shipped("convoy_sim");
   real.robots[3].kind = environment::RobotKind::Real;
-  EXPECT_THROW(run_scenario(real, RunOptions{}), ScenarioError);
+  EXPECT_THROW(run_scenario(real, RunOptions{}), ScenarioError);  // real robots need real time
+  RunOptions realtime;
+  realtime.realtime = true;
+  EXPECT_THROW(run_scenario(real, realtime), ScenarioError);  // and a way to reach them
 }
 
 TEST(Simulation, UnknownControllerOrParameterIsNamed) {

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
 
 #include "run_command.hpp"
@@ -17,9 +18,10 @@ namespace {
 namespace fs = std::filesystem;
 
 
+// Without --realtime: a run with real robots is real time by itself.
 void expect_forms_and_stops(const std::string& name, int real_robots) {
   const fs::path dir = scratch_dir(name);
-  const CommandResult r = run_rilbed("run " + shipped_scenario_arg(name) + " --realtime --stop-when-formed --duration 90 --out '" +
+  const CommandResult r = run_rilbed("run " + shipped_scenario_arg(name) + " --stop-when-formed --duration 90 --out '" +
                                      (dir / "run").string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("formed at"), std::string::npos) << r.out;
@@ -32,7 +34,22 @@ void expect_forms_and_stops(const std::string& name, int real_robots) {
   EXPECT_EQ(stopped, real_robots) << r.out;
   const auto summary = nlohmann::json::parse(read_file(dir / "run" / "summary.json"));
   EXPECT_EQ(summary["formed"], true);
+  EXPECT_EQ(summary["realtime"], true);
+  EXPECT_EQ(summary["real_robots"].size(), static_cast<std::size_t>(real_robots));
   EXPECT_LT(summary["max_overlap_m"].get<double>(), 1e-6);
+  // One status line a second: never the same second twice.
+  std::set<std::string> seconds;
+  for (std::size_t at = r.out.find("t="); at != std::string::npos; at = r.out.find("\nt=", at + 1)) {
+    const std::size_t from = r.out[at] == '\n' ? at + 1 : at;
+    EXPECT_TRUE(seconds.insert(r.out.substr(from, r.out.find(' ', from) - from)).second) << r.out;
+  }
+  EXPECT_GE(seconds.size(), 5u) << r.out;
+  // The picture marks the real robots apart, with a legend.
+  const std::string svg = read_file(dir / "run" / "trajectories.svg");
+  std::size_t squares = 0;
+  for (std::size_t at = svg.find("class=\"real\""); at != std::string::npos; at = svg.find("class=\"real\"", at + 1)) ++squares;
+  EXPECT_EQ(squares, static_cast<std::size_t>(real_robots)) << svg;
+  EXPECT_NE(svg.find("real robot (as the camera saw it)"), std::string::npos);
   fs::remove_all(dir);
 }
 
@@ -124,10 +141,16 @@ TEST(LoopBenchCli, PrintsItsTableAndStopsTheRobots) {
   EXPECT_NE(r.out.find("`D` written for 60 of 60 robot-frames; 3 of 3 robots stopped"), std::string::npos) << r.out;
 }
 
-TEST(MixedRun, RealRobotsNeedRealTime) {
+TEST(MixedRun, FastWithRealRobotsIsAnErrorThatSaysWhy) {
   const CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_mixed") + " --fast");
-  EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("are real and move in wall-clock time"), std::string::npos) << r.err;
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("robots 4, 5 are real and move in wall-clock time, so --fast cannot run them"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("--all-virtual"), std::string::npos) << r.err;
+  // All virtual, the same scenario keeps --fast.
+  const CommandResult virtual_run =
+      run_rilbed("run " + shipped_scenario_arg("convoy_mixed") + " --fast --all-virtual --duration 5");
+  EXPECT_EQ(virtual_run.exit_code, 0) << virtual_run.err;
 }
 
 }  // namespace
