@@ -142,7 +142,10 @@ int run_batch(const agents::Scenario& scenario, const RunArgs& args, agents::Run
         results[i].ended_by = "error";
       }
       std::lock_guard lock(print_mutex);
-      if (!args.quiet) print_result(results[i]);
+      if (!args.quiet) {
+        print_result(results[i]);
+        std::fflush(stdout);  // a batch of real-time runs takes minutes: show each as it ends
+      }
     }
   };
   const int jobs = std::clamp(args.jobs > 0 ? args.jobs : static_cast<int>(std::thread::hardware_concurrency()), 1, max_jobs);

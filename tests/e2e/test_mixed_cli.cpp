@@ -134,6 +134,49 @@ TEST(MixedRun, SimToRealComparison) {
   fs::remove_all(dir);
 }
 
+TEST(MixedRun, SimToRealOverABatchOfSeeds) {
+  // --seeds with real robots: one run after another on the same (emulated) robots, each
+  // placed at its seed's start poses first; then `rilbed compare` of the two batch
+  // folders prints per seed and in summary each real robot's RMS and the formation times.
+  const fs::path dir = scratch_dir("sim2real_batch");
+  const std::string common = " --seeds 3 --seed 11 --duration 8 --out '";
+  const CommandResult sim =
+      run_rilbed("run " + shipped_scenario_arg("convoy_mixed") + " --all-virtual --quiet" + common + (dir / "sim").string() + "'");
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  const CommandResult mixed = run_rilbed("run " + shipped_scenario_arg("convoy_mixed") + common + (dir / "mixed").string() + "'");
+  ASSERT_EQ(mixed.exit_code, 0) << mixed.out << mixed.err;
+  for (int seed = 11; seed <= 13; ++seed) {
+    EXPECT_NE(mixed.out.find("seed " + std::to_string(seed) + ": "), std::string::npos) << mixed.out;
+    const auto summary =
+        nlohmann::json::parse(read_file(dir / "mixed" / ("seed_" + std::to_string(seed)) / "summary.json"));
+    EXPECT_EQ(summary["real_robots"], nlohmann::json::array({4, 5}));
+    EXPECT_EQ(summary["realtime"], true);
+  }
+  EXPECT_NE(mixed.out.find("| convoy_mixed | distributed | 3 |"), std::string::npos) << mixed.out;
+  EXPECT_NE(mixed.out.find("robot 4 (emulated): last speed 0 0"), std::string::npos) << mixed.out;
+  EXPECT_NE(mixed.out.find("robot 5 (emulated): last speed 0 0"), std::string::npos) << mixed.out;
+
+  const CommandResult cmp = run_rilbed("compare '" + (dir / "sim").string() + "' '" + (dir / "mixed").string() + "'");
+  ASSERT_EQ(cmp.exit_code, 0) << cmp.err;
+  EXPECT_NE(cmp.out.find("| seed | robot 4 RMS m | robot 5 RMS m | formation A s | formation B s | difference B-A s |"),
+            std::string::npos)
+      << cmp.out;
+  for (const char* row : {"| 11 | ", "| 12 | ", "| 13 | ", "| median | ", "| p95 | "}) {
+    EXPECT_NE(cmp.out.find(row), std::string::npos) << row << "\n" << cmp.out;
+  }
+  // Placed at the same start poses and driven by the same controller, the real robots
+  // stay near their virtual twins over 8 s.
+  const std::size_t median = cmp.out.find("| median | ");
+  ASSERT_NE(median, std::string::npos);
+  EXPECT_LT(std::stod(cmp.out.substr(median + 11)), 0.05) << cmp.out;
+  // A batch against a single run is refused, naming both.
+  const CommandResult mismatch =
+      run_rilbed("compare '" + (dir / "sim").string() + "' '" + (dir / "mixed" / "seed_11").string() + "'");
+  EXPECT_EQ(mismatch.exit_code, 2);
+  EXPECT_NE(mismatch.err.find("is a batch folder and"), std::string::npos) << mismatch.err;
+  fs::remove_all(dir);
+}
+
 TEST(LoopBenchCli, PrintsItsTableAndStopsTheRobots) {
   const CommandResult r = run_rilbed("loop-bench --real 3 --virtual 20 --frames 20");
   ASSERT_EQ(r.exit_code, 0) << r.err;
