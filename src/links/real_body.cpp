@@ -24,8 +24,15 @@ environment::SensorReadings RealBody::sense(TimeUs t_us) {
   environment::SensorReadings r = world_.sense(id_, t_us, rng_);
   if (const auto real = link_->latest_proximity()) {
     if (!r.proximity) r.proximity = environment::ProximityValues{};
-    // A real obstacle and a virtual one are both "near": the nearer wins, per sensor.
-    for (int i = 0; i < environment::kProximityCount; ++i) (*r.proximity)[i] = std::max((*r.proximity)[i], real->value[i]);
+    // On the Khepera's scale (an e-puck's sensors read 0..4095), then a real obstacle and
+    // a virtual one are both "near": the nearer wins, per sensor.
+    const int full_scale = link_->config().model.max_sensor_value;
+    for (int i = 0; i < environment::kProximityCount; ++i) {
+      const int value = full_scale == environment::kProximityMax
+                            ? real->value[i]
+                            : static_cast<int>(std::lround(static_cast<double>(real->value[i]) * environment::kProximityMax / full_scale));
+      (*r.proximity)[i] = std::max((*r.proximity)[i], value);
+    }
   }
   if (const auto counters = link_->latest_counters()) r.odometry = counters->value;
   link_->request_proximity();  // fresh for the next step (ignored if one is queued)
@@ -76,7 +83,9 @@ void RealBody::drive(const agents::WheelCommand& wheels) {
     link_->set_speeds(0, 0);
     return;
   }
-  link_->set_speeds(wheels.left, wheels.right);
+  // Controllers speak Khepera units (8 mm/s); another model's firmware takes its own.
+  const double per_unit = agents::kMetresPerSecondPerUnit / link_->config().model.speed_unit_mps;
+  link_->set_speeds(static_cast<int>(std::lround(wheels.left * per_unit)), static_cast<int>(std::lround(wheels.right * per_unit)));
 }
 
 void RealBody::stop() { link_->set_speeds(0, 0); }

@@ -1,4 +1,5 @@
-// A real Khepera as an agent's body: wheel commands go out as `D` over its serial link,
+// A real Khepera (or e-puck) as an agent's body: wheel commands (Khepera units, converted
+// to the robot model's own) go out as `D` over its serial link,
 // its proximity readings combine the real `N` values with the world's virtual ones (so a
 // real robot feels virtual robots and walls), and its pose is the camera's.
 //

@@ -355,3 +355,33 @@ TEST_F(RealBodyReplugTest, HealthShowsTheLinkLostAndRecovered) {
   // Healthy again: the next control step drives.
   ASSERT_TRUE(drive_obeyed(18, 18));
 }
+
+// An e-puck's firmware takes speeds in its own steps per second and reads its sensors on
+// 0..4095: a controller's Khepera units and the world's 0..1023 scale are converted.
+class EpuckBodyTest : public RealBodyTest {
+ protected:
+  EpuckBodyTest() : RealBodyTest([] {
+      EmulatorConfig e;
+      e.model = epuck_model();
+      e.proximity = {4095, 0, 2048, 0, 0, 0, 0, 0};
+      return e;
+    }()) {}
+};
+
+TEST_F(EpuckBodyTest, ConvertsSpeedsAndProximityToTheModelsUnits) {
+  LinkConfig config = link_config();
+  config.model = epuck_model();
+  make_body(config);
+  observe(0.75, 0.6, 0.0);
+  // 10 Khepera units are 80 mm/s: 621 e-puck steps of 0.129 mm per second.
+  const double steps = 10 * 0.008 / epuck_model().speed_unit_mps;
+  const int expected = static_cast<int>(std::lround(steps));
+  ASSERT_GT(expected, 600);
+  ASSERT_TRUE(drive_expecting(10, -10, {expected, -expected}));
+  ASSERT_TRUE(eventually([&] {
+    const auto r = body_->sense(world_.time_us());
+    return r.proximity && (*r.proximity)[0] == 1023;
+  })) << log_.text();
+  const auto r = body_->sense(world_.time_us());
+  EXPECT_EQ((*r.proximity)[2], 512);  // 2048 of 4095, on the 0..1023 scale
+}
