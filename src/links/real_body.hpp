@@ -3,7 +3,7 @@
 // its proximity readings combine the real `N` values with the world's virtual ones (so a
 // real robot feels virtual robots and walls), and its pose is the camera's.
 //
-// Safety (DESIGN.md): the robot is stopped instead of driven while its link is not
+// Safety (ARCHITECTURE.md, section 5): the robot is stopped instead of driven while its link is not
 // healthy (lost, unresponsive, or not yet answering), while the camera has not
 // seen it for lost_timeout_ms, and when a command would take its centre further beyond
 // the geofence (geofence_margin_m inside the field's edge; turning on the spot and

@@ -2,7 +2,7 @@
 // one interface over a video file, a single image, a directory of images, a printf-style
 // image sequence and a live camera.
 //
-// Bad input is a result, never an exception (DESIGN.md, "Bad input"): an input that
+// Bad input is a result, never an exception (ARCHITECTURE.md, "Bad input"): an input that
 // cannot be opened gives an OpenResult with an error naming it; a frame that cannot be
 // read gives a FrameResult of kind Error naming the input and the frame index, and the
 // stream goes on with the next frame. Only the end of the input (or a video/camera that
