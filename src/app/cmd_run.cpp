@@ -105,7 +105,11 @@ void place_or_throw(links::RealRobots& real, const agents::Scenario& scenario, s
   if (!r.offset_m.empty()) {
     std::string offsets;
     for (const auto& [id, d] : r.offset_m) offsets += fmt::format("{}robot {}: {:.1f} mm", offsets.empty() ? "" : ", ", id, d * 1000.0);
-    spdlog::info("seed {}: real robots placed in {:.1f} s (distance from the start pose: {})", seed, r.wall_s, offsets);
+    spdlog::info("seed {}: real robots driven to their start poses in {:.1f} s (left from the pose: {})", seed, r.wall_s,
+                 offsets);
+  }
+  if (!r.placed_by_operator.empty()) {
+    spdlog::info("seed {}: robots {} placed by the operator", seed, id_list_text(r.placed_by_operator));
   }
 }
 

@@ -100,14 +100,16 @@ PlacementResult place_real_robots(RealRobots& robots, const std::map<int, Pose2>
   if (r.ended_by == "interrupt") {
     result.error = "interrupted while placing robots " + id_list_text(drive_ids);
   } else if (!r.not_done.empty()) {
-    std::string message = "robots " + id_list_text(r.not_done) + " did not reach their start poses within " +
-                          std::to_string(static_cast<int>(options.timeout_s)) + " s; place them by hand:";
+    char within[32];
+    std::snprintf(within, sizeof within, "%g s", options.timeout_s);
+    std::string message = "robots " + id_list_text(r.not_done) + " did not reach their start poses within " + within +
+                          "; place them by hand:";
     for (const int id : r.not_done) {
       const auto seen = last.find(id);
       message += "\n  robot " + std::to_string(id) + " to " + pose_text(targets.at(id)) +
                  (seen != last.end() ? " (the camera sees it at " + pose_text(seen->second) + ")" : " (the camera does not see it)");
     }
-    log(LogLevel::kWarning, message);
+    if (!options.ask_operator) log(LogLevel::kWarning, message);
     if (!options.ask_operator || !options.ask_operator(message)) {
       result.error = "robots " + id_list_text(r.not_done) + " are not at their start poses and nobody placed them";
     } else {
@@ -115,6 +117,7 @@ PlacementResult place_real_robots(RealRobots& robots, const std::map<int, Pose2>
         // An emulated robot is placed by the hand the operator lends it.
         if (KheperaEmulator* e = robots.emulator(id)) e->place(targets.at(id));
         result.placed_by_operator.push_back(id);
+        result.offset_m.erase(id);  // measured before the operator's hand moved it
       }
     }
   }

@@ -44,7 +44,7 @@ struct PlacementOptions {
 struct PlacementResult {
   bool ok = false;
   std::string error;                   ///< why not, naming the robots
-  std::map<int, double> offset_m;      ///< each driven robot's distance from its pose when it ended
+  std::map<int, double> offset_m;      ///< each robot driven there: its distance from its pose at the end
   std::vector<int> placed_by_operator;  ///< robots the operator placed by hand
   double wall_s = 0.0;
 };

@@ -177,6 +177,41 @@ TEST(MixedRun, SimToRealOverABatchOfSeeds) {
   fs::remove_all(dir);
 }
 
+// A batch whose real robots must be driven to their start poses (emulated robots with
+// `placement: drive`, so they go the physical way), given far too little time: rilbed
+// names them to the operator and waits; Enter goes on, no operator ends the batch.
+TEST(MixedRun, TheOperatorIsAskedWhenRobotsCannotBePlaced) {
+  const fs::path dir = scratch_dir("mixed_operator");
+  std::string text = read_file(fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_mixed.yaml");
+  const std::string link = "link: {emulate: true}";
+  ASSERT_NE(text.find(link), std::string::npos);
+  text.replace(text.find(link), link.size(), "link: {emulate: true, placement: drive}");
+  const fs::path scenario = dir / "drive.yaml";
+  std::ofstream(scenario) << text;
+  const std::string run = "'" + std::string(RILBED_BINARY) + "' run '" + scenario.string() +
+                          "' --seeds 2 --seed 5 --duration 3 --place-timeout 0.3 --quiet --out '";
+  // With an operator who presses Enter: both seeds run.
+  const fs::path answered = dir / "answered.txt";
+  int status = std::system(("printf '\\n' | " + run + (dir / "a").string() + "' >'" + answered.string() + "' 2>&1").c_str());
+  const std::string a = read_file(answered);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << a;
+  EXPECT_NE(a.find("robots 4, 5 did not reach their start poses within"), std::string::npos) << a;
+  EXPECT_NE(a.find("robot 4 to ("), std::string::npos) << a;
+  EXPECT_NE(a.find("press Enter"), std::string::npos) << a;
+  EXPECT_TRUE(fs::exists(dir / "a" / "seed_6" / "summary.json")) << a;
+  EXPECT_NE(a.find("robot 4 (emulated): last speed 0 0"), std::string::npos) << a;
+  // Nobody there (standard input closed): the batch ends after the first seed, saying why.
+  const fs::path unanswered = dir / "unanswered.txt";
+  status = std::system((run + (dir / "b").string() + "' >'" + unanswered.string() + "' 2>&1 </dev/null").c_str());
+  const std::string b = read_file(unanswered);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << b;
+  EXPECT_NE(b.find("are not at their start poses and nobody placed them"), std::string::npos) << b;
+  EXPECT_TRUE(fs::exists(dir / "b" / "seed_5" / "summary.json")) << b;
+  EXPECT_FALSE(fs::exists(dir / "b" / "seed_6" / "summary.json")) << b;
+  EXPECT_NE(b.find("robot 5 (emulated): last speed 0 0"), std::string::npos) << b;
+  fs::remove_all(dir);
+}
+
 TEST(LoopBenchCli, PrintsItsTableAndStopsTheRobots) {
   const CommandResult r = run_rilbed("loop-bench --real 3 --virtual 20 --frames 20");
   ASSERT_EQ(r.exit_code, 0) << r.err;
