@@ -41,18 +41,13 @@ struct EmulatorArgs {
   bool echo = false;
 };
 
-// `--versions TEXT`: for a Khepera the text after "b," (its first field the BIOS, the rest
-// the protocol version); for an e-puck the text after "v,".
+// `--versions TEXT`: for a Khepera the text after "b," (its first field the BIOS, the
+// second the protocol version), for an e-puck the text after "v,"; read as the link reads
+// the reply that carries it.
 links::FirmwareVersions versions_from_text(const links::RobotModel& model, const std::string& text) {
-  links::FirmwareVersions v;
-  if (!model.bios_protocol_versions) {
-    v.text = text;
-    return v;
-  }
-  const std::size_t comma = text.find(',');
-  v.bios = text.substr(0, comma);
-  if (comma != std::string::npos) v.protocol = text.substr(comma + 1);
-  return v;
+  const std::string reply = std::string(1, model.reply_letter(links::CommandKind::kReadVersions)) + "," + text;
+  const links::Result<links::Reply> decoded = links::decode_reply(model, links::CommandKind::kReadVersions, reply);
+  return decoded.ok() ? decoded->versions : links::FirmwareVersions{text, "", text};
 }
 
 // "x,y,theta_deg" (metres, metres, degrees).

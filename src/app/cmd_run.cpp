@@ -250,13 +250,7 @@ int run_command(const RunArgs& args) {
   options.interrupt = &interrupted;
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  if (real_ids.empty()) {
-    if (args.seeds > 0) {
-      return run_batch(scenario, args, options, [&](const agents::RunOptions& o) { return agents::run_scenario(scenario, o); },
-                       std::numeric_limits<int>::max());
-    }
-  }
-  if (!args.out.empty()) options.out_dir = args.out;
+  if (!args.out.empty()) options.out_dir = args.out;  // a batch puts each seed in a folder of its own
   if (options.realtime && !args.quiet && args.seeds == 0) {
     options.on_status = [](const std::string& line) {
       std::printf("%s\n", line.c_str());
@@ -278,12 +272,12 @@ int run_command(const RunArgs& args) {
       if (!args.no_place) place_or_throw(*real, scenario, o.seed, args);
       return agents::run_scenario(scenario, o, real_bodies);
     };
-    if (args.seeds > 0) {
-      // One after another: the robots are the same ones.
-      const int status = run_batch(scenario, args, options, run_seed, 1);
-      print_emulated_last_speeds(*real);
-      return status;
-    }
+  }
+  if (args.seeds > 0) {
+    // With real robots one run after another: the robots are the same ones.
+    const int status = run_batch(scenario, args, options, run_seed, real ? 1 : std::numeric_limits<int>::max());
+    if (real) print_emulated_last_speeds(*real);
+    return status;
   }
   try {
     const agents::RunResult r = run_seed(options);

@@ -443,6 +443,22 @@ struct KheperaLink::Impl {
     }
   }
 
+  // Wishes speeds 0, 0 and waits (up to `timeout_ms`, default: the command on the line and
+  // the stop with all their retries) until the robot acknowledges them or the port is
+  // lost. `lock` holds `mutex` on entry and on return. Whether the robot acknowledged.
+  bool wish_stop_and_wait(std::unique_lock<std::mutex>& lock, std::optional<int> timeout_ms) {
+    wished = WheelSpeeds{};
+    wish_pending = true;
+    const std::uint64_t stop_serial = ++wish_serial;
+    lock.unlock();
+    kick();
+    const auto wait = std::chrono::milliseconds(timeout_ms.value_or(2 * command_budget_ms() + 100));
+    lock.lock();
+    return changed.wait_for(lock, wait, [&] {
+      return acknowledged_wish_serial >= stop_serial || status.state == LinkState::kLost;
+    }) && acknowledged_wish_serial >= stop_serial;
+  }
+
   void shutdown_on_link_thread() {
     shutting_down = true;
     port_open = false;
@@ -511,17 +527,7 @@ bool KheperaLink::stop(std::optional<int> timeout_ms) {
   }
   m.stopping = true;
   const bool port_was_lost = m.status.state == LinkState::kLost;
-  m.wished = WheelSpeeds{};
-  m.wish_pending = true;
-  const std::uint64_t stop_serial = ++m.wish_serial;
-  lock.unlock();
-  m.kick();
-  // The command on the line may take its whole budget before the stop goes out.
-  const auto wait = std::chrono::milliseconds(timeout_ms.value_or(2 * m.command_budget_ms() + 100));
-  lock.lock();
-  const bool acknowledged = m.changed.wait_for(lock, wait, [&] {
-    return m.acknowledged_wish_serial >= stop_serial || m.status.state == LinkState::kLost;
-  }) && m.acknowledged_wish_serial >= stop_serial;
+  const bool acknowledged = m.wish_stop_and_wait(lock, timeout_ms);
   lock.unlock();
 
   asio::post(m.io, [&m] { m.shutdown_on_link_thread(); });
@@ -544,16 +550,7 @@ bool KheperaLink::halt(std::optional<int> timeout_ms) {
   Impl& m = *impl_;
   std::unique_lock lock(m.mutex);
   if (!m.started || m.stop_result || m.stopping) return false;
-  m.wished = WheelSpeeds{};
-  m.wish_pending = true;
-  const std::uint64_t halt_serial = ++m.wish_serial;
-  lock.unlock();
-  m.kick();
-  const auto wait = std::chrono::milliseconds(timeout_ms.value_or(2 * m.command_budget_ms() + 100));
-  lock.lock();
-  return m.changed.wait_for(lock, wait, [&] {
-    return m.acknowledged_wish_serial >= halt_serial || m.status.state == LinkState::kLost;
-  }) && m.acknowledged_wish_serial >= halt_serial;
+  return m.wish_stop_and_wait(lock, timeout_ms);
 }
 
 void KheperaLink::set_speeds(int left_units, int right_units) {
