@@ -178,6 +178,9 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     sim::Coordinator** coordinator = nullptr;  // set once built
     RunResult* result = nullptr;
     TimeUs period_us = 100'000;
+    const Scenario* scenario = nullptr;
+    WorldReport world_report;  // for the observer
+    std::chrono::steady_clock::time_point wall_start;
   };
   explicit MonitorModel(Setup setup)
       : sim::AtomicModel<TimeUs>("monitor", 1), s_(std::move(setup)),
@@ -198,10 +201,50 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   bool formed() const { return formation_.formed(); }
   std::optional<TimeUs> formation_time_us() const { return formation_.formation_time_us(); }
 
+  /// The run's status now (`state`: "running" or "ended").
+  StatusReport status(TimeUs t, const char* state) const {
+    StatusReport st;
+    st.t_us = t;
+    st.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - s_.wall_start).count();
+    st.scenario = s_.scenario->name;
+    st.seed = s_.options->seed;
+    st.mode = s_.scenario->mode == ConvoyMode::kCentral ? "central" : "distributed";
+    st.realtime = s_.options->realtime;
+    st.rt_factor = s_.options->rt_factor;
+    st.state = state;
+    st.ended_by = s_.result->ended_by;
+    st.robots = static_cast<int>(s_.agents.size());
+    st.real_robots = static_cast<int>(s_.world_report.field.real_robot_ids.size());
+    st.formed = formation_.formed();
+    if (const auto f = formation_.formation_time_us()) st.formation_time_s = us_to_seconds(*f);
+    st.collisions = s_.result->collisions;
+    return st;
+  }
+
  private:
   void end(const char* why) {
     if (s_.result->ended_by.empty()) s_.result->ended_by = why;
     (*s_.coordinator)->stop();
+  }
+
+  // An event for the run folder and for the run's observer.
+  void record(const RunEvent& event) {
+    if (s_.recorder) s_.recorder->add_event(event);
+    if (s_.options->observer) s_.options->observer->on_event(event);
+  }
+
+  // Every robot with a known pose; a real robot the camera lost at its last pose, unseen.
+  void report_poses(TimeUs t, RunObserver& observer) {
+    reports_.clear();
+    for (const AgentModel* a : s_.agents) {
+      const int id = a->body().id();
+      const environment::RobotState& state = s_.world->robot(id);
+      const auto pose = a->body().pose();
+      if (!pose && !state.observed && state.kind == environment::RobotKind::Real) continue;  // never seen
+      reports_.push_back({id, state.kind == environment::RobotKind::Real, pose.has_value(), pose.value_or(state.pose),
+                          a->behaviour(), a->body().health()});
+    }
+    observer.on_poses(t, reports_);
   }
 
   void sample(TimeUs t) {
@@ -209,10 +252,8 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     for (const auto& e : s_.world_model->drain()) {
       ++r.collisions;
       if (e.second.kind == environment::BodyKind::Robot) ++r.robot_collisions;
-      if (s_.recorder) {
-        s_.recorder->add_event({e.t_us, "collision", party_code(e.first), party_code(e.second),
-                                to_string(e.first) + " touched " + to_string(e.second)});
-      }
+      record({e.t_us, "collision", party_code(e.first), party_code(e.second),
+              to_string(e.first) + " touched " + to_string(e.second)});
     }
     r.max_overlap_m = std::max(r.max_overlap_m, s_.world->max_overlap_m());
     samples_.clear();
@@ -223,14 +264,12 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
       if (pose) samples_.push_back({t, a.body().id(), *pose, behaviour});
       const std::string_view health = a.body().health();
       if (health != last_health_[i]) {
-        if (s_.recorder) {
-          s_.recorder->add_event({t, "health", a.body().id(), 0, std::string(last_health_[i]) + " -> " + std::string(health)});
-        }
+        record({t, "health", a.body().id(), 0, std::string(last_health_[i]) + " -> " + std::string(health)});
         last_health_[i] = health;
       }
       if (behaviour != last_behaviour_[i]) {
-        if (s_.recorder && !last_behaviour_[i].empty()) {
-          s_.recorder->add_event({t, "behaviour", a.body().id(), 0,
+        if (!last_behaviour_[i].empty()) {
+          record({t, "behaviour", a.body().id(), 0,
                                   std::string(last_behaviour_[i]) + " -> " + std::string(behaviour)});
         }
         last_behaviour_[i] = behaviour;
@@ -238,6 +277,15 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     }
     if (s_.recorder) s_.recorder->add_samples(samples_);
     if (s_.options->keep_in_memory) r.trajectory.insert(r.trajectory.end(), samples_.begin(), samples_.end());
+    if (RunObserver* o = s_.options->observer) {
+      const bool new_second = t >= next_report_us_;
+      if (new_second) o->on_world(t, s_.world_report);
+      report_poses(t, *o);
+      if (new_second) {
+        next_report_us_ = (t / 1'000'000 + 1) * 1'000'000;
+        o->on_status(status(t, "running"));
+      }
+    }
     if (!s_.convoy_ids.empty()) check_formation(t);
     if (s_.options->stop_when_done &&
         std::all_of(s_.agents.begin(), s_.agents.end(), [](const AgentModel* a) { return a->done(); })) {
@@ -266,12 +314,12 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     }
     record_subteams(t, team);
     const bool was_holding = formation_.holding();
-    if (formation_.update(t, team) && s_.recorder) {
-      s_.recorder->add_event({t, "formed", 0, 0,
+    if (formation_.update(t, team)) {
+      record({t, "formed", 0, 0,
                               "convoy formed; the hold began at " + std::to_string(us_to_seconds(*formation_.formation_time_us())) + " s"});
     }
-    if (was_holding && !formation_.holding() && formation_.formed() && s_.recorder) {
-      s_.recorder->add_event({t, "broken", 0, 0, "the formed convoy broke"});
+    if (was_holding && !formation_.holding() && formation_.formed()) {
+      record({t, "broken", 0, 0, "the formed convoy broke"});
     }
     if (s_.options->stop_when_formed && formation_.formed() &&
         t >= *formation_.formed_at_us() + seconds_to_us(s_.options->after_formed_s)) {
@@ -301,7 +349,7 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
       }
       start = k;
     }
-    if (text != subteams_ && s_.recorder) s_.recorder->add_event({t, "subteams", 0, 0, text.empty() ? "none" : text});
+    if (text != subteams_) record({t, "subteams", 0, 0, text.empty() ? "none" : text});
     subteams_ = text;
   }
 
@@ -310,10 +358,35 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   FormationMonitor formation_;
   TimeUs t_us_ = 0;
   TimeUs next_status_us_ = 0;
+  TimeUs next_report_us_ = 0;
+  std::vector<PoseReport> reports_;
   std::vector<TrajectorySample> samples_;
   std::vector<std::string_view> last_behaviour_;
   std::vector<std::string_view> last_health_;
 };
+
+// The field as the run folder's picture and a watcher draw it.
+FieldDrawing field_drawing(const Scenario& scenario, const std::vector<int>& real_ids) {
+  FieldDrawing drawing{scenario.map.field.width_m, scenario.map.field.height_m, {}, {}, {}, {}};
+  for (const auto& o : scenario.map.obstacles) drawing.obstacles.push_back(o.vertices_m);
+  for (const auto& t : scenario.map.tracks) {
+    auto points = t.points_m;
+    if (t.closed && !points.empty()) points.push_back(points.front());
+    drawing.tracks.emplace_back(points, t.width_m);
+  }
+  for (const auto& b : scenario.map.beacons) drawing.beacons.push_back(b.position_m);
+  drawing.real_robot_ids = {real_ids.begin(), real_ids.end()};
+  return drawing;
+}
+
+WorldReport world_report(const Scenario& scenario, const std::vector<int>& real_ids) {
+  WorldReport w;
+  w.scenario = scenario.name;
+  w.field = field_drawing(scenario, real_ids);
+  w.walls = scenario.map.field.boundary_walls;
+  for (const RobotSpec& r : scenario.robots) w.robot_ids.push_back(r.id);
+  return w;
+}
 
 double param(const RobotSpec& spec, const std::string& key, double fallback, std::set<std::string>& used) {
   used.insert(key);
@@ -482,18 +555,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
     }
   }
   std::unique_ptr<RunRecorder> recorder;
-  if (options.out_dir) {
-    FieldDrawing drawing{scenario.map.field.width_m, scenario.map.field.height_m, {}, {}, {}};
-    for (const auto& o : scenario.map.obstacles) drawing.obstacles.push_back(o.vertices_m);
-    for (const auto& t : scenario.map.tracks) {
-      auto points = t.points_m;
-      if (t.closed && !points.empty()) points.push_back(points.front());
-      drawing.tracks.emplace_back(points, t.width_m);
-    }
-    for (const auto& b : scenario.map.beacons) drawing.beacons.push_back(b.position_m);
-    drawing.real_robot_ids = {real_ids.begin(), real_ids.end()};
-    recorder = std::make_unique<RunRecorder>(*options.out_dir, drawing);
-  }
+  if (options.out_dir) recorder = std::make_unique<RunRecorder>(*options.out_dir, field_drawing(scenario, real_ids));
   const double duration_s = options.duration_s.value_or(scenario.duration_s);
   const TimeUs end_us = seconds_to_us(duration_s);
   sim::Coordinator* coordinator_ptr = nullptr;
@@ -507,6 +569,9 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   setup.coordinator = &coordinator_ptr;
   setup.result = &result;
   setup.period_us = scenario.control_period_us;
+  setup.scenario = &scenario;
+  setup.wall_start = wall_start;
+  if (options.observer) setup.world_report = world_report(scenario, real_ids);
   auto& monitor = root->emplace<MonitorModel>(setup);
   if (camera) root->add(camera);
 
@@ -536,6 +601,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   }
   if (const auto t = monitor.formation_time_us()) result.formation_time_s = us_to_seconds(*t);
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  if (options.observer) options.observer->on_status(monitor.status(std::min(coordinator.now_us(), end_us), "ended"));
   if (recorder) {
     nlohmann::json summary = result.summary();
     summary["scenario"] = scenario.name;

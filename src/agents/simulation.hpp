@@ -21,6 +21,7 @@
 
 #include "agents/body.hpp"
 #include "agents/controller.hpp"
+#include "agents/run_observer.hpp"
 #include "agents/run_recorder.hpp"
 #include "agents/scenario.hpp"
 #include "environment/world.hpp"
@@ -50,6 +51,9 @@ struct RunOptions {
   /// The scenario's real robots that this run simulates instead (`--all-virtual`): written
   /// to summary.json, so that `rilbed compare` knows which robots the comparison is about.
   std::vector<int> virtual_stand_ins;
+  /// Told the world, every robot's pose at every control step, every event and the
+  /// status as the run goes (the LCM bus, tests); may be null. Must outlive the call.
+  RunObserver* observer = nullptr;
 };
 
 /// What a run came to.

@@ -21,6 +21,7 @@
 #include "app/commands.hpp"
 #include "core/id_list.hpp"
 #include "core/statistics.hpp"
+#include "links/lcm_bus.hpp"
 #include "links/placement.hpp"
 #include "links/real_robots.hpp"
 
@@ -80,6 +81,8 @@ struct RunArgs {
   bool quiet = false;
   std::string mode;  // overrides the scenario's
   bool all_virtual = false;
+  std::string lcm_url;        // publish the run on this LCM bus (empty: no bus)
+  std::string channel_prefix;
   bool no_place = false;      // real robots start where they stand
   double place_timeout_s = 90.0;
 };
@@ -248,6 +251,24 @@ int run_command(const RunArgs& args) {
   options.stop_when_formed = args.stop_when_formed;
   options.seed = args.seed;
   options.interrupt = &interrupted;
+  // The LCM bus: everything the run reports goes out on it while it runs.
+  std::unique_ptr<lcm::LCM> lcm;
+  std::unique_ptr<links::LcmRunPublisher> publisher;
+  if (!args.lcm_url.empty()) {
+    if (const auto problem = links::check_channel_prefix(args.channel_prefix)) {
+      spdlog::error("{}", *problem);
+      return kExitUsage;
+    }
+    std::string error;
+    lcm = links::open_lcm(args.lcm_url, error);
+    if (!lcm) {
+      spdlog::error("{}", error);
+      return kExitFailure;
+    }
+    publisher = std::make_unique<links::LcmRunPublisher>(*lcm, links::Channels::with_prefix(args.channel_prefix),
+                                                         args.lcm_url.rfind("memq://", 0) == 0);
+    options.observer = publisher.get();
+  }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   if (!args.out.empty()) options.out_dir = args.out;  // a batch puts each seed in a folder of its own
@@ -318,6 +339,9 @@ void add_run_command(CLI::App& app) {
       ->check(CLI::IsMember({"central", "distributed"}));
   cmd->add_flag("--all-virtual", args->all_virtual,
                 "Make every real robot virtual (same poses and controllers): the simulation half of a sim-to-real comparison");
+  cmd->add_option("--lcm", args->lcm_url,
+                  "Publish the run on this LCM bus while it runs (e.g. udpm://239.255.76.67:7667?ttl=0; default: none)");
+  cmd->add_option("--channel-prefix", args->channel_prefix, "Put this before every channel name (two runs on one network)");
   cmd->add_flag("--no-place", args->no_place,
                 "Real robots start where they stand (default: before each run they are driven, or put if emulated, "
                 "to the run's start poses)");

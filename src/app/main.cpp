@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
   rilbed::app::add_loop_bench_command(app);
   rilbed::app::add_khepera_command(app);
   rilbed::app::add_khepera_emu_command(app);
+  rilbed::app::add_watch_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,165 @@
+// `rilbed watch --lcm URL`: a terminal display of a run on an LCM bus: its status once per
+// simulated second with every robot's behaviour and health, and its events as they come.
+// It only listens: any number may join and leave at any time without any effect on the
+// run. It says so when no run is heard on the URL.
+#include <signal.h>
+#include <spdlog/spdlog.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "app/commands.hpp"
+#include "links/lcm_bus.hpp"
+
+namespace rilbed::app {
+
+namespace {
+
+std::atomic<bool> watch_interrupted{false};
+extern "C" void on_watch_signal(int) { watch_interrupted.store(true); }
+
+struct WatchArgs {
+  std::string url;
+  std::string prefix;
+  double for_s = 0.0;        // 0: until interrupted
+  bool until_ended = false;  // end when the run does
+  double silence_s = 2.0;    // say so when nothing is heard this long
+};
+
+// What the watcher knows of the run, kept from the messages.
+class Watcher {
+ public:
+  explicit Watcher(const WatchArgs& args) : args_(args) {}
+
+  void on_world(const lcm::ReceiveBuffer*, const std::string&, const rilbed::world_t* message) { on_world(*message); }
+  void on_world(const rilbed::world_t& w) {
+    heard();
+    if (world_scenario_ != w.scenario) {
+      world_scenario_ = w.scenario;
+      int real = 0;
+      for (const bool r : w.robot_real) real += r;
+      std::printf("watching %s on %s: %d robots (%d real), field %.2f x %.2f m\n", w.scenario.c_str(), args_.url.c_str(),
+                  w.num_robots, real, w.width_m, w.height_m);
+      std::fflush(stdout);
+    }
+  }
+  void on_poses(const lcm::ReceiveBuffer*, const std::string&, const rilbed::poses_t* message) { on_poses(*message); }
+  void on_poses(const rilbed::poses_t& p) {
+    heard();
+    poses_ = p;
+  }
+  void on_event(const lcm::ReceiveBuffer*, const std::string&, const rilbed::event_t* message) { on_event(*message); }
+  void on_event(const rilbed::event_t& e) {
+    heard();
+    if (e.kind == "behaviour" || e.kind == "collision") return;  // too many to read; the status line shows them
+    std::printf("  %7.1fs  %s", static_cast<double>(e.utime) * 1e-6, e.kind.c_str());
+    if (e.id != 0) std::printf(" robot %d", e.id);
+    std::printf(": %s\n", e.detail.c_str());
+    std::fflush(stdout);
+  }
+  void on_status(const lcm::ReceiveBuffer*, const std::string&, const rilbed::status_t* message) { on_status(*message); }
+  void on_status(const rilbed::status_t& s) {
+    heard();
+    std::string line = "t=" + one_decimal(static_cast<double>(s.utime) * 1e-6) + "s " + s.state;
+    if (s.realtime) line += " x" + one_decimal(s.rt_factor);
+    for (const auto& r : poses_.robots) {
+      line += "  " + std::to_string(r.id) + ":" + r.behaviour;
+      if (r.health != "ok") line += "(" + r.health + ")";
+    }
+    if (s.formed) line += "  [formed at " + one_decimal(s.formation_time_s) + " s]";
+    if (s.state == "ended") line += "  (ended by " + s.ended_by + ")";
+    std::printf("%s\n", line.c_str());
+    std::fflush(stdout);
+    if (s.state == "ended") ended_ = true;
+  }
+
+  bool ended() const { return ended_; }
+  bool heard_anything() const { return heard_anything_; }
+  /// Says once when the bus has been silent for the silence time.
+  void check_silence(std::chrono::steady_clock::time_point now) {
+    if (silent_reported_ || now - last_heard_ < std::chrono::duration<double>(args_.silence_s)) return;
+    silent_reported_ = true;
+    std::printf("no rilbed run heard on %s for %.0f s (channels %sRILBED_*)\n", args_.url.c_str(), args_.silence_s,
+                args_.prefix.c_str());
+    std::fflush(stdout);
+  }
+
+ private:
+  static std::string one_decimal(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.1f", v);
+    return buf;
+  }
+  void heard() {
+    heard_anything_ = true;
+    last_heard_ = std::chrono::steady_clock::now();
+    silent_reported_ = false;
+  }
+
+  const WatchArgs& args_;
+  std::string world_scenario_;
+  rilbed::poses_t poses_{};
+  bool ended_ = false;
+  bool heard_anything_ = false;
+  bool silent_reported_ = false;
+  std::chrono::steady_clock::time_point last_heard_ = std::chrono::steady_clock::now();
+};
+
+int watch_command(const WatchArgs& args) {
+  if (const auto problem = links::check_channel_prefix(args.prefix)) {
+    spdlog::error("watch: {}", *problem);
+    return kExitUsage;
+  }
+  std::string error;
+  std::unique_ptr<lcm::LCM> lcm = links::open_lcm(args.url, error);
+  if (!lcm) {
+    spdlog::error("watch: {}", error);
+    return kExitFailure;
+  }
+  const links::Channels channels = links::Channels::with_prefix(args.prefix);
+  Watcher watcher(args);
+  // LCM 1.3's C++ API takes member functions (no lambdas).
+  using W = Watcher;
+  lcm->subscribe(channels.world, static_cast<void (W::*)(const lcm::ReceiveBuffer*, const std::string&, const rilbed::world_t*)>(&W::on_world), &watcher);
+  lcm->subscribe(channels.poses, static_cast<void (W::*)(const lcm::ReceiveBuffer*, const std::string&, const rilbed::poses_t*)>(&W::on_poses), &watcher);
+  lcm->subscribe(channels.events, static_cast<void (W::*)(const lcm::ReceiveBuffer*, const std::string&, const rilbed::event_t*)>(&W::on_event), &watcher);
+  lcm->subscribe(channels.status, static_cast<void (W::*)(const lcm::ReceiveBuffer*, const std::string&, const rilbed::status_t*)>(&W::on_status), &watcher);
+  std::signal(SIGINT, on_watch_signal);
+  std::signal(SIGTERM, on_watch_signal);
+  const auto start = std::chrono::steady_clock::now();
+  while (!watch_interrupted.load()) {
+    const int handled = lcm->handleTimeout(100);
+    if (handled < 0) {
+      spdlog::error("watch: reading the LCM bus {} failed", args.url);
+      return kExitFailure;
+    }
+    const auto now = std::chrono::steady_clock::now();
+    watcher.check_silence(now);
+    if (args.until_ended && watcher.ended()) break;
+    if (args.for_s > 0.0 && now - start >= std::chrono::duration<double>(args.for_s)) break;
+  }
+  return watcher.heard_anything() ? 0 : kExitFailure;
+}
+
+}  // namespace
+
+void add_watch_command(CLI::App& app) {
+  auto args = std::make_shared<WatchArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "watch", "Show a run on an LCM bus: its status each second, every robot's behaviour and health, its events");
+  cmd->add_option("--lcm", args->url, "LCM URL of the run's bus (e.g. udpm://239.255.76.67:7667?ttl=0)")->required();
+  cmd->add_option("--channel-prefix", args->prefix, "The run's channel prefix (rilbed run --channel-prefix)");
+  cmd->add_option("--for", args->for_s, "Stop after this many seconds (default: until Ctrl-C)")->check(CLI::PositiveNumber);
+  cmd->add_flag("--until-ended", args->until_ended, "Stop when the run ends");
+  cmd->add_option("--silence", args->silence_s, "Say so when nothing is heard for this many seconds")
+      ->check(CLI::PositiveNumber)->default_val(2.0);
+  cmd->callback([args] { exit_code() = watch_command(*args); });
+}
+
+}  // namespace rilbed::app

@@ -1,0 +1,80 @@
+// A run on an LCM bus: the channels, the conversion of what a run reports into the LCM
+// types of src/links/msgs (package `rilbed`), and the publisher that the run reports
+// through (agents::RunObserver). Other programs decode these channels with types that
+// lcm-gen makes from the same .lcm files in any language.
+#pragma once
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <span>
+#include <string>
+
+#include "agents/run_observer.hpp"
+#include "rilbed/event_t.hpp"
+#include "rilbed/poses_t.hpp"
+#include "rilbed/status_t.hpp"
+#include "rilbed/world_t.hpp"
+
+namespace rilbed::links {
+
+/// The channel names of a run; `prefix` (e.g. "LAB2_") lets two runs share a network.
+struct Channels {
+  std::string poses = "RILBED_POSES";    ///< rilbed::poses_t, every control step
+  std::string events = "RILBED_EVENTS";  ///< rilbed::event_t, each event
+  std::string status = "RILBED_STATUS";  ///< rilbed::status_t, every simulated second and at the end
+  std::string world = "RILBED_WORLD";    ///< rilbed::world_t, at the start and every simulated second
+  /// The same names behind `prefix`.
+  static Channels with_prefix(const std::string& prefix);
+};
+
+/// A channel prefix is letters, digits and '_' (LCM channel names are at most 63 bytes);
+/// returns the reason when `prefix` is not one.
+std::optional<std::string> check_channel_prefix(const std::string& prefix);
+
+/// Opens an LCM instance on `url` ("memq://", "udpm://239.255.76.67:7667?ttl=0", ...).
+/// Returns nullptr and the reason when LCM cannot use it.
+std::unique_ptr<lcm::LCM> open_lcm(const std::string& url, std::string& error);
+
+/// What a run reports, as LCM messages.
+rilbed::poses_t to_lcm(TimeUs t_us, std::span<const agents::PoseReport> poses);
+rilbed::event_t to_lcm(const agents::RunEvent& event);
+rilbed::status_t to_lcm(const agents::StatusReport& status);
+rilbed::world_t to_lcm(TimeUs t_us, const agents::WorldReport& world);
+
+/// Messages and bytes sent on one channel, and publishes that failed.
+struct ChannelCount {
+  std::uint64_t messages = 0;
+  std::uint64_t bytes = 0;
+  std::uint64_t failures = 0;  ///< lcm publish returned an error (e.g. EPERM from a firewall): the message is lost
+};
+
+/// Publishes what a run reports on `lcm` (which must outlive it). A failed publish is
+/// counted and the run goes on. On an in-process bus (memq://) it also delivers the
+/// messages to the in-process subscribers after each publish, so that nothing piles up.
+class LcmRunPublisher final : public agents::RunObserver {
+ public:
+  LcmRunPublisher(lcm::LCM& lcm, Channels channels, bool in_process);
+  void on_world(TimeUs t_us, const agents::WorldReport& world) override;
+  void on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) override;
+  void on_event(const agents::RunEvent& event) override;
+  void on_status(const agents::StatusReport& status) override;
+  /// Counts per channel name so far.
+  std::map<std::string, ChannelCount> counts() const;
+
+ private:
+  template <typename Message>
+  void publish(const std::string& channel, const Message& message);
+
+  lcm::LCM& lcm_;
+  Channels channels_;
+  bool in_process_;
+  mutable std::mutex mutex_;
+  std::map<std::string, ChannelCount> counts_;
+};
+
+}  // namespace rilbed::links

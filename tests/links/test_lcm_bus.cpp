@@ -1,0 +1,144 @@
+// The run on an LCM bus: a whole run published on the in-process bus (memq://) and read
+// back by a subscriber, message by message: the world first, a poses message per control
+// step, every event as events.csv has it, the status every second and at the end.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "agents/simulation.hpp"
+#include "links/lcm_bus.hpp"
+
+namespace rilbed::links {
+namespace {
+
+struct Collector {
+  std::vector<std::string> order;  // channel of each message, in arrival order
+  std::vector<rilbed::poses_t> poses;
+  std::vector<rilbed::event_t> events;
+  std::vector<rilbed::status_t> status;
+  std::vector<rilbed::world_t> worlds;
+  void on_poses(const lcm::ReceiveBuffer*, const std::string& c, const rilbed::poses_t* m) { order.push_back(c); poses.push_back(*m); }
+  void on_event(const lcm::ReceiveBuffer*, const std::string& c, const rilbed::event_t* m) { order.push_back(c); events.push_back(*m); }
+  void on_status(const lcm::ReceiveBuffer*, const std::string& c, const rilbed::status_t* m) { order.push_back(c); status.push_back(*m); }
+  void on_world(const lcm::ReceiveBuffer*, const std::string& c, const rilbed::world_t* m) { order.push_back(c); worlds.push_back(*m); }
+};
+
+agents::Scenario convoy_sim() {
+  return agents::load_scenario(std::filesystem::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml");
+}
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(LcmBus, ARunOnTheInProcessBusIsWhatItsFolderHolds) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  const Channels channels = Channels::with_prefix("T1_");
+  Collector got;
+  lcm.subscribe(channels.poses, &Collector::on_poses, &got);
+  lcm.subscribe(channels.events, &Collector::on_event, &got);
+  lcm.subscribe(channels.status, &Collector::on_status, &got);
+  lcm.subscribe(channels.world, &Collector::on_world, &got);
+  LcmRunPublisher publisher(lcm, channels, true);
+
+  const auto dir = std::filesystem::temp_directory_path() / ("rilbed_lcm_bus_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  agents::RunOptions o;
+  o.seed = 3;
+  o.stop_when_formed = true;
+  o.out_dir = dir;
+  o.observer = &publisher;
+  const agents::RunResult r = agents::run_scenario(convoy_sim(), o);
+  ASSERT_TRUE(r.formed);
+
+  ASSERT_FALSE(got.order.empty());
+  EXPECT_EQ(got.order.front(), "T1_RILBED_WORLD");  // a viewer can draw before the first poses
+  ASSERT_FALSE(got.worlds.empty());
+  EXPECT_EQ(got.worlds.front().scenario, "convoy_sim");
+  EXPECT_DOUBLE_EQ(got.worlds.front().width_m, 1.5);
+  EXPECT_EQ(got.worlds.front().num_robots, 8);
+  // One poses message per control step, every robot in each.
+  const auto steps = static_cast<std::size_t>(std::llround(r.simulated_s / 0.1)) + 1;
+  EXPECT_NEAR(static_cast<double>(got.poses.size()), static_cast<double>(steps), 1.0);
+  for (const auto& p : got.poses) ASSERT_EQ(p.num_robots, 8);
+  // The poses are the trajectories' rows.
+  const std::string trajectories = slurp(dir / "trajectories.csv");
+  const auto& last = got.poses.back();
+  char row[128];
+  std::snprintf(row, sizeof row, "%.3f,%d,%.5f,%.5f,", static_cast<double>(last.utime) * 1e-6, last.robots[0].id,
+                last.robots[0].x_m, last.robots[0].y_m);
+  EXPECT_NE(trajectories.find(row), std::string::npos) << row;
+  // Every event, as events.csv has it, in order.
+  std::istringstream csv(slurp(dir / "events.csv"));
+  std::string line;
+  std::getline(csv, line);  // header
+  std::size_t k = 0;
+  while (std::getline(csv, line)) {
+    ASSERT_LT(k, got.events.size()) << line;
+    const auto& e = got.events[k++];
+    std::snprintf(row, sizeof row, "%.3f,", static_cast<double>(e.utime) * 1e-6);
+    EXPECT_EQ(line.rfind(std::string(row) + e.kind + "," + std::to_string(e.id) + "," + std::to_string(e.other) + ",", 0), 0u)
+        << line;
+  }
+  EXPECT_EQ(k, got.events.size());
+  // The status every simulated second, then once more at the end.
+  ASSERT_GE(got.status.size(), static_cast<std::size_t>(r.simulated_s));
+  EXPECT_EQ(got.status.front().state, "running");
+  const auto& end = got.status.back();
+  EXPECT_EQ(end.state, "ended");
+  EXPECT_EQ(end.ended_by, "formed");
+  EXPECT_TRUE(end.formed);
+  EXPECT_NEAR(end.formation_time_s, *r.formation_time_s, 1e-9);
+  EXPECT_EQ(end.seed, 3);
+  EXPECT_EQ(end.num_robots, 8);
+  // What the publisher counted is what arrived.
+  const auto counts = publisher.counts();
+  EXPECT_EQ(counts.at("T1_RILBED_POSES").messages, got.poses.size());
+  EXPECT_EQ(counts.at("T1_RILBED_EVENTS").messages, got.events.size());
+  EXPECT_EQ(counts.at("T1_RILBED_POSES").failures, 0u);
+  EXPECT_GT(counts.at("T1_RILBED_POSES").bytes, 100u * got.poses.size());
+  std::filesystem::remove_all(dir);
+}
+
+TEST(LcmBus, ChecksChannelPrefixesAndUrls) {
+  EXPECT_EQ(check_channel_prefix(""), std::nullopt);
+  EXPECT_EQ(check_channel_prefix("LAB_2_"), std::nullopt);
+  EXPECT_NE(check_channel_prefix("LAB 2"), std::nullopt);
+  EXPECT_NE(check_channel_prefix("a.b"), std::nullopt);
+  EXPECT_NE(check_channel_prefix(std::string(60, 'A')), std::nullopt);
+  EXPECT_EQ(Channels::with_prefix("X_").status, "X_RILBED_STATUS");
+  std::string error;
+  EXPECT_EQ(open_lcm("nosuch://here", error), nullptr);
+  EXPECT_NE(error.find("nosuch://here"), std::string::npos) << error;
+  EXPECT_NE(open_lcm("memq://", error), nullptr);
+}
+
+TEST(LcmBus, MessagesRoundTripThroughTheirEncoding) {
+  agents::PoseReport p{4, true, false, Pose2{{0.5, 0.25}, -1.0}, "follow", "unseen"};
+  const rilbed::poses_t poses = to_lcm(1'500'000, std::span<const agents::PoseReport>(&p, 1));
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(poses.getEncodedSize()));
+  ASSERT_EQ(poses.encode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
+  rilbed::poses_t back;
+  ASSERT_EQ(back.decode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
+  ASSERT_EQ(back.num_robots, 1);
+  EXPECT_EQ(back.utime, 1'500'000);
+  EXPECT_EQ(back.robots[0].id, 4);
+  EXPECT_TRUE(back.robots[0].real);
+  EXPECT_FALSE(back.robots[0].seen);
+  EXPECT_DOUBLE_EQ(back.robots[0].theta_rad, -1.0);
+  EXPECT_EQ(back.robots[0].behaviour, "follow");
+  EXPECT_EQ(back.robots[0].health, "unseen");
+  // Cut short, it does not decode.
+  EXPECT_LT(back.decode(bytes.data(), 0, static_cast<int>(bytes.size()) - 3), 0);
+}
+
+}  // namespace
+}  // namespace rilbed::links
