@@ -12,6 +12,8 @@
 #include <string_view>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "agents/run_recorder.hpp"
 #include "core/geometry.hpp"
 #include "core/time.hpp"
@@ -66,6 +68,8 @@ class RunObserver {
   virtual void on_event(const RunEvent& /*event*/) {}
   /// At the start, once per simulated second, and when the run ends (state "ended").
   virtual void on_status(const StatusReport& /*status*/) {}
+  /// Once, last: summary.json's object.
+  virtual void on_summary(TimeUs /*t_us*/, const nlohmann::json& /*summary*/) {}
 };
 
 }  // namespace rilbed::agents

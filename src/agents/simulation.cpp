@@ -601,17 +601,25 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   }
   if (const auto t = monitor.formation_time_us()) result.formation_time_s = us_to_seconds(*t);
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  if (options.observer) options.observer->on_status(monitor.status(std::min(coordinator.now_us(), end_us), "ended"));
+  nlohmann::json summary = result.summary();
+  summary["scenario"] = scenario.name;
+  summary["mode"] = scenario.mode == ConvoyMode::kCentral ? "central" : "distributed";
+  summary["robots"] = scenario.robots.size();
+  summary["realtime"] = options.realtime;
+  summary["real_robots"] = real_ids;
+  summary["virtual_stand_ins"] = options.virtual_stand_ins;
+  if (options.realtime) summary["rt_factor"] = options.rt_factor;
+  if (!result.formed && !convoy_ids.empty()) {
+    const RunEvent note{coordinator.now_us(), "note", 0, 0, "the convoy did not form"};
+    if (recorder) recorder->add_event(note);
+    if (options.observer) options.observer->on_event(note);
+  }
+  if (options.observer) {
+    const TimeUs end_t_us = std::min(coordinator.now_us(), end_us);
+    options.observer->on_status(monitor.status(end_t_us, "ended"));
+    options.observer->on_summary(end_t_us, summary);
+  }
   if (recorder) {
-    nlohmann::json summary = result.summary();
-    summary["scenario"] = scenario.name;
-    summary["mode"] = scenario.mode == ConvoyMode::kCentral ? "central" : "distributed";
-    summary["robots"] = scenario.robots.size();
-    summary["realtime"] = options.realtime;
-    summary["real_robots"] = real_ids;
-    summary["virtual_stand_ins"] = options.virtual_stand_ins;
-    if (options.realtime) summary["rt_factor"] = options.rt_factor;
-    if (!result.formed && !convoy_ids.empty()) recorder->add_event({coordinator.now_us(), "note", 0, 0, "the convoy did not form"});
     recorder->finish(summary);
   }
   if (failure) std::rethrow_exception(failure);

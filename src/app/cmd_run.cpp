@@ -82,6 +82,7 @@ struct RunArgs {
   std::string mode;  // overrides the scenario's
   bool all_virtual = false;
   std::string lcm_url;        // publish the run on this LCM bus (empty: no bus)
+  std::string record;         // write every message of the run to this LCM log
   std::string channel_prefix;
   bool no_place = false;      // real robots start where they stand
   double place_timeout_s = 90.0;
@@ -253,20 +254,34 @@ int run_command(const RunArgs& args) {
   options.interrupt = &interrupted;
   // The LCM bus: everything the run reports goes out on it while it runs.
   std::unique_ptr<lcm::LCM> lcm;
+  std::unique_ptr<lcm::LogFile> recording;
   std::unique_ptr<links::LcmRunPublisher> publisher;
-  if (!args.lcm_url.empty()) {
+  if (!args.record.empty()) {
+    if (args.seeds > 0) {
+      spdlog::error("--record records one run: leave out --seeds (or record each seed's run on its own)");
+      return kExitUsage;
+    }
+    recording = std::make_unique<lcm::LogFile>(args.record, "w");
+    if (!recording->good()) {
+      spdlog::error("cannot write the recording {}", args.record);
+      return kExitFailure;
+    }
+  }
+  if (!args.lcm_url.empty() || recording) {
+    // Recording without a bus: the messages go on the in-process bus, and to the log.
+    const std::string url = args.lcm_url.empty() ? "memq://" : args.lcm_url;
     if (const auto problem = links::check_channel_prefix(args.channel_prefix)) {
       spdlog::error("{}", *problem);
       return kExitUsage;
     }
     std::string error;
-    lcm = links::open_lcm(args.lcm_url, error);
+    lcm = links::open_lcm(url, error);
     if (!lcm) {
       spdlog::error("{}", error);
       return kExitFailure;
     }
     publisher = std::make_unique<links::LcmRunPublisher>(*lcm, links::Channels::with_prefix(args.channel_prefix),
-                                                         args.lcm_url.rfind("memq://", 0) == 0);
+                                                         url.rfind("memq://", 0) == 0, recording.get());
     options.observer = publisher.get();
   }
   std::signal(SIGINT, on_signal);
@@ -342,6 +357,8 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--lcm", args->lcm_url,
                   "Publish the run on this LCM bus while it runs (e.g. udpm://239.255.76.67:7667?ttl=0; default: none)");
   cmd->add_option("--channel-prefix", args->channel_prefix, "Put this before every channel name (two runs on one network)");
+  cmd->add_option("--record", args->record,
+                  "Write every message of the run to this LCM log (lcm-logplayer plays it; rilbed replay reads it)");
   cmd->add_flag("--no-place", args->no_place,
                 "Real robots start where they stand (default: before each run they are driven, or put if emulated, "
                 "to the run's start poses)");

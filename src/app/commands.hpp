@@ -33,6 +33,9 @@ void add_khepera_emu_command(CLI::App& app);
 /// `rilbed watch --lcm URL`: a terminal display of a run on an LCM bus.
 void add_watch_command(CLI::App& app);
 
+/// `rilbed replay FILE.lcm --out DIR | --lcm URL`: a recorded run again.
+void add_replay_command(CLI::App& app);
+
 /// Exit code a subcommand's callback stores for main() to return.
 int& exit_code();
 

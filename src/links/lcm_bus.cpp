@@ -1,6 +1,10 @@
 #include "links/lcm_bus.hpp"
 
 #include <cctype>
+#include <chrono>
+#include <cstdio>
+#include <limits>
+#include <type_traits>
 
 namespace rilbed::links {
 
@@ -10,6 +14,7 @@ Channels Channels::with_prefix(const std::string& prefix) {
   c.events = prefix + c.events;
   c.status = prefix + c.status;
   c.world = prefix + c.world;
+  c.summary = prefix + c.summary;
   return c;
 }
 
@@ -122,21 +127,149 @@ rilbed::world_t to_lcm(TimeUs t_us, const agents::WorldReport& w) {
   return m;
 }
 
-LcmRunPublisher::LcmRunPublisher(lcm::LCM& lcm, Channels channels, bool in_process)
-    : lcm_(lcm), channels_(std::move(channels)), in_process_(in_process) {}
+rilbed::summary_t to_lcm(TimeUs t_us, const nlohmann::json& summary) {
+  rilbed::summary_t m;
+  m.utime = t_us;
+  m.json = summary.dump();
+  return m;
+}
+
+namespace {
+
+agents::WorldReport from_lcm(const rilbed::world_t& m) {
+  agents::WorldReport w;
+  w.scenario = m.scenario;
+  w.field.width_m = m.width_m;
+  w.field.height_m = m.height_m;
+  w.walls = m.walls;
+  auto points = [](const rilbed::polyline_t& p) {
+    std::vector<Vec2> v;
+    for (std::size_t i = 0; i < p.x_m.size() && i < p.y_m.size(); ++i) v.push_back({p.x_m[i], p.y_m[i]});
+    return v;
+  };
+  for (const auto& o : m.obstacles) w.field.obstacles.push_back(points(o));
+  for (const auto& t : m.tracks) w.field.tracks.emplace_back(points(t), t.width_m);
+  for (std::size_t i = 0; i < m.beacon_x_m.size() && i < m.beacon_y_m.size(); ++i) {
+    w.field.beacons.push_back({m.beacon_x_m[i], m.beacon_y_m[i]});
+  }
+  for (std::size_t i = 0; i < m.robot_ids.size(); ++i) {
+    w.robot_ids.push_back(m.robot_ids[i]);
+    if (i < m.robot_real.size() && m.robot_real[i]) w.field.real_robot_ids.insert(m.robot_ids[i]);
+  }
+  return w;
+}
+
+agents::StatusReport from_lcm(const rilbed::status_t& m) {
+  agents::StatusReport s;
+  s.t_us = m.utime;
+  s.wall_s = static_cast<double>(m.wall_utime) * 1e-6;
+  s.scenario = m.scenario;
+  s.seed = static_cast<std::uint64_t>(m.seed);
+  s.mode = m.mode;
+  s.realtime = m.realtime;
+  s.rt_factor = m.rt_factor;
+  s.state = m.state;
+  s.ended_by = m.ended_by;
+  s.robots = m.num_robots;
+  s.real_robots = m.num_real;
+  s.formed = m.formed;
+  if (m.formation_time_s >= 0.0) s.formation_time_s = m.formation_time_s;
+  s.collisions = m.collisions;
+  return s;
+}
+
+// Decodes `data` as a `Message`; false when the bytes are not one (or not all of one).
+// lcm-gen's decoders size an array by its count field before reading it, so a corrupt
+// count throws (length_error, bad_alloc): that too is a message that is not one.
+template <typename Message>
+bool decode_as(const void* data, std::size_t size, Message& message) {
+  if (size > static_cast<std::size_t>(std::numeric_limits<int>::max())) return false;
+  const int length = static_cast<int>(size);
+  if constexpr (std::is_same_v<Message, rilbed::poses_t>) {
+    // The count of the most frequent message is at a fixed place (after the type hash and
+    // utime): refuse one that the bytes cannot hold before the decoder allocates for it.
+    constexpr int kCountAt = 16;
+    if (length < kCountAt + 4) return false;
+    const auto* b = static_cast<const std::uint8_t*>(data) + kCountAt;
+    const std::int64_t count = static_cast<std::int32_t>((std::uint32_t{b[0]} << 24) | (std::uint32_t{b[1]} << 16) |
+                                                         (std::uint32_t{b[2]} << 8) | std::uint32_t{b[3]});
+    if (count < 0 || count > length) return false;
+  }
+  try {
+    return message.decode(data, 0, length) == length;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+}  // namespace
+
+RunReportDecoder::RunReportDecoder(Channels channels, agents::RunObserver& observer)
+    : channels_(std::move(channels)), observer_(observer) {}
+
+std::optional<std::string> RunReportDecoder::decode(const std::string& channel, const void* data, std::size_t size) {
+  auto bad = [&](const char* type) {
+    return std::optional<std::string>(channel + ": " + std::to_string(size) + " bytes that are not a rilbed." + type);
+  };
+  if (channel == channels_.poses) {
+    rilbed::poses_t m;
+    if (!decode_as(data, size, m)) return bad("poses_t");
+    poses_.clear();
+    for (const rilbed::robot_pose_t& r : m.robots) {
+      poses_.push_back({r.id, r.real, r.seen, Pose2{{r.x_m, r.y_m}, r.theta_rad}, r.behaviour, r.health});
+    }
+    observer_.on_poses(m.utime, poses_);
+  } else if (channel == channels_.events) {
+    rilbed::event_t m;
+    if (!decode_as(data, size, m)) return bad("event_t");
+    observer_.on_event({m.utime, m.kind, m.id, m.other, m.detail});
+  } else if (channel == channels_.status) {
+    rilbed::status_t m;
+    if (!decode_as(data, size, m)) return bad("status_t");
+    last_status_ = m;
+    observer_.on_status(from_lcm(m));
+  } else if (channel == channels_.world) {
+    rilbed::world_t m;
+    if (!decode_as(data, size, m)) return bad("world_t");
+    observer_.on_world(m.utime, from_lcm(m));
+  } else if (channel == channels_.summary) {
+    rilbed::summary_t m;
+    if (!decode_as(data, size, m)) return bad("summary_t");
+    const nlohmann::json summary = nlohmann::json::parse(m.json, nullptr, false);
+    if (summary.is_discarded() || !summary.is_object()) return channel + ": the summary is not a JSON object";
+    summary_seen_ = true;
+    observer_.on_summary(m.utime, summary);
+  }
+  return std::nullopt;
+}
+
+LcmRunPublisher::LcmRunPublisher(lcm::LCM& lcm, Channels channels, bool in_process, lcm::LogFile* log)
+    : lcm_(lcm), channels_(std::move(channels)), in_process_(in_process), log_(log) {}
 
 template <typename Message>
 void LcmRunPublisher::publish(const std::string& channel, const Message& message) {
-  const int status = lcm_.publish(channel, &message);
-  {
-    std::lock_guard lock(mutex_);
-    ChannelCount& c = counts_[channel];
-    if (status == 0) {
-      ++c.messages;
-      c.bytes += static_cast<std::uint64_t>(message.getEncodedSize());
-    } else {
-      ++c.failures;  // lost, as on a lossy network; the run goes on
-    }
+  std::lock_guard lock(mutex_);
+  // Encoded once: the same bytes go on the bus and into the log.
+  const int size = message.getEncodedSize();
+  buffer_.resize(static_cast<std::size_t>(size));
+  message.encode(buffer_.data(), 0, size);
+  const int status = lcm_.publish(channel, buffer_.data(), static_cast<unsigned>(size));
+  ChannelCount& c = counts_[channel];
+  if (status == 0) {
+    ++c.messages;
+    c.bytes += static_cast<std::uint64_t>(size);
+  } else {
+    ++c.failures;  // lost, as on a lossy network; the run goes on
+  }
+  if (log_) {
+    lcm::LogEvent event;
+    event.eventnum = log_events_++;
+    event.timestamp = std::chrono::duration_cast<std::chrono::microseconds>(
+                          std::chrono::system_clock::now().time_since_epoch()).count();
+    event.channel = channel;
+    event.datalen = size;
+    event.data = buffer_.data();
+    log_->writeEvent(&event);
   }
   if (in_process_) {
     // memq:// queues every message until handled: deliver to the in-process subscribers now.
@@ -153,7 +286,15 @@ void LcmRunPublisher::on_poses(TimeUs t_us, std::span<const agents::PoseReport> 
 
 void LcmRunPublisher::on_event(const agents::RunEvent& event) { publish(channels_.events, to_lcm(event)); }
 
-void LcmRunPublisher::on_status(const agents::StatusReport& status) { publish(channels_.status, to_lcm(status)); }
+void LcmRunPublisher::on_status(const agents::StatusReport& status) {
+  publish(channels_.status, to_lcm(status));
+  if (log_) std::fflush(log_->getFilePtr());  // a run cut short keeps its log up to the last second
+}
+
+void LcmRunPublisher::on_summary(TimeUs t_us, const nlohmann::json& summary) {
+  publish(channels_.summary, to_lcm(t_us, summary));
+  if (log_) std::fflush(log_->getFilePtr());  // the whole run is on disk once it has ended
+}
 
 std::map<std::string, ChannelCount> LcmRunPublisher::counts() const {
   std::lock_guard lock(mutex_);

@@ -13,11 +13,13 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "agents/run_observer.hpp"
 #include "rilbed/event_t.hpp"
 #include "rilbed/poses_t.hpp"
 #include "rilbed/status_t.hpp"
+#include "rilbed/summary_t.hpp"
 #include "rilbed/world_t.hpp"
 
 namespace rilbed::links {
@@ -28,6 +30,7 @@ struct Channels {
   std::string events = "RILBED_EVENTS";  ///< rilbed::event_t, each event
   std::string status = "RILBED_STATUS";  ///< rilbed::status_t, every simulated second and at the end
   std::string world = "RILBED_WORLD";    ///< rilbed::world_t, at the start and every simulated second
+  std::string summary = "RILBED_SUMMARY";  ///< rilbed::summary_t, once when the run ends
   /// The same names behind `prefix`.
   static Channels with_prefix(const std::string& prefix);
 };
@@ -45,6 +48,28 @@ rilbed::poses_t to_lcm(TimeUs t_us, std::span<const agents::PoseReport> poses);
 rilbed::event_t to_lcm(const agents::RunEvent& event);
 rilbed::status_t to_lcm(const agents::StatusReport& status);
 rilbed::world_t to_lcm(TimeUs t_us, const agents::WorldReport& world);
+rilbed::summary_t to_lcm(TimeUs t_us, const nlohmann::json& summary);
+
+/// Hands the messages of a run's channels, as raw bytes from a bus or a log, to a
+/// RunObserver as the run reported them. Messages on other channels are ignored.
+class RunReportDecoder {
+ public:
+  RunReportDecoder(Channels channels, agents::RunObserver& observer);
+  /// Decodes one message of `channel`; returns the reason when its bytes are not a
+  /// message of that channel's type (the message is then skipped).
+  std::optional<std::string> decode(const std::string& channel, const void* data, std::size_t size);
+  /// Whether the run's summary (its last message) has come.
+  bool summary_seen() const { return summary_seen_; }
+  /// The last status decoded, if any.
+  const std::optional<rilbed::status_t>& last_status() const { return last_status_; }
+
+ private:
+  Channels channels_;
+  agents::RunObserver& observer_;
+  std::vector<agents::PoseReport> poses_;
+  bool summary_seen_ = false;
+  std::optional<rilbed::status_t> last_status_;
+};
 
 /// Messages and bytes sent on one channel, and publishes that failed.
 struct ChannelCount {
@@ -53,16 +78,18 @@ struct ChannelCount {
   std::uint64_t failures = 0;  ///< lcm publish returned an error (e.g. EPERM from a firewall): the message is lost
 };
 
-/// Publishes what a run reports on `lcm` (which must outlive it). A failed publish is
-/// counted and the run goes on. On an in-process bus (memq://) it also delivers the
-/// messages to the in-process subscribers after each publish, so that nothing piles up.
+/// Publishes what a run reports on `lcm` (which must outlive it), and writes every
+/// message to `log` too when given (a standard LCM log, as lcm-logger writes). A failed
+/// publish is counted and the run goes on. On an in-process bus (memq://) it also delivers
+/// the messages to the in-process subscribers after each publish, so nothing piles up.
 class LcmRunPublisher final : public agents::RunObserver {
  public:
-  LcmRunPublisher(lcm::LCM& lcm, Channels channels, bool in_process);
+  LcmRunPublisher(lcm::LCM& lcm, Channels channels, bool in_process, lcm::LogFile* log = nullptr);
   void on_world(TimeUs t_us, const agents::WorldReport& world) override;
   void on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) override;
   void on_event(const agents::RunEvent& event) override;
   void on_status(const agents::StatusReport& status) override;
+  void on_summary(TimeUs t_us, const nlohmann::json& summary) override;
   /// Counts per channel name so far.
   std::map<std::string, ChannelCount> counts() const;
 
@@ -73,6 +100,9 @@ class LcmRunPublisher final : public agents::RunObserver {
   lcm::LCM& lcm_;
   Channels channels_;
   bool in_process_;
+  lcm::LogFile* log_;
+  std::int64_t log_events_ = 0;
+  std::vector<std::uint8_t> buffer_;
   mutable std::mutex mutex_;
   std::map<std::string, ChannelCount> counts_;
 };

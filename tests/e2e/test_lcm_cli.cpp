@@ -78,3 +78,75 @@ TEST(LcmCli, BadBusesAndPrefixesAreClearErrors) {
 
 }  // namespace
 }  // namespace rilbed::e2e
+
+namespace rilbed::e2e {
+namespace {
+
+// A run recorded with --record, then its folder written again from the recording alone.
+TEST(LcmCli, RecordThenReplayGivesTheSameRunFolder) {
+  const fs::path dir = scratch_dir("lcm_record");
+  const std::string log = (dir / "run.lcm").string();
+  CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_mixed") + " --all-virtual --stop-when-formed --seed 9 --out '" +
+                               (dir / "live").string() + "' --record '" + log + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = run_rilbed("replay '" + log + "' --out '" + (dir / "replayed").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("wrote "), std::string::npos) << r.out;
+  for (const char* file : {"trajectories.csv", "events.csv", "summary.json", "trajectories.svg"}) {
+    const std::string live = read_file(dir / "live" / file);
+    EXPECT_FALSE(live.empty()) << file;
+    EXPECT_EQ(live, read_file(dir / "replayed" / file)) << file;
+  }
+  // A recording cut short: the folder holds what it has, and replay says so (exit 1).
+  const std::string whole = read_file(log);
+  std::ofstream(dir / "cut.lcm", std::ios::binary) << whole.substr(0, whole.size() / 2);
+  r = run_rilbed("replay '" + (dir / "cut.lcm").string() + "' --out '" + (dir / "cut").string() + "'");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("ends before the run did"), std::string::npos) << r.err;
+  const std::string rows = read_file(dir / "cut" / "trajectories.csv");
+  EXPECT_GT(rows.size(), 1000u);
+  EXPECT_EQ(read_file(dir / "live" / "trajectories.csv").rfind(rows.substr(0, rows.rfind('\n', rows.size() - 2)), 0), 0u);
+  // Not a log at all.
+  std::ofstream(dir / "junk.lcm") << "this is not an LCM log\n";
+  r = run_rilbed("replay '" + (dir / "junk.lcm").string() + "' --out '" + (dir / "junk").string() + "'");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("holds no LCM events"), std::string::npos) << r.err;
+  r = run_rilbed("replay '" + log + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  r = run_rilbed("run " + shipped_scenario_arg("convoy_sim") + " --seeds 2 --record '" + log + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  fs::remove_all(dir);
+}
+
+// Other programs: lcm-logplayer plays a rilbed recording that `rilbed watch` shows, and a
+// run recorded by lcm-logger replays to the run's own folder.
+TEST(LcmCli, LcmsOwnToolsPlayAndRecordARun) {
+  if (!namespaces_work()) GTEST_SKIP() << "cannot make a network namespace here (unshare -n needs root)";
+  const fs::path dir = scratch_dir("lcm_tools");
+  const int status = in_namespace(dir,
+      "\"$R\" run " + shipped_scenario_arg("convoy_sim") + " --stop-when-formed --seed 4 --record run.lcm --quiet > run.txt\n"
+      "\"$R\" watch --lcm \"$URL\" --until-ended --for 60 > watch.txt 2>&1 &\n"
+      "W=$!\n"
+      // The watcher must be listening before the player starts: wait until it has subscribed
+      // (it says nothing until it hears), by polling its socket.
+      "for i in $(seq 1 100); do ss -lun 2>/dev/null | grep -q 7667 && break; sleep 0.05; done\n"
+      "lcm-logplayer --lcm-url=\"$URL\" -s 5 run.lcm > player.txt 2>&1\n"
+      "wait $W\n"
+      "lcm-logger --lcm-url=\"$URL\" logged.lcm > logger.txt 2>&1 &\n"
+      "L=$!\n"
+      "for i in $(seq 1 100); do ss -lun 2>/dev/null | grep -q 7667 && break; sleep 0.05; done\n"
+      "\"$R\" run " + shipped_scenario_arg("convoy_sim") + " --realtime --rt-factor 20 --stop-when-formed --seed 4 --lcm \"$URL\" --out live --quiet > run2.txt\n"
+      "kill -INT $L; wait $L || true\n"
+      "\"$R\" replay logged.lcm --out from_logger > replay.txt 2>&1\n");
+  ASSERT_EQ(status, 0) << read_file(dir / "ns.log") << read_file(dir / "watch.txt") << read_file(dir / "replay.txt");
+  const std::string watch = read_file(dir / "watch.txt");
+  EXPECT_NE(watch.find("watching convoy_sim"), std::string::npos) << watch;
+  EXPECT_NE(watch.find("(ended by formed)"), std::string::npos) << watch;
+  for (const char* file : {"trajectories.csv", "events.csv", "summary.json"}) {
+    EXPECT_EQ(read_file(dir / "live" / file), read_file(dir / "from_logger" / file)) << file;
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rilbed::e2e
