@@ -11,6 +11,7 @@
 #include "agents/basic_controllers.hpp"
 #include "agents/c_controller.hpp"
 #include "agents/convoy.hpp"
+#include "agents/run_control.hpp"
 #include "agents/run_models.hpp"
 #include "core/id_list.hpp"
 #include "sim/clock.hpp"
@@ -199,6 +200,10 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     if (s_.options->interrupt && s_.options->interrupt->load()) end("interrupt");
   }
   bool formed() const { return formation_.formed(); }
+  /// Ends the run at the end of this step, `why` becoming RunResult::ended_by.
+  void end_run(const char* why) { end(why); }
+  /// Records an event in the run folder and tells the observer.
+  void record_event(const RunEvent& event) { record(event); }
   std::optional<TimeUs> formation_time_us() const { return formation_.formation_time_us(); }
 
   /// The run's status now (`state`: "running" or "ended").
@@ -363,6 +368,63 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   std::vector<TrajectorySample> samples_;
   std::vector<std::string_view> last_behaviour_;
   std::vector<std::string_view> last_health_;
+};
+
+// The console's actions as a DEVS model: they arrive on its input (injected from the
+// console's thread) and are applied here, on the run's thread, between two steps.
+class ControlModel final : public sim::AtomicModel<TimeUs> {  // state: unused (passive)
+ public:
+  struct Setup {
+    std::vector<AgentModel*> agents;
+    MonitorModel* monitor = nullptr;
+    sim::RealTimeClock* clock = nullptr;  // null in a fast run
+    RunObserver* observer = nullptr;
+  };
+  explicit ControlModel(Setup setup)
+      : sim::AtomicModel<TimeUs>("control", 0), s_(std::move(setup)), in_(add_input<ControlAction>("action")) {}
+  TimeUs time_advance() const override { return sim::kInfinity; }
+  void internal_transition() override {}
+  void output() override {}
+  void external_transition(TimeUs elapsed_us) override {
+    t_us_ += elapsed_us;
+    for (const ControlAction& a : in_.messages()) apply(a);
+  }
+  sim::Port<ControlAction>& input() { return in_; }
+
+ private:
+  void apply(const ControlAction& a) {
+    switch (a.kind) {
+      case ControlAction::Kind::kPause:
+        // Safety: a paused run stops every robot; nothing drives them until it resumes.
+        for (AgentModel* agent : s_.agents) agent->body().stop();
+        s_.monitor->record_event({t_us_, "console", 0, 0, "paused by " + a.who});
+        if (s_.observer) s_.observer->on_status(s_.monitor->status(t_us_, "paused"));
+        if (s_.clock) s_.clock->pause();
+        break;
+      case ControlAction::Kind::kResume:
+        s_.monitor->record_event({t_us_, "console", 0, 0, "resumed by " + a.who});
+        if (s_.clock) s_.clock->resume();
+        break;
+      case ControlAction::Kind::kRtFactor: {
+        if (s_.clock) s_.clock->set_factor(a.rt_factor);
+        std::ostringstream text;
+        text << "real-time factor " << a.rt_factor << " set by " << a.who;
+        s_.monitor->record_event({t_us_, "console", 0, 0, text.str()});
+        break;
+      }
+      case ControlAction::Kind::kExit:
+        s_.monitor->record_event({t_us_, "console", 0, 0, "ended by " + a.who});
+        s_.monitor->end_run("console");
+        break;
+      case ControlAction::Kind::kRefused:
+        s_.monitor->record_event({t_us_, "console", 0, 0, "refused " + a.what + " from " + a.who});
+        break;
+    }
+  }
+
+  Setup s_;
+  sim::Port<ControlAction>& in_;
+  TimeUs t_us_ = 0;
 };
 
 // The field as the run folder's picture and a watcher draw it.
@@ -578,8 +640,43 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   sim::FastClock fast_clock;
   sim::RealTimeClock real_clock(options.rt_factor);
   sim::Clock& clock = options.realtime ? static_cast<sim::Clock&>(real_clock) : static_cast<sim::Clock&>(fast_clock);
+  // The console's way in: a root input coupled to the control model.
+  sim::Port<ControlAction>* control_in = nullptr;
+  if (options.control) {
+    auto& control = root->emplace<ControlModel>(
+        ControlModel::Setup{agents, &monitor, options.realtime ? &real_clock : nullptr, options.observer});
+    control_in = &root->add_input<ControlAction>("control");
+    root->couple(*control_in, control.input());
+  }
   sim::Coordinator coordinator(root, clock);
   coordinator_ptr = &coordinator;
+  std::atomic<bool> paused{false};
+  if (options.control) {
+    const bool realtime = options.realtime;
+    const bool has_real = !real_ids.empty();
+    options.control->attach(
+        [&paused, realtime, has_real](const ControlAction& a) -> std::optional<std::string> {
+          switch (a.kind) {
+            case ControlAction::Kind::kPause:
+              if (!realtime) return "a fast run cannot be paused (it is not paced to the clock)";
+              if (paused.exchange(true)) return "the run is paused already";
+              return std::nullopt;
+            case ControlAction::Kind::kResume:
+              if (!paused.exchange(false)) return "the run is not paused";
+              return std::nullopt;
+            case ControlAction::Kind::kRtFactor:
+              if (!realtime) return "a fast run has no real-time factor";
+              if (has_real && a.rt_factor != 1.0) return "a run with real robots runs at a factor of 1";
+              if (!(a.rt_factor > 0.0) || !std::isfinite(a.rt_factor)) return "the factor must be a number above 0";
+              return std::nullopt;
+            case ControlAction::Kind::kExit:
+            case ControlAction::Kind::kRefused:
+              return std::nullopt;
+          }
+          return "unknown action";
+        },
+        [&coordinator, control_in](const ControlAction& a) { coordinator.inject(*control_in, a); });
+  }
   std::exception_ptr failure;
   const auto run_start = std::chrono::steady_clock::now();
   const double cpu_start = thread_cpu_seconds();
@@ -589,6 +686,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
     failure = std::current_exception();
     result.ended_by = std::string("error: ") + e.what();
   }
+  if (options.control) options.control->detach();
   result.run_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
   result.run_cpu_s = thread_cpu_seconds() - cpu_start;
   // Every body is stopped whatever happened (a real robot must not drive on).

@@ -21,6 +21,7 @@
 
 #include "agents/body.hpp"
 #include "agents/controller.hpp"
+#include "agents/run_control.hpp"
 #include "agents/run_observer.hpp"
 #include "agents/run_recorder.hpp"
 #include "agents/scenario.hpp"
@@ -54,6 +55,9 @@ struct RunOptions {
   /// Told the world, every robot's pose at every control step, every event and the
   /// status as the run goes (the LCM bus, tests); may be null. Must outlive the call.
   RunObserver* observer = nullptr;
+  /// Attached while the run runs, so that another thread (a console) can pause, resume,
+  /// change the real-time factor or end it; may be null. Must outlive the call.
+  RunControl* control = nullptr;
 };
 
 /// What a run came to.

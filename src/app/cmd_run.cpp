@@ -22,6 +22,7 @@
 #include "core/id_list.hpp"
 #include "core/statistics.hpp"
 #include "links/lcm_bus.hpp"
+#include "links/lcm_console.hpp"
 #include "links/placement.hpp"
 #include "links/real_robots.hpp"
 
@@ -283,6 +284,31 @@ int run_command(const RunArgs& args) {
     publisher = std::make_unique<links::LcmRunPublisher>(*lcm, links::Channels::with_prefix(args.channel_prefix),
                                                          url.rfind("memq://", 0) == 0, recording.get());
     options.observer = publisher.get();
+  }
+  // The console: commands on the bus, each with this run's token.
+  agents::RunControl control;
+  std::unique_ptr<links::LcmConsoleServer> console;
+  std::filesystem::path token_file;
+  std::string token;
+  // A finished run's token opens nothing: its file goes with the run (unless a newer run
+  // with the same prefix has written its own since).
+  struct TokenFileRemover {
+    const std::filesystem::path& file;
+    const std::string& token;
+    ~TokenFileRemover() {
+      if (!file.empty() && links::read_token(file) == token) std::filesystem::remove(file);
+    }
+  } remove_token_at_exit{token_file, token};
+  if (!args.lcm_url.empty()) {
+    token = links::make_run_token();
+    token_file = links::token_path(args.channel_prefix);
+    const auto problem = links::write_token(token_file, token);
+    std::fprintf(stderr, "rilbed: run token %s%s%s\n", token.c_str(), problem ? "" : " (in ",
+                 problem ? "" : (token_file.string() + ", readable by you only)").c_str());
+    if (problem) spdlog::warn("the token is not in a file ({}): give it to rilbed console with --token", *problem);
+    console = std::make_unique<links::LcmConsoleServer>(*lcm, links::Channels::with_prefix(args.channel_prefix), token,
+                                                        control, [](const std::string& m) { spdlog::info("{}", m); });
+    options.control = &control;
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);

@@ -36,6 +36,9 @@ void add_watch_command(CLI::App& app);
 /// `rilbed replay FILE.lcm --out DIR | --lcm URL`: a recorded run again.
 void add_replay_command(CLI::App& app);
 
+/// `rilbed console --lcm URL pause|resume|exit|rt-factor F`: steers a running run.
+void add_console_command(CLI::App& app);
+
 /// Exit code a subcommand's callback stores for main() to return.
 int& exit_code();
 

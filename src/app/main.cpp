@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   rilbed::app::add_khepera_emu_command(app);
   rilbed::app::add_watch_command(app);
   rilbed::app::add_replay_command(app);
+  rilbed::app::add_console_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

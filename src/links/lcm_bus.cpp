@@ -15,6 +15,8 @@ Channels Channels::with_prefix(const std::string& prefix) {
   c.status = prefix + c.status;
   c.world = prefix + c.world;
   c.summary = prefix + c.summary;
+  c.console = prefix + c.console;
+  c.console_reply = prefix + c.console_reply;
   return c;
 }
 

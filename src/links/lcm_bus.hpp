@@ -31,6 +31,8 @@ struct Channels {
   std::string status = "RILBED_STATUS";  ///< rilbed::status_t, every simulated second and at the end
   std::string world = "RILBED_WORLD";    ///< rilbed::world_t, at the start and every simulated second
   std::string summary = "RILBED_SUMMARY";  ///< rilbed::summary_t, once when the run ends
+  std::string console = "RILBED_CONSOLE";  ///< rilbed::console_command_t, from consoles
+  std::string console_reply = "RILBED_CONSOLE_REPLY";  ///< rilbed::console_reply_t, the run's answers
   /// The same names behind `prefix`.
   static Channels with_prefix(const std::string& prefix);
 };

@@ -6,8 +6,12 @@
 #include <sys/wait.h>
 
 #include <filesystem>
+#include <cmath>
 #include <fstream>
+#include <map>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "run_command.hpp"
 
@@ -144,6 +148,83 @@ TEST(LcmCli, LcmsOwnToolsPlayAndRecordARun) {
   EXPECT_NE(watch.find("(ended by formed)"), std::string::npos) << watch;
   for (const char* file : {"trajectories.csv", "events.csv", "summary.json"}) {
     EXPECT_EQ(read_file(dir / "live" / file), read_file(dir / "from_logger" / file)) << file;
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rilbed::e2e
+
+namespace rilbed::e2e {
+namespace {
+
+// `rilbed console` against a running mixed run over multicast: pause stops the real
+// robots where they are (they do not move while the run is paused), resume goes on, a
+// wrong token and bad commands are refused with the reason, exit ends the run; every
+// command is answered, and the run records them as events.
+TEST(LcmCli, TheConsoleSteersARunAndPauseStopsItsRealRobots) {
+  if (!namespaces_work()) GTEST_SKIP() << "cannot make a network namespace here (unshare -n needs root)";
+  const fs::path dir = scratch_dir("lcm_console");
+  const int status = in_namespace(dir,
+      "export XDG_RUNTIME_DIR=\"$PWD/xdg\"; mkdir -m 700 xdg\n"
+      "\"$R\" run " + shipped_scenario_arg("convoy_mixed") + " --duration 60 --lcm \"$URL\" --out run --quiet > run.txt 2> run.err &\n"
+      "P=$!\n"
+      "set +e\n"
+      // The run answers once it is up: ask until it does (a refused command proves it is there).
+      "for i in $(seq 1 100); do \"$R\" console --lcm \"$URL\" --timeout-ms 200 --token x pause 2>/dev/null; "
+      "grep -q 'refused' run.err && break; sleep 0.1; done\n"
+      "sleep 2\n"
+      "\"$R\" console --lcm \"$URL\" pause > c1.txt 2>&1; echo \"pause $?\" >> codes.txt\n"
+      "sleep 1.5\n"
+      "\"$R\" console --lcm \"$URL\" resume > c2.txt 2>&1; echo \"resume $?\" >> codes.txt\n"
+      "\"$R\" console --lcm \"$URL\" rt-factor 2 > c3.txt 2>&1; echo \"rt $?\" >> codes.txt\n"
+      "\"$R\" console --lcm \"$URL\" --token 00 exit > c4.txt 2>&1; echo \"badtoken $?\" >> codes.txt\n"
+      "sleep 1\n"
+      "\"$R\" console --lcm \"$URL\" exit > c5.txt 2>&1; echo \"exit $?\" >> codes.txt\n"
+      "wait $P; echo \"run $?\" >> codes.txt\n"
+      "\"$R\" console --lcm \"$URL\" --timeout-ms 300 pause > c6.txt 2>&1; echo \"gone $?\" >> codes.txt\n");
+  ASSERT_EQ(status, 0) << read_file(dir / "ns.log");
+  const std::string codes = read_file(dir / "codes.txt");
+  for (const char* line : {"pause 0", "resume 0", "rt 1", "badtoken 1", "exit 0", "run 0", "gone 1"}) {
+    EXPECT_NE(codes.find(line), std::string::npos) << line << "\n" << codes << read_file(dir / "run.err");
+  }
+  EXPECT_NE(read_file(dir / "c3.txt").find("refused: a run with real robots runs at a factor of 1"), std::string::npos);
+  EXPECT_NE(read_file(dir / "c4.txt").find("refused: wrong token"), std::string::npos);
+  EXPECT_NE(read_file(dir / "c6.txt").find("no run answered"), std::string::npos);
+  EXPECT_NE(read_file(dir / "run.txt").find("ended by console"), std::string::npos) << read_file(dir / "run.txt");
+  EXPECT_NE(read_file(dir / "run.err").find("run token "), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "xdg" / "rilbed" / "token"));  // a finished run's token opens nothing
+  EXPECT_NE(read_file(dir / "run.txt").find("robot 4 (emulated): last speed 0 0"), std::string::npos);
+  const std::string events = read_file(dir / "run" / "events.csv");
+  EXPECT_NE(events.find(",console,0,0,paused by "), std::string::npos) << events;
+  EXPECT_NE(events.find(",console,0,0,resumed by "), std::string::npos) << events;
+  EXPECT_NE(events.find(",console,0,0,refused 'exit' (wrong token) from "), std::string::npos) << events;
+  EXPECT_NE(events.find(",console,0,0,ended by "), std::string::npos) << events;
+  // Across the pause (1.5 s of wall time, no simulated time) the real robots stood still:
+  // their poses before and after differ by no more than one control step's motion.
+  const std::size_t paused_at = events.find(",console,0,0,paused by ");
+  const double t_pause = std::stod(events.substr(events.rfind('\n', paused_at) + 1));
+  std::istringstream rows(read_file(dir / "run" / "trajectories.csv"));
+  std::string row;
+  std::map<int, std::vector<std::pair<double, std::pair<double, double>>>> real;  // t, (x, y) of robots 4 and 5
+  std::getline(rows, row);
+  while (std::getline(rows, row)) {
+    std::istringstream f(row);
+    std::string t, id, x, y;
+    std::getline(f, t, ',');
+    std::getline(f, id, ',');
+    std::getline(f, x, ',');
+    std::getline(f, y, ',');
+    if (id == "4" || id == "5") real[std::stoi(id)].push_back({std::stod(t), {std::stod(x), std::stod(y)}});
+  }
+  for (const auto& [id, samples] : real) {
+    for (std::size_t k = 1; k < samples.size(); ++k) {
+      if (samples[k - 1].first <= t_pause && samples[k].first > t_pause) {
+        const double moved = std::hypot(samples[k].second.first - samples[k - 1].second.first,
+                                        samples[k].second.second - samples[k - 1].second.second);
+        EXPECT_LT(moved, 0.02) << "robot " << id << " moved " << moved << " m across the pause";
+      }
+    }
   }
   fs::remove_all(dir);
 }

@@ -1,0 +1,76 @@
+// `rilbed console --lcm URL COMMAND`: steers a running run over its LCM bus: pause,
+// resume, exit, rt-factor F. Every command carries the run's token (from --token, or the
+// run's token file when this user can read it) and gets an answer; the exit status is 0
+// when the run accepted it, 1 when it refused it (the reason is printed) or no run
+// answered within the timeout.
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "app/commands.hpp"
+#include "links/lcm_bus.hpp"
+#include "links/lcm_console.hpp"
+
+namespace rilbed::app {
+
+namespace {
+
+struct ConsoleArgs {
+  std::string url;
+  std::string prefix;
+  std::string token;
+  int timeout_ms = 1000;
+  std::vector<std::string> words;  // the command and its arguments
+};
+
+int console_command(const ConsoleArgs& args) {
+  if (const auto problem = links::check_channel_prefix(args.prefix)) {
+    spdlog::error("console: {}", *problem);
+    return kExitUsage;
+  }
+  std::string token = args.token;
+  if (token.empty()) {
+    const auto path = links::token_path(args.prefix);
+    if (const auto from_file = links::read_token(path)) token = *from_file;
+  }
+  std::string error;
+  std::unique_ptr<lcm::LCM> lcm = links::open_lcm(args.url, error);
+  if (!lcm) {
+    spdlog::error("console: {}", error);
+    return kExitFailure;
+  }
+  const std::vector<std::string> rest(args.words.begin() + 1, args.words.end());
+  const auto reply = links::send_console_command(*lcm, links::Channels::with_prefix(args.prefix), token, args.words.front(),
+                                                 rest, args.timeout_ms);
+  if (!reply) {
+    std::fprintf(stderr, "rilbed console: no run answered on %s within %d ms (channel %sRILBED_CONSOLE)\n", args.url.c_str(),
+                 args.timeout_ms, args.prefix.c_str());
+    return kExitFailure;
+  }
+  if (!reply->accepted) {
+    std::fprintf(stderr, "rilbed console: refused: %s\n", reply->reason.c_str());
+    return kExitFailure;
+  }
+  std::printf("accepted: %s\n", reply->reason.c_str());
+  return 0;
+}
+
+}  // namespace
+
+void add_console_command(CLI::App& app) {
+  auto args = std::make_shared<ConsoleArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "console", "Steer a running run over its LCM bus: pause | resume | exit | rt-factor F (needs the run's token)");
+  cmd->add_option("--lcm", args->url, "LCM URL of the run's bus")->required();
+  cmd->add_option("--channel-prefix", args->prefix, "The run's channel prefix");
+  cmd->add_option("--token", args->token, "The run's token (default: from the run's token file, if you can read it)");
+  cmd->add_option("--timeout-ms", args->timeout_ms, "How long to wait for the run's answer")
+      ->check(CLI::PositiveNumber)->default_val(1000);
+  cmd->add_option("command", args->words, "pause | resume | exit | rt-factor F")->required()->expected(1, 2);
+  cmd->callback([args] { exit_code() = console_command(*args); });
+}
+
+}  // namespace rilbed::app

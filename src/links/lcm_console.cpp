@@ -1,0 +1,242 @@
+#include "links/lcm_console.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <mutex>
+#include <random>
+#include <variant>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/posix/stream_descriptor.hpp>
+#include <boost/asio/post.hpp>
+
+namespace rilbed::links {
+
+namespace asio = boost::asio;
+
+std::string make_run_token() {
+  std::random_device device;
+  std::string token;
+  for (int i = 0; i < 4; ++i) {
+    char part[9];
+    std::snprintf(part, sizeof part, "%08x", static_cast<unsigned>(device()));
+    token += part;
+  }
+  return token;
+}
+
+std::filesystem::path token_path(const std::string& prefix) {
+  const char* runtime = std::getenv("XDG_RUNTIME_DIR");
+  const std::filesystem::path dir = runtime && *runtime ? std::filesystem::path(runtime) / "rilbed"
+                                                        : std::filesystem::path("/tmp") / ("rilbed-" + std::to_string(::getuid()));
+  return dir / (prefix + "token");
+}
+
+std::optional<std::string> write_token(const std::filesystem::path& path, const std::string& token) {
+  const std::filesystem::path dir = path.parent_path();
+  ::mkdir(dir.c_str(), 0700);  // may exist
+  struct stat st {};
+  if (::lstat(dir.c_str(), &st) != 0) return "cannot make " + dir.string();
+  // Someone else's folder, a link, or one others can enter: the token would not be private.
+  if (!S_ISDIR(st.st_mode) || st.st_uid != ::getuid() || (st.st_mode & 077) != 0) {
+    return dir.string() + " is not a private folder of this user (mode 0700)";
+  }
+  const std::filesystem::path temp = path.string() + ".new";
+  std::filesystem::remove(temp);
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) return "cannot write " + temp.string();
+  const std::string line = token + "\n";
+  const bool written = ::write(fd, line.data(), line.size()) == static_cast<ssize_t>(line.size());
+  ::close(fd);
+  std::error_code ec;
+  if (written) std::filesystem::rename(temp, path, ec);
+  if (!written || ec) return "cannot write " + path.string();
+  return std::nullopt;
+}
+
+std::optional<std::string> read_token(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::string token;
+  if (!in || !std::getline(in, token) || token.empty()) return std::nullopt;
+  return token;
+}
+
+std::variant<agents::ControlAction, std::string> parse_console_command(const rilbed::console_command_t& c) {
+  agents::ControlAction a;
+  a.who = c.client.empty() ? std::string("an unnamed console") : c.client;
+  const std::size_t args = c.args.size();
+  auto no_args = [&](agents::ControlAction::Kind kind) -> std::variant<agents::ControlAction, std::string> {
+    if (args != 0) return "'" + c.command + "' takes no arguments";
+    a.kind = kind;
+    return a;
+  };
+  if (c.command == "pause") return no_args(agents::ControlAction::Kind::kPause);
+  if (c.command == "resume") return no_args(agents::ControlAction::Kind::kResume);
+  if (c.command == "exit") return no_args(agents::ControlAction::Kind::kExit);
+  if (c.command == "rt-factor") {
+    if (args != 1) return std::string("'rt-factor' takes one argument, the factor");
+    char* end = nullptr;
+    const double f = std::strtod(c.args[0].c_str(), &end);
+    if (end == c.args[0].c_str() || *end != '\0' || !std::isfinite(f) || f <= 0.0) {
+      return "'" + c.args[0] + "' is not a factor above 0";
+    }
+    a.kind = agents::ControlAction::Kind::kRtFactor;
+    a.rt_factor = f;
+    return a;
+  }
+  return "unknown command '" + c.command + "' (pause, resume, exit, rt-factor F)";
+}
+
+namespace {
+
+// Equal strings in a time that does not depend on where they differ.
+bool same_token(const std::string& a, const std::string& b) {
+  unsigned char diff = a.size() == b.size() ? 0 : 1;
+  for (std::size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i % std::max<std::size_t>(b.size(), 1)]);
+  return diff == 0 && !b.empty();
+}
+
+}  // namespace
+
+struct LcmConsoleServer::Impl {
+  Impl(lcm::LCM& l, Channels c, std::string t, agents::RunControl& ctl, std::function<void(const std::string&)> lg)
+      : lcm(l), channels(std::move(c)), token(std::move(t)), control(ctl), log(std::move(lg)) {}
+
+  lcm::LCM& lcm;
+  Channels channels;
+  std::string token;
+  agents::RunControl& control;
+  std::function<void(const std::string&)> log;
+  asio::io_context io;
+  asio::posix::stream_descriptor descriptor{io};
+  std::thread thread;
+  lcm::Subscription* subscription = nullptr;
+  // Answers already given, by (client, seq), oldest first (a bounded memory).
+  std::map<std::pair<std::string, std::int64_t>, rilbed::console_reply_t> answered;
+  std::deque<std::pair<std::string, std::int64_t>> answered_order;
+
+  void wait_for_messages() {
+    descriptor.async_wait(asio::posix::stream_descriptor::wait_read, [this](const boost::system::error_code& ec) {
+      if (ec) return;  // closed: the server is going
+      lcm.handleTimeout(0);
+      wait_for_messages();
+    });
+  }
+
+  void on_command(const lcm::ReceiveBuffer*, const std::string&, const rilbed::console_command_t* c) {
+    const auto key = std::make_pair(c->client, c->seq);
+    if (const auto it = answered.find(key); it != answered.end()) {
+      lcm.publish(channels.console_reply, &it->second);  // a retry: the same answer, nothing done again
+      return;
+    }
+    rilbed::console_reply_t reply;
+    reply.seq = c->seq;
+    reply.client = c->client;
+    const std::string who = c->client.empty() ? std::string("an unnamed console") : c->client;
+    if (!same_token(c->token, token)) {
+      reply.accepted = false;
+      reply.reason = c->token.empty() ? "no token: give the run's token (--token, or its token file)"
+                                      : "wrong token: this run's token was printed at its start";
+      agents::ControlAction refused;
+      refused.kind = agents::ControlAction::Kind::kRefused;
+      refused.who = who;
+      refused.what = "'" + c->command + "' (" + reply.reason.substr(0, reply.reason.find(':')) + ")";
+      control.act(refused);
+    } else {
+      auto parsed = parse_console_command(*c);
+      if (auto* why = std::get_if<std::string>(&parsed)) {
+        reply.accepted = false;
+        reply.reason = *why;
+      } else if (auto refusal = control.act(std::get<agents::ControlAction>(parsed))) {
+        reply.accepted = false;
+        reply.reason = *refusal;
+      } else {
+        reply.accepted = true;
+        reply.reason = c->command + (c->args.empty() ? std::string() : " " + c->args[0]);
+      }
+    }
+    if (log) log("console: " + who + ": " + c->command + ": " + (reply.accepted ? "accepted" : "refused, " + reply.reason));
+    lcm.publish(channels.console_reply, &reply);
+    answered[key] = reply;
+    answered_order.push_back(key);
+    if (answered_order.size() > 1024) {
+      answered.erase(answered_order.front());
+      answered_order.pop_front();
+    }
+  }
+};
+
+LcmConsoleServer::LcmConsoleServer(lcm::LCM& lcm, Channels channels, std::string token, agents::RunControl& control,
+                                   std::function<void(const std::string&)> log)
+    : impl_(std::make_unique<Impl>(lcm, std::move(channels), std::move(token), control, std::move(log))) {
+  Impl& m = *impl_;
+  m.subscription = lcm.subscribe(m.channels.console, &Impl::on_command, &m);
+  // A duplicate of LCM's descriptor: closing ours must not close LCM's.
+  m.descriptor.assign(::dup(lcm.getFileno()));
+  m.wait_for_messages();
+  m.thread = std::thread([&m] { m.io.run(); });
+}
+
+LcmConsoleServer::~LcmConsoleServer() {
+  Impl& m = *impl_;
+  asio::post(m.io, [&m] {
+    boost::system::error_code ignored;
+    m.descriptor.close(ignored);
+    m.io.stop();
+  });
+  if (m.thread.joinable()) m.thread.join();
+  m.lcm.unsubscribe(m.subscription);
+}
+
+namespace {
+
+struct ReplyCatcher {
+  std::int64_t seq = 0;
+  std::string client;
+  std::optional<rilbed::console_reply_t> reply;
+  void on_reply(const lcm::ReceiveBuffer*, const std::string&, const rilbed::console_reply_t* r) {
+    if (r->seq == seq && r->client == client) reply = *r;
+  }
+};
+
+}  // namespace
+
+std::optional<rilbed::console_reply_t> send_console_command(lcm::LCM& lcm, const Channels& channels,
+                                                            const std::string& token, const std::string& command,
+                                                            const std::vector<std::string>& args, int timeout_ms,
+                                                            int resend_ms) {
+  std::array<char, 256> host{};
+  ::gethostname(host.data(), host.size() - 1);
+  rilbed::console_command_t c;
+  c.seq = static_cast<std::int64_t>(std::random_device{}()) << 20 ^ std::chrono::steady_clock::now().time_since_epoch().count();
+  c.client = std::string(host.data()) + ":" + std::to_string(::getpid());
+  c.token = token;
+  c.command = command;
+  c.args = args;
+  c.num_args = static_cast<std::int32_t>(args.size());
+  ReplyCatcher catcher{c.seq, c.client, std::nullopt};
+  lcm::Subscription* s = lcm.subscribe(channels.console_reply, &ReplyCatcher::on_reply, &catcher);
+  const auto start = std::chrono::steady_clock::now();
+  auto next_send = start;
+  while (!catcher.reply) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now - start >= std::chrono::milliseconds(timeout_ms)) break;
+    if (now >= next_send) {
+      lcm.publish(channels.console, &c);
+      next_send = now + std::chrono::milliseconds(resend_ms);
+    }
+    lcm.handleTimeout(20);
+  }
+  lcm.unsubscribe(s);
+  return catcher.reply;
+}
+
+}  // namespace rilbed::links

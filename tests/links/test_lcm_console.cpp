@@ -1,0 +1,141 @@
+// The console over LCM, on the in-process bus: commands parsed and checked, the token
+// required, every command answered once and applied once (a retried command gets the
+// first answer again), and the token file private to its user.
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+
+#include <atomic>
+#include <filesystem>
+#include <mutex>
+#include <variant>
+#include <vector>
+
+#include "links/lcm_console.hpp"
+
+namespace rilbed::links {
+namespace {
+
+rilbed::console_command_t command(std::string name, std::vector<std::string> args = {}, std::string token = "t0k") {
+  rilbed::console_command_t c;
+  c.seq = 7;
+  c.client = "test:1";
+  c.token = std::move(token);
+  c.command = std::move(name);
+  c.args = std::move(args);
+  c.num_args = static_cast<std::int32_t>(c.args.size());
+  return c;
+}
+
+TEST(LcmConsole, ParsesEveryCommandAndRefusesTheRest) {
+  using Kind = agents::ControlAction::Kind;
+  auto kind = [](const rilbed::console_command_t& c) { return std::get<agents::ControlAction>(parse_console_command(c)).kind; };
+  EXPECT_EQ(kind(command("pause")), Kind::kPause);
+  EXPECT_EQ(kind(command("resume")), Kind::kResume);
+  EXPECT_EQ(kind(command("exit")), Kind::kExit);
+  const auto rt = parse_console_command(command("rt-factor", {"2.5"}));
+  ASSERT_TRUE(std::holds_alternative<agents::ControlAction>(rt));
+  EXPECT_EQ(std::get<agents::ControlAction>(rt).rt_factor, 2.5);
+  EXPECT_EQ(std::get<agents::ControlAction>(rt).who, "test:1");
+  for (const auto& bad : {command("rt-factor"), command("rt-factor", {"0"}), command("rt-factor", {"x"}),
+                          command("rt-factor", {"inf"}), command("pause", {"now"}), command("fly"), command("")}) {
+    EXPECT_TRUE(std::holds_alternative<std::string>(parse_console_command(bad))) << bad.command;
+  }
+}
+
+TEST(LcmConsole, TheTokenFileIsPrivate) {
+  const auto dir = std::filesystem::temp_directory_path() / ("rilbed_token_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  ASSERT_EQ(write_token(dir / "token", "abc"), std::nullopt);
+  struct stat st {};
+  ASSERT_EQ(::stat((dir / "token").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0600u);
+  ASSERT_EQ(::stat(dir.c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0700u);
+  EXPECT_EQ(read_token(dir / "token"), "abc");
+  EXPECT_EQ(read_token(dir / "none"), std::nullopt);
+  // A folder others can enter is no place for it.
+  ::chmod(dir.c_str(), 0755);
+  EXPECT_NE(write_token(dir / "token", "def"), std::nullopt);
+  std::filesystem::remove_all(dir);
+  EXPECT_EQ(make_run_token().size(), 32u);
+  EXPECT_NE(make_run_token(), make_run_token());
+}
+
+// A run stand-in: counts what it is asked to do (a mock is fine inside a unit test).
+struct FakeRun {
+  std::mutex mutex;
+  std::vector<agents::ControlAction> applied;
+  bool paused = false;
+  void attach(agents::RunControl& control) {
+    control.attach(
+        [this](const agents::ControlAction& a) -> std::optional<std::string> {
+          std::lock_guard lock(mutex);
+          if (a.kind == agents::ControlAction::Kind::kPause && paused) return "the run is paused already";
+          return std::nullopt;
+        },
+        [this](const agents::ControlAction& a) {
+          std::lock_guard lock(mutex);
+          if (a.kind == agents::ControlAction::Kind::kPause) paused = true;
+          applied.push_back(a);
+        });
+  }
+  std::size_t count() {
+    std::lock_guard lock(mutex);
+    return applied.size();
+  }
+};
+
+struct Replies {
+  std::vector<rilbed::console_reply_t> got;
+  void on(const lcm::ReceiveBuffer*, const std::string&, const rilbed::console_reply_t* r) { got.push_back(*r); }
+};
+
+TEST(LcmConsole, AnswersEveryCommandOnceAndAppliesItOnce) {
+  lcm::LCM server_bus("memq://");
+  const Channels channels = Channels::with_prefix("C_");
+  agents::RunControl control;
+  FakeRun run;
+  run.attach(control);
+  LcmConsoleServer server(server_bus, channels, "t0k", control, {});
+
+  // The console's side on the same in-process bus.
+  auto reply = send_console_command(server_bus, channels, "t0k", "pause", {}, 2000);
+  ASSERT_TRUE(reply.has_value());
+  EXPECT_TRUE(reply->accepted) << reply->reason;
+  EXPECT_EQ(run.count(), 1u);
+  reply = send_console_command(server_bus, channels, "t0k", "pause", {}, 2000);
+  ASSERT_TRUE(reply.has_value());
+  EXPECT_FALSE(reply->accepted);
+  EXPECT_EQ(reply->reason, "the run is paused already");
+  // A wrong or missing token is refused, and the run records the refusal.
+  reply = send_console_command(server_bus, channels, "nope", "exit", {}, 2000);
+  ASSERT_TRUE(reply.has_value());
+  EXPECT_FALSE(reply->accepted);
+  EXPECT_NE(reply->reason.find("wrong token"), std::string::npos);
+  reply = send_console_command(server_bus, channels, "", "exit", {}, 2000);
+  ASSERT_TRUE(reply.has_value());
+  EXPECT_NE(reply->reason.find("no token"), std::string::npos);
+  ASSERT_EQ(run.count(), 3u);
+  EXPECT_EQ(run.applied[1].kind, agents::ControlAction::Kind::kRefused);
+  EXPECT_NE(run.applied[1].what.find("'exit'"), std::string::npos);
+  // The same command three times (a client retrying after a loss): three answers, one action.
+  Replies replies;
+  server_bus.subscribe(channels.console_reply, &Replies::on, &replies);
+  const rilbed::console_command_t resume = command("resume");
+  for (int i = 0; i < 3; ++i) server_bus.publish(channels.console, &resume);
+  for (int i = 0; i < 200 && replies.got.size() < 3; ++i) server_bus.handleTimeout(10);
+  ASSERT_EQ(replies.got.size(), 3u);
+  for (const auto& r : replies.got) EXPECT_TRUE(r.accepted);
+  EXPECT_EQ(run.count(), 4u);
+  // No run attached: refused, saying so.
+  control.detach();
+  reply = send_console_command(server_bus, channels, "t0k", "exit", {}, 2000);
+  ASSERT_TRUE(reply.has_value());
+  EXPECT_EQ(reply->reason, "no run is running");
+  // Nobody on another prefix: no answer.
+  EXPECT_FALSE(send_console_command(server_bus, Channels::with_prefix("NONE_"), "t0k", "pause", {}, 300).has_value());
+}
+
+}  // namespace
+}  // namespace rilbed::links
