@@ -6,12 +6,15 @@
 #include <cmath>
 #include <vector>
 #include <cstdio>
+#include <memory>
 #include <sstream>
+#include <utility>
 
 #include "agents/scenario.hpp"
 #include "agents/simulation.hpp"
 #include "app/commands.hpp"
 #include "core/id_list.hpp"
+#include "links/lcm_bus.hpp"
 
 namespace rilbed::app {
 
@@ -24,6 +27,7 @@ struct BenchArgs {
   double density_per_m2 = 8.0 / (1.5 * 1.2);  // the lab's convoy: 8 robots on 1.5 x 1.2 m
   std::uint64_t seed = 1;
   int repeat = 3;
+  std::string lcm_url;  // also time each count with the run published on this bus
 };
 
 // N wandering Kheperas with their eight IR sensors in a field of constant density.
@@ -65,32 +69,76 @@ int bench_command(const BenchArgs& args) {
   std::printf("| robots | field m | simulated s | wall s (median of %d) | CPU s (median) | wall ms per simulated s | real-time factor (wall) | real-time factor (CPU) | us per robot-step (CPU) | collisions | max overlap m |\n",
               args.repeat);
   std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+  std::vector<std::pair<int, double>> bus_costs;
+  // With --lcm: each count also with every message of the run published on the bus
+  // (nobody need listen), runs with and without it taking turns so that other load on
+  // the machine falls on both.
+  std::unique_ptr<lcm::LCM> lcm;
+  std::unique_ptr<links::LcmRunPublisher> publisher;
+  if (!args.lcm_url.empty()) {
+    std::string error;
+    lcm = links::open_lcm(args.lcm_url, error);
+    if (!lcm) {
+      spdlog::error("sim-bench: {}", error);
+      return kExitFailure;
+    }
+    publisher = std::make_unique<links::LcmRunPublisher>(*lcm, links::Channels{}, args.lcm_url.rfind("memq://", 0) == 0);
+  }
   for (int n : counts.ids) {
     const agents::Scenario s = bench_scenario(n, args);
-    agents::RunOptions o;
-    o.seed = args.seed;
-    o.duration_s = args.seconds;
-    std::vector<double> walls, cpus;
-    agents::RunResult r;
+    struct Timing {
+      std::vector<double> walls, cpus;
+      agents::RunResult r;
+    };
+    Timing plain, bused;
     for (int rep = 0; rep < args.repeat; ++rep) {
-      try {
-        r = agents::run_scenario(s, o);
-      } catch (const std::exception& e) {
-        spdlog::error("{} robots: {}", n, e.what());
-        return kExitFailure;
+      for (Timing* t : {&plain, &bused}) {
+        if (t == &bused && !publisher) continue;
+        agents::RunOptions o;
+        o.seed = args.seed;
+        o.duration_s = args.seconds;
+        if (t == &bused) o.observer = publisher.get();
+        try {
+          t->r = agents::run_scenario(s, o);
+        } catch (const std::exception& e) {
+          spdlog::error("{} robots: {}", n, e.what());
+          return kExitFailure;
+        }
+        t->walls.push_back(t->r.run_wall_s);
+        t->cpus.push_back(t->r.run_cpu_s);
       }
-      walls.push_back(r.run_wall_s);
-      cpus.push_back(r.run_cpu_s);
     }
-    std::sort(walls.begin(), walls.end());
-    std::sort(cpus.begin(), cpus.end());
-    const double wall_s = std::max(1e-9, walls[walls.size() / 2]);
-    const double cpu_s = std::max(1e-9, cpus[cpus.size() / 2]);
-    const double steps = n * r.simulated_s / 0.1;
-    std::printf("| %d | %.1f x %.1f | %.1f | %.3f | %.3f | %.1f | %.1f | %.1f | %.2f | %d | %.2g |\n", n,
-                s.map.field.width_m, s.map.field.height_m, r.simulated_s, wall_s, cpu_s, 1000.0 * wall_s / r.simulated_s,
-                r.simulated_s / wall_s, r.simulated_s / cpu_s, 1e6 * cpu_s / steps, r.collisions, r.max_overlap_m);
+    auto row = [&](Timing& t, const char* label) {
+      std::sort(t.walls.begin(), t.walls.end());
+      std::sort(t.cpus.begin(), t.cpus.end());
+      const double wall_s = std::max(1e-9, t.walls[t.walls.size() / 2]);
+      const double cpu_s = std::max(1e-9, t.cpus[t.cpus.size() / 2]);
+      const agents::RunResult& r = t.r;
+      const double steps = n * r.simulated_s / 0.1;
+      std::printf("| %d%s | %.1f x %.1f | %.1f | %.3f | %.3f | %.1f | %.1f | %.1f | %.2f | %d | %.2g |\n", n, label,
+                  s.map.field.width_m, s.map.field.height_m, r.simulated_s, wall_s, cpu_s, 1000.0 * wall_s / r.simulated_s,
+                  r.simulated_s / wall_s, r.simulated_s / cpu_s, 1e6 * cpu_s / steps, r.collisions, r.max_overlap_m);
+      return cpu_s;
+    };
+    const double plain_cpu = row(plain, "");
+    if (publisher) {
+      const double bused_cpu = row(bused, " (bus)");
+      bus_costs.push_back({n, 100.0 * (bused_cpu / plain_cpu - 1.0)});
+    }
     std::fflush(stdout);
+  }
+  if (publisher) {
+    std::printf("\nThe bus: every message of the run published on %s (rows \"(bus)\"): the world and status every "
+                "simulated second, every robot's pose every control step, each event. CPU cost of the bus against the "
+                "same run without it (medians):\n\n| robots | bus cost (CPU) |\n| ---: | ---: |\n",
+                args.lcm_url.c_str());
+    for (const auto& [n, pct] : bus_costs) std::printf("| %d | %+.1f %% |\n", n, pct);
+    std::printf("\nMessages and bytes per channel, all runs with the bus together:\n\n| channel | messages | bytes | "
+                "failed publishes |\n| --- | ---: | ---: | ---: |\n");
+    for (const auto& [channel, c] : publisher->counts()) {
+      std::printf("| %s | %llu | %llu | %llu |\n", channel.c_str(), static_cast<unsigned long long>(c.messages),
+                  static_cast<unsigned long long>(c.bytes), static_cast<unsigned long long>(c.failures));
+    }
   }
   return 0;
 }
@@ -109,6 +157,8 @@ void add_sim_bench_command(CLI::App& app) {
   cmd->add_option("--seed", args->seed, "Seed")->default_val(args->seed);
   cmd->add_option("--repeat", args->repeat, "Runs per count; the table shows medians")->check(CLI::PositiveNumber)
       ->default_val(args->repeat);
+  cmd->add_option("--lcm", args->lcm_url,
+                  "Also time each count with the run published on this LCM bus (e.g. memq://: nobody listening)");
   cmd->callback([args] { exit_code() = bench_command(*args); });
 }
 

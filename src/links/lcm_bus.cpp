@@ -40,23 +40,29 @@ std::unique_ptr<lcm::LCM> open_lcm(const std::string& url, std::string& error) {
   return lcm;
 }
 
-rilbed::poses_t to_lcm(TimeUs t_us, std::span<const agents::PoseReport> poses) {
-  rilbed::poses_t m;
+void fill(rilbed::poses_t& m, TimeUs t_us, std::span<const agents::PoseReport> poses) {
   m.utime = t_us;
   m.num_robots = static_cast<std::int32_t>(poses.size());
-  m.robots.reserve(poses.size());
-  for (const agents::PoseReport& p : poses) {
-    rilbed::robot_pose_t r;
+  // Resized, not rebuilt: a message kept between steps keeps its strings' storage, so a
+  // step of 10,000 robots does not allocate 20,000 strings.
+  m.robots.resize(poses.size());
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const agents::PoseReport& p = poses[i];
+    rilbed::robot_pose_t& r = m.robots[i];
     r.id = p.id;
     r.real = p.real;
     r.seen = p.seen;
     r.x_m = p.pose.position_m.x;
     r.y_m = p.pose.position_m.y;
     r.theta_rad = p.pose.heading_rad;
-    r.behaviour = std::string(p.behaviour);
-    r.health = std::string(p.health);
-    m.robots.push_back(std::move(r));
+    r.behaviour.assign(p.behaviour);
+    r.health.assign(p.health);
   }
+}
+
+rilbed::poses_t to_lcm(TimeUs t_us, std::span<const agents::PoseReport> poses) {
+  rilbed::poses_t m;
+  fill(m, t_us, poses);
   return m;
 }
 
@@ -283,7 +289,8 @@ void LcmRunPublisher::publish(const std::string& channel, const Message& message
 void LcmRunPublisher::on_world(TimeUs t_us, const agents::WorldReport& world) { publish(channels_.world, to_lcm(t_us, world)); }
 
 void LcmRunPublisher::on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) {
-  publish(channels_.poses, to_lcm(t_us, poses));
+  fill(poses_message_, t_us, poses);
+  publish(channels_.poses, poses_message_);
 }
 
 void LcmRunPublisher::on_event(const agents::RunEvent& event) { publish(channels_.events, to_lcm(event)); }

@@ -47,6 +47,8 @@ std::unique_ptr<lcm::LCM> open_lcm(const std::string& url, std::string& error);
 
 /// What a run reports, as LCM messages.
 rilbed::poses_t to_lcm(TimeUs t_us, std::span<const agents::PoseReport> poses);
+/// The same into `message`, reusing its storage (a publisher keeps one between steps).
+void fill(rilbed::poses_t& message, TimeUs t_us, std::span<const agents::PoseReport> poses);
 rilbed::event_t to_lcm(const agents::RunEvent& event);
 rilbed::status_t to_lcm(const agents::StatusReport& status);
 rilbed::world_t to_lcm(TimeUs t_us, const agents::WorldReport& world);
@@ -105,6 +107,7 @@ class LcmRunPublisher final : public agents::RunObserver {
   lcm::LogFile* log_;
   std::int64_t log_events_ = 0;
   std::vector<std::uint8_t> buffer_;
+  rilbed::poses_t poses_message_;  // kept between steps (on_poses is called from the run's thread only)
   mutable std::mutex mutex_;
   std::map<std::string, ChannelCount> counts_;
 };
