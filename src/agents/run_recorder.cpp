@@ -103,7 +103,8 @@ void RunRecorder::finish(const nlohmann::json& summary) {
   trajectories_.close();
   events_.close();
   std::ofstream json(dir_ / "summary.json");
-  json << summary.dump(2) << '\n';
+  // Names from a scenario file may not be UTF-8: replaced, not thrown at the run's end.
+  json << summary.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
   if (!json) throw std::runtime_error("cannot write " + (dir_ / "summary.json").string());
   write_svg();
 }

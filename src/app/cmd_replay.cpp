@@ -34,7 +34,7 @@ struct ReplayArgs {
 };
 
 int write_folder(const ReplayArgs& args) {
-  lcm::LogFile log(args.log, "r");
+  links::LcmLogReader log(args.log);
   if (!log.good()) {
     spdlog::error("replay: cannot read {}", args.log);
     return kExitFailure;
@@ -43,11 +43,15 @@ int write_folder(const ReplayArgs& args) {
   links::RunReportDecoder decoder(links::Channels::with_prefix(args.prefix), writer);
   long events = 0, bad = 0;
   try {
-    while (const lcm::LogEvent* e = log.readNextEvent()) {
+    while (const auto e = log.next()) {
       ++events;
-      if (const auto problem = decoder.decode(e->channel, e->data, static_cast<std::size_t>(e->datalen))) {
+      if (const auto problem = decoder.decode(e->channel, e->data.data(), e->data.size())) {
         if (++bad <= 5) spdlog::warn("replay: {}: event {}: {} (skipped)", args.log, e->eventnum, *problem);
       }
+    }
+    if (log.skipped_bytes() > 0) {
+      spdlog::warn("replay: {}: {} bytes that are not events were skipped{}", args.log, log.skipped_bytes(),
+                   log.truncated() ? " (the last event is cut short)" : "");
     }
     if (!decoder.summary_seen()) {
       // Cut short (a crash, a full disk, a truncated copy): keep what it holds, and say so.
@@ -77,7 +81,7 @@ int write_folder(const ReplayArgs& args) {
 }
 
 int publish(const ReplayArgs& args) {
-  lcm::LogFile log(args.log, "r");
+  links::LcmLogReader log(args.log);
   if (!log.good()) {
     spdlog::error("replay: cannot read {}", args.log);
     return kExitFailure;
@@ -93,17 +97,17 @@ int publish(const ReplayArgs& args) {
   std::int64_t first_us = -1;
   const auto start = std::chrono::steady_clock::now();
   long published = 0;
-  while (const lcm::LogEvent* e = log.readNextEvent()) {
+  while (const auto e = log.next()) {
     if (replay_interrupted.load()) break;
-    if (first_us < 0) first_us = e->timestamp;
-    const double at_s = static_cast<double>(e->timestamp - first_us) * 1e-6;
+    if (first_us < 0) first_us = e->timestamp_us;
+    const double at_s = static_cast<double>(e->timestamp_us - first_us) * 1e-6;
     if (at_s < args.from_s) continue;
     if (args.to_s > 0.0 && at_s > args.to_s) break;
     // The recorded pace, from --from on, divided by --speed; absolute deadlines, no drift.
     const auto due = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                  std::chrono::duration<double>((at_s - args.from_s) / args.speed));
     std::this_thread::sleep_until(due);
-    if (lcm->publish(e->channel, e->data, static_cast<unsigned>(e->datalen)) == 0) ++published;
+    if (lcm->publish(e->channel, e->data.data(), static_cast<unsigned>(e->data.size())) == 0) ++published;
   }
   std::printf("published %ld messages of %s on %s\n", published, args.log.c_str(), args.lcm_url.c_str());
   return published > 0 ? 0 : kExitFailure;

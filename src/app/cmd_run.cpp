@@ -200,7 +200,7 @@ int run_batch(const agents::Scenario& scenario, const RunArgs& args, agents::Run
   batch["per_run"] = runs;
   if (!args.out.empty()) {
     std::filesystem::create_directories(args.out);
-    std::ofstream(std::filesystem::path(args.out) / "batch.json") << batch.dump(2) << '\n';
+    std::ofstream(std::filesystem::path(args.out) / "batch.json") << batch.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
   }
   std::printf("\n| scenario | mode | runs | formed | formation time median s | formation time p95 s | collisions (robot-robot) | max overlap m | wall s (%d jobs) |\n",
               jobs);

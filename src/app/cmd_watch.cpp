@@ -13,6 +13,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "app/commands.hpp"
 #include "links/lcm_bus.hpp"
@@ -32,52 +33,57 @@ struct WatchArgs {
   double silence_s = 2.0;    // say so when nothing is heard this long
 };
 
-// What the watcher knows of the run, kept from the messages.
-class Watcher {
+// What the watcher knows of the run, kept from the messages (decoded, and checked, by
+// links::RunReportDecoder: a corrupt or hostile message is refused, never decoded blindly).
+class Watcher final : public agents::RunObserver {
  public:
   explicit Watcher(const WatchArgs& args) : args_(args) {}
 
-  void on_world(const lcm::ReceiveBuffer*, const std::string&, const rilbed::world_t* message) { on_world(*message); }
-  void on_world(const rilbed::world_t& w) {
+  void on_world(TimeUs, const agents::WorldReport& w) override {
     heard();
     if (world_scenario_ != w.scenario) {
       world_scenario_ = w.scenario;
-      int real = 0;
-      for (const bool r : w.robot_real) real += r;
-      std::printf("watching %s on %s: %d robots (%d real), field %.2f x %.2f m\n", w.scenario.c_str(), args_.url.c_str(),
-                  w.num_robots, real, w.width_m, w.height_m);
+      std::printf("watching %s on %s: %zu robots (%zu real), field %.2f x %.2f m\n", w.scenario.c_str(), args_.url.c_str(),
+                  w.robot_ids.size(), w.field.real_robot_ids.size(), w.field.width_m, w.field.height_m);
       std::fflush(stdout);
     }
   }
-  void on_poses(const lcm::ReceiveBuffer*, const std::string&, const rilbed::poses_t* message) { on_poses(*message); }
-  void on_poses(const rilbed::poses_t& p) {
+  void on_poses(TimeUs, std::span<const agents::PoseReport> poses) override {
     heard();
-    poses_ = p;
+    robots_.clear();
+    for (const agents::PoseReport& p : poses) {
+      std::string text = std::to_string(p.id) + ":" + std::string(p.behaviour);
+      if (p.health != "ok") text += "(" + std::string(p.health) + ")";
+      robots_.push_back(std::move(text));
+    }
   }
-  void on_event(const lcm::ReceiveBuffer*, const std::string&, const rilbed::event_t* message) { on_event(*message); }
-  void on_event(const rilbed::event_t& e) {
+  void on_event(const agents::RunEvent& e) override {
     heard();
     if (e.kind == "behaviour" || e.kind == "collision") return;  // too many to read; the status line shows them
-    std::printf("  %7.1fs  %s", static_cast<double>(e.utime) * 1e-6, e.kind.c_str());
+    std::printf("  %7.1fs  %s", us_to_seconds(e.t_us), e.kind.c_str());
     if (e.id != 0) std::printf(" robot %d", e.id);
     std::printf(": %s\n", e.detail.c_str());
     std::fflush(stdout);
   }
-  void on_status(const lcm::ReceiveBuffer*, const std::string&, const rilbed::status_t* message) { on_status(*message); }
-  void on_status(const rilbed::status_t& s) {
+  void on_status(const agents::StatusReport& s) override {
     heard();
-    std::string line = "t=" + one_decimal(static_cast<double>(s.utime) * 1e-6) + "s " + s.state;
+    std::string line = "t=" + one_decimal(us_to_seconds(s.t_us)) + "s " + s.state;
     if (s.realtime) line += " x" + one_decimal(s.rt_factor);
-    for (const auto& r : poses_.robots) {
-      line += "  " + std::to_string(r.id) + ":" + r.behaviour;
-      if (r.health != "ok") line += "(" + r.health + ")";
-    }
-    if (s.formed) line += "  [formed at " + one_decimal(s.formation_time_s) + " s]";
+    for (const std::string& r : robots_) line += "  " + r;
+    if (s.formed && s.formation_time_s) line += "  [formed at " + one_decimal(*s.formation_time_s) + " s]";
     if (s.state == "ended") line += "  (ended by " + s.ended_by + ")";
     std::printf("%s\n", line.c_str());
     std::fflush(stdout);
     if (s.state == "ended") ended_ = true;
   }
+
+  // A message as it came off the bus.
+  void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    if (const auto problem = decoder_->decode(channel, rbuf->data, rbuf->data_size)) {
+      if (++bad_messages_ <= 5) spdlog::warn("watch: {} (skipped)", *problem);
+    }
+  }
+  void set_decoder(links::RunReportDecoder* decoder) { decoder_ = decoder; }
 
   bool ended() const { return ended_; }
   bool heard_anything() const { return heard_anything_; }
@@ -103,11 +109,13 @@ class Watcher {
   }
 
   const WatchArgs& args_;
+  links::RunReportDecoder* decoder_ = nullptr;
   std::string world_scenario_;
-  rilbed::poses_t poses_{};
+  std::vector<std::string> robots_;
   bool ended_ = false;
   bool heard_anything_ = false;
   bool silent_reported_ = false;
+  long bad_messages_ = 0;
   std::chrono::steady_clock::time_point last_heard_ = std::chrono::steady_clock::now();
 };
 
@@ -124,12 +132,12 @@ int watch_command(const WatchArgs& args) {
   }
   const links::Channels channels = links::Channels::with_prefix(args.prefix);
   Watcher watcher(args);
-  // LCM 1.3's C++ API takes member functions (no lambdas).
-  using W = Watcher;
-  lcm->subscribe(channels.world, static_cast<void (W::*)(const lcm::ReceiveBuffer*, const std::string&, const rilbed::world_t*)>(&W::on_world), &watcher);
-  lcm->subscribe(channels.poses, static_cast<void (W::*)(const lcm::ReceiveBuffer*, const std::string&, const rilbed::poses_t*)>(&W::on_poses), &watcher);
-  lcm->subscribe(channels.events, static_cast<void (W::*)(const lcm::ReceiveBuffer*, const std::string&, const rilbed::event_t*)>(&W::on_event), &watcher);
-  lcm->subscribe(channels.status, static_cast<void (W::*)(const lcm::ReceiveBuffer*, const std::string&, const rilbed::status_t*)>(&W::on_status), &watcher);
+  links::RunReportDecoder decoder(channels, watcher);
+  watcher.set_decoder(&decoder);
+  // Raw bytes, decoded by the checked decoder (LCM 1.3's C++ API takes member functions).
+  for (const std::string* channel : {&channels.world, &channels.poses, &channels.events, &channels.status}) {
+    lcm->subscribe(*channel, &Watcher::on_message, &watcher);
+  }
   std::signal(SIGINT, on_watch_signal);
   std::signal(SIGTERM, on_watch_signal);
   const auto start = std::chrono::steady_clock::now();

@@ -1,6 +1,10 @@
 #include "links/lcm_bus.hpp"
 
+#include "links/lcm_checked.hpp"
+
 #include <cctype>
+#include <fstream>
+#include <iterator>
 #include <chrono>
 #include <cstdio>
 #include <limits>
@@ -138,7 +142,7 @@ rilbed::world_t to_lcm(TimeUs t_us, const agents::WorldReport& w) {
 rilbed::summary_t to_lcm(TimeUs t_us, const nlohmann::json& summary) {
   rilbed::summary_t m;
   m.utime = t_us;
-  m.json = summary.dump();
+  m.json = summary.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   return m;
 }
 
@@ -186,30 +190,6 @@ agents::StatusReport from_lcm(const rilbed::status_t& m) {
   return s;
 }
 
-// Decodes `data` as a `Message`; false when the bytes are not one (or not all of one).
-// lcm-gen's decoders size an array by its count field before reading it, so a corrupt
-// count throws (length_error, bad_alloc): that too is a message that is not one.
-template <typename Message>
-bool decode_as(const void* data, std::size_t size, Message& message) {
-  if (size > static_cast<std::size_t>(std::numeric_limits<int>::max())) return false;
-  const int length = static_cast<int>(size);
-  if constexpr (std::is_same_v<Message, rilbed::poses_t>) {
-    // The count of the most frequent message is at a fixed place (after the type hash and
-    // utime): refuse one that the bytes cannot hold before the decoder allocates for it.
-    constexpr int kCountAt = 16;
-    if (length < kCountAt + 4) return false;
-    const auto* b = static_cast<const std::uint8_t*>(data) + kCountAt;
-    const std::int64_t count = static_cast<std::int32_t>((std::uint32_t{b[0]} << 24) | (std::uint32_t{b[1]} << 16) |
-                                                         (std::uint32_t{b[2]} << 8) | std::uint32_t{b[3]});
-    if (count < 0 || count > length) return false;
-  }
-  try {
-    return message.decode(data, 0, length) == length;
-  } catch (const std::exception&) {
-    return false;
-  }
-}
-
 }  // namespace
 
 RunReportDecoder::RunReportDecoder(Channels channels, agents::RunObserver& observer)
@@ -221,33 +201,81 @@ std::optional<std::string> RunReportDecoder::decode(const std::string& channel, 
   };
   if (channel == channels_.poses) {
     rilbed::poses_t m;
-    if (!decode_as(data, size, m)) return bad("poses_t");
+    if (!decode_checked(data, size, m)) return bad("poses_t");
     poses_.clear();
     for (const rilbed::robot_pose_t& r : m.robots) {
-      poses_.push_back({r.id, r.real, r.seen, Pose2{{r.x_m, r.y_m}, r.theta_rad}, r.behaviour, r.health});
+      poses_.push_back({r.id, r.real != 0, r.seen != 0, Pose2{{r.x_m, r.y_m}, r.theta_rad}, r.behaviour, r.health});
     }
     observer_.on_poses(m.utime, poses_);
   } else if (channel == channels_.events) {
     rilbed::event_t m;
-    if (!decode_as(data, size, m)) return bad("event_t");
+    if (!decode_checked(data, size, m)) return bad("event_t");
     observer_.on_event({m.utime, m.kind, m.id, m.other, m.detail});
   } else if (channel == channels_.status) {
     rilbed::status_t m;
-    if (!decode_as(data, size, m)) return bad("status_t");
+    if (!decode_checked(data, size, m)) return bad("status_t");
     last_status_ = m;
     observer_.on_status(from_lcm(m));
   } else if (channel == channels_.world) {
     rilbed::world_t m;
-    if (!decode_as(data, size, m)) return bad("world_t");
+    if (!decode_checked(data, size, m)) return bad("world_t");
     observer_.on_world(m.utime, from_lcm(m));
   } else if (channel == channels_.summary) {
     rilbed::summary_t m;
-    if (!decode_as(data, size, m)) return bad("summary_t");
+    if (!decode_checked(data, size, m)) return bad("summary_t");
     const nlohmann::json summary = nlohmann::json::parse(m.json, nullptr, false);
     if (summary.is_discarded() || !summary.is_object()) return channel + ": the summary is not a JSON object";
     summary_seen_ = true;
     observer_.on_summary(m.utime, summary);
   }
+  return std::nullopt;
+}
+
+LcmLogReader::LcmLogReader(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return;
+  bytes_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  good_ = !in.bad();
+}
+
+std::optional<LcmLogReader::Event> LcmLogReader::next() {
+  constexpr std::uint32_t kSync = 0xEDA1DA01;
+  constexpr std::size_t kHeader = 4 + 8 + 8 + 4 + 4;
+  auto u32 = [this](std::size_t at) {
+    return (std::uint32_t{bytes_[at]} << 24) | (std::uint32_t{bytes_[at + 1]} << 16) | (std::uint32_t{bytes_[at + 2]} << 8) |
+           std::uint32_t{bytes_[at + 3]};
+  };
+  auto u64 = [&](std::size_t at) { return (std::uint64_t{u32(at)} << 32) | u32(at + 4); };
+  while (pos_ + 4 <= bytes_.size()) {
+    if (u32(pos_) != kSync) {  // not an event here: look for the next one
+      ++pos_;
+      ++skipped_;
+      continue;
+    }
+    if (pos_ + kHeader > bytes_.size()) break;
+    const auto channel_length = static_cast<std::int32_t>(u32(pos_ + 20));
+    const auto data_length = static_cast<std::int32_t>(u32(pos_ + 24));
+    const std::size_t left = bytes_.size() - pos_ - kHeader;
+    if (channel_length < 1 || channel_length > 255 || data_length < 0) {  // a sync word by chance: go on looking
+      ++pos_;
+      ++skipped_;
+      continue;
+    }
+    if (static_cast<std::size_t>(channel_length) + static_cast<std::size_t>(data_length) > left) break;  // cut short
+    Event e;
+    e.eventnum = static_cast<std::int64_t>(u64(pos_ + 4));
+    e.timestamp_us = static_cast<std::int64_t>(u64(pos_ + 12));
+    const std::size_t channel_at = pos_ + kHeader;
+    e.channel.assign(reinterpret_cast<const char*>(&bytes_[channel_at]), static_cast<std::size_t>(channel_length));
+    const std::size_t data_at = channel_at + static_cast<std::size_t>(channel_length);
+    e.data.assign(bytes_.begin() + static_cast<std::ptrdiff_t>(data_at),
+                  bytes_.begin() + static_cast<std::ptrdiff_t>(data_at + static_cast<std::size_t>(data_length)));
+    pos_ = data_at + static_cast<std::size_t>(data_length);
+    return e;
+  }
+  truncated_ = pos_ < bytes_.size();
+  if (truncated_) skipped_ += bytes_.size() - pos_;
+  pos_ = bytes_.size();
   return std::nullopt;
 }
 
@@ -258,11 +286,17 @@ template <typename Message>
 void LcmRunPublisher::publish(const std::string& channel, const Message& message) {
   std::lock_guard lock(mutex_);
   // Encoded once: the same bytes go on the bus and into the log.
-  const int size = message.getEncodedSize();
-  buffer_.resize(static_cast<std::size_t>(size));
-  message.encode(buffer_.data(), 0, size);
-  const int status = lcm_.publish(channel, buffer_.data(), static_cast<unsigned>(size));
+  const int room = message.getEncodedSize();
+  buffer_.resize(static_cast<std::size_t>(room));
+  // encode() stops a string at a NUL byte, so it may write fewer bytes than the room
+  // getEncodedSize() asked for: send what it wrote.
+  const int size = message.encode(buffer_.data(), 0, room);
   ChannelCount& c = counts_[channel];
+  if (size < 0) {
+    ++c.failures;
+    return;
+  }
+  const int status = lcm_.publish(channel, buffer_.data(), static_cast<unsigned>(size));
   if (status == 0) {
     ++c.messages;
     c.bytes += static_cast<std::uint64_t>(size);

@@ -1,5 +1,7 @@
 #include "links/lcm_console.hpp"
 
+#include "links/lcm_checked.hpp"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -131,7 +133,18 @@ struct LcmConsoleServer::Impl {
     });
   }
 
-  void on_command(const lcm::ReceiveBuffer*, const std::string&, const rilbed::console_command_t* c) {
+  // Raw bytes: checked before they are decoded (anyone on the multicast group can send
+  // them, before any token is looked at).
+  void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    rilbed::console_command_t command;
+    if (!decode_checked(rbuf->data, rbuf->data_size, command)) {
+      if (log) log("console: " + channel + ": " + std::to_string(rbuf->data_size) + " bytes that are not a command (ignored)");
+      return;
+    }
+    on_command(&command);
+  }
+
+  void on_command(const rilbed::console_command_t* c) {
     const auto key = std::make_pair(c->client, c->seq);
     if (const auto it = answered.find(key); it != answered.end()) {
       lcm.publish(channels.console_reply, &it->second);  // a retry: the same answer, nothing done again
@@ -178,7 +191,7 @@ LcmConsoleServer::LcmConsoleServer(lcm::LCM& lcm, Channels channels, std::string
                                    std::function<void(const std::string&)> log)
     : impl_(std::make_unique<Impl>(lcm, std::move(channels), std::move(token), control, std::move(log))) {
   Impl& m = *impl_;
-  m.subscription = lcm.subscribe(m.channels.console, &Impl::on_command, &m);
+  m.subscription = lcm.subscribe(m.channels.console, &Impl::on_message, &m);
   // A duplicate of LCM's descriptor: closing ours must not close LCM's.
   m.descriptor.assign(::dup(lcm.getFileno()));
   m.wait_for_messages();
@@ -202,8 +215,9 @@ struct ReplyCatcher {
   std::int64_t seq = 0;
   std::string client;
   std::optional<rilbed::console_reply_t> reply;
-  void on_reply(const lcm::ReceiveBuffer*, const std::string&, const rilbed::console_reply_t* r) {
-    if (r->seq == seq && r->client == client) reply = *r;
+  void on_reply(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    rilbed::console_reply_t r;
+    if (decode_checked(rbuf->data, rbuf->data_size, r) && r.seq == seq && r.client == client) reply = r;
   }
 };
 

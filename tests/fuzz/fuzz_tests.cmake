@@ -5,8 +5,8 @@
 #                       CTest runs it first whenever a fuzz test is asked for)
 #   fuzz_khepera_reply  each target runs RILBED_FUZZ_SECONDS seconds (default 20), from its
 #   fuzz_scenario       seeds and its working corpus <build>/fuzz/corpus/<target>; a crash,
-#                       leak, sanitizer report, broken invariant or hang fails the test and
-#                       leaves the input in <build>/fuzz/artifacts/
+#   fuzz_lcm_messages   leak, sanitizer report, broken invariant or hang fails the test and
+#   fuzz_lcm_log        leaves the input in <build>/fuzz/artifacts/
 # All have the label `fuzz`: `ctest -L fuzz` runs only them, `ctest -LE fuzz` all but them.
 # Without clang++ or libFuzzer, configuring says so and the fuzz tests show as disabled.
 
@@ -19,13 +19,17 @@ find_program(RILBED_FUZZ_CXX NAMES clang++ clang++-14 DOC "clang++ for the fuzz 
 
 set(_fuzz_dir ${CMAKE_CURRENT_LIST_DIR})
 set(_fuzz_bin ${CMAKE_BINARY_DIR}/fuzz)
-set(_fuzz_targets fuzz_khepera_reply fuzz_scenario)
+set(_fuzz_targets fuzz_khepera_reply fuzz_scenario fuzz_lcm_messages fuzz_lcm_log)
 # Seeds per target, read but never written (the fuzzer adds to the first corpus folder
 # only, the working one in the build tree). The scenarios ship with the project.
 set(_fuzz_seeds_fuzz_khepera_reply ${_fuzz_dir}/corpus/khepera_reply)
 set(_fuzz_seeds_fuzz_scenario ${PROJECT_SOURCE_DIR}/scenarios)
+set(_fuzz_seeds_fuzz_lcm_messages ${_fuzz_dir}/corpus/lcm_messages)
+set(_fuzz_seeds_fuzz_lcm_log ${_fuzz_dir}/corpus/lcm_log)
 set(_fuzz_dict_fuzz_khepera_reply ${_fuzz_dir}/khepera_reply.dict)
 set(_fuzz_dict_fuzz_scenario ${_fuzz_dir}/scenario.dict)
+set(_fuzz_dict_fuzz_lcm_messages ${_fuzz_dir}/lcm_messages.dict)
+set(_fuzz_dict_fuzz_lcm_log ${_fuzz_dir}/lcm_log.dict)
 
 # Can clang++ link a fuzzer? (On Debian libFuzzer comes apart, in libclang-rt-14-dev.)
 set(_fuzz_problem "")

@@ -1,0 +1,153 @@
+#include "links/lcm_checked.hpp"
+
+namespace rilbed::links {
+
+namespace {
+
+// Reads an encoding front to back; any read past the end makes it fail for good.
+class Walk {
+ public:
+  Walk(const void* data, std::size_t size) : p_(static_cast<const std::uint8_t*>(data)), left_(size) {}
+  bool ok() const { return ok_; }
+  bool done() const { return ok_ && left_ == 0; }
+  void skip(std::size_t n) {
+    if (!ok_ || n > left_) {
+      ok_ = false;
+      return;
+    }
+    p_ += n;
+    left_ -= n;
+  }
+  std::int32_t i32() {
+    if (!ok_ || left_ < 4) {
+      ok_ = false;
+      return 0;
+    }
+    const auto v = static_cast<std::int32_t>((std::uint32_t{p_[0]} << 24) | (std::uint32_t{p_[1]} << 16) |
+                                             (std::uint32_t{p_[2]} << 8) | std::uint32_t{p_[3]});
+    skip(4);
+    return v;
+  }
+  void i64() { skip(8); }
+  void f64() { skip(8); }
+  void boolean() { skip(1); }
+  // A string: its length (terminator included, so at least 1), then that many bytes.
+  void string() {
+    const std::int32_t length = i32();
+    if (length < 1) ok_ = false;
+    if (ok_) skip(static_cast<std::size_t>(length));
+  }
+  // An array's count: not negative, and no more elements than bytes left (every element
+  // takes at least `min_element_bytes`).
+  std::int32_t count(std::int32_t n, std::size_t min_element_bytes) {
+    if (n < 0 || static_cast<std::size_t>(n) > left_ / min_element_bytes) ok_ = false;
+    return ok_ ? n : 0;
+  }
+
+ private:
+  const std::uint8_t* p_;
+  std::size_t left_;
+  bool ok_ = true;
+};
+
+void robot_pose(Walk& w) {
+  w.i32();
+  w.boolean();
+  w.boolean();
+  w.f64();
+  w.f64();
+  w.f64();
+  w.string();
+  w.string();
+}
+
+void polyline(Walk& w) {
+  const std::int32_t n = w.count(w.i32(), 16);
+  for (std::int32_t i = 0; i < n && w.ok(); ++i) w.f64();
+  for (std::int32_t i = 0; i < n && w.ok(); ++i) w.f64();
+  w.boolean();
+  w.f64();
+}
+
+// The message's fields after its 8-byte type hash (which lcm-gen's decoder checks).
+void fields(Walk& w, const rilbed::poses_t*) {
+  w.i64();
+  const std::int32_t n = w.count(w.i32(), 4 + 2 + 24 + 10);
+  for (std::int32_t i = 0; i < n && w.ok(); ++i) robot_pose(w);
+}
+void fields(Walk& w, const rilbed::event_t*) {
+  w.i64();
+  w.string();
+  w.i32();
+  w.i32();
+  w.string();
+}
+void fields(Walk& w, const rilbed::status_t*) {
+  w.i64();
+  w.i64();
+  w.string();
+  w.i64();
+  w.string();
+  w.boolean();
+  w.f64();
+  w.string();
+  w.string();
+  w.i32();
+  w.i32();
+  w.boolean();
+  w.f64();
+  w.i32();
+}
+void fields(Walk& w, const rilbed::world_t*) {
+  w.i64();
+  w.string();
+  w.f64();
+  w.f64();
+  w.boolean();
+  std::int32_t n = w.count(w.i32(), 4 + 1 + 8);
+  for (std::int32_t i = 0; i < n && w.ok(); ++i) polyline(w);
+  n = w.count(w.i32(), 4 + 1 + 8);
+  for (std::int32_t i = 0; i < n && w.ok(); ++i) polyline(w);
+  n = w.count(w.i32(), 16);
+  w.skip(static_cast<std::size_t>(n) * 16);
+  n = w.count(w.i32(), 5);
+  w.skip(static_cast<std::size_t>(n) * 5);
+}
+void fields(Walk& w, const rilbed::summary_t*) {
+  w.i64();
+  w.string();
+}
+void fields(Walk& w, const rilbed::console_command_t*) {
+  w.i64();
+  w.string();
+  w.string();
+  w.string();
+  const std::int32_t n = w.count(w.i32(), 5);
+  for (std::int32_t i = 0; i < n && w.ok(); ++i) w.string();
+}
+void fields(Walk& w, const rilbed::console_reply_t*) {
+  w.i64();
+  w.string();
+  w.boolean();
+  w.string();
+}
+
+}  // namespace
+
+template <typename Message>
+bool well_formed(const void* data, std::size_t size) {
+  Walk w(data, size);
+  w.skip(8);  // the type hash
+  fields(w, static_cast<const Message*>(nullptr));
+  return w.done();
+}
+
+template bool well_formed<rilbed::poses_t>(const void*, std::size_t);
+template bool well_formed<rilbed::event_t>(const void*, std::size_t);
+template bool well_formed<rilbed::status_t>(const void*, std::size_t);
+template bool well_formed<rilbed::world_t>(const void*, std::size_t);
+template bool well_formed<rilbed::summary_t>(const void*, std::size_t);
+template bool well_formed<rilbed::console_command_t>(const void*, std::size_t);
+template bool well_formed<rilbed::console_reply_t>(const void*, std::size_t);
+
+}  // namespace rilbed::links

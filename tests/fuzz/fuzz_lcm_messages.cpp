@@ -1,0 +1,301 @@
+// Fuzz target for the LCM messages of a run (src/links/lcm_bus.hpp): the first input byte
+// picks one of the run's channels (Channels::with_prefix(""): poses, events, status, world,
+// summary, or a channel that is none of them), the rest are the message's bytes, as they
+// would come off the bus, for RunReportDecoder::decode. The observer reads every field it
+// is handed (touching_observer.hpp), so that ASan sees any read the decoder should not make.
+//
+// Whatever the bytes, decode never throws. Beyond that, what is checked holds whatever
+// messages the decoder accepts:
+//   - it accepts the bytes exactly when lcm-gen's decoder of the channel's type reads all
+//     of them (for the summary: and its text is a JSON object); an accepted message makes
+//     exactly one call of the observer, a refused one none, with a reason that names the
+//     channel; a channel that is not the run's is ignored;
+//   - the observer gets what lcm-gen's decoder read (every field, as from_lcm maps it);
+//   - the message round-trips: encoding what was decoded gives the input again, except
+//     that a string's terminating byte is written as 0 (the decoder does not look at it)
+//     and a string holding a 0 byte is cut there (LCM strings are C strings): then the
+//     encoding is shorter than the input, and than getEncodedSize() (which counts the
+//     whole string); in either case decoding the encoding and encoding that again gives
+//     the same bytes.
+// (The decoder refuses a message whose counts or string lengths its bytes cannot hold before lcm-gen's
+// decoder sees it; such bytes are not shown to lcm-gen's decoder here either.)
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <limits>
+#include <optional>
+#include <set>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "links/lcm_bus.hpp"
+#include "links/lcm_checked.hpp"
+#include "touching_observer.hpp"
+
+namespace {
+
+using namespace rilbed;
+
+std::string g_channel;  // the channel of the input being checked, for the report
+
+[[noreturn]] void broken(const char* what) {
+  std::fprintf(stderr, "\nfuzz_lcm_messages: invariant broken on channel %s: %s\n", g_channel.c_str(), what);
+  std::abort();
+}
+#define FUZZ_CHECK(condition) \
+  do {                        \
+    if (!(condition)) broken(#condition); \
+  } while (false)
+
+// The channels the first byte picks from: the run's five and one it does not use.
+const std::vector<std::string>& channel_names() {
+  static const std::vector<std::string> names = [] {
+    const links::Channels c = links::Channels::with_prefix("");
+    return std::vector<std::string>{c.poses, c.events, c.status, c.world, c.summary, "RILBED_UNKNOWN"};
+  }();
+  return names;
+}
+enum Pick { kPoses, kEvents, kStatus, kWorld, kSummary, kUnknown, kPicks };
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+bool has_nul(const std::string& s) { return s.find('\0') != std::string::npos; }
+// Whether a message holds a string with a 0 byte (which LCM's encoder cuts there).
+bool has_nul(const rilbed::event_t& m) { return has_nul(m.kind) || has_nul(m.detail); }
+bool has_nul(const rilbed::status_t& m) {
+  return has_nul(m.scenario) || has_nul(m.mode) || has_nul(m.state) || has_nul(m.ended_by);
+}
+bool has_nul(const rilbed::world_t& m) { return has_nul(m.scenario); }
+bool has_nul(const rilbed::summary_t& m) { return has_nul(m.json); }
+bool has_nul(const rilbed::poses_t& m) {
+  for (const rilbed::robot_pose_t& r : m.robots) {
+    if (has_nul(r.behaviour) || has_nul(r.health)) return true;
+  }
+  return false;
+}
+
+// lcm-gen's decoder on the bytes: whether it reads all of them (a count it cannot
+// allocate for, or a negative one, throws: that is "no" too).
+template <typename Message>
+bool generated_decode(const std::uint8_t* data, std::size_t size, Message& m) {
+  if (size > static_cast<std::size_t>(std::numeric_limits<int>::max())) return false;
+  try {
+    return m.decode(data, 0, static_cast<int>(size)) == static_cast<int>(size);
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+template <typename Message>
+void check_round_trip(const Message& m, const std::uint8_t* data, std::size_t size) {
+  // getEncodedSize counts a string's size(), encode writes it up to its first 0 byte.
+  const int n = m.getEncodedSize();
+  FUZZ_CHECK(n >= 8);
+  std::vector<std::uint8_t> encoded(static_cast<std::size_t>(n));
+  const int written = m.encode(encoded.data(), 0, n);
+  FUZZ_CHECK(written >= 8 && written <= n);
+  encoded.resize(static_cast<std::size_t>(written));
+  if (!has_nul(m)) {
+    FUZZ_CHECK(written == n && encoded.size() == size);
+    for (std::size_t i = 0; i < size; ++i) FUZZ_CHECK(encoded[i] == data[i] || encoded[i] == 0);
+  } else {
+    FUZZ_CHECK(written < n && encoded.size() < size);
+  }
+  Message again;
+  FUZZ_CHECK(again.decode(encoded.data(), 0, written) == written);
+  FUZZ_CHECK(!has_nul(again) && again.getEncodedSize() == written);
+  std::vector<std::uint8_t> reencoded(static_cast<std::size_t>(written));
+  FUZZ_CHECK(again.encode(reencoded.data(), 0, written) == written);
+  FUZZ_CHECK(reencoded == encoded);
+}
+
+void check_poses(const rilbed_fuzz::TouchingObserver& seen, const rilbed::poses_t& m) {
+  FUZZ_CHECK(seen.calls.poses == 1);
+  FUZZ_CHECK(seen.last_poses_t_us == m.utime);
+  FUZZ_CHECK(m.num_robots >= 0 && static_cast<std::size_t>(m.num_robots) == m.robots.size());
+  FUZZ_CHECK(seen.last_poses.size() == m.robots.size());
+  for (std::size_t i = 0; i < m.robots.size(); ++i) {
+    const rilbed::robot_pose_t& r = m.robots[i];
+    const rilbed_fuzz::OwnedPose& p = seen.last_poses[i];
+    FUZZ_CHECK(p.id == r.id && p.real == (r.real != 0) && p.seen == (r.seen != 0));
+    FUZZ_CHECK(same_bits(p.pose.position_m.x, r.x_m) && same_bits(p.pose.position_m.y, r.y_m));
+    FUZZ_CHECK(same_bits(p.pose.heading_rad, r.theta_rad));
+    FUZZ_CHECK(p.behaviour == r.behaviour && p.health == r.health);
+  }
+}
+
+void check_event(const rilbed_fuzz::TouchingObserver& seen, const rilbed::event_t& m) {
+  FUZZ_CHECK(seen.calls.event == 1);
+  const agents::RunEvent& e = seen.last_event;
+  FUZZ_CHECK(e.t_us == m.utime && e.kind == m.kind && e.id == m.id && e.other == m.other && e.detail == m.detail);
+}
+
+void check_status(const rilbed_fuzz::TouchingObserver& seen, const links::RunReportDecoder& decoder,
+                  const rilbed::status_t& m) {
+  FUZZ_CHECK(seen.calls.status == 1);
+  const agents::StatusReport& s = seen.last_status;
+  FUZZ_CHECK(s.t_us == m.utime && same_bits(s.wall_s, static_cast<double>(m.wall_utime) * 1e-6));
+  FUZZ_CHECK(s.scenario == m.scenario && s.seed == static_cast<std::uint64_t>(m.seed) && s.mode == m.mode);
+  FUZZ_CHECK(s.realtime == (m.realtime != 0) && same_bits(s.rt_factor, m.rt_factor));
+  FUZZ_CHECK(s.state == m.state && s.ended_by == m.ended_by);
+  FUZZ_CHECK(s.robots == m.num_robots && s.real_robots == m.num_real && s.formed == (m.formed != 0));
+  // -1 (any negative, or NaN) while not formed.
+  FUZZ_CHECK(s.formation_time_s.has_value() == (m.formation_time_s >= 0.0));
+  if (s.formation_time_s) FUZZ_CHECK(same_bits(*s.formation_time_s, m.formation_time_s));
+  FUZZ_CHECK(s.collisions == m.collisions);
+  // The decoder keeps the message itself as the last status.
+  FUZZ_CHECK(decoder.last_status().has_value());
+  const rilbed::status_t& kept = *decoder.last_status();
+  const int n = m.getEncodedSize();
+  FUZZ_CHECK(kept.getEncodedSize() == n);
+  std::vector<std::uint8_t> a(static_cast<std::size_t>(n)), b(static_cast<std::size_t>(n));
+  // A string holding a 0 byte is written up to it: compare what encode() wrote.
+  const int wa = m.encode(a.data(), 0, n);
+  const int wb = kept.encode(b.data(), 0, n);
+  FUZZ_CHECK(wa > 0 && wa == wb && std::equal(a.begin(), a.begin() + wa, b.begin()));
+}
+
+void check_world(const rilbed_fuzz::TouchingObserver& seen, const rilbed::world_t& m) {
+  FUZZ_CHECK(seen.calls.world == 1);
+  FUZZ_CHECK(seen.last_world_t_us == m.utime);
+  const agents::WorldReport& w = seen.last_world;
+  FUZZ_CHECK(w.scenario == m.scenario && w.walls == (m.walls != 0));
+  FUZZ_CHECK(same_bits(w.field.width_m, m.width_m) && same_bits(w.field.height_m, m.height_m));
+  auto same_points = [](const std::vector<Vec2>& points, const rilbed::polyline_t& p) {
+    if (p.num_points < 0 || p.x_m.size() != static_cast<std::size_t>(p.num_points) || p.y_m.size() != p.x_m.size()) {
+      return false;
+    }
+    if (points.size() != p.x_m.size()) return false;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (!same_bits(points[i].x, p.x_m[i]) || !same_bits(points[i].y, p.y_m[i])) return false;
+    }
+    return true;
+  };
+  FUZZ_CHECK(w.field.obstacles.size() == m.obstacles.size());
+  for (std::size_t i = 0; i < m.obstacles.size(); ++i) FUZZ_CHECK(same_points(w.field.obstacles[i], m.obstacles[i]));
+  FUZZ_CHECK(w.field.tracks.size() == m.tracks.size());
+  for (std::size_t i = 0; i < m.tracks.size(); ++i) {
+    FUZZ_CHECK(same_points(w.field.tracks[i].first, m.tracks[i]));
+    FUZZ_CHECK(same_bits(w.field.tracks[i].second, m.tracks[i].width_m));
+  }
+  FUZZ_CHECK(m.beacon_x_m.size() == m.beacon_y_m.size() && w.field.beacons.size() == m.beacon_x_m.size());
+  for (std::size_t i = 0; i < m.beacon_x_m.size(); ++i) {
+    FUZZ_CHECK(same_bits(w.field.beacons[i].x, m.beacon_x_m[i]) && same_bits(w.field.beacons[i].y, m.beacon_y_m[i]));
+  }
+  FUZZ_CHECK(m.robot_ids.size() == m.robot_real.size());
+  FUZZ_CHECK(w.robot_ids == std::vector<int>(m.robot_ids.begin(), m.robot_ids.end()));
+  std::set<int> real;
+  for (std::size_t i = 0; i < m.robot_ids.size(); ++i) {
+    if (m.robot_real[i]) real.insert(m.robot_ids[i]);
+  }
+  FUZZ_CHECK(w.field.real_robot_ids == real);
+}
+
+void check_summary(const rilbed_fuzz::TouchingObserver& seen, const links::RunReportDecoder& decoder,
+                   const rilbed::summary_t& m) {
+  FUZZ_CHECK(seen.calls.summary == 1 && decoder.summary_seen());
+  FUZZ_CHECK(seen.last_summary_t_us == m.utime);
+  FUZZ_CHECK(seen.last_summary.is_object());
+  FUZZ_CHECK(seen.last_summary == nlohmann::json::parse(m.json, nullptr, false));
+}
+
+// The decoder walks every message (links::well_formed) before lcm-gen's decoder sees it,
+// refusing a count or a string length its bytes cannot hold: no point (and gigabytes, or
+// a read far past the buffer) in asking lcm-gen's decoder about those.
+template <typename Message>
+bool refused_before_decoding(const std::uint8_t* data, std::size_t size) {
+  return !links::well_formed<Message>(data, size);
+}
+
+// What the decoder should have made of `data`, with lcm-gen's decoder of the channel's type.
+template <typename Message, typename Check>
+void check_channel(const std::optional<std::string>& problem, const std::uint8_t* data, std::size_t size,
+                   const Check& check_accepted) {
+  if (problem && refused_before_decoding<Message>(data, size)) return;
+  Message m;
+  const bool readable = generated_decode(data, size, m);
+  if (problem) {
+    FUZZ_CHECK(!readable);
+    return;
+  }
+  FUZZ_CHECK(readable);
+  check_accepted(m);
+  check_round_trip(m, data, size);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size == 0) return 0;
+  const auto pick = static_cast<Pick>(data[0] % kPicks);
+  g_channel = channel_names()[pick];
+  // The message alone, so that ASan sees a read past its end.
+  const std::uint8_t* message = data + 1;
+  const std::size_t length = size - 1;
+
+  rilbed_fuzz::TouchingObserver seen;
+  links::RunReportDecoder decoder(links::Channels::with_prefix(""), seen);
+  std::optional<std::string> problem;
+  try {
+    problem = decoder.decode(g_channel, message, length);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "\nfuzz_lcm_messages: decode threw: %s\n", e.what());
+    broken("RunReportDecoder::decode threw");
+  } catch (...) {
+    broken("RunReportDecoder::decode threw a non-std exception");
+  }
+
+  if (problem) {
+    FUZZ_CHECK(seen.calls.total() == 0);
+    FUZZ_CHECK(problem->rfind(g_channel + ": ", 0) == 0);
+  } else {
+    FUZZ_CHECK(seen.calls.total() == (pick == kUnknown ? 0 : 1));
+  }
+  FUZZ_CHECK(decoder.summary_seen() == (seen.calls.summary == 1));
+  FUZZ_CHECK(decoder.last_status().has_value() == (seen.calls.status == 1));
+
+  switch (pick) {
+    case kPoses:
+      check_channel<rilbed::poses_t>(problem, message, length, [&](const rilbed::poses_t& m) { check_poses(seen, m); });
+      break;
+    case kEvents:
+      check_channel<rilbed::event_t>(problem, message, length, [&](const rilbed::event_t& m) { check_event(seen, m); });
+      break;
+    case kStatus:
+      check_channel<rilbed::status_t>(problem, message, length,
+                                      [&](const rilbed::status_t& m) { check_status(seen, decoder, m); });
+      break;
+    case kWorld:
+      check_channel<rilbed::world_t>(problem, message, length, [&](const rilbed::world_t& m) { check_world(seen, m); });
+      break;
+    case kSummary: {
+      // Refused also when the bytes are a summary_t whose text is not a JSON object.
+      rilbed::summary_t m;
+      if (problem && refused_before_decoding<rilbed::summary_t>(message, length)) break;
+      const bool readable = generated_decode(message, length, m);
+      if (problem) {
+        if (readable) {
+          const nlohmann::json parsed = nlohmann::json::parse(m.json, nullptr, false);
+          FUZZ_CHECK(parsed.is_discarded() || !parsed.is_object());
+        }
+      } else {
+        FUZZ_CHECK(readable);
+        check_summary(seen, decoder, m);
+        check_round_trip(m, message, length);
+      }
+      break;
+    }
+    case kUnknown:
+    case kPicks:
+      FUZZ_CHECK(!problem);
+      break;
+  }
+  // Keep the observer's reads.
+  if (seen.sink == 0x5eed5eed5eed5eedULL) std::fputc('\0', stderr);
+  return 0;
+}

@@ -1,0 +1,148 @@
+// A RunObserver for the LCM fuzz targets (fuzz_lcm_messages, fuzz_lcm_log): it reads every
+// byte of every field it is handed (so that AddressSanitizer sees a read of memory the
+// decoder should not have handed over: freed, out of bounds, a string_view to a dead
+// string), counts the calls, and keeps a copy of the last report of each kind for the
+// targets to compare with what lcm-gen's decoder made of the same bytes.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "agents/run_observer.hpp"
+
+namespace rilbed_fuzz {
+
+/// A PoseReport with its own strings (a PoseReport's views live only during the call).
+struct OwnedPose {
+  int id = 0;
+  bool real = false;
+  bool seen = false;
+  rilbed::Pose2 pose;
+  std::string behaviour;
+  std::string health;
+};
+
+class TouchingObserver : public rilbed::agents::RunObserver {
+ public:
+  struct Calls {
+    int world = 0, poses = 0, event = 0, status = 0, summary = 0;
+    int total() const { return world + poses + event + status + summary; }
+  };
+
+  void on_world(rilbed::TimeUs t_us, const rilbed::agents::WorldReport& w) override {
+    ++calls.world;
+    touch(t_us);
+    touch(w.scenario);
+    touch(w.walls);
+    touch(w.field.width_m);
+    touch(w.field.height_m);
+    for (const auto& polygon : w.field.obstacles) touch(polygon);
+    for (const auto& [points, width_m] : w.field.tracks) {
+      touch(points);
+      touch(width_m);
+    }
+    touch(w.field.beacons);
+    for (const int id : w.field.real_robot_ids) touch(id);
+    for (const int id : w.robot_ids) touch(id);
+    last_world_t_us = t_us;
+    last_world = w;
+  }
+
+  void on_poses(rilbed::TimeUs t_us, std::span<const rilbed::agents::PoseReport> poses) override {
+    ++calls.poses;
+    touch(t_us);
+    last_poses_t_us = t_us;
+    last_poses.clear();
+    for (const rilbed::agents::PoseReport& p : poses) {
+      touch(p.id);
+      touch(p.real);
+      touch(p.seen);
+      touch(p.pose);
+      touch(p.behaviour);
+      touch(p.health);
+      last_poses.push_back({p.id, p.real, p.seen, p.pose, std::string(p.behaviour), std::string(p.health)});
+    }
+  }
+
+  void on_event(const rilbed::agents::RunEvent& e) override {
+    ++calls.event;
+    touch(e.t_us);
+    touch(e.kind);
+    touch(e.id);
+    touch(e.other);
+    touch(e.detail);
+    last_event = e;
+  }
+
+  void on_status(const rilbed::agents::StatusReport& s) override {
+    ++calls.status;
+    touch(s.t_us);
+    touch(s.wall_s);
+    touch(s.scenario);
+    touch(s.seed);
+    touch(s.mode);
+    touch(s.realtime);
+    touch(s.rt_factor);
+    touch(s.state);
+    touch(s.ended_by);
+    touch(s.robots);
+    touch(s.real_robots);
+    touch(s.formed);
+    if (s.formation_time_s) touch(*s.formation_time_s);
+    touch(s.collisions);
+    last_status = s;
+  }
+
+  void on_summary(rilbed::TimeUs t_us, const nlohmann::json& summary) override {
+    ++calls.summary;
+    touch(t_us);
+    touch(summary.dump());  // every value of the object, at any depth
+    last_summary_t_us = t_us;
+    last_summary = summary;
+  }
+
+  Calls calls;
+  rilbed::TimeUs last_world_t_us = 0, last_poses_t_us = 0, last_summary_t_us = 0;
+  rilbed::agents::WorldReport last_world;
+  std::vector<OwnedPose> last_poses;
+  rilbed::agents::RunEvent last_event;
+  rilbed::agents::StatusReport last_status;
+  nlohmann::json last_summary;
+  /// What was read, summed, so that no read can be optimised away.
+  std::uint64_t sink = 0;
+
+ private:
+  void touch(std::string_view text) {
+    sink += text.size();
+    for (const char c : text) sink = sink * 31 + static_cast<unsigned char>(c);
+  }
+  void touch(double v) {
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, &v, sizeof bits);
+    sink ^= bits;
+  }
+  void touch(std::int64_t v) { sink += static_cast<std::uint64_t>(v); }
+  void touch(std::uint64_t v) { sink += v; }
+  void touch(int v) { sink += static_cast<std::uint64_t>(static_cast<std::int64_t>(v)); }
+  void touch(bool v) { sink += v ? 1 : 2; }
+  void touch(rilbed::Vec2 v) {
+    touch(v.x);
+    touch(v.y);
+  }
+  void touch(const rilbed::Pose2& p) {
+    touch(p.position_m);
+    touch(p.heading_rad);
+  }
+  void touch(const std::vector<rilbed::Vec2>& points) {
+    sink += points.size();
+    for (const rilbed::Vec2& v : points) touch(v);
+  }
+};
+
+}  // namespace rilbed_fuzz
