@@ -142,3 +142,52 @@ TEST(LcmBus, MessagesRoundTripThroughTheirEncoding) {
 
 }  // namespace
 }  // namespace rilbed::links
+
+namespace rilbed::links {
+namespace {
+
+std::vector<std::uint8_t> from_hex(const std::string& hex) {
+  std::vector<std::uint8_t> bytes;
+  for (std::size_t i = 0; i + 1 < hex.size(); i += 2) bytes.push_back(static_cast<std::uint8_t>(std::stoi(hex.substr(i, 2), nullptr, 16)));
+  return bytes;
+}
+
+// Inputs the fuzz targets found: each once crashed or exhausted memory; now each is a
+// message (or a log) refused with a reason.
+TEST(LcmBus, HostileMessagesAndLogsAreRefusedNotDecoded) {
+  agents::RunObserver nobody;
+  RunReportDecoder decoder(Channels::with_prefix(""), nobody);
+  // A world whose obstacle count asks for 144 GB.
+  const auto world = from_hex("333e0b631fa8361d000000000000000000000001003ff80000000000003ff3333333333333017fffffff");
+  const auto problem = decoder.decode("RILBED_WORLD", world.data(), world.size());
+  ASSERT_TRUE(problem.has_value());
+  EXPECT_NE(problem->find("not a rilbed.world_t"), std::string::npos) << *problem;
+  // An event whose string length is 0x80000000 (lcm-gen's decoder wraps it and reads 2 GB
+  // past the buffer).
+  const auto log_bytes = from_hex(
+      "eda1da01000000000000000000000000000000010000000d0000002752494c4245445f4556454e5453b0cb1efb6b9edf8400000000"
+      "00000001800000006e6f7465000000000100000000000000027800");
+  const auto dir = std::filesystem::temp_directory_path() / ("rilbed_hostile_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "event.lcm", std::ios::binary).write(reinterpret_cast<const char*>(log_bytes.data()),
+                                                           static_cast<std::streamsize>(log_bytes.size()));
+  LcmLogReader reader((dir / "event.lcm").string());
+  ASSERT_TRUE(reader.good());
+  const auto event = reader.next();
+  ASSERT_TRUE(event.has_value());
+  EXPECT_EQ(event->channel, "RILBED_EVENTS");
+  EXPECT_TRUE(decoder.decode(event->channel, event->data.data(), event->data.size()).has_value());
+  EXPECT_FALSE(reader.next().has_value());
+  // A log event that claims 2 GB of data (liblcm's reader wrote through a null pointer).
+  const auto huge = from_hex("eda1da01000000000000000000000000000000010000000d7fffffff52494c4245445f4556454e5453736f6d652064617461");
+  std::ofstream(dir / "huge.lcm", std::ios::binary).write(reinterpret_cast<const char*>(huge.data()),
+                                                          static_cast<std::streamsize>(huge.size()));
+  LcmLogReader cut((dir / "huge.lcm").string());
+  EXPECT_FALSE(cut.next().has_value());
+  EXPECT_TRUE(cut.truncated());
+  EXPECT_EQ(cut.skipped_bytes(), huge.size());
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rilbed::links
