@@ -299,7 +299,9 @@ int run_command(const RunArgs& args) {
       if (!file.empty() && links::read_token(file) == token) std::filesystem::remove(file);
     }
   } remove_token_at_exit{token_file, token};
-  if (!args.lcm_url.empty()) {
+  // Only on a bus other processes reach: memq:// is this process alone (and liblcm's
+  // memq provider is not safe with a second thread handling it).
+  if (!args.lcm_url.empty() && args.lcm_url.rfind("memq://", 0) != 0) {
     token = links::make_run_token();
     token_file = links::token_path(args.channel_prefix);
     const auto problem = links::write_token(token_file, token);

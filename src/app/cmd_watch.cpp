@@ -78,8 +78,8 @@ class Watcher final : public agents::RunObserver {
   }
 
   // A message as it came off the bus.
-  void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-    if (const auto problem = decoder_->decode(channel, rbuf->data, rbuf->data_size)) {
+  void on_message(const std::string& channel, const void* data, std::size_t size) {
+    if (const auto problem = decoder_->decode(channel, data, size)) {
       if (++bad_messages_ <= 5) spdlog::warn("watch: {} (skipped)", *problem);
     }
   }
@@ -134,9 +134,11 @@ int watch_command(const WatchArgs& args) {
   Watcher watcher(args);
   links::RunReportDecoder decoder(channels, watcher);
   watcher.set_decoder(&decoder);
-  // Raw bytes, decoded by the checked decoder (LCM 1.3's C++ API takes member functions).
+  // Raw bytes, decoded by the checked decoder.
+  std::vector<std::unique_ptr<links::LcmSubscription>> subscriptions;
   for (const std::string* channel : {&channels.world, &channels.poses, &channels.events, &channels.status}) {
-    lcm->subscribe(*channel, &Watcher::on_message, &watcher);
+    subscriptions.push_back(std::make_unique<links::LcmSubscription>(
+        *lcm, *channel, [&watcher](const std::string& c, const void* data, std::size_t size) { watcher.on_message(c, data, size); }));
   }
   std::signal(SIGINT, on_watch_signal);
   std::signal(SIGTERM, on_watch_signal);

@@ -12,6 +12,20 @@
 
 namespace rilbed::links {
 
+LcmSubscription::LcmSubscription(lcm::LCM& lcm, const std::string& channel, Handler handler)
+    : lcm_(lcm.getUnderlyingLCM()), handler_(std::move(handler)) {
+  if (lcm_) subscription_ = lcm_subscribe(lcm_, channel.c_str(), &LcmSubscription::dispatch, this);
+}
+
+LcmSubscription::~LcmSubscription() {
+  if (lcm_ && subscription_) lcm_unsubscribe(lcm_, subscription_);
+}
+
+void LcmSubscription::dispatch(const lcm_recv_buf_t* rbuf, const char* channel, void* self) {
+  auto* s = static_cast<LcmSubscription*>(self);
+  s->handler_(channel, rbuf->data, static_cast<std::size_t>(rbuf->data_size));
+}
+
 Channels Channels::with_prefix(const std::string& prefix) {
   Channels c;
   c.poses = prefix + c.poses;

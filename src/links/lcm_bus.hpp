@@ -5,8 +5,10 @@
 #pragma once
 
 #include <lcm/lcm-cpp.hpp>
+#include <lcm/lcm.h>
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -23,6 +25,26 @@
 #include "rilbed/world_t.hpp"
 
 namespace rilbed::links {
+
+/// A subscription through LCM's C API: `handler(channel, data, size)` for every message on
+/// `channel` (a regular expression, as LCM takes it), on the thread that handles `lcm`.
+/// LCM 1.3's C++ subscription templates misbehave under UBSan (their callback is handed a
+/// wrong object), and rilbed decodes every message itself anyway (decode_checked).
+/// Unsubscribes when destroyed; `lcm` must outlive it.
+class LcmSubscription {
+ public:
+  using Handler = std::function<void(const std::string& channel, const void* data, std::size_t size)>;
+  LcmSubscription(lcm::LCM& lcm, const std::string& channel, Handler handler);
+  ~LcmSubscription();
+  LcmSubscription(const LcmSubscription&) = delete;
+  LcmSubscription& operator=(const LcmSubscription&) = delete;
+
+ private:
+  static void dispatch(const lcm_recv_buf_t* rbuf, const char* channel, void* self);
+  lcm_t* lcm_;
+  lcm_subscription_t* subscription_ = nullptr;
+  Handler handler_;
+};
 
 /// The channel names of a run; `prefix` (e.g. "LAB2_") lets two runs share a network.
 struct Channels {

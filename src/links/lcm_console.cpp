@@ -120,7 +120,7 @@ struct LcmConsoleServer::Impl {
   asio::io_context io;
   asio::posix::stream_descriptor descriptor{io};
   std::thread thread;
-  lcm::Subscription* subscription = nullptr;
+  std::unique_ptr<LcmSubscription> subscription;
   // Answers already given, by (client, seq), oldest first (a bounded memory).
   std::map<std::pair<std::string, std::int64_t>, rilbed::console_reply_t> answered;
   std::deque<std::pair<std::string, std::int64_t>> answered_order;
@@ -135,10 +135,10 @@ struct LcmConsoleServer::Impl {
 
   // Raw bytes: checked before they are decoded (anyone on the multicast group can send
   // them, before any token is looked at).
-  void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  void on_message(const std::string& channel, const void* data, std::size_t size) {
     rilbed::console_command_t command;
-    if (!decode_checked(rbuf->data, rbuf->data_size, command)) {
-      if (log) log("console: " + channel + ": " + std::to_string(rbuf->data_size) + " bytes that are not a command (ignored)");
+    if (!decode_checked(data, size, command)) {
+      if (log) log("console: " + channel + ": " + std::to_string(size) + " bytes that are not a command (ignored)");
       return;
     }
     on_command(&command);
@@ -188,10 +188,12 @@ struct LcmConsoleServer::Impl {
 };
 
 LcmConsoleServer::LcmConsoleServer(lcm::LCM& lcm, Channels channels, std::string token, agents::RunControl& control,
-                                   std::function<void(const std::string&)> log)
+                                   std::function<void(const std::string&)> log, bool own_thread)
     : impl_(std::make_unique<Impl>(lcm, std::move(channels), std::move(token), control, std::move(log))) {
   Impl& m = *impl_;
-  m.subscription = lcm.subscribe(m.channels.console, &Impl::on_message, &m);
+  m.subscription = std::make_unique<LcmSubscription>(
+      lcm, m.channels.console, [&m](const std::string& c, const void* data, std::size_t size) { m.on_message(c, data, size); });
+  if (!own_thread) return;
   // A duplicate of LCM's descriptor: closing ours must not close LCM's.
   m.descriptor.assign(::dup(lcm.getFileno()));
   m.wait_for_messages();
@@ -200,13 +202,15 @@ LcmConsoleServer::LcmConsoleServer(lcm::LCM& lcm, Channels channels, std::string
 
 LcmConsoleServer::~LcmConsoleServer() {
   Impl& m = *impl_;
-  asio::post(m.io, [&m] {
-    boost::system::error_code ignored;
-    m.descriptor.close(ignored);
-    m.io.stop();
-  });
-  if (m.thread.joinable()) m.thread.join();
-  m.lcm.unsubscribe(m.subscription);
+  if (m.thread.joinable()) {
+    asio::post(m.io, [&m] {
+      boost::system::error_code ignored;
+      m.descriptor.close(ignored);
+      m.io.stop();
+    });
+    m.thread.join();
+  }
+  m.subscription.reset();
 }
 
 namespace {
@@ -215,9 +219,9 @@ struct ReplyCatcher {
   std::int64_t seq = 0;
   std::string client;
   std::optional<rilbed::console_reply_t> reply;
-  void on_reply(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+  void on_reply(const void* data, std::size_t size) {
     rilbed::console_reply_t r;
-    if (decode_checked(rbuf->data, rbuf->data_size, r) && r.seq == seq && r.client == client) reply = r;
+    if (decode_checked(data, size, r) && r.seq == seq && r.client == client) reply = r;
   }
 };
 
@@ -237,7 +241,8 @@ std::optional<rilbed::console_reply_t> send_console_command(lcm::LCM& lcm, const
   c.args = args;
   c.num_args = static_cast<std::int32_t>(args.size());
   ReplyCatcher catcher{c.seq, c.client, std::nullopt};
-  lcm::Subscription* s = lcm.subscribe(channels.console_reply, &ReplyCatcher::on_reply, &catcher);
+  LcmSubscription subscription(lcm, channels.console_reply,
+                               [&catcher](const std::string&, const void* data, std::size_t size) { catcher.on_reply(data, size); });
   const auto start = std::chrono::steady_clock::now();
   auto next_send = start;
   while (!catcher.reply) {
@@ -249,7 +254,6 @@ std::optional<rilbed::console_reply_t> send_console_command(lcm::LCM& lcm, const
     }
     lcm.handleTimeout(20);
   }
-  lcm.unsubscribe(s);
   return catcher.reply;
 }
 

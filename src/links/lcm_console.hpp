@@ -53,9 +53,11 @@ std::variant<agents::ControlAction, std::string> parse_console_command(const ril
 class LcmConsoleServer {
  public:
   /// `lcm` and `control` must outlive the server. `log` (may be empty) is told of every
-  /// command and refusal.
+  /// command and refusal. With `own_thread` the server handles `lcm` on a thread of its
+  /// own (nothing else may handle it then: liblcm's memq:// provider is not safe with two
+  /// handling threads); without, whoever handles `lcm` delivers the commands.
   LcmConsoleServer(lcm::LCM& lcm, Channels channels, std::string token, agents::RunControl& control,
-                   std::function<void(const std::string&)> log);
+                   std::function<void(const std::string&)> log, bool own_thread = true);
   /// Stops serving and joins its thread.
   ~LcmConsoleServer();
   LcmConsoleServer(const LcmConsoleServer&) = delete;

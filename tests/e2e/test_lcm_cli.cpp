@@ -128,13 +128,15 @@ TEST(LcmCli, LcmsOwnToolsPlayAndRecordARun) {
   if (!namespaces_work()) GTEST_SKIP() << "cannot make a network namespace here (unshare -n needs root)";
   const fs::path dir = scratch_dir("lcm_tools");
   const int status = in_namespace(dir,
-      "\"$R\" run " + shipped_scenario_arg("convoy_sim") + " --stop-when-formed --seed 4 --record run.lcm --quiet > run.txt\n"
+      // Recorded in (scaled) real time, so that the player paces it as it was: a burst of a
+      // whole run at once would overflow the watcher's socket buffer, as UDP does.
+      "\"$R\" run " + shipped_scenario_arg("convoy_sim") + " --realtime --rt-factor 5 --stop-when-formed --seed 4 --record run.lcm --quiet > run.txt\n"
       "\"$R\" watch --lcm \"$URL\" --until-ended --for 60 > watch.txt 2>&1 &\n"
       "W=$!\n"
       // The watcher must be listening before the player starts: wait until it has subscribed
       // (it says nothing until it hears), by polling its socket.
       "for i in $(seq 1 100); do ss -lun 2>/dev/null | grep -q 7667 && break; sleep 0.05; done\n"
-      "lcm-logplayer --lcm-url=\"$URL\" -s 5 run.lcm > player.txt 2>&1\n"
+      "lcm-logplayer --lcm-url=\"$URL\" run.lcm > player.txt 2>&1\n"
       "wait $W\n"
       "lcm-logger --lcm-url=\"$URL\" logged.lcm > logger.txt 2>&1 &\n"
       "L=$!\n"

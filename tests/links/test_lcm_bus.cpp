@@ -21,10 +21,16 @@ struct Collector {
   std::vector<rilbed::event_t> events;
   std::vector<rilbed::status_t> status;
   std::vector<rilbed::world_t> worlds;
-  void on_poses(const lcm::ReceiveBuffer*, const std::string& c, const rilbed::poses_t* m) { order.push_back(c); poses.push_back(*m); }
-  void on_event(const lcm::ReceiveBuffer*, const std::string& c, const rilbed::event_t* m) { order.push_back(c); events.push_back(*m); }
-  void on_status(const lcm::ReceiveBuffer*, const std::string& c, const rilbed::status_t* m) { order.push_back(c); status.push_back(*m); }
-  void on_world(const lcm::ReceiveBuffer*, const std::string& c, const rilbed::world_t* m) { order.push_back(c); worlds.push_back(*m); }
+  // Decodes each message as its channel's type (a test does not need the checks).
+  template <typename Message>
+  LcmSubscription::Handler into(std::vector<Message>& out) {
+    return [this, &out](const std::string& c, const void* data, std::size_t size) {
+      Message m;
+      ASSERT_EQ(m.decode(data, 0, static_cast<int>(size)), static_cast<int>(size)) << c;
+      order.push_back(c);
+      out.push_back(m);
+    };
+  }
 };
 
 agents::Scenario convoy_sim() {
@@ -43,10 +49,10 @@ TEST(LcmBus, ARunOnTheInProcessBusIsWhatItsFolderHolds) {
   ASSERT_TRUE(lcm.good());
   const Channels channels = Channels::with_prefix("T1_");
   Collector got;
-  lcm.subscribe(channels.poses, &Collector::on_poses, &got);
-  lcm.subscribe(channels.events, &Collector::on_event, &got);
-  lcm.subscribe(channels.status, &Collector::on_status, &got);
-  lcm.subscribe(channels.world, &Collector::on_world, &got);
+  LcmSubscription poses(lcm, channels.poses, got.into(got.poses));
+  LcmSubscription events(lcm, channels.events, got.into(got.events));
+  LcmSubscription status(lcm, channels.status, got.into(got.status));
+  LcmSubscription worlds(lcm, channels.world, got.into(got.worlds));
   LcmRunPublisher publisher(lcm, channels, true);
 
   const auto dir = std::filesystem::temp_directory_path() / ("rilbed_lcm_bus_" + std::to_string(::getpid()));
