@@ -57,14 +57,7 @@ int write_folder(const ReplayArgs& args) {
       // Cut short (a crash, a full disk, a truncated copy): keep what it holds, and say so.
       spdlog::warn("replay: {} ends before the run did (no summary after {} messages): the folder holds what it has",
                    args.log, events);
-      nlohmann::json summary;
-      summary["truncated"] = true;
-      if (const auto& s = decoder.last_status()) {
-        summary["scenario"] = s->scenario;
-        summary["seed"] = s->seed;
-        summary["simulated_s"] = static_cast<double>(s->utime) * 1e-6;
-      }
-      writer.finish_without_summary(summary);
+      writer.finish_without_summary(decoder.cut_short_summary());
     }
   } catch (const std::exception& e) {
     spdlog::error("replay: {}", e.what());

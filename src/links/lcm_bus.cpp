@@ -245,6 +245,17 @@ std::optional<std::string> RunReportDecoder::decode(const std::string& channel, 
   return std::nullopt;
 }
 
+nlohmann::json RunReportDecoder::cut_short_summary() const {
+  nlohmann::json summary;
+  summary["truncated"] = true;
+  if (last_status_) {
+    summary["scenario"] = last_status_->scenario;
+    summary["seed"] = last_status_->seed;
+    summary["simulated_s"] = static_cast<double>(last_status_->utime) * 1e-6;
+  }
+  return summary;
+}
+
 LcmLogReader::LcmLogReader(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return;

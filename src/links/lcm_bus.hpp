@@ -88,6 +88,9 @@ class RunReportDecoder {
   bool summary_seen() const { return summary_seen_; }
   /// The last status decoded, if any.
   const std::optional<rilbed::status_t>& last_status() const { return last_status_; }
+  /// The summary a recording cut short gets (no RILBED_SUMMARY came): {"truncated": true}
+  /// and what its last status said of the run.
+  nlohmann::json cut_short_summary() const;
 
  private:
   Channels channels_;

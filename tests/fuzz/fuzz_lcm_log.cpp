@@ -135,14 +135,7 @@ void replay(const TempPaths& paths) {
     }
     if (!decoder.summary_seen()) {
       truncated = true;
-      nlohmann::json summary;
-      summary["truncated"] = true;
-      if (const auto& s = decoder.last_status()) {
-        summary["scenario"] = s->scenario;
-        summary["seed"] = s->seed;
-        summary["simulated_s"] = static_cast<double>(s->utime) * 1e-6;
-      }
-      writer.finish_without_summary(summary);
+      writer.finish_without_summary(decoder.cut_short_summary());
     }
   } catch (const std::exception& e) {
     broken(std::string("replay would stop with an error: ") + e.what());
