@@ -7,6 +7,8 @@ std::optional<std::string> RunControl::act(const ControlAction& action) {
   if (!apply_) return "no run is running";
   if (auto why = check_(action)) return why;
   apply_(action);
+  if (action.kind == ControlAction::Kind::kPause) paused_ = true;
+  if (action.kind == ControlAction::Kind::kResume) paused_ = false;
   return std::nullopt;
 }
 
@@ -21,6 +23,7 @@ void RunControl::detach() {
   std::lock_guard lock(mutex_);
   check_ = nullptr;
   apply_ = nullptr;
+  paused_ = false;
 }
 
 }  // namespace rilbed::agents

@@ -4,6 +4,7 @@
 // they are applied on the run's own thread between two steps and recorded as events.
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <mutex>
 #include <optional>
@@ -34,8 +35,11 @@ class RunControl {
   void attach(std::function<std::optional<std::string>(const ControlAction&)> check,
               std::function<void(const ControlAction&)> apply);
   void detach();
+  /// Whether the run took a pause it has not resumed from (any thread).
+  bool paused() const { return paused_.load(); }
 
  private:
+  std::atomic<bool> paused_{false};
   std::mutex mutex_;
   std::function<std::optional<std::string>(const ControlAction&)> check_;
   std::function<void(const ControlAction&)> apply_;

@@ -16,7 +16,13 @@ std::string_view RunFolderWriter::intern(std::string_view text) {
   return *it;
 }
 
-void RunFolderWriter::on_world(TimeUs, const WorldReport& world) { recorder(&world.field); }
+void RunFolderWriter::on_world(TimeUs, const WorldReport& world) {
+  if (recorder_) {
+    recorder_->set_field(world.field);
+  } else {
+    recorder(&world.field);
+  }
+}
 
 void RunFolderWriter::on_poses(TimeUs t_us, std::span<const PoseReport> poses) {
   samples_.clear();

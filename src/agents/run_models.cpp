@@ -27,6 +27,7 @@ void AgentModel::internal_transition() {
   if (state_.team) input.team = *state_.team;
   state_.last = controller_->step(input);
   body_.drive(state_.last.wheels);
+  state_.sensors = std::move(input.sensors);  // kept for the run's observer
   state_.sigma_us = period_us_;
 }
 

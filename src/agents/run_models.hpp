@@ -37,6 +37,7 @@ struct AgentState {
   TimeUs sigma_us = 0;             ///< time left to the next control step
   std::shared_ptr<const std::vector<TeamMessage>> team;  ///< the latest broadcast, as received (shared, not copied)
   ControlOutput last;              ///< the last command applied to the body
+  environment::SensorReadings sensors;  ///< what its controller read at the last step
 };
 
 /// One robot's agent: every control period it senses through its body, runs its
@@ -63,6 +64,9 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   /// The active behaviour (a static string), "idle" before the first step.
   std::string_view behaviour() const { return state_.last.behaviour; }
   const WheelCommand& wheels() const { return state_.last.wheels; }
+  /// What its controller read at its last step (empty before the first, and for a
+  /// commanded agent, which reads nothing).
+  const environment::SensorReadings& sensors() const { return state_.sensors; }
   /// Tells the controller the run ended (Controller::finish) and stops the body.
   void finish();
 

@@ -14,9 +14,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include <opencv2/core/mat.hpp>
+
+#include "agents/controller.hpp"
 #include "agents/run_recorder.hpp"
 #include "core/geometry.hpp"
 #include "core/time.hpp"
+#include "environment/sensor_readings.hpp"
 
 namespace rilbed::agents {
 
@@ -28,6 +32,37 @@ struct PoseReport {
   Pose2 pose;         ///< field frame
   std::string_view behaviour;  ///< a static string
   std::string_view health;     ///< a static string: "ok", "unseen", ...
+};
+
+/// One robot's wheel command at one control step.
+struct WheelReport {
+  int id = 0;
+  WheelCommand wheels;  ///< Khepera units (+-127, 8 mm/s each)
+};
+
+/// One robot's sensor readings at one control step. `readings` is a view, valid during
+/// the call it is handed to.
+struct SensorReport {
+  int id = 0;
+  const environment::SensorReadings* readings = nullptr;
+};
+
+/// One marker the overhead camera found in a frame.
+struct DetectionReport {
+  int id = 0;
+  double u_px = 0.0, v_px = 0.0;  ///< centre in the image, pixels
+  double heading_deg = 0.0;       ///< on screen, counter-clockwise from +u, [0, 360)
+  double score = 0.0;             ///< circular cross-covariance, [-1, 1]
+  double diameter_px = 0.0;
+  Pose2 pose;                     ///< the same in the field frame
+};
+
+/// What the overhead camera found in one frame.
+struct FrameReport {
+  TimeUs t_us = 0;            ///< when the frame was taken (simulated time)
+  std::int64_t frame = 0;     ///< frame number, from 1
+  double process_ms = 0.0;    ///< wall time the vision pipeline took on it
+  std::span<const DetectionReport> detections;
 };
 
 /// The world a run takes place in.
@@ -54,16 +89,35 @@ struct StatusReport {
   bool formed = false;
   std::optional<double> formation_time_s;
   int collisions = 0;
+  double loop_latency_ms = 0.0;  ///< realtime: the most the control loop fell behind the wall clock in the last second
+  double camera_fps = 0.0;       ///< camera frames processed per wall second over the last second
+  std::int64_t frames = 0;       ///< camera frames processed so far
 };
 
-/// Receives what a run reports. Every member has an empty default.
+/// Receives what a run reports. Every member has an empty default. A run reports each
+/// control step in this order: on_world (on a new second), on_poses, on_wheels,
+/// on_sensors, on_status (on a new second); events and camera frames as they happen.
 class RunObserver {
  public:
   virtual ~RunObserver() = default;
+  /// Whether anything comes of the step reports (on_poses, on_wheels, on_sensors) now: a
+  /// run builds them only when it does (10,000 robots' reports every step cost ~2 ms).
+  virtual bool wants_steps() const { return true; }
   /// At the start, then once per simulated second.
   virtual void on_world(TimeUs /*t_us*/, const WorldReport& /*world*/) {}
   /// After every control step: every robot with a known pose.
   virtual void on_poses(TimeUs /*t_us*/, std::span<const PoseReport> /*poses*/) {}
+  /// After every control step: every robot's wheel command (what drove it during the step).
+  virtual void on_wheels(TimeUs /*t_us*/, std::span<const WheelReport> /*wheels*/) {}
+  /// After every control step: every robot's sensor readings, as its controller read them.
+  virtual void on_sensors(TimeUs /*t_us*/, std::span<const SensorReport> /*sensors*/) {}
+  /// After every camera frame: what the vision pipeline found in it.
+  virtual void on_detections(const FrameReport& /*frame*/) {}
+  /// Whether it wants the camera's frames themselves (on_frame_image); asked once, when
+  /// the run starts. Handing over a frame costs a copy of the image.
+  virtual bool wants_frame_images() const { return false; }
+  /// Every camera frame, 8-bit grey or BGR, when wants_frame_images(); valid during the call.
+  virtual void on_frame_image(TimeUs /*t_us*/, std::int64_t /*frame*/, const cv::Mat& /*image*/) {}
   /// Each event as it is recorded (the rows of events.csv).
   virtual void on_event(const RunEvent& /*event*/) {}
   /// At the start, once per simulated second, and when the run ends (state "ended").

@@ -69,6 +69,9 @@ class RunRecorder {
   /// and closes the CSV files. Call once at the end.
   void finish(const nlohmann::json& summary);
   const std::filesystem::path& dir() const { return dir_; }
+  /// Replaces the field the picture is drawn on (a run folder written from messages
+  /// learns it from the run's world, which may come after the first rows).
+  void set_field(FieldDrawing field) { field_ = std::move(field); }
 
  private:
   void write_svg() const;

@@ -1,6 +1,7 @@
 #include "agents/simulation.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <ctime>
 #include <cmath>
@@ -74,6 +75,11 @@ class VisionModel final : public sim::AtomicModel<TimeUs> {  // state: time to t
   VisionModel(environment::World& world, vision::FieldTracker tracker, Grab grab, TimeUs period_us)
       : sim::AtomicModel<TimeUs>("camera", 0), world_(world), tracker_(std::move(tracker)), grab_(std::move(grab)),
         period_us_(period_us) {}
+  /// Tells `observer` (may be null) what every frame shows; `observer` outlives the run.
+  void report_to(RunObserver* observer) {
+    observer_ = observer;
+    send_images_ = observer && observer->wants_frame_images();
+  }
   TimeUs time_advance() const override { return state_; }
   void external_transition(TimeUs elapsed_us) override { state_ -= elapsed_us; }
   void output() override {}
@@ -85,23 +91,42 @@ class VisionModel final : public sim::AtomicModel<TimeUs> {  // state: time to t
       state_ = sim::kInfinity;  // the footage ended: no more sightings
       return;
     }
-    ++frames_;
-    for (const vision::FieldObservation& o : tracker_.process(*frame)) {
+    frames_.fetch_add(1, std::memory_order_relaxed);
+    const auto start = std::chrono::steady_clock::now();
+    const std::vector<vision::FieldObservation> seen = tracker_.process(*frame);
+    const double process_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    for (const vision::FieldObservation& o : seen) {
       if (!world_.has_robot(o.id) || world_.robot(o.id).kind != environment::RobotKind::Real) continue;
       world_.set_observed_pose(o.id, o.pose, t_us_);
       ++sightings_;
     }
+    if (observer_) report(*frame, seen, process_ms);
   }
-  long frames() const { return frames_; }
+  long frames() const { return frames_.load(std::memory_order_relaxed); }
   long sightings() const { return sightings_; }
 
  private:
+  void report(const cv::Mat& frame, const std::vector<vision::FieldObservation>& seen, double process_ms) {
+    const std::int64_t number = frames();
+    if (send_images_) observer_->on_frame_image(t_us_, number, frame);
+    detections_.clear();
+    for (const vision::FieldObservation& o : seen) {
+      const vision::MarkerDetection& d = o.detection;
+      detections_.push_back({o.id, d.u, d.v, d.heading_deg, d.score, d.diameter_px, o.pose});
+    }
+    observer_->on_detections({t_us_, number, process_ms, detections_});
+  }
+
   environment::World& world_;
   vision::FieldTracker tracker_;
   Grab grab_;
   TimeUs period_us_;
   TimeUs t_us_ = 0;
-  long frames_ = 0, sightings_ = 0;
+  std::atomic<long> frames_{0};  // read by the monitor for the status' frame rate
+  long sightings_ = 0;
+  RunObserver* observer_ = nullptr;
+  bool send_images_ = false;
+  std::vector<DetectionReport> detections_;
 };
 
 // The camera of a scenario with real robots, ready to add to the run.
@@ -182,6 +207,8 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     const Scenario* scenario = nullptr;
     WorldReport world_report;  // for the observer
     std::chrono::steady_clock::time_point wall_start;
+    const sim::RealTimeClock* clock = nullptr;  // a realtime run's clock (for the loop's latency)
+    const VisionModel* camera = nullptr;        // the overhead camera, if any (for its frame rate)
   };
   explicit MonitorModel(Setup setup)
       : sim::AtomicModel<TimeUs>("monitor", 1), s_(std::move(setup)),
@@ -223,6 +250,9 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     st.formed = formation_.formed();
     if (const auto f = formation_.formation_time_us()) st.formation_time_s = us_to_seconds(*f);
     st.collisions = s_.result->collisions;
+    st.loop_latency_ms = worst_latency_ms_;
+    st.camera_fps = camera_fps_;
+    st.frames = s_.camera ? s_.camera->frames() : 0;
     return st;
   }
 
@@ -238,11 +268,16 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     if (s_.options->observer) s_.options->observer->on_event(event);
   }
 
-  // Every robot with a known pose; a real robot the camera lost at its last pose, unseen.
-  void report_poses(TimeUs t, RunObserver& observer) {
+  // Every robot with a known pose (a real robot the camera lost at its last pose, unseen),
+  // then every robot's wheels and sensors.
+  void report_step(TimeUs t, RunObserver& observer) {
     reports_.clear();
+    wheel_reports_.clear();
+    sensor_reports_.clear();
     for (const AgentModel* a : s_.agents) {
       const int id = a->body().id();
+      wheel_reports_.push_back({id, a->wheels()});
+      sensor_reports_.push_back({id, &a->sensors()});
       const environment::RobotState& state = s_.world->robot(id);
       const auto pose = a->body().pose();
       if (!pose && !state.observed && state.kind == environment::RobotKind::Real) continue;  // never seen
@@ -250,10 +285,36 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
                           a->behaviour(), a->body().health()});
     }
     observer.on_poses(t, reports_);
+    observer.on_wheels(t, wheel_reports_);
+    observer.on_sensors(t, sensor_reports_);
+  }
+
+  // The most the control loop fell behind the wall clock, and the camera's frame rate,
+  // over each second between two statuses.
+  void measure_loop(TimeUs t) {
+    if (s_.clock && !s_.clock->paused()) {
+      const double behind_ms = static_cast<double>(s_.clock->now_us() - t) / 1000.0 / s_.clock->factor();
+      latency_window_ms_ = std::max(latency_window_ms_, behind_ms);
+    }
+  }
+  void close_second() {
+    worst_latency_ms_ = latency_window_ms_;
+    latency_window_ms_ = 0.0;
+    if (!s_.camera) return;
+    const auto now = std::chrono::steady_clock::now();
+    const long frames = s_.camera->frames();
+    const double wall_s = std::chrono::duration<double>(now - fps_since_).count();
+    if (wall_s > 0.0 && fps_frames_ >= 0) camera_fps_ = static_cast<double>(frames - fps_frames_) / wall_s;
+    fps_since_ = now;
+    fps_frames_ = frames;
   }
 
   void sample(TimeUs t) {
     RunResult& r = *s_.result;
+    RunObserver* const o = s_.options->observer;
+    const bool new_second = t >= next_report_us_;
+    // The world first, so that a viewer can draw whatever follows.
+    if (o && new_second) o->on_world(t, s_.world_report);
     for (const auto& e : s_.world_model->drain()) {
       ++r.collisions;
       if (e.second.kind == environment::BodyKind::Robot) ++r.robot_collisions;
@@ -282,12 +343,12 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     }
     if (s_.recorder) s_.recorder->add_samples(samples_);
     if (s_.options->keep_in_memory) r.trajectory.insert(r.trajectory.end(), samples_.begin(), samples_.end());
-    if (RunObserver* o = s_.options->observer) {
-      const bool new_second = t >= next_report_us_;
-      if (new_second) o->on_world(t, s_.world_report);
-      report_poses(t, *o);
+    if (o) {
+      measure_loop(t);
+      if (o->wants_steps()) report_step(t, *o);
       if (new_second) {
         next_report_us_ = (t / 1'000'000 + 1) * 1'000'000;
+        close_second();
         o->on_status(status(t, "running"));
       }
     }
@@ -295,20 +356,6 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     if (s_.options->stop_when_done &&
         std::all_of(s_.agents.begin(), s_.agents.end(), [](const AgentModel* a) { return a->done(); })) {
       end("done");
-    }
-    if (s_.options->on_status && t >= next_status_us_) {
-      // Once per simulated second: the first sample at or after each whole second.
-      next_status_us_ = (t / 1'000'000 + 1) * 1'000'000;
-      std::ostringstream line;
-      line << "t=" << std::fixed;
-      line.precision(1);
-      line << us_to_seconds(t) << "s";
-      for (const AgentModel* a : s_.agents) {
-        line << "  " << a->body().id() << ":" << a->behaviour();
-        if (a->body().health() != "ok") line << "(" << a->body().health() << ")";
-      }
-      if (formation_.formed()) line << "  [formed]";
-      s_.options->on_status(line.str());
     }
   }
 
@@ -362,9 +409,14 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   std::string subteams_;
   FormationMonitor formation_;
   TimeUs t_us_ = 0;
-  TimeUs next_status_us_ = 0;
   TimeUs next_report_us_ = 0;
   std::vector<PoseReport> reports_;
+  std::vector<WheelReport> wheel_reports_;
+  std::vector<SensorReport> sensor_reports_;
+  double latency_window_ms_ = 0.0, worst_latency_ms_ = 0.0;
+  double camera_fps_ = 0.0;
+  std::chrono::steady_clock::time_point fps_since_;
+  long fps_frames_ = -1;  // frames at the last status; -1 before the first
   std::vector<TrajectorySample> samples_;
   std::vector<std::string_view> last_behaviour_;
   std::vector<std::string_view> last_health_;
@@ -634,11 +686,16 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   setup.scenario = &scenario;
   setup.wall_start = wall_start;
   if (options.observer) setup.world_report = world_report(scenario, real_ids);
-  auto& monitor = root->emplace<MonitorModel>(setup);
-  if (camera) root->add(camera);
-
   sim::FastClock fast_clock;
   sim::RealTimeClock real_clock(options.rt_factor);
+  if (options.realtime) setup.clock = &real_clock;
+  setup.camera = camera.get();
+  auto& monitor = root->emplace<MonitorModel>(setup);
+  if (camera) {
+    camera->report_to(options.observer);
+    root->add(camera);
+  }
+
   sim::Clock& clock = options.realtime ? static_cast<sim::Clock&>(real_clock) : static_cast<sim::Clock&>(fast_clock);
   // The console's way in: a root input coupled to the control model.
   sim::Port<ControlAction>* control_in = nullptr;

@@ -42,8 +42,6 @@ struct RunOptions {
   std::optional<std::filesystem::path> out_dir;  ///< write the run folder here
   /// Set from another thread or a signal handler (it is only read) to end the run early.
   const std::atomic<bool>* interrupt = nullptr;
-  /// Called once per simulated second with a one-line status (each robot's behaviour).
-  std::function<void(const std::string&)> on_status;
   /// Record trajectories and events even without an out_dir (kept in memory, for tests).
   bool keep_in_memory = false;
   /// With `camera: {emulate: true}`: the markers of the emulated real robots at their true

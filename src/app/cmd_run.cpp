@@ -17,7 +17,9 @@
 #include <nlohmann/json.hpp>
 
 #include "agents/scenario.hpp"
+#include "agents/run_folder_writer.hpp"
 #include "agents/simulation.hpp"
+#include "agents/status_line.hpp"
 #include "app/commands.hpp"
 #include "core/id_list.hpp"
 #include "core/statistics.hpp"
@@ -84,6 +86,7 @@ struct RunArgs {
   bool all_virtual = false;
   std::string lcm_url;        // publish the run on this LCM bus (empty: no bus)
   std::string record;         // write every message of the run to this LCM log
+  bool record_frames = false; // and the camera's frames (JPEG)
   std::string channel_prefix;
   bool no_place = false;      // real robots start where they stand
   double place_timeout_s = 90.0;
@@ -253,10 +256,14 @@ int run_command(const RunArgs& args) {
   options.stop_when_formed = args.stop_when_formed;
   options.seed = args.seed;
   options.interrupt = &interrupted;
-  // The LCM bus: everything the run reports goes out on it while it runs.
-  std::unique_ptr<lcm::LCM> lcm;
+  // The LCM bus: everything the run reports goes out on it while it runs, and the run's
+  // own outputs (its folder, its status line) are subscribers of the same messages.
+  if (const auto problem = links::check_channel_prefix(args.channel_prefix)) {
+    spdlog::error("{}", *problem);
+    return kExitUsage;
+  }
+  const links::Channels channels = links::Channels::with_prefix(args.channel_prefix);
   std::unique_ptr<lcm::LogFile> recording;
-  std::unique_ptr<links::LcmRunPublisher> publisher;
   if (!args.record.empty()) {
     if (args.seeds > 0) {
       spdlog::error("--record records one run: leave out --seeds (or record each seed's run on its own)");
@@ -268,23 +275,84 @@ int run_command(const RunArgs& args) {
       return kExitFailure;
     }
   }
-  if (!args.lcm_url.empty() || recording) {
-    // Recording without a bus: the messages go on the in-process bus, and to the log.
-    const std::string url = args.lcm_url.empty() ? "memq://" : args.lcm_url;
-    if (const auto problem = links::check_channel_prefix(args.channel_prefix)) {
-      spdlog::error("{}", *problem);
-      return kExitUsage;
+  if (args.record_frames && (!recording || !scenario.camera)) {
+    if (!recording) {
+      spdlog::error("--record-frames adds the camera's frames to a recording: give --record FILE.lcm too");
+    } else {
+      spdlog::error("--record-frames: {} has no camera (no real robots)", args.scenario);
     }
+    return kExitUsage;
+  }
+  // A bus other processes reach is one for the whole batch; the in-process bus is one per
+  // run (memq:// is not safe with runs of a batch publishing on it from several threads).
+  const bool network_bus = !args.lcm_url.empty() && args.lcm_url.rfind("memq://", 0) != 0;
+  std::unique_ptr<lcm::LCM> network_lcm;
+  if (network_bus) {
     std::string error;
-    lcm = links::open_lcm(url, error);
-    if (!lcm) {
+    network_lcm = links::open_lcm(args.lcm_url, error);
+    if (!network_lcm) {
       spdlog::error("{}", error);
       return kExitFailure;
     }
-    publisher = std::make_unique<links::LcmRunPublisher>(*lcm, links::Channels::with_prefix(args.channel_prefix),
-                                                         url.rfind("memq://", 0) == 0, recording.get());
-    options.observer = publisher.get();
   }
+  if (!args.out.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(args.out, ec);
+    if (ec) {
+      spdlog::error("cannot make the run folder {}: {}", args.out, ec.message());
+      return kExitFailure;
+    }
+  }
+  // The publisher of the run now going (a paused run re-publishes its world and status).
+  std::mutex current_mutex;
+  links::LcmRunPublisher* current_publisher = nullptr;
+  const bool status_line = options.realtime && !args.quiet && args.seeds == 0;
+  // Runs one seed with `run` on its bus: its folder (options.out_dir) written by a
+  // subscriber, not by the run.
+  auto on_bus = [&](const SeedRunner& run) -> SeedRunner {
+    return [&, run](const agents::RunOptions& given) {
+      agents::RunOptions o = given;
+      std::unique_ptr<lcm::LCM> own_lcm;
+      lcm::LCM* bus = network_lcm.get();
+      if (!bus) {
+        std::string error;
+        own_lcm = links::open_lcm("memq://", error);
+        if (!own_lcm) throw std::runtime_error(error);
+        bus = own_lcm.get();
+      }
+      links::LcmRunPublisher::Options po;
+      po.in_process = !network_bus;
+      po.log = recording.get();
+      po.frames = args.record_frames;
+      links::LcmRunPublisher publisher(*bus, channels, po);
+      std::unique_ptr<agents::RunFolderWriter> folder;
+      if (o.out_dir) {
+        folder = std::make_unique<agents::RunFolderWriter>(*o.out_dir);
+        publisher.add_local_subscriber(*folder);
+        o.out_dir.reset();
+      }
+      agents::StatusLine line([](const std::string& text) {
+        std::printf("%s\n", text.c_str());
+        std::fflush(stdout);
+      });
+      if (status_line) publisher.add_local_subscriber(line);
+      o.observer = &publisher;
+      {
+        std::lock_guard lock(current_mutex);
+        current_publisher = &publisher;
+      }
+      struct Forget {
+        std::mutex& m;
+        links::LcmRunPublisher*& p;
+        ~Forget() {
+          std::lock_guard lock(m);
+          p = nullptr;
+        }
+      } forget{current_mutex, current_publisher};
+      agents::RunResult r = run(o);
+      return r;
+    };
+  };
   // The console: commands on the bus, each with this run's token.
   agents::RunControl control;
   std::unique_ptr<links::LcmConsoleServer> console;
@@ -301,45 +369,47 @@ int run_command(const RunArgs& args) {
   } remove_token_at_exit{token_file, token};
   // Only on a bus other processes reach: memq:// is this process alone (and liblcm's
   // memq provider is not safe with a second thread handling it).
-  if (!args.lcm_url.empty() && args.lcm_url.rfind("memq://", 0) != 0) {
+  if (network_bus) {
     token = links::make_run_token();
     token_file = links::token_path(args.channel_prefix);
     const auto problem = links::write_token(token_file, token);
     std::fprintf(stderr, "rilbed: run token %s%s%s\n", token.c_str(), problem ? "" : " (in ",
                  problem ? "" : (token_file.string() + ", readable by you only)").c_str());
     if (problem) spdlog::warn("the token is not in a file ({}): give it to rilbed console with --token", *problem);
-    console = std::make_unique<links::LcmConsoleServer>(*lcm, links::Channels::with_prefix(args.channel_prefix), token,
-                                                        control, [](const std::string& m) { spdlog::info("{}", m); });
+    console = std::make_unique<links::LcmConsoleServer>(
+        *network_lcm, channels, token, control, [](const std::string& m) { spdlog::info("{}", m); }, true,
+        [&] {
+          // While paused the run reports nothing: its last world and status go out again
+          // every second, for viewers that join meanwhile.
+          std::lock_guard lock(current_mutex);
+          if (current_publisher) current_publisher->republish_world_and_status();
+        });
     options.control = &control;
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   if (!args.out.empty()) options.out_dir = args.out;  // a batch puts each seed in a folder of its own
-  if (options.realtime && !args.quiet && args.seeds == 0) {
-    options.on_status = [](const std::string& line) {
-      std::printf("%s\n", line.c_str());
-      std::fflush(stdout);
-    };
-  }
   // Real robots: their links (and emulators) stay open from run to run of a batch, and
   // live until every run has stopped them.
   std::unique_ptr<links::RealRobots> real;
   agents::RealBodyFactory real_bodies;
-  SeedRunner run_seed = [&](const agents::RunOptions& o) { return agents::run_scenario(scenario, o, real_bodies); };
+  SeedRunner run_seed = on_bus([&](const agents::RunOptions& o) { return agents::run_scenario(scenario, o, real_bodies); });
   if (!real_ids.empty()) {
     real = std::make_unique<links::RealRobots>(scenario, log_to_spdlog);
     real_bodies = real->body_factory();
     options.emulated_markers = [&real] { return real->emulated_markers(); };
     // Before each run, every real robot goes to the run's start pose (as its all-virtual
     // twin starts): emulated ones are put there, physical ones driven there.
-    run_seed = [&](const agents::RunOptions& o) {
+    run_seed = on_bus([&](const agents::RunOptions& o) {
       if (!args.no_place) place_or_throw(*real, scenario, o.seed, args);
       return agents::run_scenario(scenario, o, real_bodies);
-    };
+    });
   }
   if (args.seeds > 0) {
     // With real robots one run after another: the robots are the same ones.
-    const int status = run_batch(scenario, args, options, run_seed, real ? 1 : std::numeric_limits<int>::max());
+    // With real robots one run after another (the robots are the same ones), and on a bus
+    // others watch too (a watcher follows one run at a time).
+    const int status = run_batch(scenario, args, options, run_seed, real || network_bus ? 1 : std::numeric_limits<int>::max());
     if (real) print_emulated_last_speeds(*real);
     return status;
   }
@@ -383,10 +453,14 @@ void add_run_command(CLI::App& app) {
   cmd->add_flag("--all-virtual", args->all_virtual,
                 "Make every real robot virtual (same poses and controllers): the simulation half of a sim-to-real comparison");
   cmd->add_option("--lcm", args->lcm_url,
-                  "Publish the run on this LCM bus while it runs (e.g. udpm://239.255.76.67:7667?ttl=0; default: none)");
+                  "Publish the run on this LCM bus, visible to other processes (e.g. udpm://239.255.76.67:7667?ttl=0; "
+                  "default: memq://, the run's own in-process bus, which sends nothing on the network)");
   cmd->add_option("--channel-prefix", args->channel_prefix, "Put this before every channel name (two runs on one network)");
   cmd->add_option("--record", args->record,
                   "Write every message of the run to this LCM log (lcm-logplayer plays it; rilbed replay reads it)");
+  cmd->add_flag("--record-frames", args->record_frames,
+                "With --record: add the overhead camera's frames (JPEG, channel RILBED_FRAMES), so that `rilbed detect "
+                "FILE.lcm` can run the vision pipeline on them again with other settings");
   cmd->add_flag("--no-place", args->no_place,
                 "Real robots start where they stand (default: before each run they are driven, or put if emulated, "
                 "to the run's start poses)");

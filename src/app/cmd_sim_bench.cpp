@@ -27,7 +27,7 @@ struct BenchArgs {
   double density_per_m2 = 8.0 / (1.5 * 1.2);  // the lab's convoy: 8 robots on 1.5 x 1.2 m
   std::uint64_t seed = 1;
   int repeat = 3;
-  std::string lcm_url;  // also time each count with the run published on this bus
+  std::vector<std::string> lcm_urls;  // also time each count with the run published on each of these buses
 };
 
 // N wandering Kheperas with their eight IR sensors in a field of constant density.
@@ -69,75 +69,96 @@ int bench_command(const BenchArgs& args) {
   std::printf("| robots | field m | simulated s | wall s (median of %d) | CPU s (median) | wall ms per simulated s | real-time factor (wall) | real-time factor (CPU) | us per robot-step (CPU) | collisions | max overlap m |\n",
               args.repeat);
   std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
-  std::vector<std::pair<int, double>> bus_costs;
-  // With --lcm: each count also with every message of the run published on the bus
+  // With --lcm: each count also with every message of the run published on each bus
   // (nobody need listen), runs with and without it taking turns so that other load on
-  // the machine falls on both.
-  std::unique_ptr<lcm::LCM> lcm;
-  std::unique_ptr<links::LcmRunPublisher> publisher;
-  if (!args.lcm_url.empty()) {
+  // the machine falls on all alike.
+  struct Bus {
+    std::string url;
+    std::unique_ptr<lcm::LCM> lcm;
+    std::unique_ptr<links::LcmRunPublisher> publisher;
+    std::vector<std::pair<int, double>> costs;  // robots, CPU cost in per cent
+  };
+  std::vector<Bus> buses;
+  for (const std::string& url : args.lcm_urls) {
+    Bus bus;
+    bus.url = url;
     std::string error;
-    lcm = links::open_lcm(args.lcm_url, error);
-    if (!lcm) {
+    bus.lcm = links::open_lcm(url, error);
+    if (!bus.lcm) {
       spdlog::error("sim-bench: {}", error);
       return kExitFailure;
     }
-    publisher = std::make_unique<links::LcmRunPublisher>(*lcm, links::Channels{}, args.lcm_url.rfind("memq://", 0) == 0);
+    bus.publisher = std::make_unique<links::LcmRunPublisher>(*bus.lcm, links::Channels{}, url.rfind("memq://", 0) == 0);
+    buses.push_back(std::move(bus));
   }
+  struct Timing {
+    std::vector<double> walls, cpus;
+    agents::RunResult r;
+  };
   for (int n : counts.ids) {
     const agents::Scenario s = bench_scenario(n, args);
-    struct Timing {
-      std::vector<double> walls, cpus;
-      agents::RunResult r;
-    };
-    Timing plain, bused;
+    Timing plain;
+    std::vector<Timing> bused(buses.size());
     for (int rep = 0; rep < args.repeat; ++rep) {
-      for (Timing* t : {&plain, &bused}) {
-        if (t == &bused && !publisher) continue;
+      for (std::size_t k = 0; k <= buses.size(); ++k) {
+        Timing& t = k == 0 ? plain : bused[k - 1];
         agents::RunOptions o;
         o.seed = args.seed;
         o.duration_s = args.seconds;
-        if (t == &bused) o.observer = publisher.get();
+        if (k > 0) o.observer = buses[k - 1].publisher.get();
         try {
-          t->r = agents::run_scenario(s, o);
+          t.r = agents::run_scenario(s, o);
         } catch (const std::exception& e) {
           spdlog::error("{} robots: {}", n, e.what());
           return kExitFailure;
         }
-        t->walls.push_back(t->r.run_wall_s);
-        t->cpus.push_back(t->r.run_cpu_s);
+        t.walls.push_back(t.r.run_wall_s);
+        t.cpus.push_back(t.r.run_cpu_s);
       }
     }
-    auto row = [&](Timing& t, const char* label) {
+    auto row = [&](Timing& t, const std::string& label) {
       std::sort(t.walls.begin(), t.walls.end());
       std::sort(t.cpus.begin(), t.cpus.end());
       const double wall_s = std::max(1e-9, t.walls[t.walls.size() / 2]);
       const double cpu_s = std::max(1e-9, t.cpus[t.cpus.size() / 2]);
       const agents::RunResult& r = t.r;
       const double steps = n * r.simulated_s / 0.1;
-      std::printf("| %d%s | %.1f x %.1f | %.1f | %.3f | %.3f | %.1f | %.1f | %.1f | %.2f | %d | %.2g |\n", n, label,
+      std::printf("| %d%s | %.1f x %.1f | %.1f | %.3f | %.3f | %.1f | %.1f | %.1f | %.2f | %d | %.2g |\n", n, label.c_str(),
                   s.map.field.width_m, s.map.field.height_m, r.simulated_s, wall_s, cpu_s, 1000.0 * wall_s / r.simulated_s,
                   r.simulated_s / wall_s, r.simulated_s / cpu_s, 1e6 * cpu_s / steps, r.collisions, r.max_overlap_m);
       return cpu_s;
     };
     const double plain_cpu = row(plain, "");
-    if (publisher) {
-      const double bused_cpu = row(bused, " (bus)");
-      bus_costs.push_back({n, 100.0 * (bused_cpu / plain_cpu - 1.0)});
+    for (std::size_t k = 0; k < buses.size(); ++k) {
+      const double bused_cpu = row(bused[k], " (bus " + buses[k].url + ")");
+      buses[k].costs.push_back({n, 100.0 * (bused_cpu / plain_cpu - 1.0)});
     }
     std::fflush(stdout);
   }
-  if (publisher) {
-    std::printf("\nThe bus: every message of the run published on %s (rows \"(bus)\"): the world and status every "
-                "simulated second, every robot's pose every control step, each event. CPU cost of the bus against the "
-                "same run without it (medians):\n\n| robots | bus cost (CPU) |\n| ---: | ---: |\n",
-                args.lcm_url.c_str());
-    for (const auto& [n, pct] : bus_costs) std::printf("| %d | %+.1f %% |\n", n, pct);
-    std::printf("\nMessages and bytes per channel, all runs with the bus together:\n\n| channel | messages | bytes | "
-                "failed publishes |\n| --- | ---: | ---: | ---: |\n");
-    for (const auto& [channel, c] : publisher->counts()) {
-      std::printf("| %s | %llu | %llu | %llu |\n", channel.c_str(), static_cast<unsigned long long>(c.messages),
-                  static_cast<unsigned long long>(c.bytes), static_cast<unsigned long long>(c.failures));
+  if (!buses.empty()) {
+    std::printf("\nThe bus: every message of the run published on it (rows \"(bus ...)\"): the world and status every "
+                "simulated second; every robot's pose, wheel command and sensor readings every control step; each event. "
+                "Nobody in this process listens; on memq:// (the default bus of `rilbed run`) that means nothing is even "
+                "encoded. CPU cost of the bus against the same run without it (medians):\n\n| robots |");
+    for (const Bus& b : buses) std::printf(" %s |", b.url.c_str());
+    std::printf("\n| ---: |");
+    for (std::size_t k = 0; k < buses.size(); ++k) std::printf(" ---: |");
+    std::printf("\n");
+    for (std::size_t i = 0; i < counts.ids.size(); ++i) {
+      std::printf("| %d |", counts.ids[i]);
+      for (const Bus& b : buses) std::printf(" %+.1f %% |", b.costs[i].second);
+      std::printf("\n");
+    }
+    for (const Bus& b : buses) {
+      std::printf("\nMessages and bytes per channel on %s, all its runs together:\n\n| channel | messages | bytes | "
+                  "failed publishes |\n| --- | ---: | ---: | ---: |\n",
+                  b.url.c_str());
+      const auto counts_now = b.publisher->counts();
+      if (counts_now.empty()) std::printf("| (none: nothing was encoded) | 0 | 0 | 0 |\n");
+      for (const auto& [channel, c] : counts_now) {
+        std::printf("| %s | %llu | %llu | %llu |\n", channel.c_str(), static_cast<unsigned long long>(c.messages),
+                    static_cast<unsigned long long>(c.bytes), static_cast<unsigned long long>(c.failures));
+      }
     }
   }
   return 0;
@@ -157,8 +178,9 @@ void add_sim_bench_command(CLI::App& app) {
   cmd->add_option("--seed", args->seed, "Seed")->default_val(args->seed);
   cmd->add_option("--repeat", args->repeat, "Runs per count; the table shows medians")->check(CLI::PositiveNumber)
       ->default_val(args->repeat);
-  cmd->add_option("--lcm", args->lcm_url,
-                  "Also time each count with the run published on this LCM bus (e.g. memq://: nobody listening)");
+  cmd->add_option("--lcm", args->lcm_urls,
+                  "Also time each count with the run published on this LCM bus, nobody listening (repeatable; e.g. "
+                  "memq:// as `rilbed run` publishes by default, or udpm://239.255.76.67:7667?ttl=0)");
   cmd->callback([args] { exit_code() = bench_command(*args); });
 }
 

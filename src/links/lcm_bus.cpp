@@ -2,6 +2,9 @@
 
 #include "links/lcm_checked.hpp"
 
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
 #include <cctype>
 #include <fstream>
 #include <iterator>
@@ -35,6 +38,10 @@ Channels Channels::with_prefix(const std::string& prefix) {
   c.summary = prefix + c.summary;
   c.console = prefix + c.console;
   c.console_reply = prefix + c.console_reply;
+  c.wheels = prefix + c.wheels;
+  c.sensors = prefix + c.sensors;
+  c.detections = prefix + c.detections;
+  c.frames = prefix + c.frames;
   return c;
 }
 
@@ -44,7 +51,7 @@ std::optional<std::string> check_channel_prefix(const std::string& prefix) {
       return "channel prefix '" + prefix + "' may hold only letters, digits and '_'";
     }
   }
-  // The longest channel, RILBED_EVENTS/RILBED_STATUS, is 13 bytes; LCM allows 63.
+  // The longest channel, RILBED_CONSOLE_REPLY, is 20 bytes; LCM allows 63.
   if (prefix.size() > 50) return "channel prefix '" + prefix + "' is longer than 50 characters";
   return std::nullopt;
 }
@@ -110,6 +117,96 @@ rilbed::status_t to_lcm(const agents::StatusReport& s) {
   m.formed = s.formed;
   m.formation_time_s = s.formation_time_s.value_or(-1.0);
   m.collisions = s.collisions;
+  m.loop_latency_ms = s.loop_latency_ms;
+  m.camera_fps = s.camera_fps;
+  m.frames = s.frames;
+  return m;
+}
+
+void fill(rilbed::wheels_t& m, TimeUs t_us, std::span<const agents::WheelReport> wheels) {
+  m.utime = t_us;
+  m.num_robots = static_cast<std::int32_t>(wheels.size());
+  m.robots.resize(wheels.size());
+  for (std::size_t i = 0; i < wheels.size(); ++i) {
+    rilbed::robot_wheels_t& r = m.robots[i];
+    r.id = wheels[i].id;
+    r.left_units = static_cast<std::int16_t>(wheels[i].wheels.left);
+    r.right_units = static_cast<std::int16_t>(wheels[i].wheels.right);
+    r.left_mps = wheels[i].wheels.left * agents::kMetresPerSecondPerUnit;
+    r.right_mps = wheels[i].wheels.right * agents::kMetresPerSecondPerUnit;
+  }
+}
+
+void fill(rilbed::sensors_t& m, TimeUs t_us, std::span<const agents::SensorReport> sensors) {
+  m.utime = t_us;
+  m.num_robots = static_cast<std::int32_t>(sensors.size());
+  m.robots.resize(sensors.size());
+  for (std::size_t i = 0; i < sensors.size(); ++i) {
+    rilbed::robot_sensors_t& r = m.robots[i];
+    const environment::SensorReadings& s = *sensors[i].readings;
+    r.id = sensors[i].id;
+    r.proximity.clear();
+    if (s.proximity) {
+      for (const int v : *s.proximity) r.proximity.push_back(static_cast<std::int16_t>(v));
+    }
+    r.num_proximity = static_cast<std::int8_t>(r.proximity.size());
+    // Counts are int8/int16 on the wire: a robot carries a handful of each sensor.
+    const std::size_t ranges = std::min<std::size_t>(s.ranges.size(), 127);
+    r.range_m.resize(ranges);
+    r.range_hit.resize(ranges);
+    for (std::size_t k = 0; k < ranges; ++k) {
+      r.range_m[k] = s.ranges[k].distance_m;
+      r.range_hit[k] = s.ranges[k].hit;
+    }
+    r.num_ranges = static_cast<std::int8_t>(ranges);
+    const std::size_t beacons = std::min<std::size_t>(s.beacons.size(), 127);
+    r.beacon_id.resize(beacons);
+    r.beacon_bearing_rad.resize(beacons);
+    for (std::size_t k = 0; k < beacons; ++k) {
+      r.beacon_id[k] = s.beacons[k].id;
+      r.beacon_bearing_rad[k] = s.beacons[k].bearing_rad;
+    }
+    r.num_beacons = static_cast<std::int8_t>(beacons);
+    const std::size_t track = std::min<std::size_t>(s.track.size(), 32767);
+    r.track.assign(s.track.begin(), s.track.begin() + static_cast<std::ptrdiff_t>(track));
+    r.num_track = static_cast<std::int16_t>(track);
+    r.has_odometry = s.odometry.has_value();
+    r.left_pulses = s.odometry ? s.odometry->left_pulses : 0;
+    r.right_pulses = s.odometry ? s.odometry->right_pulses : 0;
+  }
+}
+
+rilbed::detections_t to_lcm(const agents::FrameReport& f) {
+  rilbed::detections_t m;
+  m.utime = f.t_us;
+  m.frame = f.frame;
+  m.process_ms = f.process_ms;
+  m.num_detections = static_cast<std::int32_t>(f.detections.size());
+  for (const agents::DetectionReport& d : f.detections) {
+    rilbed::detection_t x;
+    x.id = d.id;
+    x.u_px = d.u_px;
+    x.v_px = d.v_px;
+    x.heading_deg = d.heading_deg;
+    x.score = d.score;
+    x.diameter_px = d.diameter_px;
+    x.x_m = d.pose.position_m.x;
+    x.y_m = d.pose.position_m.y;
+    x.theta_rad = d.pose.heading_rad;
+    m.detections.push_back(x);
+  }
+  return m;
+}
+
+rilbed::frame_t to_lcm(TimeUs t_us, std::int64_t frame, const cv::Mat& image, int quality) {
+  rilbed::frame_t m;
+  m.utime = t_us;
+  m.frame = frame;
+  m.width_px = image.cols;
+  m.height_px = image.rows;
+  m.format = "jpeg";
+  if (!image.empty()) cv::imencode(".jpg", image, m.data, {cv::IMWRITE_JPEG_QUALITY, std::clamp(quality, 1, 100)});
+  m.size = static_cast<std::int32_t>(m.data.size());
   return m;
 }
 
@@ -201,6 +298,26 @@ agents::StatusReport from_lcm(const rilbed::status_t& m) {
   s.formed = m.formed;
   if (m.formation_time_s >= 0.0) s.formation_time_s = m.formation_time_s;
   s.collisions = m.collisions;
+  s.loop_latency_ms = m.loop_latency_ms;
+  s.camera_fps = m.camera_fps;
+  s.frames = m.frames;
+  return s;
+}
+
+environment::SensorReadings from_lcm(const rilbed::robot_sensors_t& m, TimeUs t_us) {
+  environment::SensorReadings s;
+  s.t_us = t_us;
+  if (m.proximity.size() == environment::kProximityCount) {
+    environment::ProximityValues values{};
+    std::copy(m.proximity.begin(), m.proximity.end(), values.begin());
+    s.proximity = values;
+  }
+  for (std::size_t k = 0; k < m.range_m.size() && k < m.range_hit.size(); ++k) s.ranges.push_back({m.range_hit[k] != 0, m.range_m[k]});
+  for (std::size_t k = 0; k < m.beacon_id.size() && k < m.beacon_bearing_rad.size(); ++k) {
+    s.beacons.push_back({m.beacon_id[k], m.beacon_bearing_rad[k]});
+  }
+  s.track.assign(m.track.begin(), m.track.end());
+  if (m.has_odometry) s.odometry = environment::OdometryReading{m.left_pulses, m.right_pulses};
   return s;
 }
 
@@ -234,6 +351,45 @@ std::optional<std::string> RunReportDecoder::decode(const std::string& channel, 
     rilbed::world_t m;
     if (!decode_checked(data, size, m)) return bad("world_t");
     observer_.on_world(m.utime, from_lcm(m));
+  } else if (channel == channels_.wheels) {
+    rilbed::wheels_t m;
+    if (!decode_checked(data, size, m)) return bad("wheels_t");
+    wheels_.clear();
+    for (const rilbed::robot_wheels_t& r : m.robots) wheels_.push_back({r.id, {r.left_units, r.right_units}});
+    observer_.on_wheels(m.utime, wheels_);
+  } else if (channel == channels_.sensors) {
+    rilbed::sensors_t m;
+    if (!decode_checked(data, size, m)) return bad("sensors_t");
+    readings_.resize(m.robots.size());
+    sensors_.clear();
+    for (std::size_t i = 0; i < m.robots.size(); ++i) {
+      readings_[i] = from_lcm(m.robots[i], m.utime);
+      sensors_.push_back({m.robots[i].id, &readings_[i]});
+    }
+    observer_.on_sensors(m.utime, sensors_);
+  } else if (channel == channels_.detections) {
+    rilbed::detections_t m;
+    if (!decode_checked(data, size, m)) return bad("detections_t");
+    detections_.clear();
+    for (const rilbed::detection_t& d : m.detections) {
+      detections_.push_back({d.id, d.u_px, d.v_px, d.heading_deg, d.score, d.diameter_px, Pose2{{d.x_m, d.y_m}, d.theta_rad}});
+    }
+    observer_.on_detections({m.utime, m.frame, m.process_ms, detections_});
+  } else if (channel == channels_.frames) {
+    if (!observer_.wants_frame_images()) return std::nullopt;
+    rilbed::frame_t m;
+    if (!decode_checked(data, size, m)) return bad("frame_t");
+    if (m.format != "jpeg") return channel + ": frame " + std::to_string(m.frame) + " is '" + m.format + "', not jpeg";
+    cv::Mat image;
+    try {
+      image = cv::imdecode(m.data, cv::IMREAD_UNCHANGED);
+    } catch (const cv::Exception&) {
+      image.release();
+    }
+    if (image.empty() || image.cols != m.width_px || image.rows != m.height_px) {
+      return channel + ": frame " + std::to_string(m.frame) + " is not a JPEG image of its stated size";
+    }
+    observer_.on_frame_image(m.utime, m.frame, image);
   } else if (channel == channels_.summary) {
     rilbed::summary_t m;
     if (!decode_checked(data, size, m)) return bad("summary_t");
@@ -304,13 +460,57 @@ std::optional<LcmLogReader::Event> LcmLogReader::next() {
   return std::nullopt;
 }
 
-LcmRunPublisher::LcmRunPublisher(lcm::LCM& lcm, Channels channels, bool in_process, lcm::LogFile* log)
-    : lcm_(lcm), channels_(std::move(channels)), in_process_(in_process), log_(log) {}
+// Hands what the publisher decodes to every local subscriber.
+class LcmRunPublisher::Fanout final : public agents::RunObserver {
+ public:
+  std::vector<agents::RunObserver*> observers;
+  bool wants_frame_images() const override {
+    return std::any_of(observers.begin(), observers.end(), [](auto* o) { return o->wants_frame_images(); });
+  }
+  void on_world(TimeUs t, const agents::WorldReport& w) override { each([&](auto& o) { o.on_world(t, w); }); }
+  void on_poses(TimeUs t, std::span<const agents::PoseReport> p) override { each([&](auto& o) { o.on_poses(t, p); }); }
+  void on_wheels(TimeUs t, std::span<const agents::WheelReport> w) override { each([&](auto& o) { o.on_wheels(t, w); }); }
+  void on_sensors(TimeUs t, std::span<const agents::SensorReport> s) override { each([&](auto& o) { o.on_sensors(t, s); }); }
+  void on_detections(const agents::FrameReport& f) override { each([&](auto& o) { o.on_detections(f); }); }
+  void on_frame_image(TimeUs t, std::int64_t n, const cv::Mat& image) override {
+    each([&](auto& o) {
+      if (o.wants_frame_images()) o.on_frame_image(t, n, image);
+    });
+  }
+  void on_event(const agents::RunEvent& e) override { each([&](auto& o) { o.on_event(e); }); }
+  void on_status(const agents::StatusReport& s) override { each([&](auto& o) { o.on_status(s); }); }
+  void on_summary(TimeUs t, const nlohmann::json& j) override { each([&](auto& o) { o.on_summary(t, j); }); }
+
+ private:
+  template <typename F>
+  void each(F f) {
+    for (agents::RunObserver* o : observers) f(*o);
+  }
+};
+
+LcmRunPublisher::LcmRunPublisher(lcm::LCM& lcm, Channels channels, Options options)
+    : lcm_(lcm), channels_(std::move(channels)), options_(options) {}
+
+LcmRunPublisher::~LcmRunPublisher() = default;
+
+void LcmRunPublisher::add_local_subscriber(agents::RunObserver& observer) {
+  if (!fanout_) {
+    fanout_ = std::make_unique<Fanout>();
+    local_decoder_ = std::make_unique<RunReportDecoder>(channels_, *fanout_);
+  }
+  fanout_->observers.push_back(&observer);
+}
+
+std::unique_ptr<LcmSubscription> LcmRunPublisher::subscribe(const std::string& channel, LcmSubscription::Handler handler) {
+  auto subscription = std::make_unique<LcmSubscription>(lcm_, channel, std::move(handler));
+  ++bus_subscribers_;
+  return subscription;
+}
 
 template <typename Message>
 void LcmRunPublisher::publish(const std::string& channel, const Message& message) {
   std::lock_guard lock(mutex_);
-  // Encoded once: the same bytes go on the bus and into the log.
+  // Encoded once: the same bytes go on the bus, into the log and to the local subscribers.
   const int room = message.getEncodedSize();
   buffer_.resize(static_cast<std::size_t>(room));
   // encode() stops a string at a NUL byte, so it may write fewer bytes than the room
@@ -321,14 +521,16 @@ void LcmRunPublisher::publish(const std::string& channel, const Message& message
     ++c.failures;
     return;
   }
-  const int status = lcm_.publish(channel, buffer_.data(), static_cast<unsigned>(size));
-  if (status == 0) {
-    ++c.messages;
-    c.bytes += static_cast<std::uint64_t>(size);
-  } else {
-    ++c.failures;  // lost, as on a lossy network; the run goes on
+  if (channel == channels_.world) last_world_.assign(buffer_.begin(), buffer_.begin() + size);
+  if (channel == channels_.status) last_status_.assign(buffer_.begin(), buffer_.begin() + size);
+  const bool to_bus = !options_.in_process || bus_subscribers_ > 0;
+  if (to_bus) {
+    const int status = lcm_.publish(channel, buffer_.data(), static_cast<unsigned>(size));
+    if (status != 0) ++c.failures;  // lost, as on a lossy network; the run goes on
   }
-  if (log_) {
+  ++c.messages;
+  c.bytes += static_cast<std::uint64_t>(size);
+  if (options_.log) {
     lcm::LogEvent event;
     event.eventnum = log_events_++;
     event.timestamp = std::chrono::duration_cast<std::chrono::microseconds>(
@@ -336,32 +538,67 @@ void LcmRunPublisher::publish(const std::string& channel, const Message& message
     event.channel = channel;
     event.datalen = size;
     event.data = buffer_.data();
-    log_->writeEvent(&event);
+    options_.log->writeEvent(&event);
   }
-  if (in_process_) {
+  if (local_decoder_) local_decoder_->decode(channel, buffer_.data(), static_cast<std::size_t>(size));
+  if (to_bus && options_.in_process) {
     // memq:// queues every message until handled: deliver to the in-process subscribers now.
     while (lcm_.handleTimeout(0) > 0) {
     }
   }
 }
 
-void LcmRunPublisher::on_world(TimeUs t_us, const agents::WorldReport& world) { publish(channels_.world, to_lcm(t_us, world)); }
+void LcmRunPublisher::republish_world_and_status() {
+  std::lock_guard lock(mutex_);
+  if (options_.in_process && bus_subscribers_ == 0) return;
+  if (!last_world_.empty()) lcm_.publish(channels_.world, last_world_.data(), static_cast<unsigned>(last_world_.size()));
+  if (!last_status_.empty()) lcm_.publish(channels_.status, last_status_.data(), static_cast<unsigned>(last_status_.size()));
+}
+
+void LcmRunPublisher::on_world(TimeUs t_us, const agents::WorldReport& world) {
+  if (heard()) publish(channels_.world, to_lcm(t_us, world));
+}
 
 void LcmRunPublisher::on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) {
+  if (!heard()) return;
   fill(poses_message_, t_us, poses);
   publish(channels_.poses, poses_message_);
 }
 
-void LcmRunPublisher::on_event(const agents::RunEvent& event) { publish(channels_.events, to_lcm(event)); }
+void LcmRunPublisher::on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wheels) {
+  if (!heard()) return;
+  fill(wheels_message_, t_us, wheels);
+  publish(channels_.wheels, wheels_message_);
+}
+
+void LcmRunPublisher::on_sensors(TimeUs t_us, std::span<const agents::SensorReport> sensors) {
+  if (!heard()) return;
+  fill(sensors_message_, t_us, sensors);
+  publish(channels_.sensors, sensors_message_);
+}
+
+void LcmRunPublisher::on_detections(const agents::FrameReport& frame) {
+  if (heard()) publish(channels_.detections, to_lcm(frame));
+}
+
+void LcmRunPublisher::on_frame_image(TimeUs t_us, std::int64_t frame, const cv::Mat& image) {
+  if (heard()) publish(channels_.frames, to_lcm(t_us, frame, image, options_.jpeg_quality));
+}
+
+void LcmRunPublisher::on_event(const agents::RunEvent& event) {
+  if (heard()) publish(channels_.events, to_lcm(event));
+}
 
 void LcmRunPublisher::on_status(const agents::StatusReport& status) {
+  if (!heard()) return;
   publish(channels_.status, to_lcm(status));
-  if (log_) std::fflush(log_->getFilePtr());  // a run cut short keeps its log up to the last second
+  if (options_.log) std::fflush(options_.log->getFilePtr());  // a run cut short keeps its log up to the last second
 }
 
 void LcmRunPublisher::on_summary(TimeUs t_us, const nlohmann::json& summary) {
+  if (!heard()) return;
   publish(channels_.summary, to_lcm(t_us, summary));
-  if (log_) std::fflush(log_->getFilePtr());  // the whole run is on disk once it has ended
+  if (options_.log) std::fflush(options_.log->getFilePtr());  // the whole run is on disk once it has ended
 }
 
 std::map<std::string, ChannelCount> LcmRunPublisher::counts() const {

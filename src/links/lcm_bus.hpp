@@ -8,6 +8,7 @@
 #include <lcm/lcm.h>
 
 #include <cstdint>
+#include <atomic>
 #include <functional>
 #include <map>
 #include <memory>
@@ -18,10 +19,14 @@
 #include <vector>
 
 #include "agents/run_observer.hpp"
+#include "rilbed/detections_t.hpp"
 #include "rilbed/event_t.hpp"
+#include "rilbed/frame_t.hpp"
 #include "rilbed/poses_t.hpp"
+#include "rilbed/sensors_t.hpp"
 #include "rilbed/status_t.hpp"
 #include "rilbed/summary_t.hpp"
+#include "rilbed/wheels_t.hpp"
 #include "rilbed/world_t.hpp"
 
 namespace rilbed::links {
@@ -53,6 +58,10 @@ struct Channels {
   std::string status = "RILBED_STATUS";  ///< rilbed::status_t, every simulated second and at the end
   std::string world = "RILBED_WORLD";    ///< rilbed::world_t, at the start and every simulated second
   std::string summary = "RILBED_SUMMARY";  ///< rilbed::summary_t, once when the run ends
+  std::string wheels = "RILBED_WHEELS";    ///< rilbed::wheels_t, every control step
+  std::string sensors = "RILBED_SENSORS";  ///< rilbed::sensors_t, every control step
+  std::string detections = "RILBED_DETECTIONS";  ///< rilbed::detections_t, every camera frame
+  std::string frames = "RILBED_FRAMES";    ///< rilbed::frame_t (JPEG), every camera frame, only when asked for
   std::string console = "RILBED_CONSOLE";  ///< rilbed::console_command_t, from consoles
   std::string console_reply = "RILBED_CONSOLE_REPLY";  ///< rilbed::console_reply_t, the run's answers
   /// The same names behind `prefix`.
@@ -75,6 +84,11 @@ rilbed::event_t to_lcm(const agents::RunEvent& event);
 rilbed::status_t to_lcm(const agents::StatusReport& status);
 rilbed::world_t to_lcm(TimeUs t_us, const agents::WorldReport& world);
 rilbed::summary_t to_lcm(TimeUs t_us, const nlohmann::json& summary);
+void fill(rilbed::wheels_t& message, TimeUs t_us, std::span<const agents::WheelReport> wheels);
+void fill(rilbed::sensors_t& message, TimeUs t_us, std::span<const agents::SensorReport> sensors);
+rilbed::detections_t to_lcm(const agents::FrameReport& frame);
+/// A camera frame as JPEG of `quality` (1..100); an empty image gives size 0.
+rilbed::frame_t to_lcm(TimeUs t_us, std::int64_t frame, const cv::Mat& image, int quality);
 
 /// Hands the messages of a run's channels, as raw bytes from a bus or a log, to a
 /// RunObserver as the run reported them. Messages on other channels are ignored.
@@ -96,6 +110,10 @@ class RunReportDecoder {
   Channels channels_;
   agents::RunObserver& observer_;
   std::vector<agents::PoseReport> poses_;
+  std::vector<agents::WheelReport> wheels_;
+  std::vector<environment::SensorReadings> readings_;
+  std::vector<agents::SensorReport> sensors_;
+  std::vector<agents::DetectionReport> detections_;
   bool summary_seen_ = false;
   std::optional<rilbed::status_t> last_status_;
 };
@@ -131,20 +149,54 @@ class LcmLogReader {
 
 /// Messages and bytes sent on one channel, and publishes that failed.
 struct ChannelCount {
-  std::uint64_t messages = 0;
+  std::uint64_t messages = 0;  ///< published, including those the bus refused (also counted in failures)
   std::uint64_t bytes = 0;
   std::uint64_t failures = 0;  ///< lcm publish returned an error (e.g. EPERM from a firewall): the message is lost
 };
 
 /// Publishes what a run reports on `lcm` (which must outlive it), and writes every
 /// message to `log` too when given (a standard LCM log, as lcm-logger writes). A failed
-/// publish is counted and the run goes on. On an in-process bus (memq://) it also delivers
-/// the messages to the in-process subscribers after each publish, so nothing piles up.
+/// publish is counted and the run goes on.
+///
+/// In-process subscribers (add_local_subscriber: the run folder, the terminal status line)
+/// get the very bytes that went on the bus, decoded, synchronously: they never miss a
+/// message, whatever the bus loses. On the in-process bus (memq://) the messages are
+/// published only when something in the process subscribed to it (subscribe()), and when
+/// nothing at all wants them (no subscriber, no log) they are not even encoded: a plain
+/// run pays nothing for its bus.
 class LcmRunPublisher final : public agents::RunObserver {
  public:
-  LcmRunPublisher(lcm::LCM& lcm, Channels channels, bool in_process, lcm::LogFile* log = nullptr);
+  struct Options {
+    bool in_process = false;       ///< the bus is memq://
+    lcm::LogFile* log = nullptr;   ///< also write every message here (not owned)
+    bool frames = false;           ///< publish the camera frames themselves (RILBED_FRAMES, JPEG)
+    int jpeg_quality = 90;         ///< of those frames; higher is larger and closer to the camera's
+  };
+  LcmRunPublisher(lcm::LCM& lcm, Channels channels, Options options);
+  ~LcmRunPublisher() override;
+  /// The pre-options form: `in_process` is memq://.
+  LcmRunPublisher(lcm::LCM& lcm, Channels channels, bool in_process, lcm::LogFile* log = nullptr)
+      : LcmRunPublisher(lcm, std::move(channels), Options{in_process, log}) {}
+  /// Hands `observer` every message published from now on, decoded from its bytes, on the
+  /// publishing thread. `observer` must outlive the publisher. Not thread-safe: add
+  /// subscribers before the run starts.
+  void add_local_subscriber(agents::RunObserver& observer);
+  /// Subscribes `handler` to `channel` on the publisher's bus and, on memq://, makes the
+  /// publisher publish there (it does only once something subscribed). The subscription
+  /// must not outlive the bus.
+  std::unique_ptr<LcmSubscription> subscribe(const std::string& channel, LcmSubscription::Handler handler);
+  /// Publishes the last world and status again (a paused run does, every second, for
+  /// viewers that join while it is paused). Thread-safe.
+  void republish_world_and_status();
+
+  bool wants_steps() const override { return heard(); }
   void on_world(TimeUs t_us, const agents::WorldReport& world) override;
   void on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) override;
+  void on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wheels) override;
+  void on_sensors(TimeUs t_us, std::span<const agents::SensorReport> sensors) override;
+  void on_detections(const agents::FrameReport& frame) override;
+  bool wants_frame_images() const override { return options_.frames; }
+  void on_frame_image(TimeUs t_us, std::int64_t frame, const cv::Mat& image) override;
   void on_event(const agents::RunEvent& event) override;
   void on_status(const agents::StatusReport& status) override;
   void on_summary(TimeUs t_us, const nlohmann::json& summary) override;
@@ -152,16 +204,27 @@ class LcmRunPublisher final : public agents::RunObserver {
   std::map<std::string, ChannelCount> counts() const;
 
  private:
+  class Fanout;
+  // Whether a message would reach anyone: a subscriber in the process, the log, or a bus
+  // other processes may listen on.
+  bool heard() const { return !options_.in_process || bus_subscribers_ > 0 || options_.log || fanout_; }
   template <typename Message>
   void publish(const std::string& channel, const Message& message);
 
   lcm::LCM& lcm_;
   Channels channels_;
-  bool in_process_;
-  lcm::LogFile* log_;
+  Options options_;
   std::int64_t log_events_ = 0;
   std::vector<std::uint8_t> buffer_;
-  rilbed::poses_t poses_message_;  // kept between steps (on_poses is called from the run's thread only)
+  // Kept between steps (their on_ calls come from the run's thread only), so that a step
+  // of 10,000 robots does not allocate their strings and arrays anew.
+  rilbed::poses_t poses_message_;
+  rilbed::wheels_t wheels_message_;
+  rilbed::sensors_t sensors_message_;
+  std::unique_ptr<Fanout> fanout_;  // the local subscribers
+  std::unique_ptr<RunReportDecoder> local_decoder_;
+  std::atomic<int> bus_subscribers_{0};
+  std::vector<std::uint8_t> last_world_, last_status_;  // their bytes, for republish_world_and_status
   mutable std::mutex mutex_;
   std::map<std::string, ChannelCount> counts_;
 };

@@ -28,6 +28,24 @@ class Walk {
     skip(4);
     return v;
   }
+  std::int8_t i8() {
+    if (!ok_ || left_ < 1) {
+      ok_ = false;
+      return 0;
+    }
+    const auto v = static_cast<std::int8_t>(p_[0]);
+    skip(1);
+    return v;
+  }
+  std::int16_t i16() {
+    if (!ok_ || left_ < 2) {
+      ok_ = false;
+      return 0;
+    }
+    const auto v = static_cast<std::int16_t>((std::uint16_t{p_[0]} << 8) | std::uint16_t{p_[1]});
+    skip(2);
+    return v;
+  }
   void i64() { skip(8); }
   void f64() { skip(8); }
   void boolean() { skip(1); }
@@ -97,6 +115,9 @@ void fields(Walk& w, const rilbed::status_t*) {
   w.boolean();
   w.f64();
   w.i32();
+  w.f64();
+  w.f64();
+  w.i64();
 }
 void fields(Walk& w, const rilbed::world_t*) {
   w.i64();
@@ -132,6 +153,47 @@ void fields(Walk& w, const rilbed::console_reply_t*) {
   w.string();
 }
 
+void fields(Walk& w, const rilbed::wheels_t*) {
+  w.i64();
+  const std::int32_t n = w.count(w.i32(), 4 + 2 + 2 + 8 + 8);
+  w.skip(static_cast<std::size_t>(n) * (4 + 2 + 2 + 8 + 8));
+}
+void robot_sensors(Walk& w) {
+  w.i32();
+  std::int32_t n = w.count(w.i8(), 2);
+  w.skip(static_cast<std::size_t>(n) * 2);
+  n = w.count(w.i8(), 9);
+  w.skip(static_cast<std::size_t>(n) * 9);
+  n = w.count(w.i8(), 12);
+  w.skip(static_cast<std::size_t>(n) * 12);
+  n = w.count(w.i16(), 4);
+  w.skip(static_cast<std::size_t>(n) * 4);
+  w.boolean();
+  w.i64();
+  w.i64();
+}
+void fields(Walk& w, const rilbed::sensors_t*) {
+  w.i64();
+  const std::int32_t n = w.count(w.i32(), 4 + 1 + 1 + 1 + 2 + 1 + 16);
+  for (std::int32_t i = 0; i < n && w.ok(); ++i) robot_sensors(w);
+}
+void fields(Walk& w, const rilbed::detections_t*) {
+  w.i64();
+  w.i64();
+  w.f64();
+  const std::int32_t n = w.count(w.i32(), 4 + 8 * 8);
+  w.skip(static_cast<std::size_t>(n) * (4 + 8 * 8));
+}
+void fields(Walk& w, const rilbed::frame_t*) {
+  w.i64();
+  w.i64();
+  w.i32();
+  w.i32();
+  w.string();
+  const std::int32_t n = w.count(w.i32(), 1);
+  w.skip(static_cast<std::size_t>(n));
+}
+
 }  // namespace
 
 template <typename Message>
@@ -149,5 +211,9 @@ template bool well_formed<rilbed::world_t>(const void*, std::size_t);
 template bool well_formed<rilbed::summary_t>(const void*, std::size_t);
 template bool well_formed<rilbed::console_command_t>(const void*, std::size_t);
 template bool well_formed<rilbed::console_reply_t>(const void*, std::size_t);
+template bool well_formed<rilbed::wheels_t>(const void*, std::size_t);
+template bool well_formed<rilbed::sensors_t>(const void*, std::size_t);
+template bool well_formed<rilbed::detections_t>(const void*, std::size_t);
+template bool well_formed<rilbed::frame_t>(const void*, std::size_t);
 
 }  // namespace rilbed::links

@@ -13,10 +13,14 @@
 
 #include "rilbed/console_command_t.hpp"
 #include "rilbed/console_reply_t.hpp"
+#include "rilbed/detections_t.hpp"
 #include "rilbed/event_t.hpp"
+#include "rilbed/frame_t.hpp"
 #include "rilbed/poses_t.hpp"
+#include "rilbed/sensors_t.hpp"
 #include "rilbed/status_t.hpp"
 #include "rilbed/summary_t.hpp"
+#include "rilbed/wheels_t.hpp"
 #include "rilbed/world_t.hpp"
 
 namespace rilbed::links {

@@ -19,6 +19,7 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/posix/stream_descriptor.hpp>
 #include <boost/asio/post.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 namespace rilbed::links {
 
@@ -119,6 +120,8 @@ struct LcmConsoleServer::Impl {
   std::function<void(const std::string&)> log;
   asio::io_context io;
   asio::posix::stream_descriptor descriptor{io};
+  asio::steady_timer tick{io};
+  std::function<void()> while_paused;
   std::thread thread;
   std::unique_ptr<LcmSubscription> subscription;
   // Answers already given, by (client, seq), oldest first (a bounded memory).
@@ -130,6 +133,15 @@ struct LcmConsoleServer::Impl {
       if (ec) return;  // closed: the server is going
       lcm.handleTimeout(0);
       wait_for_messages();
+    });
+  }
+
+  void every_second() {
+    tick.expires_after(std::chrono::seconds(1));
+    tick.async_wait([this](const boost::system::error_code& ec) {
+      if (ec) return;
+      if (control.paused()) while_paused();
+      every_second();
     });
   }
 
@@ -188,15 +200,18 @@ struct LcmConsoleServer::Impl {
 };
 
 LcmConsoleServer::LcmConsoleServer(lcm::LCM& lcm, Channels channels, std::string token, agents::RunControl& control,
-                                   std::function<void(const std::string&)> log, bool own_thread)
+                                   std::function<void(const std::string&)> log, bool own_thread,
+                                   std::function<void()> while_paused)
     : impl_(std::make_unique<Impl>(lcm, std::move(channels), std::move(token), control, std::move(log))) {
   Impl& m = *impl_;
+  m.while_paused = std::move(while_paused);
   m.subscription = std::make_unique<LcmSubscription>(
       lcm, m.channels.console, [&m](const std::string& c, const void* data, std::size_t size) { m.on_message(c, data, size); });
   if (!own_thread) return;
   // A duplicate of LCM's descriptor: closing ours must not close LCM's.
   m.descriptor.assign(::dup(lcm.getFileno()));
   m.wait_for_messages();
+  if (m.while_paused) m.every_second();
   m.thread = std::thread([&m] { m.io.run(); });
 }
 
@@ -206,6 +221,7 @@ LcmConsoleServer::~LcmConsoleServer() {
     asio::post(m.io, [&m] {
       boost::system::error_code ignored;
       m.descriptor.close(ignored);
+      m.tick.cancel();
       m.io.stop();
     });
     m.thread.join();

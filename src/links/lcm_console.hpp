@@ -56,8 +56,11 @@ class LcmConsoleServer {
   /// command and refusal. With `own_thread` the server handles `lcm` on a thread of its
   /// own (nothing else may handle it then: liblcm's memq:// provider is not safe with two
   /// handling threads); without, whoever handles `lcm` delivers the commands.
+  /// `while_paused` (may be empty) is called on the server's thread every second while the
+  /// run is paused (the run then reports nothing; it re-publishes its world and status).
   LcmConsoleServer(lcm::LCM& lcm, Channels channels, std::string token, agents::RunControl& control,
-                   std::function<void(const std::string&)> log, bool own_thread = true);
+                   std::function<void(const std::string&)> log, bool own_thread = true,
+                   std::function<void()> while_paused = {});
   /// Stops serving and joins its thread.
   ~LcmConsoleServer();
   LcmConsoleServer(const LcmConsoleServer&) = delete;

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "agents/simulation.hpp"
+#include "agents/status_line.hpp"
 
 namespace rilbed::agents {
 namespace {
@@ -177,7 +178,8 @@ TEST(Simulation, StatusLineOncePerSimulatedSecond) {
     std::vector<std::string> lines;
     RunOptions o;
     o.duration_s = 12.0;
-    o.on_status = [&](const std::string& line) { lines.push_back(line); };
+    StatusLine status_line([&](const std::string& line) { lines.push_back(line); });
+    o.observer = &status_line;
     run_scenario(s, o);
     ASSERT_EQ(lines.size(), 12u) << "period " << period_us << " us";
     for (std::size_t k = 0; k < lines.size(); ++k) {

@@ -21,6 +21,8 @@ struct Collector {
   std::vector<rilbed::event_t> events;
   std::vector<rilbed::status_t> status;
   std::vector<rilbed::world_t> worlds;
+  std::vector<rilbed::wheels_t> wheels;
+  std::vector<rilbed::sensors_t> sensors;
   // Decodes each message as its channel's type (a test does not need the checks).
   template <typename Message>
   LcmSubscription::Handler into(std::vector<Message>& out) {
@@ -49,11 +51,13 @@ TEST(LcmBus, ARunOnTheInProcessBusIsWhatItsFolderHolds) {
   ASSERT_TRUE(lcm.good());
   const Channels channels = Channels::with_prefix("T1_");
   Collector got;
-  LcmSubscription poses(lcm, channels.poses, got.into(got.poses));
-  LcmSubscription events(lcm, channels.events, got.into(got.events));
-  LcmSubscription status(lcm, channels.status, got.into(got.status));
-  LcmSubscription worlds(lcm, channels.world, got.into(got.worlds));
   LcmRunPublisher publisher(lcm, channels, true);
+  const auto poses = publisher.subscribe(channels.poses, got.into(got.poses));
+  const auto events = publisher.subscribe(channels.events, got.into(got.events));
+  const auto status = publisher.subscribe(channels.status, got.into(got.status));
+  const auto worlds = publisher.subscribe(channels.world, got.into(got.worlds));
+  const auto wheels = publisher.subscribe(channels.wheels, got.into(got.wheels));
+  const auto sensors = publisher.subscribe(channels.sensors, got.into(got.sensors));
 
   const auto dir = std::filesystem::temp_directory_path() / ("rilbed_lcm_bus_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
@@ -75,6 +79,26 @@ TEST(LcmBus, ARunOnTheInProcessBusIsWhatItsFolderHolds) {
   const auto steps = static_cast<std::size_t>(std::llround(r.simulated_s / 0.1)) + 1;
   EXPECT_NEAR(static_cast<double>(got.poses.size()), static_cast<double>(steps), 1.0);
   for (const auto& p : got.poses) ASSERT_EQ(p.num_robots, 8);
+  // Every robot's wheels and sensors at every step; the convoy's Kheperas carry 8 IR sensors.
+  ASSERT_EQ(got.wheels.size(), got.poses.size());
+  ASSERT_EQ(got.sensors.size(), got.poses.size());
+  bool moved = false;
+  for (std::size_t i = 0; i < got.wheels.size(); ++i) {
+    ASSERT_EQ(got.wheels[i].utime, got.poses[i].utime);
+    ASSERT_EQ(got.wheels[i].num_robots, 8);
+    for (const auto& w : got.wheels[i].robots) {
+      ASSERT_LE(std::abs(w.left_units), 127);
+      EXPECT_DOUBLE_EQ(w.left_mps, w.left_units * 0.008);
+      moved = moved || w.left_units != 0 || w.right_units != 0;
+    }
+    ASSERT_EQ(got.sensors[i].num_robots, 8);
+    for (const auto& r : got.sensors[i].robots) {
+      ASSERT_EQ(r.num_proximity, i == 0 ? r.num_proximity : 8);  // before the first step nothing was read
+      for (const auto v : r.proximity) ASSERT_TRUE(v >= 0 && v <= 1023) << v;
+    }
+  }
+  EXPECT_TRUE(moved);
+  EXPECT_EQ(got.sensors.back().robots[0].num_proximity, 8);
   // The poses are the trajectories' rows.
   const std::string trajectories = slurp(dir / "trajectories.csv");
   const auto& last = got.poses.back();
@@ -112,6 +136,45 @@ TEST(LcmBus, ARunOnTheInProcessBusIsWhatItsFolderHolds) {
   EXPECT_EQ(counts.at("T1_RILBED_POSES").failures, 0u);
   EXPECT_GT(counts.at("T1_RILBED_POSES").bytes, 100u * got.poses.size());
   std::filesystem::remove_all(dir);
+}
+
+// A run nobody hears (the in-process bus, no subscriber, no log) costs no encoding; a
+// local subscriber gets exactly what a bus subscriber gets, without the bus.
+TEST(LcmBus, NothingIsEncodedForNobodyAndLocalSubscribersHearAll) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  agents::RunOptions o;
+  o.seed = 5;
+  o.duration_s = 3.0;
+  {
+    LcmRunPublisher unheard(lcm, Channels{}, true);
+    o.observer = &unheard;
+    agents::run_scenario(convoy_sim(), o);
+    EXPECT_TRUE(unheard.counts().empty());
+  }
+  struct Counter final : agents::RunObserver {
+    int worlds = 0, poses = 0, wheels = 0, sensors = 0, statuses = 0, summaries = 0;
+    void on_world(TimeUs, const agents::WorldReport&) override { ++worlds; }
+    void on_poses(TimeUs, std::span<const agents::PoseReport>) override { ++poses; }
+    void on_wheels(TimeUs, std::span<const agents::WheelReport>) override { ++wheels; }
+    void on_sensors(TimeUs, std::span<const agents::SensorReport>) override { ++sensors; }
+    void on_status(const agents::StatusReport&) override { ++statuses; }
+    void on_summary(TimeUs, const nlohmann::json&) override { ++summaries; }
+  } local;
+  Collector bus;
+  LcmRunPublisher heard(lcm, Channels{}, true);
+  heard.add_local_subscriber(local);
+  const auto poses = heard.subscribe(Channels{}.poses, bus.into(bus.poses));
+  o.observer = &heard;
+  agents::run_scenario(convoy_sim(), o);
+  EXPECT_EQ(static_cast<std::size_t>(local.poses), bus.poses.size());
+  EXPECT_GT(local.poses, 25);
+  EXPECT_EQ(local.wheels, local.poses);
+  EXPECT_EQ(local.sensors, local.poses);
+  EXPECT_GE(local.worlds, 3);
+  EXPECT_GE(local.statuses, 4);  // every second and the end
+  EXPECT_EQ(local.summaries, 1);
+  EXPECT_EQ(heard.counts().at("RILBED_POSES").messages, bus.poses.size());
 }
 
 TEST(LcmBus, ChecksChannelPrefixesAndUrls) {
