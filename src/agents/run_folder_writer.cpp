@@ -17,6 +17,13 @@ std::string_view RunFolderWriter::intern(std::string_view text) {
 }
 
 void RunFolderWriter::on_world(TimeUs, const WorldReport& world) {
+  if (finished_) {
+    // The run ended and another began on the same bus (the console's reset starts a run
+    // over): the folder holds the run that goes on.
+    recorder_.reset();
+    samples_.clear();
+    finished_ = false;
+  }
   if (recorder_) {
     recorder_->set_field(world.field);
   } else {

@@ -28,6 +28,8 @@ class RunFolderWriter final : public RunObserver {
   /// Whether the summary arrived (the folder is complete).
   bool finished() const { return finished_; }
   /// Ends a folder whose summary never came (a recording cut short) with `summary`.
+  /// (A world after the summary, a run started over by the console's reset, starts the
+  /// folder over.)
   void finish_without_summary(const nlohmann::json& summary);
 
  private:

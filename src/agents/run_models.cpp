@@ -1,24 +1,52 @@
 #include "agents/run_models.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace rilbed::agents {
 
-AgentModel::AgentModel(Body& body, std::unique_ptr<Controller> controller, TimeUs period_us, TimeUs first_step_us)
+AgentModel::AgentModel(Body& body, std::unique_ptr<Controller> controller, TimeUs period_us, TimeUs first_step_us,
+                       bool commanded)
     : sim::AtomicModel<AgentState>("agent" + std::to_string(body.id()), AgentState{}),
       body_(body),
       controller_(std::move(controller)),
       period_us_(period_us),
       team_in_(add_input<TeamBroadcast>("team")),
-      command_in_(add_input<AgentCommand>("command")) {
+      command_in_(add_input<AgentCommand>("command")),
+      console_in_(add_input<ConsoleOrder>("console")) {
   if (period_us <= 0) throw std::invalid_argument("agent " + std::to_string(body.id()) + ": control period must be > 0");
-  state_.sigma_us = controller_ ? first_step_us : sim::kInfinity;
+  state_.commanded = commanded;
+  state_.sigma_us = controller_ && !commanded ? first_step_us : sim::kInfinity;
 }
 
 TimeUs AgentModel::time_advance() const { return state_.sigma_us; }
 
 void AgentModel::internal_transition() {
   state_.t_us += state_.sigma_us;
+  if (state_.manual && state_.t_us >= state_.manual->until_us) {
+    // The hand drive is over: the controller (or the coordinator's next command) takes over.
+    state_.manual.reset();
+    state_.last = {};
+    body_.stop();
+  }
+  if (state_.manual) {
+    body_.drive(state_.manual->wheels);
+    state_.last.wheels = state_.manual->wheels;
+    state_.last.behaviour = "console";
+  } else if (controller_ && !state_.commanded) {
+    step();
+  }
+  const bool stepping = controller_ && !state_.commanded;
+  if (stepping) {
+    state_.sigma_us = period_us_;
+  } else if (state_.manual) {
+    state_.sigma_us = std::min(period_us_, state_.manual->until_us - state_.t_us);
+  } else {
+    state_.sigma_us = sim::kInfinity;
+  }
+}
+
+void AgentModel::step() {
   ControlInput input;
   input.t_us = state_.t_us;
   input.robot_id = body_.id();
@@ -28,17 +56,44 @@ void AgentModel::internal_transition() {
   state_.last = controller_->step(input);
   body_.drive(state_.last.wheels);
   state_.sensors = std::move(input.sensors);  // kept for the run's observer
-  state_.sigma_us = period_us_;
 }
 
 void AgentModel::external_transition(TimeUs elapsed_us) {
   state_.t_us += elapsed_us;
   if (state_.sigma_us != sim::kInfinity) state_.sigma_us -= elapsed_us;
   if (!team_in_.messages().empty()) state_.team = team_in_.messages().back();
+  for (const ConsoleOrder& order : console_in_.messages()) apply(order);
+  if (state_.manual) return;  // driven by hand: commands wait
   for (const AgentCommand& c : command_in_.messages()) {
     if (c.id != body_.id()) continue;
     state_.last = c.output;
     body_.drive(c.output.wheels);
+  }
+}
+
+void AgentModel::apply(const ConsoleOrder& order) {
+  switch (order.kind) {
+    case ConsoleOrder::Kind::kDrive:
+      if (order.robot_id != body_.id()) return;
+      state_.manual = ManualDrive{order.wheels, order.until_us};
+      body_.drive(order.wheels);  // now, not at the next step
+      state_.last.wheels = order.wheels;
+      state_.last.behaviour = "console";
+      // A stepping agent keeps its step times (the drive ends at a step); one that waits
+      // for commands wakes when the drive ends.
+      if (!controller_ || state_.commanded) state_.sigma_us = std::max<TimeUs>(0, order.until_us - state_.t_us);
+      return;
+    case ConsoleOrder::Kind::kMode:
+      if (!controller_ || state_.commanded == order.central) return;
+      state_.commanded = order.central;
+      // Distributed: its controller decides from now on (this instant); central: it waits
+      // for the coordinator's commands (or the end of a hand drive).
+      if (!state_.commanded) {
+        state_.sigma_us = 0;
+      } else if (!state_.manual) {
+        state_.sigma_us = sim::kInfinity;
+      }
+      return;
   }
 }
 
@@ -69,12 +124,16 @@ void TeamBroadcaster::output() {
   t_us_ += period_us_;
 }
 
-CentralConvoyModel::CentralConvoyModel(std::vector<Body*> bodies, ConvoyConfig config, TimeUs period_us, TimeUs first_us)
-    : sim::AtomicModel<CentralState>("central_convoy", CentralState{0, first_us, {}}),
+CentralConvoyModel::CentralConvoyModel(std::vector<Body*> bodies, ConvoyConfig config, TimeUs period_us, TimeUs first_us,
+                                       bool active)
+    : sim::AtomicModel<CentralState>("central_convoy", CentralState{0, active ? first_us : sim::kInfinity, {}}),
       bodies_(std::move(bodies)),
+      config_(config),
       convoy_(config),
       period_us_(period_us),
-      commands_out_(add_output<AgentCommand>("commands")) {
+      active_(active),
+      commands_out_(add_output<AgentCommand>("commands")),
+      console_in_(add_input<ConsoleOrder>("console")) {
   if (period_us <= 0) throw std::invalid_argument("central convoy: period must be > 0");
 }
 
@@ -95,9 +154,19 @@ void CentralConvoyModel::internal_transition() {
 
 void CentralConvoyModel::external_transition(TimeUs elapsed_us) {
   state_.t_us += elapsed_us;
-  state_.sigma_us -= elapsed_us;
+  if (state_.sigma_us != sim::kInfinity) state_.sigma_us -= elapsed_us;
+  for (const ConsoleOrder& order : console_in_.messages()) {
+    if (order.kind != ConsoleOrder::Kind::kMode || order.central == active_) continue;
+    active_ = order.central;
+    state_.pending.clear();
+    if (active_) {
+      convoy_ = CentralConvoy(config_);  // afresh: the agents moved on meanwhile
+      state_.sigma_us = 0;               // decide now
+    } else {
+      state_.sigma_us = sim::kInfinity;
+    }
+  }
 }
-
 void CentralConvoyModel::output() {
   for (const AgentCommand& c : state_.pending) commands_out_.add(c);
 }

@@ -31,6 +31,23 @@ struct AgentCommand {
   ControlOutput output;
 };
 
+/// An order from the console (RunControl) to the agents and the central coordinator,
+/// applied between two steps.
+struct ConsoleOrder {
+  enum class Kind { kDrive, kMode };
+  Kind kind = Kind::kDrive;
+  int robot_id = 0;     ///< kDrive: the robot driven by hand
+  WheelCommand wheels;  ///< kDrive
+  TimeUs until_us = 0;  ///< kDrive: its controller (or the coordinator) takes over again at the first step from then
+  bool central = false; ///< kMode: the convoy's agents obey the central coordinator (else their own controllers)
+};
+
+/// A robot driven by hand (the console's drive command) until a time.
+struct ManualDrive {
+  WheelCommand wheels;
+  TimeUs until_us = 0;
+};
+
 /// State of an agent model.
 struct AgentState {
   TimeUs t_us = 0;                 ///< simulated time of the last transition
@@ -38,17 +55,23 @@ struct AgentState {
   std::shared_ptr<const std::vector<TeamMessage>> team;  ///< the latest broadcast, as received (shared, not copied)
   ControlOutput last;              ///< the last command applied to the body
   environment::SensorReadings sensors;  ///< what its controller read at the last step
+  bool commanded = false;          ///< it obeys the "command" input (central mode), its controller idle
+  std::optional<ManualDrive> manual;  ///< driven by hand (its controller and commands set aside) until then
 };
 
 /// One robot's agent: every control period it senses through its body, runs its
-/// controller and drives its body. Without a controller it is commanded: it applies the
-/// commands that arrive on its `command` port (central mode).
-/// Inputs: "team" (TeamBroadcast), "command" (AgentCommand).
+/// controller and drives its body. Without a controller, or while commanded (central
+/// mode), it applies the commands that arrive on its `command` port instead. A console
+/// order may switch it between the two, or drive its robot by hand for a while.
+/// Inputs: "team" (TeamBroadcast), "command" (AgentCommand), "console" (ConsoleOrder).
 class AgentModel final : public sim::AtomicModel<AgentState> {
  public:
   /// `body` must outlive the model. `controller` may be null (commanded agent).
   /// The first control step is at `first_step_us`, then every `period_us` (> 0).
-  AgentModel(Body& body, std::unique_ptr<Controller> controller, TimeUs period_us, TimeUs first_step_us = 0);
+  /// `commanded`: it starts obeying its "command" input (central mode) rather than its
+  /// controller.
+  AgentModel(Body& body, std::unique_ptr<Controller> controller, TimeUs period_us, TimeUs first_step_us = 0,
+             bool commanded = false);
 
   TimeUs time_advance() const override;
   void internal_transition() override;
@@ -60,7 +83,7 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   bool wants_team() const { return controller_ && controller_->wants_team(); }
   /// Whether it has no goal left: no controller (it stands still or is commanded), or
   /// its controller is done.
-  bool done() const { return !controller_ || controller_->done(); }
+  bool done() const { return !controller_ || state_.commanded || controller_->done(); }
   /// The active behaviour (a static string), "idle" before the first step.
   std::string_view behaviour() const { return state_.last.behaviour; }
   const WheelCommand& wheels() const { return state_.last.wheels; }
@@ -74,8 +97,13 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   Body& body_;
   std::unique_ptr<Controller> controller_;
   TimeUs period_us_;
+  void apply(const ConsoleOrder& order);
+  // Its own step: sense, decide (controller or hand), drive.
+  void step();
+
   sim::Port<TeamBroadcast>& team_in_;
   sim::Port<AgentCommand>& command_in_;
+  sim::Port<ConsoleOrder>& console_in_;
 };
 
 /// Broadcasts every agent's pose and behaviour to the team every period.
@@ -105,11 +133,14 @@ struct CentralState {
 };
 
 /// Central mode (paper 001 §5): one coordinator that knows every agent's pose and sensors
-/// and sends each its command. Output: "commands" (AgentCommand, one per agent).
+/// and sends each its command. Output: "commands" (AgentCommand, one per agent). Input:
+/// "console" (ConsoleOrder kMode): it decides only while central mode is on, and starts
+/// afresh each time it is switched on.
 class CentralConvoyModel final : public sim::AtomicModel<CentralState> {
  public:
   /// `bodies` must outlive the model. Decides every `period_us` from `first_us`.
-  CentralConvoyModel(std::vector<Body*> bodies, ConvoyConfig config, TimeUs period_us, TimeUs first_us = 0);
+  CentralConvoyModel(std::vector<Body*> bodies, ConvoyConfig config, TimeUs period_us, TimeUs first_us = 0,
+                     bool active = true);
   TimeUs time_advance() const override { return state_.sigma_us; }
   void internal_transition() override;
   void external_transition(TimeUs elapsed_us) override;
@@ -117,9 +148,12 @@ class CentralConvoyModel final : public sim::AtomicModel<CentralState> {
 
  private:
   std::vector<Body*> bodies_;
+  ConvoyConfig config_;
   CentralConvoy convoy_;
   TimeUs period_us_;
+  bool active_;
   sim::Port<AgentCommand>& commands_out_;
+  sim::Port<ConsoleOrder>& console_in_;
 };
 
 }  // namespace rilbed::agents

@@ -231,6 +231,8 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   void end_run(const char* why) { end(why); }
   /// Records an event in the run folder and tells the observer.
   void record_event(const RunEvent& event) { record(event); }
+  /// The convoy's mode now (the console may switch it).
+  void set_central(bool central) { central_ = central; }
   std::optional<TimeUs> formation_time_us() const { return formation_.formation_time_us(); }
 
   /// The run's status now (`state`: "running" or "ended").
@@ -240,7 +242,7 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     st.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - s_.wall_start).count();
     st.scenario = s_.scenario->name;
     st.seed = s_.options->seed;
-    st.mode = s_.scenario->mode == ConvoyMode::kCentral ? "central" : "distributed";
+    st.mode = central_ ? "central" : "distributed";
     st.realtime = s_.options->realtime;
     st.rt_factor = s_.options->rt_factor;
     st.state = state;
@@ -406,6 +408,7 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   }
 
   Setup s_;
+  bool central_ = s_.scenario->mode == ConvoyMode::kCentral;
   std::string subteams_;
   FormationMonitor formation_;
   TimeUs t_us_ = 0;
@@ -423,8 +426,10 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
 };
 
 // The console's actions as a DEVS model: they arrive on its input (injected from the
-// console's thread) and are applied here, on the run's thread, between two steps.
-class ControlModel final : public sim::AtomicModel<TimeUs> {  // state: unused (passive)
+// console's thread) and are applied here, on the run's thread, between two steps. Those
+// for the agents (drive one by hand, switch the convoy's mode) go out on its "orders"
+// output at the same instant.
+class ControlModel final : public sim::AtomicModel<std::vector<ConsoleOrder>> {  // state: orders to send now
  public:
   struct Setup {
     std::vector<AgentModel*> agents;
@@ -433,15 +438,21 @@ class ControlModel final : public sim::AtomicModel<TimeUs> {  // state: unused (
     RunObserver* observer = nullptr;
   };
   explicit ControlModel(Setup setup)
-      : sim::AtomicModel<TimeUs>("control", 0), s_(std::move(setup)), in_(add_input<ControlAction>("action")) {}
-  TimeUs time_advance() const override { return sim::kInfinity; }
-  void internal_transition() override {}
-  void output() override {}
+      : sim::AtomicModel<std::vector<ConsoleOrder>>("control", {}),
+        s_(std::move(setup)),
+        in_(add_input<ControlAction>("action")),
+        out_(add_output<ConsoleOrder>("orders")) {}
+  TimeUs time_advance() const override { return state_.empty() ? sim::kInfinity : 0; }
+  void internal_transition() override { state_.clear(); }
+  void output() override {
+    for (const ConsoleOrder& o : state_) out_.add(o);
+  }
   void external_transition(TimeUs elapsed_us) override {
     t_us_ += elapsed_us;
     for (const ControlAction& a : in_.messages()) apply(a);
   }
   sim::Port<ControlAction>& input() { return in_; }
+  sim::Port<ConsoleOrder>& orders() { return out_; }
 
  private:
   void apply(const ControlAction& a) {
@@ -468,6 +479,33 @@ class ControlModel final : public sim::AtomicModel<TimeUs> {  // state: unused (
         s_.monitor->record_event({t_us_, "console", 0, 0, "ended by " + a.who});
         s_.monitor->end_run("console");
         break;
+      case ControlAction::Kind::kReset:
+        s_.monitor->record_event({t_us_, "console", 0, 0, "reset by " + a.who + ": the run starts over"});
+        s_.monitor->end_run("reset");
+        break;
+      case ControlAction::Kind::kMode: {
+        ConsoleOrder o;
+        o.kind = ConsoleOrder::Kind::kMode;
+        o.central = a.central;
+        state_.push_back(o);
+        s_.monitor->set_central(a.central);
+        s_.monitor->record_event({t_us_, "console", 0, 0,
+                                  std::string("mode ") + (a.central ? "central" : "distributed") + " set by " + a.who});
+        break;
+      }
+      case ControlAction::Kind::kDrive: {
+        ConsoleOrder o;
+        o.kind = ConsoleOrder::Kind::kDrive;
+        o.robot_id = a.robot_id;
+        o.wheels = {a.left, a.right};
+        o.until_us = t_us_ + seconds_to_us(a.duration_s);
+        state_.push_back(o);
+        std::ostringstream text;
+        text << "robot " << a.robot_id << " driven " << a.left << " " << a.right << " for " << a.duration_s << " s by "
+             << a.who;
+        s_.monitor->record_event({t_us_, "console", a.robot_id, 0, text.str()});
+        break;
+      }
       case ControlAction::Kind::kRefused:
         s_.monitor->record_event({t_us_, "console", 0, 0, "refused " + a.what + " from " + a.who});
         break;
@@ -476,6 +514,7 @@ class ControlModel final : public sim::AtomicModel<TimeUs> {  // state: unused (
 
   Setup s_;
   sim::Port<ControlAction>& in_;
+  sim::Port<ConsoleOrder>& out_;
   TimeUs t_us_ = 0;
 };
 
@@ -532,7 +571,9 @@ std::unique_ptr<Controller> make_controller(const Scenario& scenario, const Robo
   std::set<std::string> used;
   std::unique_ptr<Controller> controller;
   if (name == "convoy") {
-    if (scenario.mode == ConvoyMode::kDistributed) controller = std::make_unique<ConvoyController>(spec.id, scenario.convoy);
+    // Its own controller in either mode: in central mode it idles until the console
+    // switches the run to distributed.
+    controller = std::make_unique<ConvoyController>(spec.id, scenario.convoy);
   } else if (name == "wander") {
     WanderConfig c;
     c.speed_mps = param(spec, "speed_mps", c.speed_mps, used);
@@ -648,18 +689,24 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   auto root = std::make_shared<sim::Coupled>("run");
   auto& world_model = root->emplace<WorldModel>(world, scenario.physics_step_us, noise_rng);
   std::vector<AgentModel*> agents;
+  const bool central = scenario.mode == ConvoyMode::kCentral;
   for (std::size_t i = 0; i < scenario.robots.size(); ++i) {
     auto controller = make_controller(scenario, scenario.robots[i]);
-    agents.push_back(&root->emplace<AgentModel>(*bodies[i], std::move(controller), scenario.control_period_us));
+    const bool commanded = central && i < convoy_ids.size();
+    agents.push_back(&root->emplace<AgentModel>(*bodies[i], std::move(controller), scenario.control_period_us, 0, commanded));
   }
-  if (scenario.mode == ConvoyMode::kCentral && !convoy_ids.empty()) {
+  // Both ways of running a convoy are built; the mode says which one drives (the console
+  // may switch it while the run runs).
+  CentralConvoyModel* central_model = nullptr;
+  if (!convoy_ids.empty()) {
     std::vector<Body*> convoy_bodies;
     for (std::size_t i = 0; i < convoy_ids.size(); ++i) convoy_bodies.push_back(bodies[i].get());
-    auto& central = root->emplace<CentralConvoyModel>(convoy_bodies, scenario.convoy, scenario.control_period_us);
+    central_model = &root->emplace<CentralConvoyModel>(convoy_bodies, scenario.convoy, scenario.control_period_us, 0, central);
     for (std::size_t i = 0; i < convoy_ids.size(); ++i) {
-      root->couple(*central.find_output("commands"), *agents[i]->find_input("command"));
+      root->couple(*central_model->find_output("commands"), *agents[i]->find_input("command"));
     }
-  } else if (std::any_of(agents.begin(), agents.end(), [](const AgentModel* a) { return a->wants_team(); })) {
+  }
+  if (std::any_of(agents.begin(), agents.end(), [](const AgentModel* a) { return a->wants_team(); })) {
     // Every robot is in the broadcast (a convoy agent avoids wanderers too); only the
     // agents that read it receive it.
     auto& broadcaster = root->emplace<TeamBroadcaster>(std::vector<const AgentModel*>(agents.begin(), agents.end()),
@@ -704,15 +751,21 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
         ControlModel::Setup{agents, &monitor, options.realtime ? &real_clock : nullptr, options.observer});
     control_in = &root->add_input<ControlAction>("control");
     root->couple(*control_in, control.input());
+    for (AgentModel* a : agents) root->couple(control.orders(), *a->find_input("console"));
+    if (central_model) root->couple(control.orders(), *central_model->find_input("console"));
   }
   sim::Coordinator coordinator(root, clock);
   coordinator_ptr = &coordinator;
   std::atomic<bool> paused{false};
+  std::atomic<bool> central_now{central};
   if (options.control) {
     const bool realtime = options.realtime;
     const bool has_real = !real_ids.empty();
+    const bool has_convoy = !convoy_ids.empty();
+    std::set<int> ids;
+    for (const RobotSpec& r : scenario.robots) ids.insert(r.id);
     options.control->attach(
-        [&paused, realtime, has_real](const ControlAction& a) -> std::optional<std::string> {
+        [&paused, &central_now, realtime, has_real, has_convoy, ids](const ControlAction& a) -> std::optional<std::string> {
           switch (a.kind) {
             case ControlAction::Kind::kPause:
               if (!realtime) return "a fast run cannot be paused (it is not paced to the clock)";
@@ -726,7 +779,20 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
               if (has_real && a.rt_factor != 1.0) return "a run with real robots runs at a factor of 1";
               if (!(a.rt_factor > 0.0) || !std::isfinite(a.rt_factor)) return "the factor must be a number above 0";
               return std::nullopt;
+            case ControlAction::Kind::kMode:
+              if (!has_convoy) return "this run has no convoy, so no mode to switch";
+              if (central_now.exchange(a.central) == a.central) {
+                return std::string("the convoy is in ") + (a.central ? "central" : "distributed") + " mode already";
+              }
+              return std::nullopt;
+            case ControlAction::Kind::kDrive:
+              if (!ids.contains(a.robot_id)) return "this run has no robot " + std::to_string(a.robot_id);
+              if (paused.load()) return "the run is paused: resume it first";
+              if (std::abs(a.left) > 127 || std::abs(a.right) > 127) return "wheel speeds are -127..127 (Khepera units)";
+              if (!(a.duration_s > 0.0) || !std::isfinite(a.duration_s)) return "the seconds must be above 0";
+              return std::nullopt;
             case ControlAction::Kind::kExit:
+            case ControlAction::Kind::kReset:
             case ControlAction::Kind::kRefused:
               return std::nullopt;
           }

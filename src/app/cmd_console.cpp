@@ -1,11 +1,13 @@
 // `rilbed console --lcm URL COMMAND`: steers a running run over its LCM bus: pause,
-// resume, exit, rt-factor F. Every command carries the run's token (from --token, or the
-// run's token file when this user can read it) and gets an answer; the exit status is 0
+// resume, exit, reset, rt-factor F, mode central|distributed, drive ID LEFT RIGHT --for S.
+// Every command carries the run's token (from --token, or the run's token file when this
+// user can read it) and gets an answer; the exit status is 0
 // when the run accepted it, 1 when it refused it (the reason is printed) or no run
 // answered within the timeout.
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
+#include <optional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -24,6 +26,7 @@ struct ConsoleArgs {
   std::string token;
   int timeout_ms = 1000;
   std::vector<std::string> words;  // the command and its arguments
+  std::optional<double> for_s;     // drive: for how long
 };
 
 int console_command(const ConsoleArgs& args) {
@@ -42,7 +45,18 @@ int console_command(const ConsoleArgs& args) {
     spdlog::error("console: {}", error);
     return kExitFailure;
   }
-  const std::vector<std::string> rest(args.words.begin() + 1, args.words.end());
+  std::vector<std::string> rest(args.words.begin() + 1, args.words.end());
+  if (args.words.front() == "drive") {
+    // drive ID LEFT RIGHT --for S: the seconds travel as the fourth argument.
+    if (rest.size() != 3 || !args.for_s) {
+      spdlog::error("console: drive takes ID LEFT RIGHT and --for SECONDS (e.g. drive 3 40 40 --for 2)");
+      return kExitUsage;
+    }
+    rest.push_back(fmt::format("{}", *args.for_s));
+  } else if (args.for_s) {
+    spdlog::error("console: --for goes with drive only");
+    return kExitUsage;
+  }
   const auto reply = links::send_console_command(*lcm, links::Channels::with_prefix(args.prefix), token, args.words.front(),
                                                  rest, args.timeout_ms);
   if (!reply) {
@@ -69,7 +83,12 @@ void add_console_command(CLI::App& app) {
   cmd->add_option("--token", args->token, "The run's token (default: from the run's token file, if you can read it)");
   cmd->add_option("--timeout-ms", args->timeout_ms, "How long to wait for the run's answer")
       ->check(CLI::PositiveNumber)->default_val(1000);
-  cmd->add_option("command", args->words, "pause | resume | exit | rt-factor F")->required()->expected(1, 2);
+  cmd->add_option("command", args->words,
+                  "pause | resume | exit | reset | rt-factor F | mode central|distributed | drive ID LEFT RIGHT --for S "
+                  "(wheel speeds in Khepera units, -127..127, 8 mm/s each)")
+      ->required()->expected(1, 4);
+  cmd->add_option("--for", args->for_s, "With drive: seconds (simulated) to drive, then the robot's controller again")
+      ->check(CLI::PositiveNumber);
   cmd->callback([args] { exit_code() = console_command(*args); });
 }
 

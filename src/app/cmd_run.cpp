@@ -405,6 +405,15 @@ int run_command(const RunArgs& args) {
       return agents::run_scenario(scenario, o, real_bodies);
     });
   }
+  // The console's reset ends a run to start it over (its folder too), as it began: real
+  // robots are placed again.
+  run_seed = [run_seed](const agents::RunOptions& o) {
+    for (;;) {
+      agents::RunResult r = run_seed(o);
+      if (r.ended_by != "reset" || interrupted.load()) return r;
+      spdlog::info("seed {}: reset from the console: the run starts over", o.seed);
+    }
+  };
   if (args.seeds > 0) {
     // With real robots one run after another: the robots are the same ones.
     // With real robots one run after another (the robots are the same ones), and on a bus

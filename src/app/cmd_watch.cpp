@@ -71,10 +71,14 @@ class Watcher final : public agents::RunObserver {
     if (s.realtime) line += " x" + one_decimal(s.rt_factor);
     for (const std::string& r : robots_) line += "  " + r;
     if (s.formed && s.formation_time_s) line += "  [formed at " + one_decimal(*s.formation_time_s) + " s]";
+    // How the loop keeps up: behind the wall clock by a millisecond or more, the camera's rate.
+    if (s.realtime && s.loop_latency_ms >= 1.0) line += "  [loop " + one_decimal(s.loop_latency_ms) + " ms late]";
+    if (s.frames > 0) line += "  [camera " + one_decimal(s.camera_fps) + " fps]";
     if (s.state == "ended") line += "  (ended by " + s.ended_by + ")";
     std::printf("%s\n", line.c_str());
     std::fflush(stdout);
-    if (s.state == "ended") ended_ = true;
+    // A reset run starts over: the watcher stays for the run that follows.
+    if (s.state == "ended" && s.ended_by != "reset") ended_ = true;
   }
 
   // A message as it came off the bus.

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -72,6 +73,21 @@ std::optional<std::string> read_token(const std::filesystem::path& path) {
   return token;
 }
 
+namespace {
+
+// A whole number in decimal ("12", "-40"), within int's range; nullopt otherwise.
+std::optional<long> whole_number(const std::string& text) {
+  char* end = nullptr;
+  errno = 0;
+  const long v = std::strtol(text.c_str(), &end, 10);
+  if (text.empty() || end == text.c_str() || *end != '\0' || errno != 0 || v < -1'000'000'000 || v > 1'000'000'000) {
+    return std::nullopt;
+  }
+  return v;
+}
+
+}  // namespace
+
 std::variant<agents::ControlAction, std::string> parse_console_command(const rilbed::console_command_t& c) {
   agents::ControlAction a;
   a.who = c.client.empty() ? std::string("an unnamed console") : c.client;
@@ -95,7 +111,37 @@ std::variant<agents::ControlAction, std::string> parse_console_command(const ril
     a.rt_factor = f;
     return a;
   }
-  return "unknown command '" + c.command + "' (pause, resume, exit, rt-factor F)";
+  if (c.command == "reset") return no_args(agents::ControlAction::Kind::kReset);
+  if (c.command == "mode") {
+    if (args != 1 || (c.args[0] != "central" && c.args[0] != "distributed")) {
+      return std::string("'mode' takes one argument, central or distributed");
+    }
+    a.kind = agents::ControlAction::Kind::kMode;
+    a.central = c.args[0] == "central";
+    return a;
+  }
+  if (c.command == "drive") {
+    if (args != 4) return std::string("'drive' takes ID LEFT RIGHT and the seconds (--for S)");
+    const auto id = whole_number(c.args[0]);
+    const auto left = whole_number(c.args[1]);
+    const auto right = whole_number(c.args[2]);
+    char* end = nullptr;
+    const double s = std::strtod(c.args[3].c_str(), &end);
+    if (!id || *id < 0) return "'" + c.args[0] + "' is not a robot ID";
+    if (!left || std::abs(*left) > 127) return "left speed '" + c.args[1] + "' is not a whole number in -127..127 (Khepera units)";
+    if (!right || std::abs(*right) > 127) return "right speed '" + c.args[2] + "' is not a whole number in -127..127 (Khepera units)";
+    if (end == c.args[3].c_str() || *end != '\0' || !std::isfinite(s) || s <= 0.0 || s > 600.0) {
+      return "'" + c.args[3] + "' is not a number of seconds in (0, 600]";
+    }
+    a.kind = agents::ControlAction::Kind::kDrive;
+    a.robot_id = static_cast<int>(*id);
+    a.left = static_cast<int>(*left);
+    a.right = static_cast<int>(*right);
+    a.duration_s = s;
+    return a;
+  }
+  return "unknown command '" + c.command + "' (pause, resume, exit, reset, rt-factor F, mode central|distributed, "
+         "drive ID LEFT RIGHT --for S)";
 }
 
 namespace {
@@ -185,7 +231,8 @@ struct LcmConsoleServer::Impl {
         reply.reason = *refusal;
       } else {
         reply.accepted = true;
-        reply.reason = c->command + (c->args.empty() ? std::string() : " " + c->args[0]);
+        reply.reason = c->command;
+        for (const std::string& arg : c->args) reply.reason += " " + arg;
       }
     }
     if (log) log("console: " + who + ": " + c->command + ": " + (reply.accepted ? "accepted" : "refused, " + reply.reason));

@@ -42,7 +42,9 @@ std::optional<std::string> write_token(const std::filesystem::path& path, const 
 std::optional<std::string> read_token(const std::filesystem::path& path);
 
 /// What a console command asks, checked: the action for the run, or why it is refused.
-/// `command` is "pause", "resume", "exit" or "rt-factor" (one argument, the factor).
+/// `command` is "pause", "resume", "exit", "reset" (no arguments), "rt-factor" (the
+/// factor), "mode" ("central" or "distributed") or "drive" (ID, left and right speed in
+/// Khepera units, seconds).
 std::variant<agents::ControlAction, std::string> parse_console_command(const rilbed::console_command_t& command);
 
 /// The run's side: answers every command on `channels.console` with a reply on

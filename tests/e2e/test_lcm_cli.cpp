@@ -164,6 +164,58 @@ namespace {
 // robots where they are (they do not move while the run is paused), resume goes on, a
 // wrong token and bad commands are refused with the reason, exit ends the run; every
 // command is answered, and the run records them as events.
+TEST(LcmCli, TheConsoleDrivesARobotSwitchesTheModeAndResetsTheRun) {
+  if (!namespaces_work()) GTEST_SKIP() << "cannot make a network namespace here (unshare -n needs root)";
+  const fs::path dir = scratch_dir("lcm_console_more");
+  const int status = in_namespace(dir,
+      "export XDG_RUNTIME_DIR=\"$PWD/xdg\"; mkdir -m 700 xdg\n"
+      "\"$R\" run " + shipped_scenario_arg("convoy_mixed") + " --duration 120 --lcm \"$URL\" --out run --record rec.lcm --quiet > run.txt 2> run.err &\n"
+      "P=$!\n"
+      "set +e\n"
+      "for i in $(seq 1 100); do \"$R\" console --lcm \"$URL\" --timeout-ms 200 --token x pause 2>/dev/null; "
+      "grep -q 'refused' run.err && break; sleep 0.1; done\n"
+      // A real (emulated) robot driven by hand, backwards on one wheel.
+      "\"$R\" console --lcm \"$URL\" drive 4 30 -30 --for 1 > d1.txt 2>&1; echo \"drive $?\" >> codes.txt\n"
+      "\"$R\" console --lcm \"$URL\" drive 42 30 30 --for 1 > d2.txt 2>&1; echo \"drive-none $?\" >> codes.txt\n"
+      "\"$R\" console --lcm \"$URL\" drive 4 30 30 > d3.txt 2>&1; echo \"drive-nofor $?\" >> codes.txt\n"
+      "\"$R\" console --lcm \"$URL\" mode central > m1.txt 2>&1; echo \"central $?\" >> codes.txt\n"
+      "\"$R\" console --lcm \"$URL\" mode central > m2.txt 2>&1; echo \"central-again $?\" >> codes.txt\n"
+      "\"$R\" console --lcm \"$URL\" mode distributed > m3.txt 2>&1; echo \"distributed $?\" >> codes.txt\n"
+      "\"$R\" console --lcm \"$URL\" reset > r1.txt 2>&1; echo \"reset $?\" >> codes.txt\n"
+      // The run starts over (its real robots placed again): ask until the new one answers.
+      "for i in $(seq 1 300); do \"$R\" console --lcm \"$URL\" --timeout-ms 300 exit > e1.txt 2>&1 && break; sleep 0.1; done\n"
+      "echo \"exit $?\" >> codes.txt\n"
+      "wait $P; echo \"run $?\" >> codes.txt\n"
+      "\"$R\" replay rec.lcm --out replayed > replay.txt 2>&1; echo \"replay $?\" >> codes.txt\n");
+  ASSERT_EQ(status, 0) << read_file(dir / "ns.log");
+  const std::string codes = read_file(dir / "codes.txt");
+  for (const char* line : {"drive 0", "drive-none 1", "drive-nofor 2", "central 0", "central-again 1", "distributed 0",
+                           "reset 0", "exit 0", "run 0", "replay 0"}) {
+    EXPECT_NE(codes.find(line), std::string::npos) << line << "\n" << codes << read_file(dir / "run.err");
+  }
+  EXPECT_NE(read_file(dir / "d1.txt").find("accepted: drive 4 30 -30 1"), std::string::npos) << read_file(dir / "d1.txt");
+  EXPECT_NE(read_file(dir / "d2.txt").find("refused: this run has no robot 42"), std::string::npos);
+  EXPECT_NE(read_file(dir / "d3.txt").find("drive takes ID LEFT RIGHT and --for SECONDS"), std::string::npos);
+  EXPECT_NE(read_file(dir / "m2.txt").find("refused: the convoy is in central mode already"), std::string::npos);
+  const std::string err = read_file(dir / "run.err");
+  EXPECT_NE(err.find("reset from the console: the run starts over"), std::string::npos) << err;
+  // The folder holds the run that went on to its end; the recording holds both.
+  const std::string events = read_file(dir / "run" / "events.csv");
+  EXPECT_EQ(events.find("reset by"), std::string::npos) << events;
+  EXPECT_NE(events.find(",console,0,0,ended by "), std::string::npos) << events;
+  EXPECT_EQ(events, read_file(dir / "replayed" / "events.csv"));
+  EXPECT_EQ(read_file(dir / "run" / "trajectories.csv"), read_file(dir / "replayed" / "trajectories.csv"));
+  EXPECT_NE(read_file(dir / "run.txt").find("robot 4 (emulated): last speed 0 0"), std::string::npos);
+  // The first run's events are in the recording: replay up to the reset.
+  std::ifstream rec(dir / "rec.lcm", std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(rec)), std::istreambuf_iterator<char>());
+  for (const char* text : {"robot 4 driven 30 -30 for 1 s by ", "mode central set by ", "mode distributed set by ",
+                           "reset by "}) {
+    EXPECT_NE(bytes.find(text), std::string::npos) << text;
+  }
+  fs::remove_all(dir);
+}
+
 TEST(LcmCli, TheConsoleSteersARunAndPauseStopsItsRealRobots) {
   if (!namespaces_work()) GTEST_SKIP() << "cannot make a network namespace here (unshare -n needs root)";
   const fs::path dir = scratch_dir("lcm_console");

@@ -37,6 +37,25 @@ TEST(LcmConsole, ParsesEveryCommandAndRefusesTheRest) {
   ASSERT_TRUE(std::holds_alternative<agents::ControlAction>(rt));
   EXPECT_EQ(std::get<agents::ControlAction>(rt).rt_factor, 2.5);
   EXPECT_EQ(std::get<agents::ControlAction>(rt).who, "test:1");
+  EXPECT_EQ(kind(command("reset")), Kind::kReset);
+  const auto mode = std::get<agents::ControlAction>(parse_console_command(command("mode", {"central"})));
+  EXPECT_EQ(mode.kind, Kind::kMode);
+  EXPECT_TRUE(mode.central);
+  EXPECT_FALSE(std::get<agents::ControlAction>(parse_console_command(command("mode", {"distributed"}))).central);
+  const auto drive = std::get<agents::ControlAction>(parse_console_command(command("drive", {"3", "-40", "127", "2.5"})));
+  EXPECT_EQ(drive.kind, Kind::kDrive);
+  EXPECT_EQ(drive.robot_id, 3);
+  EXPECT_EQ(drive.left, -40);
+  EXPECT_EQ(drive.right, 127);
+  EXPECT_EQ(drive.duration_s, 2.5);
+  for (const auto& bad : {command("mode"), command("mode", {"fast"}), command("mode", {"central", "x"}), command("reset", {"1"}),
+                          command("drive", {"3", "40", "40"}), command("drive", {"3", "128", "0", "1"}),
+                          command("drive", {"3", "0", "-128", "1"}), command("drive", {"x", "0", "0", "1"}),
+                          command("drive", {"3", "1.5", "0", "1"}), command("drive", {"3", "0", "0", "0"}),
+                          command("drive", {"3", "0", "0", "nan"}), command("drive", {"3", "0", "0", "601"}),
+                          command("drive", {"99999999999", "0", "0", "1"}), command("drive", {"-1", "0", "0", "1"})}) {
+    EXPECT_TRUE(std::holds_alternative<std::string>(parse_console_command(bad))) << bad.command << " " << bad.args.size();
+  }
   for (const auto& bad : {command("rt-factor"), command("rt-factor", {"0"}), command("rt-factor", {"x"}),
                           command("rt-factor", {"inf"}), command("pause", {"now"}), command("fly"), command("")}) {
     EXPECT_TRUE(std::holds_alternative<std::string>(parse_console_command(bad))) << bad.command;
