@@ -1,5 +1,8 @@
 #include "agents/run_folder_writer.hpp"
 
+#include <cstdio>
+#include <stdexcept>
+
 namespace rilbed::agents {
 
 RunFolderWriter::RunFolderWriter(std::filesystem::path dir) : dir_(std::move(dir)) {}
@@ -22,6 +25,7 @@ void RunFolderWriter::on_world(TimeUs, const WorldReport& world) {
     // over): the folder holds the run that goes on.
     recorder_.reset();
     samples_.clear();
+    if (detections_.is_open()) detections_.close();
     finished_ = false;
   }
   if (recorder_) {
@@ -42,8 +46,25 @@ void RunFolderWriter::on_poses(TimeUs t_us, std::span<const PoseReport> poses) {
 
 void RunFolderWriter::on_event(const RunEvent& event) { recorder().add_event(event); }
 
+void RunFolderWriter::on_detections(const FrameReport& frame) {
+  RunRecorder& r = recorder();
+  if (!detections_.is_open()) {
+    detections_.open(r.dir() / "detections.csv");
+    if (!detections_) throw std::runtime_error("cannot write " + (r.dir() / "detections.csv").string());
+    detections_ << "frame,t_s,id,u_px,v_px,heading_deg,score,diameter_px,x_m,y_m,theta_deg\n";
+  }
+  char row[256];
+  for (const DetectionReport& d : frame.detections) {
+    std::snprintf(row, sizeof row, "%lld,%.3f,%d,%.3f,%.3f,%.2f,%.4f,%.2f,%.5f,%.5f,%.2f\n",
+                  static_cast<long long>(frame.frame), us_to_seconds(frame.t_us), d.id, d.u_px, d.v_px, d.heading_deg,
+                  d.score, d.diameter_px, d.pose.position_m.x, d.pose.position_m.y, wrap_deg_360(rad_to_deg(d.pose.heading_rad)));
+    detections_ << row;
+  }
+}
+
 void RunFolderWriter::on_summary(TimeUs, const nlohmann::json& summary) {
   if (finished_) return;
+  if (detections_.is_open()) detections_.close();
   recorder().finish(summary);
   finished_ = true;
 }

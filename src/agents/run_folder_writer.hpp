@@ -1,10 +1,12 @@
 // A run folder written from what a run reports (agents::RunObserver) rather than from
-// inside the run: the same trajectories.csv, events.csv, summary.json and
-// trajectories.svg, from the messages alone. `rilbed replay` writes a recording's folder
+// inside the run: trajectories.csv, events.csv, summary.json, trajectories.svg (and
+// detections.csv for a run with a camera), from the messages alone. `rilbed run` writes
+// its folder with it, as a subscriber of its own bus. `rilbed replay` writes a recording's folder
 // with it, so a recorded run's folder is byte for byte the live run's.
 #pragma once
 
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <set>
 #include <string>
@@ -24,6 +26,10 @@ class RunFolderWriter final : public RunObserver {
   void on_world(TimeUs t_us, const WorldReport& world) override;
   void on_poses(TimeUs t_us, std::span<const PoseReport> poses) override;
   void on_event(const RunEvent& event) override;
+  /// A run with a camera also gets detections.csv (header
+  /// frame,t_s,id,u_px,v_px,heading_deg,score,diameter_px,x_m,y_m,theta_deg): every marker
+  /// the camera found, frame by frame (frame numbers from 1).
+  void on_detections(const FrameReport& frame) override;
   void on_summary(TimeUs t_us, const nlohmann::json& summary) override;
   /// Whether the summary arrived (the folder is complete).
   bool finished() const { return finished_; }
@@ -40,6 +46,7 @@ class RunFolderWriter final : public RunObserver {
   std::unique_ptr<RunRecorder> recorder_;
   std::set<std::string, std::less<>> names_;  // behaviours, kept for the samples' views
   std::vector<TrajectorySample> samples_;
+  std::ofstream detections_;  // opened with the first camera frame
   bool finished_ = false;
 };
 

@@ -14,6 +14,7 @@
 #include <optional>
 
 #include "app/commands.hpp"
+#include "links/lcm_frame_source.hpp"
 #include "core/geometry.hpp"
 #include "core/id_list.hpp"
 #include "vision/field_mapping.hpp"
@@ -100,7 +101,10 @@ int run_detect(const DetectOptions& opt) {
     calib = loaded.calibration;
   }
 
-  vision::OpenResult opened = opt.camera >= 0 ? vision::open_camera(opt.camera) : vision::open_frame_source(opt.input);
+  // A run's recording (--record-frames) is footage too: its frames go through the pipeline again.
+  vision::OpenResult opened = opt.camera >= 0                         ? vision::open_camera(opt.camera)
+                              : links::is_lcm_log_path(opt.input) ? links::open_lcm_frames(opt.input)
+                                                                      : vision::open_frame_source(opt.input);
   if (!opened.ok()) {
     spdlog::error("{}", opened.error);
     return kExitFailure;
@@ -208,7 +212,8 @@ void add_detect_command(CLI::App& app) {
   auto opt = std::make_shared<DetectOptions>();
   CLI::App* cmd = app.add_subcommand("detect", "Find, identify and track markers in footage or a live camera");
   cmd->add_option("input", opt->input,
-                  "Video file, image, directory of images (name order) or printf-style sequence (img_%04d.png)");
+                  "Video file, image, directory of images (name order), printf-style sequence (img_%04d.png), or a "
+                  "run's recording FILE.lcm made with --record-frames");
   cmd->add_option("--camera", opt->camera, "Live camera index instead of INPUT")->check(CLI::NonNegativeNumber);
   cmd->add_option("--family", opt->family, "Marker family (6ucp, or kucp for k in 7..14)")->capture_default_str();
   cmd->add_option("--ids", opt->ids, "IDs that may be present, e.g. 1-8 or 1,3,6 (default: every ID of the family)");
