@@ -42,6 +42,7 @@ int write_folder(const ReplayArgs& args) {
   agents::RunFolderWriter writer(args.out);
   links::RunReportDecoder decoder(links::Channels::with_prefix(args.prefix), writer);
   long events = 0, bad = 0;
+  bool cut_short = false;
   try {
     while (const auto e = log.next()) {
       ++events;
@@ -53,11 +54,12 @@ int write_folder(const ReplayArgs& args) {
       spdlog::warn("replay: {}: {} bytes that are not events were skipped{}", args.log, log.skipped_bytes(),
                    log.truncated() ? " (the last event is cut short)" : "");
     }
-    if (!decoder.summary_seen()) {
+    if (!writer.finished()) {
       // Cut short (a crash, a full disk, a truncated copy): keep what it holds, and say so.
       spdlog::warn("replay: {} ends before the run did (no summary after {} messages): the folder holds what it has",
                    args.log, events);
       writer.finish_without_summary(decoder.cut_short_summary());
+      cut_short = true;
     }
   } catch (const std::exception& e) {
     spdlog::error("replay: {}", e.what());
@@ -70,7 +72,7 @@ int write_folder(const ReplayArgs& args) {
   std::printf("wrote %s from %ld messages of %s%s\n", args.out.c_str(), events, args.log.c_str(),
               bad > 0 ? (" (" + std::to_string(bad) + " bad ones skipped)").c_str() : "");
   // A folder without the run's end is written, but is not a whole run.
-  return decoder.summary_seen() ? 0 : kExitFailure;
+  return cut_short ? kExitFailure : 0;
 }
 
 int publish(const ReplayArgs& args) {

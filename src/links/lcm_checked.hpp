@@ -9,7 +9,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <type_traits>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
 
 #include "rilbed/console_command_t.hpp"
 #include "rilbed/console_reply_t.hpp"
@@ -41,6 +45,18 @@ bool decode_checked(const void* data, std::size_t size, Message& message) {
   } catch (const std::exception&) {
     return false;
   }
+}
+
+/// Publishes `message` on `channel` as the bytes its encoder wrote. (LCM's own
+/// publish(channel, &message) sends getEncodedSize() bytes, but a string holding a 0 byte
+/// is written only up to it: the message would go out with stray bytes at its end, which
+/// every careful reader refuses.) Returns LCM's status (0 when sent).
+template <typename Message>
+int publish_encoded(lcm::LCM& lcm, const std::string& channel, const Message& message) {
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(message.getEncodedSize()));
+  const int written = message.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  if (written < 0) return -1;
+  return lcm.publish(channel, bytes.data(), static_cast<unsigned>(written));
 }
 
 }  // namespace rilbed::links

@@ -205,7 +205,7 @@ struct LcmConsoleServer::Impl {
   void on_command(const rilbed::console_command_t* c) {
     const auto key = std::make_pair(c->client, c->seq);
     if (const auto it = answered.find(key); it != answered.end()) {
-      lcm.publish(channels.console_reply, &it->second);  // a retry: the same answer, nothing done again
+      publish_encoded(lcm, channels.console_reply, it->second);  // a retry: the same answer, nothing done again
       return;
     }
     rilbed::console_reply_t reply;
@@ -236,7 +236,7 @@ struct LcmConsoleServer::Impl {
       }
     }
     if (log) log("console: " + who + ": " + c->command + ": " + (reply.accepted ? "accepted" : "refused, " + reply.reason));
-    lcm.publish(channels.console_reply, &reply);
+    publish_encoded(lcm, channels.console_reply, reply);
     answered[key] = reply;
     answered_order.push_back(key);
     if (answered_order.size() > 1024) {
@@ -312,7 +312,7 @@ std::optional<rilbed::console_reply_t> send_console_command(lcm::LCM& lcm, const
     const auto now = std::chrono::steady_clock::now();
     if (now - start >= std::chrono::milliseconds(timeout_ms)) break;
     if (now >= next_send) {
-      lcm.publish(channels.console, &c);
+      publish_encoded(lcm, channels.console, c);
       next_send = now + std::chrono::milliseconds(resend_ms);
     }
     lcm.handleTimeout(20);

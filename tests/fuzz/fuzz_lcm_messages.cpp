@@ -56,11 +56,12 @@ std::string g_channel;  // the channel of the input being checked, for the repor
 const std::vector<std::string>& channel_names() {
   static const std::vector<std::string> names = [] {
     const links::Channels c = links::Channels::with_prefix("");
-    return std::vector<std::string>{c.poses, c.events, c.status, c.world, c.summary, "RILBED_UNKNOWN"};
+    return std::vector<std::string>{c.poses,   c.events,     c.status, c.world,         c.summary,
+                                    c.wheels,  c.sensors,    c.detections, c.frames, "RILBED_UNKNOWN"};
   }();
   return names;
 }
-enum Pick { kPoses, kEvents, kStatus, kWorld, kSummary, kUnknown, kPicks };
+enum Pick { kPoses, kEvents, kStatus, kWorld, kSummary, kWheels, kSensors, kDetections, kFrames, kUnknown, kPicks };
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
@@ -72,6 +73,10 @@ bool has_nul(const rilbed::status_t& m) {
 }
 bool has_nul(const rilbed::world_t& m) { return has_nul(m.scenario); }
 bool has_nul(const rilbed::summary_t& m) { return has_nul(m.json); }
+bool has_nul(const rilbed::wheels_t&) { return false; }
+bool has_nul(const rilbed::sensors_t&) { return false; }
+bool has_nul(const rilbed::detections_t&) { return false; }
+bool has_nul(const rilbed::frame_t& m) { return has_nul(m.format); }
 bool has_nul(const rilbed::poses_t& m) {
   for (const rilbed::robot_pose_t& r : m.robots) {
     if (has_nul(r.behaviour) || has_nul(r.health)) return true;
@@ -148,6 +153,8 @@ void check_status(const rilbed_fuzz::TouchingObserver& seen, const links::RunRep
   FUZZ_CHECK(s.formation_time_s.has_value() == (m.formation_time_s >= 0.0));
   if (s.formation_time_s) FUZZ_CHECK(same_bits(*s.formation_time_s, m.formation_time_s));
   FUZZ_CHECK(s.collisions == m.collisions);
+  FUZZ_CHECK(same_bits(s.loop_latency_ms, m.loop_latency_ms) && same_bits(s.camera_fps, m.camera_fps));
+  FUZZ_CHECK(s.frames == m.frames);
   // The decoder keeps the message itself as the last status.
   FUZZ_CHECK(decoder.last_status().has_value());
   const rilbed::status_t& kept = *decoder.last_status();
@@ -194,6 +201,48 @@ void check_world(const rilbed_fuzz::TouchingObserver& seen, const rilbed::world_
     if (m.robot_real[i]) real.insert(m.robot_ids[i]);
   }
   FUZZ_CHECK(w.field.real_robot_ids == real);
+}
+
+void check_wheels(const rilbed_fuzz::TouchingObserver& seen, const rilbed::wheels_t& m) {
+  FUZZ_CHECK(seen.calls.wheels == 1 && seen.last_wheels.size() == m.robots.size());
+  for (std::size_t i = 0; i < m.robots.size(); ++i) {
+    const auto& w = seen.last_wheels[i];
+    FUZZ_CHECK(w.id == m.robots[i].id && w.wheels.left == m.robots[i].left_units && w.wheels.right == m.robots[i].right_units);
+  }
+}
+
+void check_sensors(const rilbed_fuzz::TouchingObserver& seen, const rilbed::sensors_t& m) {
+  FUZZ_CHECK(seen.calls.sensors == 1 && seen.last_sensors.size() == m.robots.size());
+  for (std::size_t i = 0; i < m.robots.size(); ++i) {
+    const rilbed::robot_sensors_t& r = m.robots[i];
+    const auto& [id, s] = seen.last_sensors[i];
+    FUZZ_CHECK(id == r.id && s.t_us == m.utime);
+    // Eight proximity values or none (a robot without the Khepera's ring).
+    FUZZ_CHECK(s.proximity.has_value() == (r.proximity.size() == 8));
+    if (s.proximity) FUZZ_CHECK(std::equal(s.proximity->begin(), s.proximity->end(), r.proximity.begin()));
+    FUZZ_CHECK(s.ranges.size() == r.range_m.size());
+    for (std::size_t k = 0; k < s.ranges.size(); ++k) {
+      FUZZ_CHECK(same_bits(s.ranges[k].distance_m, r.range_m[k]) && s.ranges[k].hit == (r.range_hit[k] != 0));
+    }
+    FUZZ_CHECK(s.beacons.size() == r.beacon_id.size());
+    for (std::size_t k = 0; k < s.beacons.size(); ++k) {
+      FUZZ_CHECK(s.beacons[k].id == r.beacon_id[k] && same_bits(s.beacons[k].bearing_rad, r.beacon_bearing_rad[k]));
+    }
+    FUZZ_CHECK(std::equal(s.track.begin(), s.track.end(), r.track.begin(), r.track.end()));
+    FUZZ_CHECK(s.odometry.has_value() == (r.has_odometry != 0));
+    if (s.odometry) FUZZ_CHECK(s.odometry->left_pulses == r.left_pulses && s.odometry->right_pulses == r.right_pulses);
+  }
+}
+
+void check_detections(const rilbed_fuzz::TouchingObserver& seen, const rilbed::detections_t& m) {
+  FUZZ_CHECK(seen.calls.detections == 1 && seen.last_frame_number == m.frame);
+  FUZZ_CHECK(seen.last_detections.size() == m.detections.size());
+  for (std::size_t i = 0; i < m.detections.size(); ++i) {
+    const auto& d = seen.last_detections[i];
+    const rilbed::detection_t& x = m.detections[i];
+    FUZZ_CHECK(d.id == x.id && same_bits(d.u_px, x.u_px) && same_bits(d.v_px, x.v_px) && same_bits(d.score, x.score));
+    FUZZ_CHECK(same_bits(d.heading_deg, x.heading_deg) && same_bits(d.pose.position_m.x, x.x_m));
+  }
 }
 
 void check_summary(const rilbed_fuzz::TouchingObserver& seen, const links::RunReportDecoder& decoder,
@@ -286,6 +335,30 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       } else {
         FUZZ_CHECK(readable);
         check_summary(seen, decoder, m);
+        check_round_trip(m, message, length);
+      }
+      break;
+    }
+    case kWheels:
+      check_channel<rilbed::wheels_t>(problem, message, length, [&](const rilbed::wheels_t& m) { check_wheels(seen, m); });
+      break;
+    case kSensors:
+      check_channel<rilbed::sensors_t>(problem, message, length, [&](const rilbed::sensors_t& m) { check_sensors(seen, m); });
+      break;
+    case kDetections:
+      check_channel<rilbed::detections_t>(problem, message, length,
+                                          [&](const rilbed::detections_t& m) { check_detections(seen, m); });
+      break;
+    case kFrames: {
+      // Accepted exactly when the bytes are a frame_t whose data is a JPEG image of its
+      // stated size; the observer then has that image.
+      rilbed::frame_t m;
+      if (problem && refused_before_decoding<rilbed::frame_t>(message, length)) break;
+      const bool readable = generated_decode(message, length, m);
+      if (!problem) {
+        FUZZ_CHECK(readable && m.format == "jpeg");
+        FUZZ_CHECK(seen.calls.frames == 1 && seen.last_frame_number == m.frame);
+        FUZZ_CHECK(seen.last_image_size == cv::Size(m.width_px, m.height_px));
         check_round_trip(m, message, length);
       }
       break;

@@ -31,8 +31,8 @@ struct OwnedPose {
 class TouchingObserver : public rilbed::agents::RunObserver {
  public:
   struct Calls {
-    int world = 0, poses = 0, event = 0, status = 0, summary = 0;
-    int total() const { return world + poses + event + status + summary; }
+    int world = 0, poses = 0, event = 0, status = 0, summary = 0, wheels = 0, sensors = 0, detections = 0, frames = 0;
+    int total() const { return world + poses + event + status + summary + wheels + sensors + detections + frames; }
   };
 
   void on_world(rilbed::TimeUs t_us, const rilbed::agents::WorldReport& w) override {
@@ -96,7 +96,81 @@ class TouchingObserver : public rilbed::agents::RunObserver {
     touch(s.formed);
     if (s.formation_time_s) touch(*s.formation_time_s);
     touch(s.collisions);
+    touch(s.loop_latency_ms);
+    touch(s.camera_fps);
+    touch(s.frames);
     last_status = s;
+  }
+
+  void on_wheels(rilbed::TimeUs t_us, std::span<const rilbed::agents::WheelReport> wheels) override {
+    ++calls.wheels;
+    touch(t_us);
+    last_wheels.assign(wheels.begin(), wheels.end());
+    for (const auto& w : wheels) {
+      touch(w.id);
+      touch(w.wheels.left);
+      touch(w.wheels.right);
+    }
+  }
+
+  void on_sensors(rilbed::TimeUs t_us, std::span<const rilbed::agents::SensorReport> sensors) override {
+    ++calls.sensors;
+    touch(t_us);
+    last_sensors.clear();
+    for (const auto& r : sensors) {
+      touch(r.id);
+      const rilbed::environment::SensorReadings& s = *r.readings;
+      touch(s.t_us);
+      if (s.proximity) {
+        for (const int v : *s.proximity) touch(v);
+      }
+      for (const auto& range : s.ranges) {
+        touch(range.hit);
+        touch(range.distance_m);
+      }
+      for (const auto& b : s.beacons) {
+        touch(b.id);
+        touch(b.bearing_rad);
+      }
+      for (const int v : s.track) touch(v);
+      if (s.odometry) {
+        touch(s.odometry->left_pulses);
+        touch(s.odometry->right_pulses);
+      }
+      last_sensors.emplace_back(r.id, s);
+    }
+  }
+
+  void on_detections(const rilbed::agents::FrameReport& f) override {
+    ++calls.detections;
+    touch(f.t_us);
+    touch(f.frame);
+    touch(f.process_ms);
+    last_frame_number = f.frame;
+    last_detections.assign(f.detections.begin(), f.detections.end());
+    for (const auto& d : f.detections) {
+      touch(d.id);
+      touch(d.u_px);
+      touch(d.v_px);
+      touch(d.heading_deg);
+      touch(d.score);
+      touch(d.diameter_px);
+      touch(d.pose);
+    }
+  }
+
+  bool wants_frame_images() const override { return true; }
+  void on_frame_image(rilbed::TimeUs t_us, std::int64_t frame, const cv::Mat& image) override {
+    ++calls.frames;
+    touch(t_us);
+    touch(frame);
+    last_frame_number = frame;
+    last_image_size = image.size();
+    // Every byte of the decoded image.
+    for (int y = 0; y < image.rows; ++y) {
+      const auto* row = image.ptr<std::uint8_t>(y);
+      for (std::size_t x = 0; x < static_cast<std::size_t>(image.cols) * image.elemSize(); ++x) sink += row[x];
+    }
   }
 
   void on_summary(rilbed::TimeUs t_us, const nlohmann::json& summary) override {
@@ -114,6 +188,11 @@ class TouchingObserver : public rilbed::agents::RunObserver {
   rilbed::agents::RunEvent last_event;
   rilbed::agents::StatusReport last_status;
   nlohmann::json last_summary;
+  std::vector<rilbed::agents::WheelReport> last_wheels;
+  std::vector<std::pair<int, rilbed::environment::SensorReadings>> last_sensors;
+  std::vector<rilbed::agents::DetectionReport> last_detections;
+  std::int64_t last_frame_number = 0;
+  cv::Size last_image_size;
   /// What was read, summed, so that no read can be optimised away.
   std::uint64_t sink = 0;
 

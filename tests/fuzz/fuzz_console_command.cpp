@@ -1,0 +1,116 @@
+// Fuzz target for the console's commands (src/links/lcm_console.hpp): the input is one
+// message as it would come off the bus on RILBED_CONSOLE, from anyone on the multicast
+// group. It goes to a real LcmConsoleServer on the in-process bus (handled on this thread),
+// whose run is a stand-in that takes every action it is handed (a mock is fine in a test).
+//
+// Whatever the bytes, nothing throws or crashes, and:
+//   - bytes that are not a console_command_t (links::decode_checked) get no reply and no
+//     action; a command gets exactly one reply, with its seq and client;
+//   - a command is accepted only with the run's token, and only when parse_console_command
+//     accepts it; an accepted command reaches the run as exactly one action of its kind,
+//     with its arguments in range (rt-factor finite and above 0; drive: speeds within
+//     -127..127, seconds in (0, 600]); a wrong token reaches it as one "refused" record;
+//   - sent again (a retry after a loss), it gets the same reply and nothing more happens.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "agents/run_control.hpp"
+#include "links/lcm_bus.hpp"
+#include "links/lcm_checked.hpp"
+#include "links/lcm_console.hpp"
+
+namespace {
+
+using namespace rilbed;
+
+[[noreturn]] void broken(const char* what) {
+  std::fprintf(stderr, "\nfuzz_console_command: invariant broken: %s\n", what);
+  std::abort();
+}
+#define FUZZ_CHECK(condition) \
+  do {                        \
+    if (!(condition)) broken(#condition); \
+  } while (false)
+
+const char* const kToken = "t0k";
+
+struct Replies {
+  std::vector<rilbed::console_reply_t> got;
+};
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  static lcm::LCM bus("memq://");
+  if (!bus.good()) broken("memq:// did not open");
+  const links::Channels channels = links::Channels::with_prefix("");
+  agents::RunControl control;
+  std::vector<agents::ControlAction> taken;
+  control.attach([](const agents::ControlAction&) -> std::optional<std::string> { return std::nullopt; },
+                 [&taken](const agents::ControlAction& a) { taken.push_back(a); });
+  links::LcmConsoleServer server(bus, channels, kToken, control, {}, false);
+  Replies replies;
+  links::LcmSubscription subscription(bus, channels.console_reply, [&replies](const std::string&, const void* d, std::size_t n) {
+    rilbed::console_reply_t r;
+    if (links::decode_checked(d, n, r)) replies.got.push_back(r);
+  });
+
+  for (int send = 0; send < 2; ++send) {
+    bus.publish(channels.console, data, static_cast<unsigned>(size));
+    while (bus.handleTimeout(0) > 0) {
+    }
+  }
+
+  rilbed::console_command_t c;
+  if (!links::decode_checked(data, size, c)) {
+    FUZZ_CHECK(replies.got.empty() && taken.empty());
+    return 0;
+  }
+  FUZZ_CHECK(replies.got.size() == 2);
+  const rilbed::console_reply_t& r = replies.got[0];
+  // LCM strings are C strings: a client name holding a 0 byte travels up to it.
+  FUZZ_CHECK(r.seq == c.seq && std::string(r.client.c_str()) == std::string(c.client.c_str()));
+  FUZZ_CHECK(replies.got[1].accepted == r.accepted && replies.got[1].reason == r.reason);
+  FUZZ_CHECK(taken.size() <= 1);  // the retry did nothing
+  if (c.token != kToken) {
+    FUZZ_CHECK(!r.accepted);
+    FUZZ_CHECK(taken.size() == 1 && taken[0].kind == agents::ControlAction::Kind::kRefused);
+    return 0;
+  }
+  const auto parsed = links::parse_console_command(c);
+  FUZZ_CHECK(r.accepted == std::holds_alternative<agents::ControlAction>(parsed));
+  if (!r.accepted) {
+    FUZZ_CHECK(taken.empty() && !r.reason.empty());
+    return 0;
+  }
+  FUZZ_CHECK(taken.size() == 1);
+  const agents::ControlAction& a = taken[0];
+  using Kind = agents::ControlAction::Kind;
+  switch (a.kind) {
+    case Kind::kPause: FUZZ_CHECK(c.command == "pause" && c.args.empty()); break;
+    case Kind::kResume: FUZZ_CHECK(c.command == "resume" && c.args.empty()); break;
+    case Kind::kExit: FUZZ_CHECK(c.command == "exit" && c.args.empty()); break;
+    case Kind::kReset: FUZZ_CHECK(c.command == "reset" && c.args.empty()); break;
+    case Kind::kRtFactor:
+      FUZZ_CHECK(c.command == "rt-factor" && c.args.size() == 1);
+      FUZZ_CHECK(std::isfinite(a.rt_factor) && a.rt_factor > 0.0);
+      break;
+    case Kind::kMode:
+      FUZZ_CHECK(c.command == "mode" && c.args.size() == 1);
+      FUZZ_CHECK(a.central == (c.args[0] == "central"));
+      break;
+    case Kind::kDrive:
+      FUZZ_CHECK(c.command == "drive" && c.args.size() == 4);
+      FUZZ_CHECK(a.robot_id >= 0 && std::abs(a.left) <= 127 && std::abs(a.right) <= 127);
+      FUZZ_CHECK(std::isfinite(a.duration_s) && a.duration_s > 0.0 && a.duration_s <= 600.0);
+      break;
+    case Kind::kRefused: broken("an accepted command became a refusal");
+  }
+  return 0;
+}
