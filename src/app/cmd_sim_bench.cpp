@@ -77,6 +77,7 @@ int bench_command(const BenchArgs& args) {
     std::unique_ptr<lcm::LCM> lcm;
     std::unique_ptr<links::LcmRunPublisher> publisher;
     std::vector<std::pair<int, double>> costs;  // robots, CPU cost in per cent
+    std::vector<double> core_shares;            // extra CPU per simulated second: the share of a core at real time
   };
   std::vector<Bus> buses;
   for (const std::string& url : args.lcm_urls) {
@@ -132,6 +133,7 @@ int bench_command(const BenchArgs& args) {
     for (std::size_t k = 0; k < buses.size(); ++k) {
       const double bused_cpu = row(bused[k], " (bus " + buses[k].url + ")");
       buses[k].costs.push_back({n, 100.0 * (bused_cpu / plain_cpu - 1.0)});
+      buses[k].core_shares.push_back(100.0 * (bused_cpu - plain_cpu) / std::max(1e-9, bused[k].r.simulated_s));
     }
     std::fflush(stdout);
   }
@@ -139,14 +141,16 @@ int bench_command(const BenchArgs& args) {
     std::printf("\nThe bus: every message of the run published on it (rows \"(bus ...)\"): the world and status every "
                 "simulated second; every robot's pose, wheel command and sensor readings every control step; each event. "
                 "Nobody in this process listens; on memq:// (the default bus of `rilbed run`) that means nothing is even "
-                "encoded. CPU cost of the bus against the same run without it (medians):\n\n| robots |");
-    for (const Bus& b : buses) std::printf(" %s |", b.url.c_str());
+                "encoded. CPU cost of the bus against the same run without it (medians), and that extra CPU per "
+                "simulated second, which is the share of one core the bus takes when the run goes in real time:\n\n"
+                "| robots |");
+    for (const Bus& b : buses) std::printf(" %s: slower by | %s: share of a core at real time |", b.url.c_str(), b.url.c_str());
     std::printf("\n| ---: |");
-    for (std::size_t k = 0; k < buses.size(); ++k) std::printf(" ---: |");
+    for (std::size_t k = 0; k < buses.size(); ++k) std::printf(" ---: | ---: |");
     std::printf("\n");
     for (std::size_t i = 0; i < counts.ids.size(); ++i) {
       std::printf("| %d |", counts.ids[i]);
-      for (const Bus& b : buses) std::printf(" %+.1f %% |", b.costs[i].second);
+      for (const Bus& b : buses) std::printf(" %+.1f %% | %.2f %% |", b.costs[i].second, b.core_shares[i]);
       std::printf("\n");
     }
     for (const Bus& b : buses) {
