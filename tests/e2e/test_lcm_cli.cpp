@@ -207,6 +207,12 @@ TEST(LcmCli, ARecordingsFramesGoThroughTheVisionPipelineAgain) {
     EXPECT_NEAR(std::remainder(heading - it->second[2], 360.0), 0.0, 3.0) << row;
   }
   EXPECT_GE(matched, live.size() * 95 / 100);
+  // The recording gives the same folder again, detections too (the frames are skipped).
+  r = run_rilbed("replay '" + rec + "' --out '" + (dir / "replayed").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* file : {"trajectories.csv", "events.csv", "summary.json", "detections.csv", "trajectories.svg"}) {
+    EXPECT_EQ(read_file(dir / "run" / file), read_file(dir / "replayed" / file)) << file;
+  }
   // Other settings give another result: a score no marker reaches finds nothing.
   r = run_rilbed("detect '" + rec + "' --ids 4-5 -q --min-score 0.999 --csv '" + (dir / "strict.csv").string() + "'");
   EXPECT_EQ(r.exit_code, 0) << r.err;
