@@ -242,3 +242,37 @@ TEST(Simulation, UnknownControllerOrParameterIsNamed) {
 
 }  // namespace
 }  // namespace rilbed::agents
+
+namespace rilbed::agents {
+namespace {
+
+TEST(StatusLine, ShowsEachRobotItsHealthAndTheFormation) {
+  const std::vector<PoseReport> poses = {{1, false, true, Pose2{}, "lead", "ok"}, {4, true, false, Pose2{}, "follow", "unseen"}};
+  StatusReport s;
+  s.t_us = 12'040'000;
+  s.state = "running";
+  EXPECT_EQ(StatusLine::format(s, poses), "t=12.0s  1:lead  4:follow(unseen)");
+  s.formed = true;
+  EXPECT_EQ(StatusLine::format(s, poses), "t=12.0s  1:lead  4:follow(unseen)  [formed]");
+  s.state = "paused";
+  EXPECT_EQ(StatusLine::format(s, poses), "t=12.0s  paused");
+  s.state = "ended";
+  EXPECT_EQ(StatusLine::format(s, poses), "");
+  // As a subscriber it keeps the last poses' strings after the call that handed them.
+  std::vector<std::string> lines;
+  StatusLine line([&](const std::string& l) { lines.push_back(l); });
+  {
+    std::string behaviour = "search";
+    const std::vector<PoseReport> step = {{2, false, true, Pose2{}, behaviour, "ok"}};
+    line.on_poses(0, step);
+    behaviour = "XXXXXX";
+  }
+  s.state = "running";
+  s.formed = false;
+  line.on_status(s);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_EQ(lines[0], "t=12.0s  2:search");
+}
+
+}  // namespace
+}  // namespace rilbed::agents

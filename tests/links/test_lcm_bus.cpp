@@ -3,6 +3,9 @@
 // step, every event as events.csv has it, the status every second and at the end.
 #include <gtest/gtest.h>
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -256,6 +259,116 @@ TEST(LcmBus, HostileMessagesAndLogsAreRefusedNotDecoded) {
   EXPECT_TRUE(cut.truncated());
   EXPECT_EQ(cut.skipped_bytes(), huge.size());
   std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rilbed::links
+
+namespace rilbed::links {
+namespace {
+
+// Each report, encoded as the publisher encodes it and decoded as every subscriber
+// decodes it, is the report again.
+TEST(LcmBus, WheelsSensorsAndDetectionsSurviveTheBus) {
+  struct Got final : agents::RunObserver {
+    std::vector<agents::WheelReport> wheels;
+    std::vector<std::pair<int, environment::SensorReadings>> sensors;
+    std::vector<agents::DetectionReport> detections;
+    agents::StatusReport status;
+    std::int64_t frame = 0;
+    cv::Mat image;
+    bool wants_frame_images() const override { return true; }
+    void on_wheels(TimeUs, std::span<const agents::WheelReport> w) override { wheels.assign(w.begin(), w.end()); }
+    void on_sensors(TimeUs, std::span<const agents::SensorReport> s) override {
+      for (const auto& r : s) sensors.emplace_back(r.id, *r.readings);
+    }
+    void on_detections(const agents::FrameReport& f) override {
+      frame = f.frame;
+      detections.assign(f.detections.begin(), f.detections.end());
+    }
+    void on_frame_image(TimeUs, std::int64_t, const cv::Mat& m) override { image = m.clone(); }
+    void on_status(const agents::StatusReport& s) override { status = s; }
+  } got;
+  const Channels channels;
+  RunReportDecoder decoder(channels, got);
+  auto through = [&](const std::string& channel, const auto& message) {
+    std::vector<std::uint8_t> bytes(static_cast<std::size_t>(message.getEncodedSize()));
+    ASSERT_EQ(message.encode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
+    ASSERT_EQ(decoder.decode(channel, bytes.data(), bytes.size()), std::nullopt) << channel;
+  };
+  const std::vector<agents::WheelReport> wheels = {{1, {127, -127}}, {7, {0, 3}}};
+  rilbed::wheels_t w;
+  fill(w, 500'000, wheels);
+  EXPECT_DOUBLE_EQ(w.robots[0].left_mps, 127 * 0.008);
+  through(channels.wheels, w);
+  ASSERT_EQ(got.wheels.size(), 2u);
+  EXPECT_EQ(got.wheels[0].wheels, (agents::WheelCommand{127, -127}));
+  EXPECT_EQ(got.wheels[1].id, 7);
+
+  environment::SensorReadings full;
+  full.proximity = environment::ProximityValues{0, 1, 2, 3, 1020, 1021, 1022, 1023};
+  full.ranges = {{true, 0.25}, {false, 1.5}};
+  full.beacons = {{3, -1.0}};
+  full.track = {0, 255, 17};
+  full.odometry = environment::OdometryReading{-5, 123456789012};
+  const environment::SensorReadings none;  // a robot that carries no sensor
+  const std::vector<agents::SensorReport> sensors = {{2, &full}, {9, &none}};
+  rilbed::sensors_t s;
+  fill(s, 600'000, sensors);
+  through(channels.sensors, s);
+  ASSERT_EQ(got.sensors.size(), 2u);
+  const environment::SensorReadings& back = got.sensors[0].second;
+  EXPECT_EQ(got.sensors[0].first, 2);
+  EXPECT_EQ(back.t_us, 600'000);
+  EXPECT_EQ(back.proximity, full.proximity);
+  ASSERT_EQ(back.ranges.size(), 2u);
+  EXPECT_TRUE(back.ranges[0].hit);
+  EXPECT_EQ(back.ranges[1].distance_m, 1.5);
+  ASSERT_EQ(back.beacons.size(), 1u);
+  EXPECT_EQ(back.beacons[0].bearing_rad, -1.0);
+  EXPECT_EQ(back.track, full.track);
+  ASSERT_TRUE(back.odometry.has_value());
+  EXPECT_EQ(back.odometry->right_pulses, 123456789012);
+  const environment::SensorReadings& empty = got.sensors[1].second;
+  EXPECT_FALSE(empty.proximity || empty.odometry);
+  EXPECT_TRUE(empty.ranges.empty() && empty.beacons.empty() && empty.track.empty());
+
+  const std::vector<agents::DetectionReport> found = {{4, 812.5, 90.25, 359.5, 0.97, 31.0, Pose2{{0.4, 1.1}, -2.0}}};
+  through(channels.detections, to_lcm(agents::FrameReport{700'000, 21, 0.4, found}));
+  EXPECT_EQ(got.frame, 21);
+  ASSERT_EQ(got.detections.size(), 1u);
+  EXPECT_EQ(got.detections[0].u_px, 812.5);
+  EXPECT_EQ(got.detections[0].heading_deg, 359.5);
+  EXPECT_EQ(got.detections[0].pose.heading_rad, -2.0);
+
+  // A frame goes as JPEG and comes back as an image of its size, close to the original.
+  cv::Mat image(48, 64, CV_8UC1, cv::Scalar(180));
+  cv::rectangle(image, {10, 10}, {30, 30}, cv::Scalar(20), -1);
+  const rilbed::frame_t f = to_lcm(800'000, 22, image, 90);
+  EXPECT_EQ(f.size, static_cast<std::int32_t>(f.data.size()));
+  through(channels.frames, f);
+  ASSERT_EQ(got.image.size(), image.size());
+  EXPECT_LT(cv::norm(got.image, image, cv::NORM_INF), 40.0);
+  EXPECT_LT(cv::norm(got.image, image, cv::NORM_L1) / image.total(), 2.0);
+  // Not JPEG: refused, saying why.
+  rilbed::frame_t png = f;
+  png.format = "png";
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(png.getEncodedSize()));
+  png.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  const auto problem = decoder.decode(channels.frames, bytes.data(), bytes.size());
+  ASSERT_TRUE(problem.has_value());
+  EXPECT_NE(problem->find("not jpeg"), std::string::npos) << *problem;
+
+  agents::StatusReport st;
+  st.state = "paused";
+  st.loop_latency_ms = 3.5;
+  st.camera_fps = 29.9;
+  st.frames = 1234;
+  through(channels.status, to_lcm(st));
+  EXPECT_EQ(got.status.state, "paused");
+  EXPECT_EQ(got.status.loop_latency_ms, 3.5);
+  EXPECT_EQ(got.status.camera_fps, 29.9);
+  EXPECT_EQ(got.status.frames, 1234);
 }
 
 }  // namespace
