@@ -350,6 +350,19 @@ int run_command(const RunArgs& args) {
         }
       } forget{current_mutex, current_publisher};
       agents::RunResult r = run(o);
+      if (network_bus) {
+        // The end goes out twice more: a watcher that lost it would wait for it forever.
+        for (int k = 0; k < 2; ++k) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(50));
+          publisher.repeat_end();
+        }
+        // A publish the network refused (a firewall's EPERM) is lost: say how many.
+        std::uint64_t refused = 0;
+        for (const auto& [channel, count] : publisher.counts()) refused += count.failures;
+        if (refused > 0) {
+          spdlog::warn("seed {}: the bus refused {} of the run's messages (they were lost; a firewall?)", o.seed, refused);
+        }
+      }
       return r;
     };
   };

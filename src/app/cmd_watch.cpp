@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,9 @@ class Watcher final : public agents::RunObserver {
   }
   void on_status(const agents::StatusReport& s) override {
     heard();
+    // The same status again (a paused run, or the end, is published more than once).
+    if (last_status_ && last_status_->first == s.t_us && last_status_->second == s.state) return;
+    last_status_ = std::make_pair(s.t_us, s.state);
     std::string line = "t=" + one_decimal(us_to_seconds(s.t_us)) + "s " + s.state;
     if (s.realtime) line += " x" + one_decimal(s.rt_factor);
     for (const std::string& r : robots_) line += "  " + r;
@@ -79,6 +83,16 @@ class Watcher final : public agents::RunObserver {
     std::fflush(stdout);
     // A reset run starts over: the watcher stays for the run that follows.
     if (s.state == "ended" && s.ended_by != "reset") ended_ = true;
+  }
+
+  void on_summary(TimeUs, const nlohmann::json& summary) override {
+    heard();
+    const std::string ended_by = summary.value("ended_by", std::string("?"));
+    if (ended_ || ended_by == "reset") return;
+    // The run's last status was lost on the way, its summary was not.
+    std::printf("run ended (ended by %s; its last status was not heard)\n", ended_by.c_str());
+    std::fflush(stdout);
+    ended_ = true;
   }
 
   // A message as it came off the bus.
@@ -95,8 +109,9 @@ class Watcher final : public agents::RunObserver {
   void check_silence(std::chrono::steady_clock::time_point now) {
     if (silent_reported_ || now - last_heard_ < std::chrono::duration<double>(args_.silence_s)) return;
     silent_reported_ = true;
-    std::printf("no rilbed run heard on %s for %.0f s (channels %sRILBED_*)\n", args_.url.c_str(), args_.silence_s,
-                args_.prefix.c_str());
+    std::printf("no rilbed run heard on %s for %.0f s (channels %sRILBED_*)%s\n", args_.url.c_str(), args_.silence_s,
+                args_.prefix.c_str(),
+                heard_anything_ && !ended_ ? ": the run went silent before its end was heard" : "");
     std::fflush(stdout);
   }
 
@@ -116,6 +131,7 @@ class Watcher final : public agents::RunObserver {
   links::RunReportDecoder* decoder_ = nullptr;
   std::string world_scenario_;
   std::vector<std::string> robots_;
+  std::optional<std::pair<TimeUs, std::string>> last_status_;  // time and state of the last shown
   bool ended_ = false;
   bool heard_anything_ = false;
   bool silent_reported_ = false;
@@ -140,7 +156,7 @@ int watch_command(const WatchArgs& args) {
   watcher.set_decoder(&decoder);
   // Raw bytes, decoded by the checked decoder.
   std::vector<std::unique_ptr<links::LcmSubscription>> subscriptions;
-  for (const std::string* channel : {&channels.world, &channels.poses, &channels.events, &channels.status}) {
+  for (const std::string* channel : {&channels.world, &channels.poses, &channels.events, &channels.status, &channels.summary}) {
     subscriptions.push_back(std::make_unique<links::LcmSubscription>(
         *lcm, *channel, [&watcher](const std::string& c, const void* data, std::size_t size) { watcher.on_message(c, data, size); }));
   }
@@ -149,6 +165,7 @@ int watch_command(const WatchArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   while (!watch_interrupted.load()) {
     const int handled = lcm->handleTimeout(100);
+    if (handled < 0 && watch_interrupted.load()) break;  // Ctrl-C while waiting: not a failure
     if (handled < 0) {
       spdlog::error("watch: reading the LCM bus {} failed", args.url);
       return kExitFailure;

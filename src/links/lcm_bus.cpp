@@ -523,6 +523,7 @@ void LcmRunPublisher::publish(const std::string& channel, const Message& message
   }
   if (channel == channels_.world) last_world_.assign(buffer_.begin(), buffer_.begin() + size);
   if (channel == channels_.status) last_status_.assign(buffer_.begin(), buffer_.begin() + size);
+  if (channel == channels_.summary) last_summary_.assign(buffer_.begin(), buffer_.begin() + size);
   const bool to_bus = !options_.in_process || bus_subscribers_ > 0;
   if (to_bus) {
     const int status = lcm_.publish(channel, buffer_.data(), static_cast<unsigned>(size));
@@ -553,6 +554,19 @@ void LcmRunPublisher::republish_world_and_status() {
   if (options_.in_process && bus_subscribers_ == 0) return;
   if (!last_world_.empty()) lcm_.publish(channels_.world, last_world_.data(), static_cast<unsigned>(last_world_.size()));
   if (!last_status_.empty()) lcm_.publish(channels_.status, last_status_.data(), static_cast<unsigned>(last_status_.size()));
+}
+
+void LcmRunPublisher::repeat_end() {
+  std::lock_guard lock(mutex_);
+  if (options_.in_process && bus_subscribers_ == 0) return;
+  if (!last_status_.empty()) lcm_.publish(channels_.status, last_status_.data(), static_cast<unsigned>(last_status_.size()));
+  if (!last_summary_.empty()) {
+    lcm_.publish(channels_.summary, last_summary_.data(), static_cast<unsigned>(last_summary_.size()));
+  }
+  if (options_.in_process) {
+    while (lcm_.handleTimeout(0) > 0) {
+    }
+  }
 }
 
 void LcmRunPublisher::on_world(TimeUs t_us, const agents::WorldReport& world) {

@@ -188,6 +188,10 @@ class LcmRunPublisher final : public agents::RunObserver {
   /// Publishes the last world and status again (a paused run does, every second, for
   /// viewers that join while it is paused). Thread-safe.
   void republish_world_and_status();
+  /// Publishes the run's last status and its summary again, on the bus only (not to the
+  /// log or the local subscribers): each goes out once, and a watcher on a lossy network
+  /// that missed it would not learn that the run ended. Thread-safe.
+  void repeat_end();
 
   bool wants_steps() const override { return heard(); }
   void on_world(TimeUs t_us, const agents::WorldReport& world) override;
@@ -224,7 +228,7 @@ class LcmRunPublisher final : public agents::RunObserver {
   std::unique_ptr<Fanout> fanout_;  // the local subscribers
   std::unique_ptr<RunReportDecoder> local_decoder_;
   std::atomic<int> bus_subscribers_{0};
-  std::vector<std::uint8_t> last_world_, last_status_;  // their bytes, for republish_world_and_status
+  std::vector<std::uint8_t> last_world_, last_status_, last_summary_;  // their bytes, to publish again
   mutable std::mutex mutex_;
   std::map<std::string, ChannelCount> counts_;
 };

@@ -7,14 +7,17 @@
 #include <unistd.h>
 
 #include <array>
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <mutex>
 #include <random>
+#include <thread>
 #include <variant>
 
 #include <boost/asio/io_context.hpp>
@@ -173,6 +176,12 @@ struct LcmConsoleServer::Impl {
   // Answers already given, by (client, seq), oldest first (a bounded memory).
   std::map<std::pair<std::string, std::int64_t>, rilbed::console_reply_t> answered;
   std::deque<std::pair<std::string, std::int64_t>> answered_order;
+  // When the last command was answered (steady clock, ms): the server stays a moment after
+  // the run, for the retries of a console whose answer was lost (`exit` ends the run).
+  std::atomic<std::int64_t> last_answer_ms{std::numeric_limits<std::int64_t>::min() / 2};
+  static std::int64_t now_ms() {
+    return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  }
 
   void wait_for_messages() {
     descriptor.async_wait(asio::posix::stream_descriptor::wait_read, [this](const boost::system::error_code& ec) {
@@ -238,6 +247,7 @@ struct LcmConsoleServer::Impl {
     if (log) log("console: " + who + ": " + c->command + ": " + (reply.accepted ? "accepted" : "refused, " + reply.reason));
     publish_encoded(lcm, channels.console_reply, reply);
     answered[key] = reply;
+    last_answer_ms = now_ms();
     answered_order.push_back(key);
     if (answered_order.size() > 1024) {
       answered.erase(answered_order.front());
@@ -265,6 +275,11 @@ LcmConsoleServer::LcmConsoleServer(lcm::LCM& lcm, Channels channels, std::string
 LcmConsoleServer::~LcmConsoleServer() {
   Impl& m = *impl_;
   if (m.thread.joinable()) {
+    // A console answered less than kLingerMs ago may not have heard its answer (UDP loses
+    // messages) and is sending its command again: answer it from the cache until then.
+    constexpr std::int64_t kLingerMs = 1500;
+    const std::int64_t left = m.last_answer_ms.load() + kLingerMs - Impl::now_ms();
+    if (left > 0) std::this_thread::sleep_for(std::chrono::milliseconds(left));
     asio::post(m.io, [&m] {
       boost::system::error_code ignored;
       m.descriptor.close(ignored);
