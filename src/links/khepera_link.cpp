@@ -550,7 +550,15 @@ bool KheperaLink::halt(std::optional<int> timeout_ms) {
   Impl& m = *impl_;
   std::unique_lock lock(m.mutex);
   if (!m.started || m.stop_result || m.stopping) return false;
-  return m.wish_stop_and_wait(lock, timeout_ms);
+  const bool acknowledged = m.wish_stop_and_wait(lock, timeout_ms);
+  const bool lost = m.status.state == LinkState::kLost;
+  lock.unlock();
+  if (!acknowledged) {
+    // The stop stays wished: the link sends it again until the robot acknowledges it.
+    m.log(LogLevel::kWarning, lost ? "halt: the port is lost; the stop goes first when it is back"
+                                   : "halt: the robot has not acknowledged D,0,0 yet; it is sent until it does");
+  }
+  return acknowledged;
 }
 
 void KheperaLink::set_speeds(int left_units, int right_units) {

@@ -17,7 +17,12 @@ RealBody::RealBody(int id, environment::World& world, std::shared_ptr<KheperaLin
   link_->request_proximity();
 }
 
-RealBody::~RealBody() { link_->halt(); }
+RealBody::~RealBody() {
+  // The run is over: the robot must stand before anything else happens (the next run of a
+  // batch, placement, the end of the program). A busy line or machine may take longer than
+  // one command's retries: wait once more, longer.
+  if (!link_->halt()) link_->halt(3000);
+}
 
 environment::SensorReadings RealBody::sense(TimeUs t_us) {
   // Virtual sensors at the camera's pose: walls, obstacles and every robot, virtual or real.

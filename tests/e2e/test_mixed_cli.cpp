@@ -91,8 +91,8 @@ TEST(MixedRun, FaultsNeverStopTheRun) {
   std::ofstream(scenario) << text;
   const CommandResult r = run_rilbed("run '" + scenario.string() + "' --realtime --duration 12 --out '" + (dir / "run").string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
-  EXPECT_NE(r.out.find("robot 4 (emulated): last speed 0 0"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("robot 5 (emulated): last speed 0 0"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("robot 4 (emulated): last speed 0 0"), std::string::npos) << r.out << r.err;
+  EXPECT_NE(r.out.find("robot 5 (emulated): last speed 0 0"), std::string::npos) << r.out << r.err;
   const std::string events = read_file(dir / "run" / "events.csv");
   // Robot 5's link is lost (it may pass through "unresponsive" on the way), then back.
   const std::size_t lost = events.find("-> link lost");
