@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "lcm_namespace.hpp"
 #include "run_command.hpp"
 
 namespace rilbed::e2e {
@@ -22,25 +23,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Runs `body` (shell lines, with $R the rilbed binary and $URL the bus) in a fresh network
-// namespace whose loopback carries multicast. Returns the exit status, or -1 when this
-// machine cannot make a namespace (then the test is skipped).
-int in_namespace(const fs::path& dir, const std::string& body) {
-  const fs::path script = dir / "ns.sh";
-  std::ofstream(script) << "set -e\nip link set lo up\nip link set lo multicast on\nip route add 224.0.0.0/4 dev lo\n"
-                        << "R='" << RILBED_BINARY << "'\nURL='udpm://239.255.76.67:7667?ttl=0'\ncd '" << dir.string() << "'\n"
-                        << body;
-  const int status = std::system(("unshare -n /bin/bash '" + script.string() + "' >'" + (dir / "ns.log").string() + "' 2>&1").c_str());
-  if (!WIFEXITED(status)) return -1;
-  return WEXITSTATUS(status);
-}
-
-bool namespaces_work() {
-  return std::system("unshare -n true >/dev/null 2>&1") == 0;
-}
-
 TEST(LcmCli, WatchShowsARunOverMulticastAndItsEnd) {
-  if (!namespaces_work()) GTEST_SKIP() << "cannot make a network namespace here (unshare -n needs root)";
+  SKIP_WITHOUT_NAMESPACES();
   const fs::path dir = scratch_dir("lcm_watch");
   const int status = in_namespace(dir,
       "\"$R\" watch --lcm \"$URL\" --until-ended --for 60 > watch.txt 2>&1 &\n"
@@ -127,7 +111,7 @@ TEST(LcmCli, RecordThenReplayGivesTheSameRunFolder) {
 // Other programs: lcm-logplayer plays a rilbed recording that `rilbed watch` shows, and a
 // run recorded by lcm-logger replays to the run's own folder.
 TEST(LcmCli, LcmsOwnToolsPlayAndRecordARun) {
-  if (!namespaces_work()) GTEST_SKIP() << "cannot make a network namespace here (unshare -n needs root)";
+  SKIP_WITHOUT_NAMESPACES();
   const fs::path dir = scratch_dir("lcm_tools");
   const int status = in_namespace(dir,
       // Recorded in (scaled) real time, so that the player paces it as it was: a burst of a
@@ -234,10 +218,9 @@ TEST(LcmCli, ARecordingsFramesGoThroughTheVisionPipelineAgain) {
 }
 
 TEST(LcmCli, TheConsoleDrivesARobotSwitchesTheModeAndResetsTheRun) {
-  if (!namespaces_work()) GTEST_SKIP() << "cannot make a network namespace here (unshare -n needs root)";
+  SKIP_WITHOUT_NAMESPACES();
   const fs::path dir = scratch_dir("lcm_console_more");
   const int status = in_namespace(dir,
-      "export XDG_RUNTIME_DIR=\"$PWD/xdg\"; mkdir -m 700 xdg\n"
       "\"$R\" run " + shipped_scenario_arg("convoy_mixed") + " --duration 120 --lcm \"$URL\" --out run --record rec.lcm --quiet > run.txt 2> run.err &\n"
       "P=$!\n"
       "set +e\n"
@@ -286,10 +269,9 @@ TEST(LcmCli, TheConsoleDrivesARobotSwitchesTheModeAndResetsTheRun) {
 }
 
 TEST(LcmCli, TheConsoleSteersARunAndPauseStopsItsRealRobots) {
-  if (!namespaces_work()) GTEST_SKIP() << "cannot make a network namespace here (unshare -n needs root)";
+  SKIP_WITHOUT_NAMESPACES();
   const fs::path dir = scratch_dir("lcm_console");
   const int status = in_namespace(dir,
-      "export XDG_RUNTIME_DIR=\"$PWD/xdg\"; mkdir -m 700 xdg\n"
       "\"$R\" run " + shipped_scenario_arg("convoy_mixed") + " --duration 60 --lcm \"$URL\" --out run --quiet > run.txt 2> run.err &\n"
       "P=$!\n"
       "set +e\n"
