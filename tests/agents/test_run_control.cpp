@@ -99,7 +99,9 @@ TEST(RunControl, DriveTakesARobotByHandThenGivesItBack) {
       EXPECT_EQ(behaviour, "console") << "t " << t;
       ++by_hand;
     }
-    if (t <= 900'000 || t >= 2'700'000) EXPECT_NE(behaviour, "console") << "t " << t;
+    if (t <= 900'000 || t >= 2'700'000) {
+      EXPECT_NE(behaviour, "console") << "t " << t;
+    }
   }
   EXPECT_GE(by_hand, 13);
 }

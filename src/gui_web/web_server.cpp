@@ -1,0 +1,499 @@
+#include "gui_web/web_server.hpp"
+
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+
+#include <array>
+#include <chrono>
+#include <deque>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+namespace rilbed::gui_web {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+using tcp = asio::ip::tcp;
+
+bool same_secret(std::string_view a, std::string_view b) {
+  unsigned char diff = a.size() == b.size() ? 0 : 1;
+  const std::size_t n = std::max<std::size_t>(b.size(), 1);
+  for (std::size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ (b.empty() ? 0 : b[i % n]));
+  return diff == 0 && !b.empty();
+}
+
+namespace {
+
+std::string_view sv(beast::string_view v) { return {v.data(), v.size()}; }
+
+// "/ws?token=abc&x=1" -> path "/ws", the token's value.
+struct Target {
+  std::string path;
+  std::string token;
+};
+
+Target parse_target(std::string_view target) {
+  Target t;
+  const std::size_t q = target.find('?');
+  t.path = std::string(target.substr(0, q));
+  if (q == std::string_view::npos) return t;
+  std::string_view query = target.substr(q + 1);
+  while (!query.empty()) {
+    const std::size_t amp = query.find('&');
+    const std::string_view pair = query.substr(0, amp);
+    if (pair.rfind("token=", 0) == 0) t.token = std::string(pair.substr(6));
+    if (amp == std::string_view::npos) break;
+    query.remove_prefix(amp + 1);
+  }
+  return t;
+}
+
+std::string content_type(const std::filesystem::path& p) {
+  const std::string ext = p.extension().string();
+  if (ext == ".html") return "text/html; charset=utf-8";
+  if (ext == ".js" || ext == ".mjs") return "text/javascript; charset=utf-8";
+  if (ext == ".css") return "text/css; charset=utf-8";
+  if (ext == ".json") return "application/json";
+  if (ext == ".svg") return "image/svg+xml";
+  if (ext == ".png") return "image/png";
+  return "application/octet-stream";
+}
+
+// The client offered the Foxglove subprotocol (the header is a comma-separated list).
+bool offers_subprotocol(std::string_view header) {
+  while (!header.empty()) {
+    const std::size_t comma = header.find(',');
+    std::string_view item = header.substr(0, comma);
+    while (!item.empty() && (item.front() == ' ' || item.front() == '\t')) item.remove_prefix(1);
+    while (!item.empty() && (item.back() == ' ' || item.back() == '\t')) item.remove_suffix(1);
+    if (item == foxglove::kSubprotocol) return true;
+    if (comma == std::string_view::npos) break;
+    header.remove_prefix(comma + 1);
+  }
+  return false;
+}
+
+}  // namespace
+
+class WsSession;
+
+struct WebServer::Impl {
+  WebServerConfig config;
+  Handlers handlers;
+  asio::io_context io;
+  tcp::acceptor acceptor{io};
+  std::thread thread;
+  std::uint16_t port = 0;
+  mutable std::mutex mutex;                 // guards channels and counters
+  std::vector<foxglove::Channel> channels;  // every channel offered, in id order
+  WebServerCounters counts;
+  std::set<std::shared_ptr<WsSession>> sessions;  // the server's thread only
+  std::atomic<std::size_t> client_count{0};
+
+  void count(std::uint64_t WebServerCounters::*field, std::uint64_t n = 1) {
+    std::lock_guard lock(mutex);
+    counts.*field += n;
+  }
+  std::vector<foxglove::Channel> channels_now() const {
+    std::lock_guard lock(mutex);
+    return channels;
+  }
+  bool has_channel(std::uint32_t id) const {
+    std::lock_guard lock(mutex);
+    return id >= 1 && id <= channels.size();
+  }
+  // The Origin a browser sends with the WebSocket: this server's own page, or one allowed.
+  bool origin_allowed(std::string_view origin) const {
+    if (origin.empty()) return true;  // not a browser (a program: FoxgloveClient in Node, a test)
+    for (const std::string& allowed : config.allowed_origins) {
+      if (origin == allowed) return true;
+    }
+    const std::string p = ":" + std::to_string(port);
+    for (const std::string& host : {std::string("127.0.0.1"), std::string("localhost"), std::string("[::1]"), config.bind_address}) {
+      if (origin == "http://" + host + p) return true;
+    }
+    return false;
+  }
+  void accept();
+  void remove(const std::shared_ptr<WsSession>& s);
+};
+
+// One WebSocket client: its subscriptions, its channels, its send queue.
+class WsSession : public std::enable_shared_from_this<WsSession> {
+ public:
+  WsSession(tcp::socket socket, WebServer::Impl& server)
+      : ws_(std::move(socket)), server_(server) {
+    beast::error_code ec;
+    const auto remote = beast::get_lowest_layer(ws_).socket().remote_endpoint(ec);
+    name_ = ec ? std::string("client") : remote.address().to_string() + ":" + std::to_string(remote.port());
+  }
+  const std::string& name() const { return name_; }
+
+  void start(http::request<http::string_body> request) {
+    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    ws_.set_option(websocket::stream_base::decorator([](websocket::response_type& r) {
+      r.set(http::field::sec_websocket_protocol, std::string(foxglove::kSubprotocol));
+      r.set(http::field::server, "rilbed");
+    }));
+    ws_.read_message_max(server_.config.max_message_bytes);
+    ws_.async_accept(request, [self = shared_from_this()](beast::error_code ec) {
+      if (ec) return self->close();
+      self->send_text(foxglove::server_info(self->server_.config.name, {"clientPublish"}, {"json"}, self->server_.config.session_id));
+      const auto channels = self->server_.channels_now();
+      self->send_text(foxglove::advertise(channels));
+      self->read();
+    });
+  }
+
+  void advertise(const foxglove::Channel& c) { send_text(foxglove::advertise(std::span(&c, 1))); }
+
+  // A data message on `channel`, if this client subscribed to it.
+  void offer(std::uint32_t channel, std::uint64_t t_ns, const std::shared_ptr<const std::string>& payload) {
+    const auto it = channel_to_sub_.find(channel);
+    if (it == channel_to_sub_.end()) return;
+    Out o;
+    o.binary = true;
+    o.header = foxglove::message_data_header(it->second, t_ns);
+    o.payload = payload;
+    o.bytes = 13 + payload->size();
+    make_room(o.bytes);
+    queued_bytes_ += o.bytes;
+    queue_.push_back(std::move(o));
+    server_.count(&WebServerCounters::messages_sent);
+    write();
+  }
+
+  void close() {
+    if (closed_) return;
+    closed_ = true;
+    beast::error_code ignored;
+    beast::get_lowest_layer(ws_).socket().close(ignored);
+    server_.remove(shared_from_this());
+  }
+
+ private:
+  struct Out {
+    bool binary = false;
+    std::shared_ptr<const std::string> text;
+    std::array<std::uint8_t, 13> header{};
+    std::shared_ptr<const std::string> payload;
+    std::size_t bytes = 0;
+  };
+
+  void send_text(std::string text) {
+    Out o;
+    o.bytes = text.size();
+    o.text = std::make_shared<const std::string>(std::move(text));
+    queued_bytes_ += o.bytes;
+    queue_.push_back(std::move(o));  // never dropped: control messages are small and few
+    write();
+  }
+
+  // Drops the oldest data messages (not the one being written) until `bytes` more fit:
+  // a client that does not keep up sees the newest state, late.
+  void make_room(std::size_t bytes) {
+    std::size_t dropped = 0;
+    for (auto it = queue_.begin() + (writing_ ? 1 : 0); it != queue_.end() && queued_bytes_ + bytes > server_.config.max_queued_bytes;) {
+      if (!it->binary) {
+        ++it;
+        continue;
+      }
+      queued_bytes_ -= it->bytes;
+      it = queue_.erase(it);
+      ++dropped;
+    }
+    if (dropped == 0) return;
+    server_.count(&WebServerCounters::messages_dropped, dropped);
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_drop_status_ >= std::chrono::seconds(1)) {
+      last_drop_status_ = now;
+      send_text(foxglove::status(foxglove::Level::kWarning, "Send buffer limit reached: this client does not keep up, "
+                                                            "older messages were dropped", "slow"));
+    }
+  }
+
+  void write() {
+    if (writing_ || queue_.empty() || closed_) return;
+    writing_ = true;
+    Out& o = queue_.front();
+    auto done = [self = shared_from_this()](beast::error_code ec, std::size_t) {
+      self->writing_ = false;
+      if (ec) return self->close();
+      self->queued_bytes_ -= self->queue_.front().bytes;
+      self->queue_.pop_front();
+      self->write();
+    };
+    if (o.binary) {
+      ws_.binary(true);
+      const std::array<asio::const_buffer, 2> buffers = {asio::buffer(o.header), asio::buffer(*o.payload)};
+      ws_.async_write(buffers, std::move(done));
+    } else {
+      ws_.text(true);
+      ws_.async_write(asio::buffer(*o.text), std::move(done));
+    }
+  }
+
+  void read() {
+    ws_.async_read(buffer_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+      if (ec) return self->close();  // closed, or a message over max_message_bytes (closed with 1009)
+      const auto data = self->buffer_.cdata();
+      const std::span<const std::uint8_t> bytes(static_cast<const std::uint8_t*>(data.data()), data.size());
+      if (self->ws_.got_text()) {
+        self->on_text(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+      } else {
+        self->on_binary(bytes);
+      }
+      self->buffer_.consume(self->buffer_.size());
+      self->read();
+    });
+  }
+
+  void refuse(foxglove::Level level, const std::string& why) {
+    server_.count(&WebServerCounters::bad_client_messages);
+    send_text(foxglove::status(level, why));
+  }
+
+  void on_text(std::string_view text) {
+    auto parsed = foxglove::parse_client_text(text);
+    if (auto* why = std::get_if<std::string>(&parsed)) return refuse(foxglove::Level::kError, *why);
+    std::visit([this](const auto& m) { handle(m); }, std::get<foxglove::ClientText>(parsed));
+  }
+
+  void handle(const foxglove::Subscribe& m) {
+    for (const auto& s : m.subscriptions) {
+      if (!server_.has_channel(s.channel_id)) {
+        refuse(foxglove::Level::kWarning, "Channel " + std::to_string(s.channel_id) + " is not available; ignoring subscription");
+      } else if (sub_to_channel_.contains(s.id)) {
+        refuse(foxglove::Level::kError, "Client subscription id " + std::to_string(s.id) + " was already used; ignoring subscription");
+      } else if (channel_to_sub_.contains(s.channel_id)) {
+        refuse(foxglove::Level::kWarning, "Client already subscribed to channel " + std::to_string(s.channel_id) + "; ignoring subscription");
+      } else {
+        sub_to_channel_[s.id] = s.channel_id;
+        channel_to_sub_[s.channel_id] = s.id;
+      }
+    }
+  }
+  void handle(const foxglove::Unsubscribe& m) {
+    for (const std::uint32_t id : m.subscription_ids) {
+      const auto it = sub_to_channel_.find(id);
+      if (it == sub_to_channel_.end()) {
+        refuse(foxglove::Level::kWarning, "Client subscription id " + std::to_string(id) + " did not exist; ignoring unsubscription");
+        continue;
+      }
+      channel_to_sub_.erase(it->second);
+      sub_to_channel_.erase(it);
+    }
+  }
+  void handle(const foxglove::ClientAdvertise& m) {
+    for (const auto& c : m.channels) {
+      if (client_channels_.contains(c.id)) {
+        refuse(foxglove::Level::kError, "Channel " + std::to_string(c.id) + " was already advertised");
+      } else if (c.encoding != "json") {
+        refuse(foxglove::Level::kError, "Channel " + std::to_string(c.id) + ": encoding '" + c.encoding + "' is not supported (json is)");
+      } else if (client_channels_.size() >= foxglove::kMaxItems) {
+        refuse(foxglove::Level::kError, "Too many client channels");
+      } else {
+        client_channels_[c.id] = c;
+      }
+    }
+  }
+  void handle(const foxglove::ClientUnadvertise& m) {
+    for (const std::uint32_t id : m.channel_ids) client_channels_.erase(id);
+  }
+  void handle(const foxglove::GetParameters&) {
+    refuse(foxglove::Level::kError, "Operation 'getParameters' not supported as server capability 'parameters' is missing");
+  }
+  void handle(const foxglove::SetParameters&) {
+    refuse(foxglove::Level::kError, "Operation 'setParameters' not supported as server capability 'parameters' is missing");
+  }
+
+  void on_binary(std::span<const std::uint8_t> bytes) {
+    auto parsed = foxglove::parse_client_binary(bytes);
+    if (auto* why = std::get_if<std::string>(&parsed)) return refuse(foxglove::Level::kError, *why);
+    const foxglove::ClientMessage& m = std::get<foxglove::ClientMessage>(parsed);
+    const auto it = client_channels_.find(m.channel_id);
+    if (it == client_channels_.end()) {
+      return refuse(foxglove::Level::kError, "Channel " + std::to_string(m.channel_id) + " is not advertised");
+    }
+    if (!server_.handlers.on_client_message) return refuse(foxglove::Level::kError, "this server takes no messages");
+    const std::string_view payload(reinterpret_cast<const char*>(m.payload.data()), m.payload.size());
+    if (auto why = server_.handlers.on_client_message(name_, it->second.topic, it->second.encoding, payload)) {
+      refuse(foxglove::Level::kError, *why);
+    }
+  }
+
+  websocket::stream<beast::tcp_stream> ws_;
+  WebServer::Impl& server_;
+  std::string name_;
+  beast::flat_buffer buffer_;
+  std::map<std::uint32_t, std::uint32_t> sub_to_channel_, channel_to_sub_;
+  std::map<std::uint32_t, foxglove::ClientChannel> client_channels_;
+  std::deque<Out> queue_;
+  std::size_t queued_bytes_ = 0;
+  bool writing_ = false;
+  bool closed_ = false;
+  std::chrono::steady_clock::time_point last_drop_status_{};
+};
+
+// One HTTP request: the page's files, or the upgrade to a WebSocket.
+class HttpSession : public std::enable_shared_from_this<HttpSession> {
+ public:
+  HttpSession(tcp::socket socket, WebServer::Impl& server) : stream_(std::move(socket)), server_(server) {}
+
+  void start() {
+    parser_.body_limit(64 * 1024);
+    stream_.expires_after(std::chrono::seconds(30));
+    http::async_read(stream_, buffer_, parser_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+      if (!ec) self->on_request(self->parser_.release());
+    });
+  }
+
+ private:
+  void on_request(http::request<http::string_body> req) {
+    const Target target = parse_target(sv(req.target()));
+    if (!same_secret(target.token, server_.config.token)) return refuse(req, http::status::unauthorized, "a valid ?token= is needed\n");
+    if (websocket::is_upgrade(req)) {
+      if (target.path != "/ws") return refuse(req, http::status::not_found, "the WebSocket is at /ws\n");
+      if (!server_.origin_allowed(sv(req[http::field::origin]))) return refuse(req, http::status::forbidden, "Origin not allowed\n");
+      if (!offers_subprotocol(sv(req[http::field::sec_websocket_protocol]))) {
+        return refuse(req, http::status::bad_request, "Missing expected sec-websocket-protocol header (foxglove.websocket.v1)\n");
+      }
+      stream_.expires_never();
+      auto session = std::make_shared<WsSession>(stream_.release_socket(), server_);
+      server_.sessions.insert(session);
+      server_.client_count = server_.sessions.size();
+      server_.count(&WebServerCounters::connections);
+      session->start(std::move(req));
+      return;
+    }
+    if (req.method() != http::verb::get && req.method() != http::verb::head) {
+      return refuse(req, http::status::method_not_allowed, "GET only\n");
+    }
+    serve_file(req, target.path);
+  }
+
+  void serve_file(const http::request<http::string_body>& req, const std::string& path) {
+    if (server_.config.web_root.empty() || path.find("..") != std::string::npos || path.empty() || path[0] != '/') {
+      return respond(req, http::status::not_found, "text/plain", "not found\n");
+    }
+    const std::filesystem::path file = server_.config.web_root / (path == "/" ? std::string("index.html") : path.substr(1));
+    std::ifstream in(file, std::ios::binary);
+    if (!in) return respond(req, http::status::not_found, "text/plain", "not found\n");
+    std::ostringstream body;
+    body << in.rdbuf();
+    respond(req, http::status::ok, content_type(file), body.str());
+  }
+
+  void refuse(const http::request<http::string_body>& req, http::status status, const std::string& why) {
+    server_.count(&WebServerCounters::refused);
+    respond(req, status, "text/plain", why);
+  }
+
+  void respond(const http::request<http::string_body>& req, http::status status, const std::string& type, std::string body) {
+    auto res = std::make_shared<http::response<http::string_body>>(status, req.version());
+    res->set(http::field::server, "rilbed");
+    res->set(http::field::content_type, type);
+    res->set(http::field::cache_control, "no-store");
+    res->keep_alive(false);
+    res->body() = req.method() == http::verb::head ? std::string() : std::move(body);
+    res->prepare_payload();
+    http::async_write(stream_, *res, [self = shared_from_this(), res](beast::error_code, std::size_t) {
+      beast::error_code ignored;
+      self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+    });
+  }
+
+  beast::tcp_stream stream_;
+  WebServer::Impl& server_;
+  beast::flat_buffer buffer_;
+  http::request_parser<http::string_body> parser_;
+};
+
+void WebServer::Impl::accept() {
+  acceptor.async_accept([this](beast::error_code ec, tcp::socket socket) {
+    if (ec == asio::error::operation_aborted || !acceptor.is_open()) return;
+    if (!ec) std::make_shared<HttpSession>(std::move(socket), *this)->start();
+    accept();
+  });
+}
+
+void WebServer::Impl::remove(const std::shared_ptr<WsSession>& s) {
+  if (sessions.erase(s) == 0) return;
+  client_count = sessions.size();
+  if (handlers.on_client_gone) handlers.on_client_gone(s->name());
+}
+
+WebServer::WebServer(WebServerConfig config, Handlers handlers) : impl_(std::make_shared<Impl>()) {
+  if (config.token.empty()) throw std::invalid_argument("web server: the token must not be empty");
+  Impl& m = *impl_;
+  m.config = std::move(config);
+  m.handlers = std::move(handlers);
+  beast::error_code ec;
+  const auto address = asio::ip::make_address(m.config.bind_address, ec);
+  if (ec) throw std::runtime_error("web server: '" + m.config.bind_address + "' is not an IP address");
+  const tcp::endpoint endpoint(address, m.config.port);
+  m.acceptor.open(endpoint.protocol(), ec);
+  if (!ec) m.acceptor.set_option(asio::socket_base::reuse_address(true), ec);
+  if (!ec) m.acceptor.bind(endpoint, ec);
+  if (!ec) m.acceptor.listen(asio::socket_base::max_listen_connections, ec);
+  if (ec) {
+    throw std::runtime_error("web server: cannot listen on " + m.config.bind_address + ":" + std::to_string(m.config.port) +
+                             ": " + ec.message());
+  }
+  m.port = m.acceptor.local_endpoint().port();
+  m.accept();
+  m.thread = std::thread([&m] { m.io.run(); });
+}
+
+WebServer::~WebServer() {
+  Impl& m = *impl_;
+  asio::post(m.io, [&m] {
+    beast::error_code ignored;
+    m.acceptor.close(ignored);
+    for (const auto& s : std::vector<std::shared_ptr<WsSession>>(m.sessions.begin(), m.sessions.end())) s->close();
+    m.io.stop();
+  });
+  if (m.thread.joinable()) m.thread.join();
+  m.sessions.clear();
+}
+
+std::uint16_t WebServer::port() const { return impl_->port; }
+
+std::uint32_t WebServer::add_channel(foxglove::Channel channel) {
+  Impl& m = *impl_;
+  {
+    std::lock_guard lock(m.mutex);
+    channel.id = static_cast<std::uint32_t>(m.channels.size() + 1);
+    m.channels.push_back(channel);
+  }
+  asio::post(m.io, [&m, channel] {
+    for (const auto& s : m.sessions) s->advertise(channel);
+  });
+  return channel.id;
+}
+
+void WebServer::publish(std::uint32_t channel, std::uint64_t t_ns, std::shared_ptr<const std::string> payload) {
+  Impl& m = *impl_;
+  asio::post(m.io, [&m, channel, t_ns, payload = std::move(payload)] {
+    for (const auto& s : m.sessions) s->offer(channel, t_ns, payload);
+  });
+}
+
+std::size_t WebServer::clients() const { return impl_->client_count.load(); }
+
+WebServerCounters WebServer::counters() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->counts;
+}
+
+}  // namespace rilbed::gui_web

@@ -1,0 +1,94 @@
+// rilbed's web server: HTTP for the page and a WebSocket (/ws) speaking the Foxglove
+// WebSocket protocol, on a Boost.Asio io_context with one thread of its own (as each serial
+// link and the LCM console server have). It knows nothing of runs: whoever owns it adds
+// channels and publishes on them (any thread, never blocking), and hears what clients
+// publish on theirs. The GUI bridge (LCM in, console commands out) is one such owner.
+//
+// Safety of the door: every request, page or WebSocket, needs the token (`?token=`,
+// compared in constant time; 401 otherwise); a browser's WebSocket must come from the
+// server's own page (its Origin, when it sends one, must be this server or one allowed);
+// the server binds to 127.0.0.1 unless told otherwise.
+//
+// Slow viewers: each client has a bounded send queue. When a client does not keep up, the
+// oldest queued data messages are dropped (newest state wins) and it is told once per
+// second in a status message; it never slows the publisher or the other clients.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "gui_web/foxglove_protocol.hpp"
+
+namespace rilbed::gui_web {
+
+/// How the server listens and what it allows; each knob says what it costs.
+struct WebServerConfig {
+  std::string bind_address = "127.0.0.1";  ///< anything else opens the run to the network
+  std::uint16_t port = 8080;               ///< 0: any free port (tests; port() tells which)
+  std::string token;                       ///< required on every request; must not be empty
+  std::string name = "rilbed";             ///< serverInfo's name
+  std::string session_id;                  ///< serverInfo's sessionId (a run)
+  std::filesystem::path web_root;          ///< the page's files; empty: no page, only /ws
+  std::size_t max_queued_bytes = 8u << 20; ///< per client; more memory lets a slow client lag longer
+  std::size_t max_message_bytes = 1u << 20;  ///< largest message a client may send; larger closes its socket (1009)
+  std::vector<std::string> allowed_origins;  ///< Origins allowed besides the server's own, e.g. "https://app.foxglove.dev"
+};
+
+/// What the server counted (all clients together).
+struct WebServerCounters {
+  std::uint64_t connections = 0;        ///< WebSocket clients accepted
+  std::uint64_t refused = 0;            ///< requests refused: token, Origin, subprotocol, method
+  std::uint64_t messages_sent = 0;      ///< data messages queued to clients
+  std::uint64_t messages_dropped = 0;   ///< data messages dropped for clients that did not keep up
+  std::uint64_t bad_client_messages = 0;  ///< client messages answered with an error status
+};
+
+/// The web server. Thread-safe; runs until destroyed.
+class WebServer {
+ public:
+  /// What clients do that the owner hears, on the server's thread (quick, never blocking).
+  struct Handlers {
+    /// A client published `payload` on its channel `topic` (advertised with `encoding`).
+    /// Returns an error for the client (a status message), or nullopt.
+    std::function<std::optional<std::string>(const std::string& client, const std::string& topic,
+                                             const std::string& encoding, std::string_view payload)>
+        on_client_message;
+    /// A client's socket closed (for a dead man's switch).
+    std::function<void(const std::string& client)> on_client_gone;
+  };
+
+  /// Binds and starts serving. Throws std::invalid_argument for an empty token and
+  /// std::runtime_error naming the address when it cannot listen.
+  WebServer(WebServerConfig config, Handlers handlers);
+  ~WebServer();
+  WebServer(const WebServer&) = delete;
+  WebServer& operator=(const WebServer&) = delete;
+
+  /// The port it listens on.
+  std::uint16_t port() const;
+  /// Offers a channel to every client, present and future; returns its id (from 1).
+  std::uint32_t add_channel(foxglove::Channel channel);
+  /// Sends `payload` on `channel` to every client subscribed to it, stamped `t_ns`. Never
+  /// blocks: the message is queued on the server's thread.
+  void publish(std::uint32_t channel, std::uint64_t t_ns, std::shared_ptr<const std::string> payload);
+  /// Clients connected now.
+  std::size_t clients() const;
+  WebServerCounters counters() const;
+
+  struct Impl;
+
+ private:
+  std::shared_ptr<Impl> impl_;
+};
+
+/// Whether `a` equals `b`, in a time that depends only on their lengths.
+bool same_secret(std::string_view a, std::string_view b);
+
+}  // namespace rilbed::gui_web

@@ -1,0 +1,338 @@
+// The web server with real clients (Beast's, synchronous, on loopback): the token on every
+// request, the Origin and the subprotocol of a WebSocket, the Foxglove protocol's greeting,
+// subscriptions and their data, a client's messages, bad messages answered with a status
+// and the socket kept, an oversized one closing only its socket, many clients, and a client
+// that never reads, which must not hold up the others.
+#include <gtest/gtest.h>
+
+#include <boost/asio/connect.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "gui_web/web_server.hpp"
+
+namespace rilbed::gui_web {
+namespace {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+using tcp = asio::ip::tcp;
+using nlohmann::json;
+
+const std::string kToken = "0123456789abcdef0123456789abcdef";
+
+WebServerConfig config() {
+  WebServerConfig c;
+  c.port = 0;
+  c.token = kToken;
+  c.session_id = "test";
+  return c;
+}
+
+// An HTTP GET; returns the status code and body.
+std::pair<int, std::string> get(std::uint16_t port, const std::string& target) {
+  asio::io_context io;
+  beast::tcp_stream stream(io);
+  stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+  http::request<http::empty_body> req(http::verb::get, target, 11);
+  req.set(http::field::host, "127.0.0.1");
+  http::write(stream, req);
+  beast::flat_buffer buffer;
+  http::response<http::string_body> res;
+  http::read(stream, buffer, res);
+  return {static_cast<int>(res.result_int()), res.body()};
+}
+
+// The status of a WebSocket upgrade request (101 when accepted), as a browser would send
+// it. (Beast 1.74's client does not keep the response of a declined handshake.)
+int upgrade_status(std::uint16_t port, const std::string& target, const std::string& subprotocol = "foxglove.websocket.v1",
+                   const std::string& origin = "") {
+  asio::io_context io;
+  beast::tcp_stream stream(io);
+  stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+  http::request<http::empty_body> req(http::verb::get, target, 11);
+  req.set(http::field::host, "127.0.0.1:" + std::to_string(port));
+  req.set(http::field::upgrade, "websocket");
+  req.set(http::field::connection, "upgrade");
+  req.set(http::field::sec_websocket_key, "dGhlIHNhbXBsZSBub25jZQ==");
+  req.set(http::field::sec_websocket_version, "13");
+  if (!subprotocol.empty()) req.set(http::field::sec_websocket_protocol, subprotocol);
+  if (!origin.empty()) req.set(http::field::origin, origin);
+  http::write(stream, req);
+  beast::flat_buffer buffer;
+  http::response_parser<http::empty_body> res;
+  res.skip(true);  // a 101 has no body
+  beast::error_code ec;
+  http::read_header(stream, buffer, res, ec);
+  return ec ? -1 : static_cast<int>(res.get().result_int());
+}
+
+// A Foxglove client: connects, reads the greeting.
+struct Client {
+  asio::io_context io;
+  websocket::stream<beast::tcp_stream> ws{io};
+  beast::flat_buffer buffer;
+
+  // Returns the HTTP status of a refused handshake, or 101.
+  int connect(std::uint16_t port, const std::string& target, const std::string& subprotocol = "foxglove.websocket.v1",
+              const std::string& origin = "") {
+    beast::get_lowest_layer(ws).connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+    ws.set_option(websocket::stream_base::decorator([subprotocol, origin](websocket::request_type& r) {
+      if (!subprotocol.empty()) r.set(http::field::sec_websocket_protocol, subprotocol);
+      if (!origin.empty()) r.set(http::field::origin, origin);
+    }));
+    websocket::response_type res;
+    beast::error_code ec;
+    ws.handshake(res, "127.0.0.1:" + std::to_string(port), target, ec);
+    if (!ec) {
+      EXPECT_EQ(res[http::field::sec_websocket_protocol], "foxglove.websocket.v1");
+    }
+    return static_cast<int>(res.result_int());
+  }
+  // The next message: text as JSON, binary as raw bytes.
+  std::variant<json, std::string> next() {
+    buffer.consume(buffer.size());
+    ws.read(buffer);
+    std::string bytes = beast::buffers_to_string(buffer.data());
+    if (ws.got_text()) return json::parse(bytes);
+    return bytes;
+  }
+  json next_json() {
+    auto m = next();
+    EXPECT_TRUE(std::holds_alternative<json>(m));
+    return std::holds_alternative<json>(m) ? std::get<json>(m) : json();
+  }
+  void send_text(const json& j) {
+    ws.text(true);
+    ws.write(asio::buffer(j.dump()));
+  }
+  void send_binary(const std::string& bytes) {
+    ws.binary(true);
+    ws.write(asio::buffer(bytes));
+  }
+};
+
+foxglove::Channel poses_channel() {
+  return {0, "/rilbed/poses", "json", "rilbed.poses", R"({"type":"object"})", "jsonschema"};
+}
+
+TEST(WebServer, TheTokenOpensEverythingAndNothingOpensWithoutIt) {
+  const auto root = std::filesystem::temp_directory_path() / ("rilbed_web_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(root);
+  std::ofstream(root / "index.html") << "<!doctype html><title>rilbed</title>";
+  WebServerConfig c = config();
+  c.web_root = root;
+  WebServer server(c, {});
+  EXPECT_EQ(get(server.port(), "/?token=" + kToken), (std::pair<int, std::string>{200, "<!doctype html><title>rilbed</title>"}));
+  EXPECT_EQ(get(server.port(), "/").first, 401);
+  EXPECT_EQ(get(server.port(), "/?token=" + kToken.substr(1)).first, 401);
+  EXPECT_EQ(get(server.port(), "/?token=" + kToken + "0").first, 401);
+  EXPECT_EQ(get(server.port(), "/nothing.js?token=" + kToken).first, 404);
+  EXPECT_EQ(get(server.port(), "/../../etc/passwd?token=" + kToken).first, 404);
+  // The WebSocket: the token, the subprotocol, and a browser's Origin.
+  EXPECT_EQ(upgrade_status(server.port(), "/ws"), 401);
+  EXPECT_EQ(upgrade_status(server.port(), "/ws?token=nope"), 401);
+  EXPECT_EQ(upgrade_status(server.port(), "/ws?token=" + kToken, ""), 400);
+  EXPECT_EQ(upgrade_status(server.port(), "/ws?token=" + kToken, "foxglove.websocket.v1", "http://evil.example"), 403);
+  EXPECT_EQ(upgrade_status(server.port(), "/ws?token=" + kToken, "foxglove.websocket.v1",
+                           "http://127.0.0.1:" + std::to_string(server.port())), 101);
+  EXPECT_EQ(upgrade_status(server.port(), "/ws?token=" + kToken, "other, foxglove.websocket.v1"), 101);
+  EXPECT_EQ(Client().connect(server.port(), "/ws?token=" + kToken), 101);
+  EXPECT_EQ(server.counters().refused, 7u);  // 3 pages, 4 WebSockets
+  std::filesystem::remove_all(root);
+  EXPECT_THROW(WebServer(WebServerConfig{}, {}), std::invalid_argument);  // no token
+  WebServerConfig taken = config();
+  taken.port = server.port();
+  taken.bind_address = "127.0.0.2";  // another address, same port: fine; the same address is not
+  taken.bind_address = "127.0.0.1";
+  EXPECT_THROW(WebServer(taken, {}), std::runtime_error);
+}
+
+TEST(WebServer, GreetsSubscribesAndSendsData) {
+  WebServer server(config(), {});
+  const std::uint32_t poses = server.add_channel(poses_channel());
+  EXPECT_EQ(poses, 1u);
+  Client client;
+  ASSERT_EQ(client.connect(server.port(), "/ws?token=" + kToken), 101);
+  const json info = client.next_json();
+  EXPECT_EQ(info["op"], "serverInfo");
+  EXPECT_EQ(info["sessionId"], "test");
+  const json adv = client.next_json();
+  ASSERT_EQ(adv["op"], "advertise");
+  ASSERT_EQ(adv["channels"].size(), 1u);
+  EXPECT_EQ(adv["channels"][0]["topic"], "/rilbed/poses");
+  // Subscription id 0 is the client's first.
+  client.send_text({{"op", "subscribe"}, {"subscriptions", {{{"id", 0}, {"channelId", poses}}}}});
+  for (int i = 0; i < 200 && server.counters().messages_sent == 0; ++i) {
+    server.publish(poses, 1'000'000'000ULL + i, std::make_shared<const std::string>(R"({"n":)" + std::to_string(i) + "}"));
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  const auto data = std::get<std::string>(client.next());
+  ASSERT_GE(data.size(), 13u);
+  EXPECT_EQ(static_cast<unsigned char>(data[0]), 0x01);
+  EXPECT_EQ(data.substr(1, 4), std::string("\0\0\0\0", 4));  // subscription 0
+  EXPECT_EQ(data.substr(13, 5), R"({"n":)");
+  // A channel added later is advertised to the client.
+  const std::uint32_t world = server.add_channel({0, "/rilbed/world", "json", "rilbed.world", R"({"type":"object"})", "jsonschema"});
+  for (;;) {
+    auto m = client.next();
+    if (std::holds_alternative<json>(m) && std::get<json>(m)["op"] == "advertise") {
+      EXPECT_EQ(std::get<json>(m)["channels"][0]["id"], world);
+      break;
+    }
+  }
+}
+
+TEST(WebServer, ClientMessagesReachTheOwnerAndBadOnesGetAStatus) {
+  std::mutex mutex;
+  std::vector<std::string> heard;
+  WebServer::Handlers h;
+  h.on_client_message = [&](const std::string&, const std::string& topic, const std::string&, std::string_view payload)
+      -> std::optional<std::string> {
+    std::lock_guard lock(mutex);
+    heard.push_back(topic + " " + std::string(payload));
+    if (payload == "refuse") return std::string("not a command");
+    return std::nullopt;
+  };
+  WebServer server(config(), h);
+  Client client;
+  ASSERT_EQ(client.connect(server.port(), "/ws?token=" + kToken), 101);
+  client.next_json();
+  client.next_json();
+  auto expect_status = [&](int level, const std::string& text) {
+    const json st = client.next_json();
+    EXPECT_EQ(st["op"], "status");
+    EXPECT_EQ(st["level"], level);
+    EXPECT_NE(st["message"].get<std::string>().find(text), std::string::npos) << st.dump();
+  };
+  client.send_text({{"op", "advertise"}, {"channels", {{{"id", 1}, {"topic", "/rilbed/console"}, {"encoding", "json"}, {"schemaName", "c"}}}}});
+  client.send_binary(std::string("\x01\x01\x00\x00\x00", 5) + R"({"command":"pause"})");
+  client.send_binary(std::string("\x01\x01\x00\x00\x00", 5) + "refuse");
+  expect_status(2, "not a command");
+  client.send_text({{"op", "fly"}});
+  expect_status(2, "unknown op 'fly'");
+  client.ws.text(true);
+  client.ws.write(asio::buffer(std::string("{not json")));
+  expect_status(2, "not JSON");
+  client.send_binary(std::string("\x01\x09\x00\x00\x00{}", 7));
+  expect_status(2, "Channel 9 is not advertised");
+  client.send_binary(std::string("\x07", 1));
+  expect_status(2, "unknown binary opcode 7");
+  client.send_text({{"op", "subscribe"}, {"subscriptions", {{{"id", 0}, {"channelId", 42}}}}});
+  expect_status(1, "Channel 42 is not available");
+  client.send_text({{"op", "advertise"}, {"channels", {{{"id", 2}, {"topic", "/x"}, {"encoding", "cdr"}, {"schemaName", "c"}}}}});
+  expect_status(2, "encoding 'cdr' is not supported");
+  {
+    std::lock_guard lock(mutex);
+    EXPECT_EQ(heard, (std::vector<std::string>{R"(/rilbed/console {"command":"pause"})", "/rilbed/console refuse"}));
+  }
+  EXPECT_EQ(server.counters().bad_client_messages, 7u);
+  // Oversized: only that socket closes (1009); the server serves the next client.
+  WebServerConfig small = config();
+  small.max_message_bytes = 1024;
+  WebServer strict(small, {});
+  Client big;
+  ASSERT_EQ(big.connect(strict.port(), "/ws?token=" + kToken), 101);
+  big.next_json();
+  big.next_json();
+  beast::error_code ec;
+  big.ws.text(true);
+  // The server may close before the whole message is written (then the write fails).
+  big.ws.write(asio::buffer(json{{"op", "unsubscribe"}, {"subscriptionIds", json::array()}, {"pad", std::string(4096, 'x')}}.dump()), ec);
+  if (!ec) {
+    big.buffer.consume(big.buffer.size());
+    big.ws.read(big.buffer, ec);
+    EXPECT_EQ(ec, websocket::error::closed) << ec.message();
+    EXPECT_EQ(big.ws.reason().code, websocket::close_code::too_big);
+  }
+  for (int i = 0; i < 200 && strict.clients() > 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  EXPECT_EQ(strict.clients(), 0u);  // its socket closed
+  Client after;
+  EXPECT_EQ(after.connect(strict.port(), "/ws?token=" + kToken), 101);
+}
+
+TEST(WebServer, FiftyClientsAndOneThatNeverReadsHoldsUpNobody) {
+  WebServerConfig c = config();
+  c.max_queued_bytes = 256 * 1024;
+  WebServer server(c, {});
+  const std::uint32_t channel = server.add_channel(poses_channel());
+  std::vector<std::unique_ptr<Client>> clients;
+  for (int i = 0; i < 50; ++i) {
+    clients.push_back(std::make_unique<Client>());
+    ASSERT_EQ(clients.back()->connect(server.port(), "/ws?token=" + kToken), 101);
+    clients.back()->next_json();
+    clients.back()->next_json();
+    clients.back()->send_text({{"op", "subscribe"}, {"subscriptions", {{{"id", 5}, {"channelId", channel}}}}});
+  }
+  for (int i = 0; i < 200 && server.clients() < 50; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  EXPECT_EQ(server.clients(), 50u);
+  // Client 0 never reads again; the others read as they go. 2,000 messages of 16 kB: 32 MB
+  // for each client, far beyond what the stalled one's socket and queue hold.
+  const std::string blob(16 * 1024, 'x');
+  std::atomic<bool> stop{false};
+  std::vector<std::thread> readers;
+  std::vector<std::atomic<int>> got(50);
+  for (int k = 1; k < 50; ++k) {
+    readers.emplace_back([&, k] {
+      while (!stop.load()) {
+        beast::error_code ec;
+        clients[k]->buffer.consume(clients[k]->buffer.size());
+        clients[k]->ws.read(clients[k]->buffer, ec);
+        if (ec) return;
+        if (!clients[k]->ws.got_text()) ++got[k];
+      }
+    });
+  }
+  // Wait until every subscription is in (a message reaches each reader).
+  for (int i = 0; i < 500; ++i) {
+    server.publish(channel, 1, std::make_shared<const std::string>("{}"));
+    bool all = true;
+    for (int k = 1; k < 50; ++k) all = all && got[k] > 0;
+    if (all) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  const auto payload = std::make_shared<const std::string>(blob);
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < 2000; ++i) server.publish(channel, 2, payload);
+  const auto queued_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // The last message reaches every reading client: wait for a marker after the blobs.
+  const auto last = std::make_shared<const std::string>("{\"last\":true}");
+  std::vector<int> before(50);
+  for (int k = 1; k < 50; ++k) before[k] = got[k];
+  for (int i = 0; i < 3000; ++i) {
+    server.publish(channel, 3, last);
+    bool all = true;
+    for (int k = 1; k < 50; ++k) all = all && got[k] > before[k];
+    if (all) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  for (int k = 1; k < 50; ++k) EXPECT_GT(got[k].load(), before[k]) << "client " << k;
+  stop = true;
+  for (int k = 1; k < 50; ++k) {
+    beast::error_code ignored;
+    beast::get_lowest_layer(clients[k]->ws).socket().shutdown(tcp::socket::shutdown_both, ignored);
+  }
+  for (auto& t : readers) t.join();
+  // The stalled client lost messages; publishing never waited for it.
+  EXPECT_GT(server.counters().messages_dropped, 0u);
+  std::printf("[ web      ] 2,000 x 16 kB to 50 clients (one stalled): queued in %.3f s, %llu dropped for slow clients\n",
+              queued_s, static_cast<unsigned long long>(server.counters().messages_dropped));
+}
+
+}  // namespace
+}  // namespace rilbed::gui_web
