@@ -38,6 +38,8 @@ void add_replay_command(CLI::App& app);
 
 /// `rilbed console --lcm URL pause|resume|exit|rt-factor F`: steers a running run.
 void add_console_command(CLI::App& app);
+/// `rilbed gui --lcm URL`: the web control panel for a run on an LCM bus.
+void add_gui_command(CLI::App& app);
 
 /// Exit code a subcommand's callback stores for main() to return.
 int& exit_code();

@@ -1,0 +1,198 @@
+// `rilbed gui --lcm URL`: the web control panel's server for any run (or `rilbed replay`)
+// that publishes on URL. It subscribes to the run's channels and serves them over the
+// Foxglove WebSocket protocol (src/gui_web), and sends the console commands that browsers
+// publish on /rilbed/console ({"command": "pause", "args": []}) to the run over LCM, with
+// the run's token; the run's answers go back on /rilbed/console_reply.
+#include <spdlog/spdlog.h>
+
+#include <atomic>
+#include <condition_variable>
+#include <csignal>
+#include <cstdio>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "app/commands.hpp"
+#include "gui_web/run_channels.hpp"
+#include "gui_web/web_server.hpp"
+#include "links/lcm_bus.hpp"
+#include "links/lcm_console.hpp"
+
+namespace rilbed::app {
+
+namespace {
+
+std::atomic<bool> gui_interrupted{false};
+extern "C" void on_gui_signal(int) { gui_interrupted.store(true); }
+
+struct GuiArgs {
+  std::string url;
+  std::string prefix;
+  std::string bind = "127.0.0.1";
+  int port = 8080;
+  std::string run_token;  // the run's console token (default: its token file)
+  std::string web_root = RILBED_WEB_ROOT;
+};
+
+// Console commands from browsers, sent to the run one at a time on a thread of their own
+// (an answer takes up to a second; the web server's thread never waits for it).
+class ConsoleSender {
+ public:
+  ConsoleSender(const GuiArgs& args, gui_web::RunChannels& channels) : args_(args), channels_(channels) {
+    thread_ = std::thread([this] { loop(); });
+  }
+  ~ConsoleSender() {
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+    }
+    wake_.notify_all();
+    thread_.join();
+  }
+  // Checks a client's message; returns why it is not a command, or queues it.
+  std::optional<std::string> take(const std::string& client, std::string_view payload) {
+    const auto j = nlohmann::json::parse(payload, nullptr, false);
+    if (j.is_discarded() || !j.is_object() || !j.contains("command") || !j["command"].is_string()) {
+      return std::string("a console message is {\"command\": \"pause\", \"args\": []}");
+    }
+    Job job{client, j["command"].get<std::string>(), {}};
+    if (j.contains("args")) {
+      if (!j["args"].is_array() || j["args"].size() > 8) return std::string("args must be a list of at most 8 strings");
+      for (const auto& a : j["args"]) {
+        if (!a.is_string() && !a.is_number()) return std::string("args must be strings or numbers");
+        job.args.push_back(a.is_string() ? a.get<std::string>() : a.dump());
+      }
+    }
+    std::lock_guard lock(mutex_);
+    if (jobs_.size() >= 16) return std::string("too many console commands waiting");
+    jobs_.push_back(std::move(job));
+    wake_.notify_all();
+    return std::nullopt;
+  }
+
+ private:
+  struct Job {
+    std::string client, command;
+    std::vector<std::string> args;
+  };
+  void loop() {
+    std::string error;
+    auto lcm = links::open_lcm(args_.url, error);
+    for (;;) {
+      Job job;
+      {
+        std::unique_lock lock(mutex_);
+        wake_.wait(lock, [&] { return stopping_ || !jobs_.empty(); });
+        if (stopping_) return;
+        job = std::move(jobs_.front());
+        jobs_.pop_front();
+      }
+      std::string token = args_.run_token;
+      if (token.empty()) token = links::read_token(links::token_path(args_.prefix)).value_or("");
+      std::optional<rilbed::console_reply_t> reply;
+      if (lcm) reply = links::send_console_command(*lcm, links::Channels::with_prefix(args_.prefix), token, job.command, job.args, 1000);
+      if (reply) {
+        channels_.console_reply(0, reply->accepted, reply->reason, job.client);
+      } else {
+        channels_.console_reply(0, false, "no run answered on " + args_.url + " within a second", job.client);
+      }
+    }
+  }
+  const GuiArgs& args_;
+  gui_web::RunChannels& channels_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<Job> jobs_;
+  bool stopping_ = false;
+  std::thread thread_;
+};
+
+int gui_command(const GuiArgs& args) {
+  if (const auto problem = links::check_channel_prefix(args.prefix)) {
+    spdlog::error("gui: {}", *problem);
+    return kExitUsage;
+  }
+  if (args.port < 0 || args.port > 65535) {
+    spdlog::error("gui: --gui-port {} is not a port", args.port);
+    return kExitUsage;
+  }
+  std::string error;
+  std::unique_ptr<lcm::LCM> lcm = links::open_lcm(args.url, error);
+  if (!lcm) {
+    spdlog::error("gui: {}", error);
+    return kExitFailure;
+  }
+  gui_web::WebServerConfig config;
+  config.bind_address = args.bind;
+  config.port = static_cast<std::uint16_t>(args.port);
+  config.token = links::make_run_token();
+  config.session_id = config.token.substr(0, 8);
+  if (std::filesystem::is_directory(args.web_root)) config.web_root = args.web_root;
+  if (args.bind != "127.0.0.1") {
+    spdlog::warn("gui: serving on {}: anyone who can reach it and has the URL's token can watch and steer the run", args.bind);
+  }
+  std::unique_ptr<gui_web::RunChannels> channels;
+  std::unique_ptr<ConsoleSender> console;
+  gui_web::WebServer::Handlers handlers;
+  handlers.on_client_message = [&](const std::string& client, const std::string& topic, const std::string&,
+                                   std::string_view payload) -> std::optional<std::string> {
+    if (topic != "/rilbed/console") return "this server takes messages on /rilbed/console only, not " + topic;
+    return console->take(client, payload);
+  };
+  std::unique_ptr<gui_web::WebServer> server;
+  try {
+    server = std::make_unique<gui_web::WebServer>(config, handlers);
+  } catch (const std::exception& e) {
+    spdlog::error("gui: {}", e.what());
+    return kExitFailure;
+  }
+  channels = std::make_unique<gui_web::RunChannels>(*server);
+  console = std::make_unique<ConsoleSender>(args, *channels);
+  const links::Channels run_channels = links::Channels::with_prefix(args.prefix);
+  links::RunReportDecoder decoder(run_channels, *channels);
+  std::vector<std::unique_ptr<links::LcmSubscription>> subscriptions;
+  long bad = 0;
+  for (const std::string* c : {&run_channels.world, &run_channels.poses, &run_channels.events, &run_channels.status,
+                               &run_channels.summary, &run_channels.wheels, &run_channels.sensors, &run_channels.detections}) {
+    subscriptions.push_back(std::make_unique<links::LcmSubscription>(*lcm, *c, [&](const std::string& ch, const void* d, std::size_t n) {
+      if (const auto problem = decoder.decode(ch, d, n)) {
+        if (++bad <= 5) spdlog::warn("gui: {} (skipped)", *problem);
+      }
+    }));
+  }
+  std::printf("rilbed gui: http://%s:%u/?token=%s (the run on %s)\n", args.bind.c_str(), server->port(), config.token.c_str(),
+              args.url.c_str());
+  std::fflush(stdout);
+  std::signal(SIGINT, on_gui_signal);
+  std::signal(SIGTERM, on_gui_signal);
+  while (!gui_interrupted.load()) {
+    if (lcm->handleTimeout(100) < 0 && !gui_interrupted.load()) {
+      spdlog::error("gui: reading the LCM bus {} failed", args.url);
+      return kExitFailure;
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_gui_command(CLI::App& app) {
+  auto args = std::make_shared<GuiArgs>();
+  CLI::App* cmd = app.add_subcommand("gui", "Serve the web control panel (Foxglove WebSocket protocol) for a run on an LCM bus");
+  cmd->add_option("--lcm", args->url, "LCM URL of the run's bus (e.g. udpm://239.255.76.67:7667?ttl=0)")->required();
+  cmd->add_option("--channel-prefix", args->prefix, "The run's channel prefix");
+  cmd->add_option("--gui-port", args->port, "TCP port (0: any free one)")->default_val(8080);
+  cmd->add_option("--gui-bind", args->bind, "Address to serve on (anything but 127.0.0.1 opens it to the network)")
+      ->default_val("127.0.0.1");
+  cmd->add_option("--token", args->run_token, "The run's console token (default: from the run's token file)");
+  cmd->add_option("--web-root", args->web_root, "The page's files")->default_val(args->web_root);
+  cmd->callback([args] { exit_code() = gui_command(*args); });
+}
+
+}  // namespace rilbed::app

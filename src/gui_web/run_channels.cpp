@@ -1,0 +1,240 @@
+#include "gui_web/run_channels.hpp"
+
+#include <cmath>
+
+namespace rilbed::gui_web {
+
+namespace {
+
+using nlohmann::json;
+
+double seconds(TimeUs t_us) { return static_cast<double>(t_us) * 1e-6; }
+
+// A JSON Schema of an object with these properties (name -> type or schema).
+std::string object_schema(const std::string& title, const json& properties) {
+  return json{{"title", title}, {"type", "object"}, {"properties", properties}}.dump();
+}
+
+json number() { return {{"type", "number"}}; }
+json integer() { return {{"type", "integer"}}; }
+json text() { return {{"type", "string"}}; }
+json boolean() { return {{"type", "boolean"}}; }
+json array_of(const json& items) { return {{"type", "array"}, {"items", items}}; }
+json object_of(const json& properties) { return {{"type", "object"}, {"properties", properties}}; }
+
+json time_of(TimeUs t_us) {
+  const TimeUs t = std::max<TimeUs>(0, t_us);
+  return {{"sec", t / 1'000'000}, {"nsec", (t % 1'000'000) * 1000}};
+}
+json point(double x, double y, double z = 0.0) { return {{"x", x}, {"y", y}, {"z", z}}; }
+json pose(double x, double y, double z, double yaw_rad) {
+  return {{"position", point(x, y, z)}, {"orientation", {{"x", 0.0}, {"y", 0.0}, {"z", std::sin(yaw_rad / 2)}, {"w", std::cos(yaw_rad / 2)}}}};
+}
+json color(double r, double g, double b, double a = 1.0) { return {{"r", r}, {"g", g}, {"b", b}, {"a", a}}; }
+
+json entity(TimeUs t_us, const std::string& id) {
+  return {{"timestamp", time_of(t_us)}, {"frame_id", "field"}, {"id", id}, {"lifetime", {{"sec", 0}, {"nsec", 0}}},
+          {"frame_locked", false}, {"metadata", json::array()}, {"arrows", json::array()}, {"cubes", json::array()},
+          {"spheres", json::array()}, {"cylinders", json::array()}, {"lines", json::array()}, {"triangles", json::array()},
+          {"texts", json::array()}, {"models", json::array()}};
+}
+
+json line(const std::vector<Vec2>& points, bool loop, double thickness_m, const json& c) {
+  json pts = json::array();
+  for (const Vec2& p : points) pts.push_back(point(p.x, p.y));
+  return {{"type", loop ? 1 : 0}, {"pose", pose(0, 0, 0, 0)}, {"thickness", thickness_m}, {"scale_invariant", false},
+          {"points", pts}, {"color", c}, {"colors", json::array()}, {"indices", json::array()}};
+}
+
+// The parts of foxglove.SceneUpdate this server fills (Foxglove reads the datatypes of
+// what is there; the schema's name is what its 3D panel goes by).
+std::string scene_schema() {
+  const json vec3 = object_of({{"x", number()}, {"y", number()}, {"z", number()}});
+  const json quat = object_of({{"x", number()}, {"y", number()}, {"z", number()}, {"w", number()}});
+  const json pose_s = object_of({{"position", vec3}, {"orientation", quat}});
+  const json color_s = object_of({{"r", number()}, {"g", number()}, {"b", number()}, {"a", number()}});
+  const json time_s = object_of({{"sec", integer()}, {"nsec", integer()}});
+  const json cylinder = object_of({{"pose", pose_s}, {"size", vec3}, {"bottom_scale", number()}, {"top_scale", number()}, {"color", color_s}});
+  const json text_s = object_of({{"pose", pose_s}, {"billboard", boolean()}, {"font_size", number()}, {"scale_invariant", boolean()},
+                                 {"color", color_s}, {"text", text()}});
+  const json line_s = object_of({{"type", integer()}, {"pose", pose_s}, {"thickness", number()}, {"scale_invariant", boolean()},
+                                 {"points", array_of(vec3)}, {"color", color_s}, {"colors", array_of(color_s)},
+                                 {"indices", array_of(integer())}});
+  const json arrow = object_of({{"pose", pose_s}, {"shaft_length", number()}, {"shaft_diameter", number()},
+                                {"head_length", number()}, {"head_diameter", number()}, {"color", color_s}});
+  const json entity_s = object_of({{"timestamp", time_s}, {"frame_id", text()}, {"id", text()}, {"lifetime", time_s},
+                                   {"frame_locked", boolean()}, {"cylinders", array_of(cylinder)}, {"texts", array_of(text_s)},
+                                   {"lines", array_of(line_s)}, {"arrows", array_of(arrow)}});
+  const json deletion = object_of({{"timestamp", time_s}, {"type", integer()}, {"id", text()}});
+  return object_schema("foxglove.SceneUpdate", {{"deletions", array_of(deletion)}, {"entities", array_of(entity_s)}});
+}
+
+foxglove::Channel channel(const std::string& topic, const std::string& schema_name, const std::string& schema) {
+  return {0, topic, "json", schema_name, schema, "jsonschema"};
+}
+
+}  // namespace
+
+RunChannels::RunChannels(WebServer& server) : server_(server) {
+  const json robot_pose = object_of({{"id", integer()}, {"real", boolean()}, {"seen", boolean()}, {"x_m", number()},
+                                     {"y_m", number()}, {"theta_rad", number()}, {"behaviour", text()}, {"health", text()}});
+  const json polyline = array_of(object_of({{"x_m", number()}, {"y_m", number()}}));
+  world_ = server_.add_channel(channel("/rilbed/world", "rilbed.world",
+      object_schema("rilbed.world", {{"t_s", number()}, {"scenario", text()}, {"width_m", number()}, {"height_m", number()},
+                                     {"walls", boolean()}, {"obstacles", array_of(polyline)},
+                                     {"tracks", array_of(object_of({{"points", polyline}, {"width_m", number()}}))},
+                                     {"beacons", polyline}, {"robots", array_of(object_of({{"id", integer()}, {"real", boolean()}}))}})));
+  status_ = server_.add_channel(channel("/rilbed/status", "rilbed.status",
+      object_schema("rilbed.status", {{"t_s", number()}, {"wall_s", number()}, {"scenario", text()}, {"seed", integer()},
+                                      {"mode", text()}, {"realtime", boolean()}, {"rt_factor", number()}, {"state", text()},
+                                      {"ended_by", text()}, {"robots", integer()}, {"real_robots", integer()},
+                                      {"formed", boolean()}, {"formation_time_s", number()}, {"collisions", integer()},
+                                      {"loop_latency_ms", number()}, {"camera_fps", number()}, {"frames", integer()}})));
+  poses_ = server_.add_channel(channel("/rilbed/poses", "rilbed.poses",
+      object_schema("rilbed.poses", {{"t_s", number()}, {"robots", array_of(robot_pose)}})));
+  wheels_ = server_.add_channel(channel("/rilbed/wheels", "rilbed.wheels",
+      object_schema("rilbed.wheels", {{"t_s", number()}, {"robots", array_of(object_of({{"id", integer()}, {"left_units", integer()},
+                                                                                        {"right_units", integer()}}))}})));
+  sensors_ = server_.add_channel(channel("/rilbed/sensors", "rilbed.sensors",
+      object_schema("rilbed.sensors", {{"t_s", number()},
+                                       {"robots", array_of(object_of({{"id", integer()}, {"proximity", array_of(integer())},
+                                                                      {"range_m", array_of(number())}, {"range_hit", array_of(boolean())},
+                                                                      {"beacon_id", array_of(integer())},
+                                                                      {"beacon_bearing_rad", array_of(number())},
+                                                                      {"track", array_of(integer())}}))}})));
+  detections_ = server_.add_channel(channel("/rilbed/detections", "rilbed.detections",
+      object_schema("rilbed.detections", {{"t_s", number()}, {"frame", integer()}, {"process_ms", number()},
+                                          {"detections", array_of(object_of({{"id", integer()}, {"u_px", number()}, {"v_px", number()},
+                                                                             {"heading_deg", number()}, {"score", number()},
+                                                                             {"diameter_px", number()}, {"x_m", number()},
+                                                                             {"y_m", number()}, {"theta_rad", number()}}))}})));
+  events_ = server_.add_channel(channel("/rilbed/events", "rilbed.event",
+      object_schema("rilbed.event", {{"t_s", number()}, {"kind", text()}, {"id", integer()}, {"other", integer()}, {"detail", text()}})));
+  summary_ = server_.add_channel(channel("/rilbed/summary", "rilbed.summary", object_schema("rilbed.summary", json::object())));
+  scene_ = server_.add_channel(channel("/rilbed/scene", "foxglove.SceneUpdate", scene_schema()));
+  console_reply_ = server_.add_channel(channel("/rilbed/console_reply", "rilbed.console_reply",
+      object_schema("rilbed.console_reply", {{"t_s", number()}, {"accepted", boolean()}, {"reason", text()}, {"client", text()}})));
+}
+
+void RunChannels::send(std::uint32_t channel, TimeUs t_us, const json& message) {
+  server_.publish(channel, static_cast<std::uint64_t>(std::max<TimeUs>(0, t_us)) * 1000,
+                  std::make_shared<const std::string>(message.dump(-1, ' ', false, json::error_handler_t::replace)));
+}
+
+json RunChannels::world_json(TimeUs t_us, const agents::WorldReport& w) {
+  auto points = [](const std::vector<Vec2>& ps) {
+    json a = json::array();
+    for (const Vec2& p : ps) a.push_back({{"x_m", p.x}, {"y_m", p.y}});
+    return a;
+  };
+  json obstacles = json::array();
+  for (const auto& o : w.field.obstacles) obstacles.push_back(points(o));
+  json tracks = json::array();
+  for (const auto& [ps, width_m] : w.field.tracks) tracks.push_back({{"points", points(ps)}, {"width_m", width_m}});
+  json robots = json::array();
+  for (const int id : w.robot_ids) robots.push_back({{"id", id}, {"real", w.field.real_robot_ids.contains(id)}});
+  return {{"t_s", seconds(t_us)}, {"scenario", w.scenario}, {"width_m", w.field.width_m}, {"height_m", w.field.height_m},
+          {"walls", w.walls}, {"obstacles", obstacles}, {"tracks", tracks}, {"beacons", points(w.field.beacons)}, {"robots", robots}};
+}
+
+json RunChannels::poses_json(TimeUs t_us, std::span<const agents::PoseReport> poses) {
+  json robots = json::array();
+  for (const auto& p : poses) {
+    robots.push_back({{"id", p.id}, {"real", p.real}, {"seen", p.seen}, {"x_m", p.pose.position_m.x}, {"y_m", p.pose.position_m.y},
+                      {"theta_rad", p.pose.heading_rad}, {"behaviour", p.behaviour}, {"health", p.health}});
+  }
+  return {{"t_s", seconds(t_us)}, {"robots", robots}};
+}
+
+json RunChannels::status_json(const agents::StatusReport& s) {
+  return {{"t_s", seconds(s.t_us)}, {"wall_s", s.wall_s}, {"scenario", s.scenario}, {"seed", s.seed}, {"mode", s.mode},
+          {"realtime", s.realtime}, {"rt_factor", s.rt_factor}, {"state", s.state}, {"ended_by", s.ended_by},
+          {"robots", s.robots}, {"real_robots", s.real_robots}, {"formed", s.formed},
+          {"formation_time_s", s.formation_time_s ? json(*s.formation_time_s) : json(nullptr)}, {"collisions", s.collisions},
+          {"loop_latency_ms", s.loop_latency_ms}, {"camera_fps", s.camera_fps}, {"frames", s.frames}};
+}
+
+json RunChannels::scene_json(TimeUs t_us, std::span<const agents::PoseReport> poses, const std::optional<agents::WorldReport>& world) {
+  json entities = json::array();
+  if (world) {
+    json field = entity(t_us, "field");
+    const double w = world->field.width_m, h = world->field.height_m;
+    field["lines"].push_back(line({{0, 0}, {w, 0}, {w, h}, {0, h}}, true, 0.01, color(0.1, 0.7, 0.1)));
+    for (const auto& o : world->field.obstacles) field["lines"].push_back(line(o, true, 0.01, color(0.3, 0.3, 0.3)));
+    for (const auto& [ps, width_m] : world->field.tracks) field["lines"].push_back(line(ps, false, width_m, color(0.2, 0.2, 0.2, 0.6)));
+    entities.push_back(std::move(field));
+  }
+  constexpr double kDiameter_m = 0.055;  // a Khepera
+  for (const auto& p : poses) {
+    json e = entity(t_us, "robot " + std::to_string(p.id));
+    const json c = p.real ? color(0.15, 0.35, 0.9, p.seen ? 0.9 : 0.4) : color(0.9, 0.15, 0.15, 0.8);
+    const double x = p.pose.position_m.x, y = p.pose.position_m.y;
+    e["cylinders"].push_back({{"pose", pose(x, y, 0.01, p.pose.heading_rad)}, {"size", point(kDiameter_m, kDiameter_m, 0.02)},
+                              {"bottom_scale", 1.0}, {"top_scale", 1.0}, {"color", c}});
+    e["arrows"].push_back({{"pose", pose(x, y, 0.025, p.pose.heading_rad)}, {"shaft_length", 0.03}, {"shaft_diameter", 0.006},
+                           {"head_length", 0.012}, {"head_diameter", 0.014}, {"color", color(0, 0, 0)}});
+    e["texts"].push_back({{"pose", pose(x, y, 0.06, 0)}, {"billboard", true}, {"font_size", 12.0}, {"scale_invariant", true},
+                          {"color", color(0, 0, 0)}, {"text", std::to_string(p.id) + " " + std::string(p.behaviour)}});
+    entities.push_back(std::move(e));
+  }
+  return {{"deletions", json::array()}, {"entities", entities}};
+}
+
+void RunChannels::on_world(TimeUs t_us, const agents::WorldReport& world) {
+  world_report_ = world;
+  send(world_, t_us, world_json(t_us, world));
+}
+
+void RunChannels::on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) {
+  send(poses_, t_us, poses_json(t_us, poses));
+  send(scene_, t_us, scene_json(t_us, poses, world_report_));
+}
+
+void RunChannels::on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wheels) {
+  json robots = json::array();
+  for (const auto& w : wheels) robots.push_back({{"id", w.id}, {"left_units", w.wheels.left}, {"right_units", w.wheels.right}});
+  send(wheels_, t_us, {{"t_s", seconds(t_us)}, {"robots", robots}});
+}
+
+void RunChannels::on_sensors(TimeUs t_us, std::span<const agents::SensorReport> sensors) {
+  json robots = json::array();
+  for (const auto& r : sensors) {
+    const environment::SensorReadings& s = *r.readings;
+    json ranges = json::array(), hits = json::array(), ids = json::array(), bearings = json::array();
+    for (const auto& x : s.ranges) {
+      ranges.push_back(x.distance_m);
+      hits.push_back(x.hit);
+    }
+    for (const auto& b : s.beacons) {
+      ids.push_back(b.id);
+      bearings.push_back(b.bearing_rad);
+    }
+    robots.push_back({{"id", r.id}, {"proximity", s.proximity ? json(*s.proximity) : json::array()}, {"range_m", ranges},
+                      {"range_hit", hits}, {"beacon_id", ids}, {"beacon_bearing_rad", bearings}, {"track", s.track}});
+  }
+  send(sensors_, t_us, {{"t_s", seconds(t_us)}, {"robots", robots}});
+}
+
+void RunChannels::on_detections(const agents::FrameReport& f) {
+  json list = json::array();
+  for (const auto& d : f.detections) {
+    list.push_back({{"id", d.id}, {"u_px", d.u_px}, {"v_px", d.v_px}, {"heading_deg", d.heading_deg}, {"score", d.score},
+                    {"diameter_px", d.diameter_px}, {"x_m", d.pose.position_m.x}, {"y_m", d.pose.position_m.y},
+                    {"theta_rad", d.pose.heading_rad}});
+  }
+  send(detections_, f.t_us, {{"t_s", seconds(f.t_us)}, {"frame", f.frame}, {"process_ms", f.process_ms}, {"detections", list}});
+}
+
+void RunChannels::on_event(const agents::RunEvent& e) {
+  send(events_, e.t_us, {{"t_s", seconds(e.t_us)}, {"kind", e.kind}, {"id", e.id}, {"other", e.other}, {"detail", e.detail}});
+}
+
+void RunChannels::on_status(const agents::StatusReport& status) { send(status_, status.t_us, status_json(status)); }
+
+void RunChannels::on_summary(TimeUs t_us, const nlohmann::json& summary) { send(summary_, t_us, summary); }
+
+void RunChannels::console_reply(TimeUs t_us, bool accepted, const std::string& reason, const std::string& client) {
+  send(console_reply_, t_us, {{"t_s", seconds(t_us)}, {"accepted", accepted}, {"reason", reason}, {"client", client}});
+}
+
+}  // namespace rilbed::gui_web

@@ -1,0 +1,54 @@
+// A run as the web server's channels: what a run reports (agents::RunObserver, decoded from
+// its LCM messages) as JSON messages on Foxglove channels, with their JSON Schemas, for
+// rilbed's page and for Foxglove Studio or Lichtblick. Topics:
+//   /rilbed/world, /rilbed/status, /rilbed/poses, /rilbed/wheels, /rilbed/sensors,
+//   /rilbed/detections, /rilbed/events  (rilbed.* schemas, the LCM messages' fields)
+//   /rilbed/scene       (foxglove.SceneUpdate: the field and every robot, frame "field")
+//   /rilbed/console_reply  (the run's answers to console commands sent from a browser)
+// Times are simulated seconds (t_s); the binary header's time is the same in nanoseconds.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "agents/run_observer.hpp"
+#include "gui_web/web_server.hpp"
+
+namespace rilbed::gui_web {
+
+/// Publishes a run's reports on `server` (which must outlive it). Each on_ call converts
+/// and queues (WebServer::publish never blocks); call from one thread.
+class RunChannels final : public agents::RunObserver {
+ public:
+  explicit RunChannels(WebServer& server);
+  void on_world(TimeUs t_us, const agents::WorldReport& world) override;
+  void on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) override;
+  void on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wheels) override;
+  void on_sensors(TimeUs t_us, std::span<const agents::SensorReport> sensors) override;
+  void on_detections(const agents::FrameReport& frame) override;
+  void on_event(const agents::RunEvent& event) override;
+  void on_status(const agents::StatusReport& status) override;
+  void on_summary(TimeUs t_us, const nlohmann::json& summary) override;
+  /// The run's answer to a console command from a client (accepted, and why or what).
+  void console_reply(TimeUs t_us, bool accepted, const std::string& reason, const std::string& client);
+
+  /// The JSON messages, for tests and other servers.
+  static nlohmann::json world_json(TimeUs t_us, const agents::WorldReport& world);
+  static nlohmann::json poses_json(TimeUs t_us, std::span<const agents::PoseReport> poses);
+  static nlohmann::json status_json(const agents::StatusReport& status);
+  /// foxglove.SceneUpdate: every robot as a disc (virtual red, real blue) with its ID and
+  /// behaviour, and the field's boundary, obstacles and tracks as lines.
+  static nlohmann::json scene_json(TimeUs t_us, std::span<const agents::PoseReport> poses,
+                                   const std::optional<agents::WorldReport>& world);
+
+ private:
+  void send(std::uint32_t channel, TimeUs t_us, const nlohmann::json& message);
+
+  WebServer& server_;
+  std::uint32_t world_, status_, poses_, wheels_, sensors_, detections_, events_, scene_, console_reply_, summary_;
+  std::optional<agents::WorldReport> world_report_;
+};
+
+}  // namespace rilbed::gui_web
