@@ -1,0 +1,57 @@
+// `rilbed gui --lcm URL` against a real run on UDP multicast inside a private namespace,
+// with a Foxglove WebSocket client (ws_probe): the page's door needs the token, the run's
+// poses arrive as JSON on /rilbed/poses with every robot, and a pause published on
+// /rilbed/console reaches the run and comes back accepted on /rilbed/console_reply.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "lcm_namespace.hpp"
+#include "run_command.hpp"
+
+namespace rilbed::e2e {
+namespace {
+
+TEST(GuiCli, ServesARunOnTheBusAndSendsItsConsoleCommands) {
+  SKIP_WITHOUT_NAMESPACES();
+  const auto dir = scratch_dir("gui_cli");
+  const int status = in_namespace(dir,
+      "P2='" RILBED_WS_PROBE "'\n"
+      "\"$R\" run " + shipped_scenario_arg("convoy_sim") + " --realtime --duration 120 --lcm \"$URL\" --out run --quiet > run.txt 2> run.err &\n"
+      "P=$!\n"
+      "\"$R\" gui --lcm \"$URL\" --gui-port 0 > gui.txt 2> gui.err &\n"
+      "G=$!\n"
+      "for i in $(seq 1 200); do grep -q 'token=' gui.txt && break; sleep 0.05; done\n"
+      "HOSTPORT=$(sed -n 's|.*http://\\([^/]*\\)/?token=.*|\\1|p' gui.txt)\n"
+      "TOKEN=$(sed -n 's|.*?token=\\([0-9a-f]*\\).*|\\1|p' gui.txt)\n"
+      "set +e\n"
+      "\"$P2\" \"ws://$HOSTPORT/ws?token=wrong\" --topics /rilbed/poses --count 1 --timeout 5 > wrong.txt 2>&1; echo \"wrong $?\" >> codes.txt\n"
+      "\"$P2\" \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses,/rilbed/console_reply --count 1000 --until /rilbed/console_reply --timeout 60 "
+      "--send '/rilbed/console={\"command\":\"pause\"}' > probe.txt 2>&1; echo \"probe $?\" >> codes.txt\n"
+      "\"$R\" console --lcm \"$URL\" exit > exit.txt 2>&1; echo \"exit $?\" >> codes.txt\n"
+      "wait $P; echo \"run $?\" >> codes.txt\n"
+      "kill -INT $G; wait $G; echo \"gui $?\" >> codes.txt\n");
+  ASSERT_EQ(status, 0) << read_file(dir / "ns.log");
+  const std::string codes = read_file(dir / "codes.txt");
+  const std::string probe = read_file(dir / "probe.txt");
+  for (const char* line : {"wrong 1", "probe 0", "exit 0", "run 0", "gui 0"}) {
+    EXPECT_NE(codes.find(line), std::string::npos) << line << "\n" << codes << probe << read_file(dir / "gui.err");
+  }
+  EXPECT_NE(read_file(dir / "wrong.txt").find("declined"), std::string::npos) << read_file(dir / "wrong.txt");
+  // Poses: every robot of the run, as the run's folder has them.
+  const std::size_t first = probe.find("/rilbed/poses {");
+  ASSERT_NE(first, std::string::npos) << probe;
+  const auto poses = nlohmann::json::parse(probe.substr(first + 14, probe.find('\n', first) - first - 14));
+  EXPECT_EQ(poses["robots"].size(), 8u);
+  EXPECT_TRUE(poses["robots"][0].contains("behaviour"));
+  // The pause was accepted by the run, and the run recorded who asked.
+  EXPECT_NE(probe.find(R"(/rilbed/console_reply {"accepted":true)"), std::string::npos) << probe;
+  EXPECT_NE(probe.find(R"("reason":"pause")"), std::string::npos) << probe;
+  EXPECT_NE(read_file(dir / "run" / "events.csv").find(",console,0,0,paused by "), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rilbed::e2e
