@@ -122,6 +122,11 @@ int gui_command(const GuiArgs& args) {
     spdlog::error("gui: --gui-port {} is not a port", args.port);
     return kExitUsage;
   }
+  if (args.url.rfind("memq://", 0) == 0) {
+    spdlog::error("gui: memq:// is a bus inside one process, and no run can be heard on it from here: give the run's "
+                  "URL (rilbed run --lcm 'udpm://239.255.76.67:7667?ttl=0')");
+    return kExitUsage;
+  }
   std::string error;
   std::unique_ptr<lcm::LCM> lcm = links::open_lcm(args.url, error);
   if (!lcm) {
