@@ -112,9 +112,11 @@ struct WebServer::Impl {
     std::lock_guard lock(mutex);
     return id >= 1 && id <= channels.size();
   }
-  // The Origin a browser sends with the WebSocket: this server's own page, or one allowed.
-  bool origin_allowed(std::string_view origin) const {
+  // The Origin a browser sends with the WebSocket: this server's own page (the Origin is
+  // the host the browser asked for, on this port), or one allowed.
+  bool origin_allowed(std::string_view origin, std::string_view host) const {
     if (origin.empty()) return true;  // not a browser (a program: FoxgloveClient in Node, a test)
+    if (!host.empty() && origin == "http://" + std::string(host)) return true;
     for (const std::string& allowed : config.allowed_origins) {
       if (origin == allowed) return true;
     }
@@ -364,7 +366,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     if (!same_secret(target.token, server_.config.token)) return refuse(req, http::status::unauthorized, "a valid ?token= is needed\n");
     if (websocket::is_upgrade(req)) {
       if (target.path != "/ws") return refuse(req, http::status::not_found, "the WebSocket is at /ws\n");
-      if (!server_.origin_allowed(sv(req[http::field::origin]))) return refuse(req, http::status::forbidden, "Origin not allowed\n");
+      if (!server_.origin_allowed(sv(req[http::field::origin]), sv(req[http::field::host]))) return refuse(req, http::status::forbidden, "Origin not allowed\n");
       if (!offers_subprotocol(sv(req[http::field::sec_websocket_protocol]))) {
         return refuse(req, http::status::bad_request, "Missing expected sec-websocket-protocol header (foxglove.websocket.v1)\n");
       }

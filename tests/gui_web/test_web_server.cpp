@@ -61,12 +61,12 @@ std::pair<int, std::string> get(std::uint16_t port, const std::string& target) {
 // The status of a WebSocket upgrade request (101 when accepted), as a browser would send
 // it. (Beast 1.74's client does not keep the response of a declined handshake.)
 int upgrade_status(std::uint16_t port, const std::string& target, const std::string& subprotocol = "foxglove.websocket.v1",
-                   const std::string& origin = "") {
+                   const std::string& origin = "", const std::string& host = "") {
   asio::io_context io;
   beast::tcp_stream stream(io);
   stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
   http::request<http::empty_body> req(http::verb::get, target, 11);
-  req.set(http::field::host, "127.0.0.1:" + std::to_string(port));
+  req.set(http::field::host, host.empty() ? "127.0.0.1:" + std::to_string(port) : host);
   req.set(http::field::upgrade, "websocket");
   req.set(http::field::connection, "upgrade");
   req.set(http::field::sec_websocket_key, "dGhlIHNhbXBsZSBub25jZQ==");
@@ -152,8 +152,12 @@ TEST(WebServer, TheTokenOpensEverythingAndNothingOpensWithoutIt) {
   EXPECT_EQ(upgrade_status(server.port(), "/ws?token=" + kToken, "foxglove.websocket.v1",
                            "http://127.0.0.1:" + std::to_string(server.port())), 101);
   EXPECT_EQ(upgrade_status(server.port(), "/ws?token=" + kToken, "other, foxglove.websocket.v1"), 101);
+  // A page loaded from this server under another name (the lab machine's, on the LAN) is its own.
+  const std::string lan = "rilbed-lab.local:" + std::to_string(server.port());
+  EXPECT_EQ(upgrade_status(server.port(), "/ws?token=" + kToken, "foxglove.websocket.v1", "http://" + lan, lan), 101);
+  EXPECT_EQ(upgrade_status(server.port(), "/ws?token=" + kToken, "foxglove.websocket.v1", "http://evil.example", lan), 403);
   EXPECT_EQ(Client().connect(server.port(), "/ws?token=" + kToken), 101);
-  EXPECT_EQ(server.counters().refused, 7u);  // 3 pages, 4 WebSockets
+  EXPECT_EQ(server.counters().refused, 8u);  // 3 pages, 5 WebSockets
   std::filesystem::remove_all(root);
   EXPECT_THROW(WebServer(WebServerConfig{}, {}), std::invalid_argument);  // no token
   WebServerConfig taken = config();
