@@ -1,6 +1,7 @@
 #include "links/real_body.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -22,6 +23,15 @@ RealBody::~RealBody() {
   // batch, placement, the end of the program). A busy line or machine may take longer than
   // one command's retries: wait once more, longer.
   if (!link_->halt()) link_->halt(3000);
+  // D's reply ("d") carries nothing: on a slow line a late reply to an earlier D can pass
+  // for the stop's (seen: the link had its "acknowledgement" while the robot still drove
+  // at 18 19). The robot's own speeds, read back (E), tell: stop until they are 0 0.
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    const auto speeds = link_->query(Command::read_speeds(), std::chrono::milliseconds(1500));
+    if (!speeds) return;  // a link that is not running or lost: its own stop handles it
+    if (speeds->wheels.left == 0 && speeds->wheels.right == 0) return;
+    link_->halt(3000);
+  }
 }
 
 environment::SensorReadings RealBody::sense(TimeUs t_us) {
