@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
+#include <thread>
 
 namespace rilbed::links {
 
@@ -20,17 +21,19 @@ RealBody::RealBody(int id, environment::World& world, std::shared_ptr<KheperaLin
 
 RealBody::~RealBody() {
   // The run is over: the robot must stand before anything else happens (the next run of a
-  // batch, placement, the end of the program). A busy line or machine may take longer than
-  // one command's retries: wait once more, longer.
-  if (!link_->halt()) link_->halt(3000);
-  // D's reply ("d") carries nothing: on a slow line a late reply to an earlier D can pass
-  // for the stop's (seen: the link had its "acknowledgement" while the robot still drove
-  // at 18 19). The robot's own speeds, read back (E), tell: stop until they are 0 0.
-  for (int attempt = 0; attempt < 3; ++attempt) {
-    const auto speeds = link_->query(Command::read_speeds(), std::chrono::milliseconds(1500));
-    if (!speeds) return;  // a link that is not running or lost: its own stop handles it
-    if (speeds->wheels.left == 0 && speeds->wheels.right == 0) return;
+  // batch, placement, the end of the program). D's reply ("d") carries nothing, so a late
+  // reply to an earlier D can pass for the stop's on a slow line: the robot's own speeds,
+  // read back (E), tell. A port lost just now (a cable pulled) is reopened by the link
+  // every reopen interval: wait for it, within a bound, so that the stop can go out.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (link_->state() == LinkState::kLost) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      continue;
+    }
     link_->halt(3000);
+    const auto speeds = link_->query(Command::read_speeds(), std::chrono::milliseconds(1500));
+    if (speeds && speeds->wheels.left == 0 && speeds->wheels.right == 0) return;
   }
 }
 
