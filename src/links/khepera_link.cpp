@@ -1,11 +1,14 @@
 #include "links/khepera_link.hpp"
 
+#include <sys/file.h>
 #include <termios.h>
 
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cerrno>
 #include <condition_variable>
+#include <cstring>
 #include <deque>
 #include <future>
 #include <mutex>
@@ -144,6 +147,17 @@ struct KheperaLink::Impl {
     boost::system::error_code ec;
     serial.open(config.port, ec);
     if (ec) return prefix + "cannot open: " + ec.message();
+    // One program per robot: two runs driving the same robot would fight over it, and a
+    // reply read by the other would look lost to each. An advisory lock (released when the
+    // port closes, however the program ends) rather than TIOCEXCL, which root ignores and
+    // which outlives our descriptor on a pty whose other side stays open.
+    if (::flock(serial.native_handle(), LOCK_EX | LOCK_NB) != 0) {
+      const int error = errno;
+      boost::system::error_code ignored;
+      serial.close(ignored);
+      return prefix + "cannot open: " +
+             (error == EWOULDBLOCK ? std::string("another program is using it") : std::string(std::strerror(error)));
+    }
     using base = asio::serial_port_base;
     serial.set_option(base::baud_rate(config.baud), ec);
     if (!ec) serial.set_option(base::character_size(8), ec);

@@ -35,6 +35,11 @@ RealBody::~RealBody() {
     const auto speeds = link_->query(Command::read_speeds(), std::chrono::milliseconds(1500));
     if (speeds && speeds->wheels.left == 0 && speeds->wheels.right == 0) return;
   }
+  // Nothing more software can do: say so loudly, so that someone goes to the robot.
+  if (const LogCallback& log = link_->config().log) {
+    log(LogLevel::kError, "could not confirm that the robot stopped (its speeds never read back 0 0 within 10 s): "
+                          "switch it off by hand");
+  }
 }
 
 environment::SensorReadings RealBody::sense(TimeUs t_us) {

@@ -1,6 +1,10 @@
 #include "links/real_robots.hpp"
 
+#include <stdlib.h>
+
+#include <cerrno>
 #include <chrono>
+#include <system_error>
 #include <thread>
 
 namespace rilbed::links {
@@ -39,6 +43,28 @@ RealRobots::~RealRobots() {
     links = std::move(links_);
   }
   for (auto& [id, link] : links) link->stop();
+  links.clear();  // closes the ports (bodies may hold the last references, and are gone by now)
+  std::lock_guard lock(mutex_);
+  emulators_.clear();
+  if (!emulator_dir_.empty()) {
+    std::error_code ignored;
+    std::filesystem::remove_all(emulator_dir_, ignored);
+  }
+}
+
+std::string RealRobots::emulator_link_path(int id) {
+  // Under the caller's lock. The emulated robot is reached through a symlink that follows
+  // its pty across an unplug: a replugged pty may get another number, and its old
+  // /dev/pts/N may by then be another program's robot (as /dev/ttyUSB0 may after a real
+  // replug; on a real rig, use /dev/serial/by-id/).
+  if (emulator_dir_.empty()) {
+    std::string pattern = (std::filesystem::temp_directory_path() / "rilbed-robots-XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr) {
+      throw std::system_error(errno, std::generic_category(), "cannot make a folder for the emulated robots' ports");
+    }
+    emulator_dir_ = pattern;
+  }
+  return (emulator_dir_ / ("robot-" + std::to_string(id))).string();
 }
 
 std::shared_ptr<KheperaLink> RealRobots::connect(const agents::RobotSpec& spec, const Pose2& pose_if_new) {
@@ -63,9 +89,11 @@ std::shared_ptr<KheperaLink> RealRobots::connect(const agents::RobotSpec& spec, 
   // the wheel counters at their own rate.
   config.counters_period_ms = spec.link->counters_period_ms;
   if (spec.link->emulate) {
-    auto emulator = std::make_unique<KheperaEmulator>(emulator_config(spec, config.model, pose_if_new));
-    config.port = emulator->device_path();
     std::lock_guard lock(mutex_);
+    EmulatorConfig emu = emulator_config(spec, config.model, pose_if_new);
+    emu.stable_path = emulator_link_path(spec.id);
+    auto emulator = std::make_unique<KheperaEmulator>(emu);
+    config.port = emulator->device_path();
     emulators_[spec.id] = std::move(emulator);
   } else {
     config.port = spec.link->port;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <functional>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -51,9 +52,16 @@ class RealRobots {
   const agents::Scenario& scenario() const { return scenario_; }
 
  private:
+  // The stable device path for emulated robot `id` (makes emulator_dir_ if needed).
+  std::string emulator_link_path(int id);
+
   const agents::Scenario& scenario_;
   LogCallback log_;
   mutable std::mutex mutex_;
+  // A private folder for the emulated robots' stable device links ("robot-4" -> /dev/pts/N),
+  // made on the first emulated robot and removed with this object. Declared first: it
+  // outlives the emulators, which remove their links.
+  std::filesystem::path emulator_dir_;
   // Declared before the links: the links close (and stop their robots) first.
   std::map<int, std::unique_ptr<KheperaEmulator>> emulators_;
   std::map<int, std::shared_ptr<KheperaLink>> links_;

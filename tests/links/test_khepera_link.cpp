@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -337,6 +338,29 @@ TEST(KheperaLink, DestroyingTheLinkStopsTheRobot) {
     ASSERT_TRUE(eventually([&] { return emulator.last_speeds() == WheelSpeeds{40, 40}; })) << log.text();
   }
   EXPECT_EQ(emulator.last_speeds(), (WheelSpeeds{0, 0}));
+}
+
+TEST(KheperaLink, ARobotDrivenByOneProgramIsNotOpenedByAnother) {
+  // Two runs on one robot would fight over its wheels and read each other's replies. The
+  // second finds the port locked, says so, and gets it once the first lets go.
+  KheperaEmulator emulator;
+  LogSink first_log;
+  LogSink second_log;
+  auto first = std::make_unique<KheperaLink>(config_for(emulator, first_log));
+  ASSERT_EQ(first->start(), std::nullopt);
+  ASSERT_TRUE(eventually([&] { return first->state() == LinkState::kOk; })) << first_log.text();
+  KheperaLink second(config_for(emulator, second_log));
+  const std::optional<std::string> failure = second.start();
+  ASSERT_TRUE(failure.has_value());
+  EXPECT_NE(failure->find("another program is using it"), std::string::npos) << *failure;
+  EXPECT_EQ(second.state(), LinkState::kLost);
+  first->set_speeds(30, 30);
+  ASSERT_TRUE(eventually([&] { return emulator.last_speeds() == WheelSpeeds{30, 30}; })) << first_log.text();
+  first.reset();  // stops the robot and closes the port
+  EXPECT_EQ(emulator.last_speeds(), (WheelSpeeds{0, 0}));
+  ASSERT_TRUE(eventually([&] { return second.state() == LinkState::kOk; })) << second_log.text();
+  second.set_speeds(20, 20);
+  EXPECT_TRUE(eventually([&] { return emulator.last_speeds() == WheelSpeeds{20, 20}; })) << second_log.text();
 }
 
 TEST(KheperaLink, AMissingPortFailsAtOnceNamingIt) {
