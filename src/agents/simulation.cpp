@@ -500,6 +500,13 @@ class ControlModel final : public sim::AtomicModel<std::vector<ConsoleOrder>> { 
         o.wheels = {a.left, a.right};
         o.until_us = t_us_ + seconds_to_us(a.duration_s);
         state_.push_back(o);
+        // A held drive (the web panel's, renewed every few tenths of a second) is one
+        // event while its speeds stay and it does not lapse, not one per renewal.
+        const auto last = drives_.find(a.robot_id);
+        const bool renewal = last != drives_.end() && last->second.wheels == o.wheels && last->second.until_us >= t_us_ &&
+                             last->second.who == a.who;
+        drives_[a.robot_id] = {o.wheels, o.until_us, a.who};
+        if (renewal) break;
         std::ostringstream text;
         text << "robot " << a.robot_id << " driven " << a.left << " " << a.right << " for " << a.duration_s << " s by "
              << a.who;
@@ -512,10 +519,18 @@ class ControlModel final : public sim::AtomicModel<std::vector<ConsoleOrder>> { 
     }
   }
 
+  // The last hand drive of each robot (to tell a renewal from a new drive).
+  struct LastDrive {
+    WheelCommand wheels;
+    TimeUs until_us = 0;
+    std::string who;
+  };
+
   Setup s_;
   sim::Port<ControlAction>& in_;
   sim::Port<ConsoleOrder>& out_;
   TimeUs t_us_ = 0;
+  std::map<int, LastDrive> drives_;
 };
 
 // The field as the run folder's picture and a watcher draw it.

@@ -19,8 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.hpp"
-#include "gui_web/run_channels.hpp"
-#include "gui_web/web_server.hpp"
+#include "gui_web/gui_service.hpp"
 #include "links/lcm_bus.hpp"
 #include "links/lcm_console.hpp"
 
@@ -40,78 +39,23 @@ struct GuiArgs {
   std::string web_root = RILBED_WEB_ROOT;
 };
 
-// Console commands from browsers, sent to the run one at a time on a thread of their own
-// (an answer takes up to a second; the web server's thread never waits for it).
-class ConsoleSender {
- public:
-  ConsoleSender(const GuiArgs& args, gui_web::RunChannels& channels) : args_(args), channels_(channels) {
-    thread_ = std::thread([this] { loop(); });
-  }
-  ~ConsoleSender() {
-    {
-      std::lock_guard lock(mutex_);
-      stopping_ = true;
-    }
-    wake_.notify_all();
-    thread_.join();
-  }
-  // Checks a client's message; returns why it is not a command, or queues it.
-  std::optional<std::string> take(const std::string& client, std::string_view payload) {
-    const auto j = nlohmann::json::parse(payload, nullptr, false);
-    if (j.is_discarded() || !j.is_object() || !j.contains("command") || !j["command"].is_string()) {
-      return std::string("a console message is {\"command\": \"pause\", \"args\": []}");
-    }
-    Job job{client, j["command"].get<std::string>(), {}};
-    if (j.contains("args")) {
-      if (!j["args"].is_array() || j["args"].size() > 8) return std::string("args must be a list of at most 8 strings");
-      for (const auto& a : j["args"]) {
-        if (!a.is_string() && !a.is_number()) return std::string("args must be strings or numbers");
-        job.args.push_back(a.is_string() ? a.get<std::string>() : a.dump());
-      }
-    }
-    std::lock_guard lock(mutex_);
-    if (jobs_.size() >= 16) return std::string("too many console commands waiting");
-    jobs_.push_back(std::move(job));
-    wake_.notify_all();
-    return std::nullopt;
-  }
-
- private:
-  struct Job {
-    std::string client, command;
-    std::vector<std::string> args;
-  };
-  void loop() {
+// The console sink of `rilbed gui`: each command goes to the run over LCM with the run's
+// token, and waits (up to a second, resending) for its answer. Called on the GUI service's
+// thread only, which owns this LCM instance.
+gui_web::ConsoleSink lcm_console_sink(const GuiArgs& args) {
+  auto lcm = std::shared_ptr<lcm::LCM>();
+  return [&args, lcm](const gui_web::ConsoleRequest& request) mutable -> gui_web::ConsoleAnswer {
     std::string error;
-    auto lcm = links::open_lcm(args_.url, error);
-    for (;;) {
-      Job job;
-      {
-        std::unique_lock lock(mutex_);
-        wake_.wait(lock, [&] { return stopping_ || !jobs_.empty(); });
-        if (stopping_) return;
-        job = std::move(jobs_.front());
-        jobs_.pop_front();
-      }
-      std::string token = args_.run_token;
-      if (token.empty()) token = links::read_token(links::token_path(args_.prefix)).value_or("");
-      std::optional<rilbed::console_reply_t> reply;
-      if (lcm) reply = links::send_console_command(*lcm, links::Channels::with_prefix(args_.prefix), token, job.command, job.args, 1000);
-      if (reply) {
-        channels_.console_reply(0, reply->accepted, reply->reason, job.client);
-      } else {
-        channels_.console_reply(0, false, "no run answered on " + args_.url + " within a second", job.client);
-      }
-    }
-  }
-  const GuiArgs& args_;
-  gui_web::RunChannels& channels_;
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  std::deque<Job> jobs_;
-  bool stopping_ = false;
-  std::thread thread_;
-};
+    if (!lcm) lcm = links::open_lcm(args.url, error);
+    if (!lcm) return {false, "cannot reach the bus " + args.url + ": " + error};
+    std::string token = args.run_token;
+    if (token.empty()) token = links::read_token(links::token_path(args.prefix)).value_or("");
+    const auto reply = links::send_console_command(*lcm, links::Channels::with_prefix(args.prefix), token, request.command,
+                                                   request.args, 1000, 200, request.client);
+    if (!reply) return {false, "no run answered on " + args.url + " within a second"};
+    return {reply->accepted != 0, reply->reason};
+  };
+}
 
 int gui_command(const GuiArgs& args) {
   if (const auto problem = links::check_channel_prefix(args.prefix)) {
@@ -142,25 +86,15 @@ int gui_command(const GuiArgs& args) {
   if (args.bind != "127.0.0.1") {
     spdlog::warn("gui: serving on {}: anyone who can reach it and has the URL's token can watch and steer the run", args.bind);
   }
-  std::unique_ptr<gui_web::RunChannels> channels;
-  std::unique_ptr<ConsoleSender> console;
-  gui_web::WebServer::Handlers handlers;
-  handlers.on_client_message = [&](const std::string& client, const std::string& topic, const std::string&,
-                                   std::string_view payload) -> std::optional<std::string> {
-    if (topic != "/rilbed/console") return "this server takes messages on /rilbed/console only, not " + topic;
-    return console->take(client, payload);
-  };
-  std::unique_ptr<gui_web::WebServer> server;
+  std::unique_ptr<gui_web::GuiService> gui;
   try {
-    server = std::make_unique<gui_web::WebServer>(config, handlers);
+    gui = std::make_unique<gui_web::GuiService>(config, lcm_console_sink(args));
   } catch (const std::exception& e) {
     spdlog::error("gui: {}", e.what());
     return kExitFailure;
   }
-  channels = std::make_unique<gui_web::RunChannels>(*server);
-  console = std::make_unique<ConsoleSender>(args, *channels);
   const links::Channels run_channels = links::Channels::with_prefix(args.prefix);
-  links::RunReportDecoder decoder(run_channels, *channels);
+  links::RunReportDecoder decoder(run_channels, *gui);
   std::vector<std::unique_ptr<links::LcmSubscription>> subscriptions;
   long bad = 0;
   for (const std::string* c : {&run_channels.world, &run_channels.poses, &run_channels.events, &run_channels.status,
@@ -171,8 +105,7 @@ int gui_command(const GuiArgs& args) {
       }
     }));
   }
-  std::printf("rilbed gui: http://%s:%u/?token=%s (the run on %s)\n", args.bind.c_str(), server->port(), config.token.c_str(),
-              args.url.c_str());
+  std::printf("rilbed gui: %s (the run on %s)\n", gui->url().c_str(), args.url.c_str());
   std::fflush(stdout);
   std::signal(SIGINT, on_gui_signal);
   std::signal(SIGTERM, on_gui_signal);

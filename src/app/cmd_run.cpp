@@ -23,6 +23,7 @@
 #include "app/commands.hpp"
 #include "core/id_list.hpp"
 #include "core/statistics.hpp"
+#include "gui_web/gui_service.hpp"
 #include "links/lcm_bus.hpp"
 #include "links/lcm_console.hpp"
 #include "links/placement.hpp"
@@ -90,7 +91,30 @@ struct RunArgs {
   std::string channel_prefix;
   bool no_place = false;      // real robots start where they stand
   double place_timeout_s = 90.0;
+  bool gui = false;           // serve the web control panel from this process
+  int gui_port = 8080;
+  std::string gui_bind = "127.0.0.1";
+  std::string web_root = RILBED_WEB_ROOT;
 };
+
+// The console sink of `rilbed run --gui`: a browser's command acts on this run's own
+// RunControl, checked as a console's command over LCM is (the web server has checked the
+// token already).
+gui_web::ConsoleSink run_control_sink(agents::RunControl& control) {
+  return [&control](const gui_web::ConsoleRequest& request) -> gui_web::ConsoleAnswer {
+    rilbed::console_command_t c;
+    c.client = "gui " + request.client;
+    c.command = request.command;
+    c.args = request.args;
+    c.num_args = static_cast<std::int32_t>(c.args.size());
+    auto parsed = links::parse_console_command(c);
+    if (auto* why = std::get_if<std::string>(&parsed)) return {false, *why};
+    if (auto refusal = control.act(std::get<agents::ControlAction>(parsed))) return {false, *refusal};
+    std::string done = request.command;
+    for (const std::string& arg : request.args) done += " " + arg;
+    return {true, done};
+  };
+}
 
 // Puts the real robots at the start poses of `seed` (links::place_real_robots), reports
 // what it did, and throws when they could not be placed (the batch then ends).
@@ -303,6 +327,12 @@ int run_command(const RunArgs& args) {
       return kExitFailure;
     }
   }
+  // Steering the run (the console on the bus, the web panel).
+  agents::RunControl control;
+  // The web panel (--gui), made below; declared here for the runs' buses to feed it. It
+  // outlives every run (a reset starts a new one; its viewers stay) and goes before the
+  // control its commands act on.
+  std::unique_ptr<gui_web::GuiService> gui;
   // The publisher of the run now going (a paused run re-publishes its world and status).
   std::mutex current_mutex;
   links::LcmRunPublisher* current_publisher = nullptr;
@@ -336,6 +366,7 @@ int run_command(const RunArgs& args) {
         std::fflush(stdout);
       });
       if (status_line) publisher.add_local_subscriber(line);
+      if (gui) publisher.add_local_subscriber(*gui);
       o.observer = &publisher;
       {
         std::lock_guard lock(current_mutex);
@@ -367,7 +398,6 @@ int run_command(const RunArgs& args) {
     };
   };
   // The console: commands on the bus, each with this run's token.
-  agents::RunControl control;
   std::unique_ptr<links::LcmConsoleServer> console;
   std::filesystem::path token_file;
   std::string token;
@@ -397,6 +427,36 @@ int run_command(const RunArgs& args) {
           std::lock_guard lock(current_mutex);
           if (current_publisher) current_publisher->republish_world_and_status();
         });
+    options.control = &control;
+  }
+  // The web control panel, in this process: a local subscriber of the run's messages
+  // (as the folder is) whose commands act on the run's control.
+  if (args.gui) {
+    if (args.seeds > 0) {
+      spdlog::error("--gui shows one run: leave out --seeds");
+      return kExitUsage;
+    }
+    if (args.gui_port < 0 || args.gui_port > 65535) {
+      spdlog::error("--gui-port {} is not a port", args.gui_port);
+      return kExitUsage;
+    }
+    gui_web::WebServerConfig config;
+    config.bind_address = args.gui_bind;
+    config.port = static_cast<std::uint16_t>(args.gui_port);
+    config.token = token.empty() ? links::make_run_token() : token;
+    config.session_id = config.token.substr(0, 8);
+    if (std::filesystem::is_directory(args.web_root)) config.web_root = args.web_root;
+    if (args.gui_bind != "127.0.0.1") {
+      spdlog::warn("gui: serving on {}: anyone who can reach it and has the URL's token can watch and steer the run", args.gui_bind);
+    }
+    try {
+      gui = std::make_unique<gui_web::GuiService>(config, run_control_sink(control));
+    } catch (const std::exception& e) {
+      spdlog::error("gui: {}", e.what());
+      return kExitFailure;
+    }
+    std::printf("rilbed gui: %s\n", gui->url().c_str());
+    std::fflush(stdout);
     options.control = &control;
   }
   std::signal(SIGINT, on_signal);
@@ -440,6 +500,9 @@ int run_command(const RunArgs& args) {
     print_result(r);
     if (real) print_emulated_last_speeds(*real);
     if (!args.out.empty()) std::printf("run folder: %s\n", args.out.c_str());
+    // The page's viewers get the run's end (its last status and summary) before the
+    // server goes; their page then says the run ended, not that the server vanished.
+    if (gui) gui->server().flush(std::chrono::seconds(2));
   } catch (const agents::ScenarioError& e) {
     spdlog::error("{}", e.what());
     return kExitFailure;
@@ -489,6 +552,11 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--place-timeout", args->place_timeout_s,
                   "Seconds the real robots get to drive to their start poses before the operator is asked")
       ->check(CLI::PositiveNumber)->default_val(90);
+  cmd->add_flag("--gui", args->gui, "Serve the web control panel from this run (prints its URL with a fresh token)");
+  cmd->add_option("--gui-port", args->gui_port, "With --gui: TCP port (0: any free one)")->default_val(8080);
+  cmd->add_option("--gui-bind", args->gui_bind, "With --gui: address to serve on (anything but 127.0.0.1 opens it to the network)")
+      ->default_val("127.0.0.1");
+  cmd->add_option("--web-root", args->web_root, "With --gui: the page's files")->default_val(args->web_root);
   cmd->add_flag("--quiet", args->quiet, "No per-second status (realtime) or per-run lines (batch)");
   cmd->callback([args] { exit_code() = run_command(*args); });
 }

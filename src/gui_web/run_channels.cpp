@@ -83,15 +83,15 @@ RunChannels::RunChannels(WebServer& server) : server_(server) {
       object_schema("rilbed.world", {{"t_s", number()}, {"scenario", text()}, {"width_m", number()}, {"height_m", number()},
                                      {"walls", boolean()}, {"obstacles", array_of(polyline)},
                                      {"tracks", array_of(object_of({{"points", polyline}, {"width_m", number()}}))},
-                                     {"beacons", polyline}, {"robots", array_of(object_of({{"id", integer()}, {"real", boolean()}}))}})));
+                                     {"beacons", polyline}, {"robots", array_of(object_of({{"id", integer()}, {"real", boolean()}}))}})), /*latched=*/true);
   status_ = server_.add_channel(channel("/rilbed/status", "rilbed.status",
       object_schema("rilbed.status", {{"t_s", number()}, {"wall_s", number()}, {"scenario", text()}, {"seed", integer()},
                                       {"mode", text()}, {"realtime", boolean()}, {"rt_factor", number()}, {"state", text()},
                                       {"ended_by", text()}, {"robots", integer()}, {"real_robots", integer()},
                                       {"formed", boolean()}, {"formation_time_s", number()}, {"collisions", integer()},
-                                      {"loop_latency_ms", number()}, {"camera_fps", number()}, {"frames", integer()}})));
+                                      {"loop_latency_ms", number()}, {"camera_fps", number()}, {"frames", integer()}})), /*latched=*/true);
   poses_ = server_.add_channel(channel("/rilbed/poses", "rilbed.poses",
-      object_schema("rilbed.poses", {{"t_s", number()}, {"robots", array_of(robot_pose)}})));
+      object_schema("rilbed.poses", {{"t_s", number()}, {"robots", array_of(robot_pose)}})), /*latched=*/true);
   wheels_ = server_.add_channel(channel("/rilbed/wheels", "rilbed.wheels",
       object_schema("rilbed.wheels", {{"t_s", number()}, {"robots", array_of(object_of({{"id", integer()}, {"left_units", integer()},
                                                                                         {"right_units", integer()}}))}})));
@@ -111,7 +111,7 @@ RunChannels::RunChannels(WebServer& server) : server_(server) {
   events_ = server_.add_channel(channel("/rilbed/events", "rilbed.event",
       object_schema("rilbed.event", {{"t_s", number()}, {"kind", text()}, {"id", integer()}, {"other", integer()}, {"detail", text()}})));
   summary_ = server_.add_channel(channel("/rilbed/summary", "rilbed.summary", object_schema("rilbed.summary", json::object())));
-  scene_ = server_.add_channel(channel("/rilbed/scene", "foxglove.SceneUpdate", scene_schema()));
+  scene_ = server_.add_channel(channel("/rilbed/scene", "foxglove.SceneUpdate", scene_schema()), /*latched=*/true);
   console_reply_ = server_.add_channel(channel("/rilbed/console_reply", "rilbed.console_reply",
       object_schema("rilbed.console_reply", {{"t_s", number()}, {"accepted", boolean()}, {"reason", text()}, {"client", text()}})));
 }

@@ -5,6 +5,8 @@
 //   /rilbed/detections, /rilbed/events  (rilbed.* schemas, the LCM messages' fields)
 //   /rilbed/scene       (foxglove.SceneUpdate: the field and every robot, frame "field")
 //   /rilbed/console_reply  (the run's answers to console commands sent from a browser)
+// The world, status, poses and scene are latched: a viewer that joins gets the
+// last of each at once (a paused run sends nothing new).
 // Times are simulated seconds (t_s); the binary header's time is the same in nanoseconds.
 #pragma once
 

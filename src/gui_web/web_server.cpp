@@ -10,6 +10,7 @@
 #include <chrono>
 #include <deque>
 #include <fstream>
+#include <future>
 #include <map>
 #include <mutex>
 #include <set>
@@ -58,6 +59,21 @@ Target parse_target(std::string_view target) {
   return t;
 }
 
+// The value of cookie `name` in a Cookie header ("a=1; b=2"), or "".
+std::string cookie_value(std::string_view header, const std::string& name) {
+  while (!header.empty()) {
+    const std::size_t semi = header.find(';');
+    std::string_view item = header.substr(0, semi);
+    while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
+    if (item.size() > name.size() && item.substr(0, name.size()) == name && item[name.size()] == '=') {
+      return std::string(item.substr(name.size() + 1));
+    }
+    if (semi == std::string_view::npos) break;
+    header.remove_prefix(semi + 1);
+  }
+  return {};
+}
+
 std::string content_type(const std::filesystem::path& p) {
   const std::string ext = p.extension().string();
   if (ext == ".html") return "text/html; charset=utf-8";
@@ -98,6 +114,9 @@ struct WebServer::Impl {
   std::vector<foxglove::Channel> channels;  // every channel offered, in id order
   WebServerCounters counts;
   std::set<std::shared_ptr<WsSession>> sessions;  // the server's thread only
+  std::set<std::uint32_t> latched;                // guarded by mutex
+  // The last message of each latched channel (the server's thread only).
+  std::map<std::uint32_t, std::pair<std::uint64_t, std::shared_ptr<const std::string>>> latest;
   std::atomic<std::size_t> client_count{0};
 
   void count(std::uint64_t WebServerCounters::*field, std::uint64_t n = 1) {
@@ -140,6 +159,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     name_ = ec ? std::string("client") : remote.address().to_string() + ":" + std::to_string(remote.port());
   }
   const std::string& name() const { return name_; }
+  // Nothing queued or being written.
+  bool idle() const { return queue_.empty() && !writing_; }
 
   void start(http::request<http::string_body> request) {
     ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
@@ -282,6 +303,9 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
       } else {
         sub_to_channel_[s.id] = s.channel_id;
         channel_to_sub_[s.channel_id] = s.id;
+        if (const auto it = server_.latest.find(s.channel_id); it != server_.latest.end()) {
+          offer(s.channel_id, it->second.first, it->second.second);
+        }
       }
     }
   }
@@ -363,7 +387,14 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
  private:
   void on_request(http::request<http::string_body> req) {
     const Target target = parse_target(sv(req.target()));
-    if (!same_secret(target.token, server_.config.token)) return refuse(req, http::status::unauthorized, "a valid ?token= is needed\n");
+    const bool by_query = same_secret(target.token, server_.config.token);
+    // The page's own files (its script, its style sheet) are fetched without the query:
+    // the page's load sets a cookie with the token (this port's own name: cookies do not
+    // tell ports apart). The WebSocket needs the query, as Foxglove's clients send it.
+    const bool by_cookie = !by_query && !websocket::is_upgrade(req) &&
+                           same_secret(cookie_value(sv(req[http::field::cookie]), cookie_name()), server_.config.token);
+    if (!by_query && !by_cookie) return refuse(req, http::status::unauthorized, "a valid ?token= is needed\n");
+    set_cookie_ = by_query;
     if (websocket::is_upgrade(req)) {
       if (target.path != "/ws") return refuse(req, http::status::not_found, "the WebSocket is at /ws\n");
       if (!server_.origin_allowed(sv(req[http::field::origin]), sv(req[http::field::host]))) return refuse(req, http::status::forbidden, "Origin not allowed\n");
@@ -383,6 +414,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     }
     serve_file(req, target.path);
   }
+
+  std::string cookie_name() const { return "rilbed_token_" + std::to_string(server_.port); }
 
   void serve_file(const http::request<http::string_body>& req, const std::string& path) {
     if (server_.config.web_root.empty() || path.find("..") != std::string::npos || path.empty() || path[0] != '/') {
@@ -406,6 +439,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     res->set(http::field::server, "rilbed");
     res->set(http::field::content_type, type);
     res->set(http::field::cache_control, "no-store");
+    if (set_cookie_ && status == http::status::ok) {
+      res->set(http::field::set_cookie, cookie_name() + "=" + server_.config.token + "; Path=/; HttpOnly; SameSite=Strict");
+    }
     res->keep_alive(false);
     res->body() = req.method() == http::verb::head ? std::string() : std::move(body);
     res->prepare_payload();
@@ -417,6 +453,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 
   beast::tcp_stream stream_;
   WebServer::Impl& server_;
+  bool set_cookie_ = false;  // this request came with the token in its query
   beast::flat_buffer buffer_;
   http::request_parser<http::string_body> parser_;
 };
@@ -471,12 +508,13 @@ WebServer::~WebServer() {
 
 std::uint16_t WebServer::port() const { return impl_->port; }
 
-std::uint32_t WebServer::add_channel(foxglove::Channel channel) {
+std::uint32_t WebServer::add_channel(foxglove::Channel channel, bool latched) {
   Impl& m = *impl_;
   {
     std::lock_guard lock(m.mutex);
     channel.id = static_cast<std::uint32_t>(m.channels.size() + 1);
     m.channels.push_back(channel);
+    if (latched) m.latched.insert(channel.id);
   }
   asio::post(m.io, [&m, channel] {
     for (const auto& s : m.sessions) s->advertise(channel);
@@ -486,12 +524,37 @@ std::uint32_t WebServer::add_channel(foxglove::Channel channel) {
 
 void WebServer::publish(std::uint32_t channel, std::uint64_t t_ns, std::shared_ptr<const std::string> payload) {
   Impl& m = *impl_;
-  asio::post(m.io, [&m, channel, t_ns, payload = std::move(payload)] {
+  bool latched = false;
+  {
+    std::lock_guard lock(m.mutex);
+    latched = m.latched.contains(channel);
+  }
+  asio::post(m.io, [&m, channel, t_ns, latched, payload = std::move(payload)] {
+    if (latched) m.latest[channel] = {t_ns, payload};
     for (const auto& s : m.sessions) s->offer(channel, t_ns, payload);
   });
 }
 
 std::size_t WebServer::clients() const { return impl_->client_count.load(); }
+
+bool WebServer::flush(std::chrono::milliseconds timeout) {
+  Impl& m = *impl_;
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    // Asked on the server's thread, after everything published before this call.
+    auto idle = std::make_shared<std::promise<bool>>();
+    std::future<bool> answer = idle->get_future();
+    asio::post(m.io, [&m, idle] {
+      bool all = true;
+      for (const auto& s : m.sessions) all = all && s->idle();
+      idle->set_value(all);
+    });
+    if (answer.wait_until(deadline) != std::future_status::ready) return false;
+    if (answer.get()) return true;
+    if (std::chrono::steady_clock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
 
 WebServerCounters WebServer::counters() const {
   std::lock_guard lock(impl_->mutex);

@@ -15,6 +15,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -73,11 +74,16 @@ class WebServer {
 
   /// The port it listens on.
   std::uint16_t port() const;
-  /// Offers a channel to every client, present and future; returns its id (from 1).
-  std::uint32_t add_channel(foxglove::Channel channel);
+  /// Offers a channel to every client, present and future; returns its id (from 1). A
+  /// `latched` channel's last message is sent to each client as it subscribes (the run's
+  /// world and status, for a viewer joining a paused run); costs one message's memory.
+  std::uint32_t add_channel(foxglove::Channel channel, bool latched = false);
   /// Sends `payload` on `channel` to every client subscribed to it, stamped `t_ns`. Never
   /// blocks: the message is queued on the server's thread.
   void publish(std::uint32_t channel, std::uint64_t t_ns, std::shared_ptr<const std::string> payload);
+  /// Waits until everything published so far has been written to every client (or
+  /// dropped for one that did not keep up), at most `timeout`; returns whether it was.
+  bool flush(std::chrono::milliseconds timeout);
   /// Clients connected now.
   std::size_t clients() const;
   WebServerCounters counters() const;

@@ -308,12 +308,13 @@ struct ReplyCatcher {
 std::optional<rilbed::console_reply_t> send_console_command(lcm::LCM& lcm, const Channels& channels,
                                                             const std::string& token, const std::string& command,
                                                             const std::vector<std::string>& args, int timeout_ms,
-                                                            int resend_ms) {
+                                                            int resend_ms, const std::string& on_behalf_of) {
   std::array<char, 256> host{};
   ::gethostname(host.data(), host.size() - 1);
   rilbed::console_command_t c;
   c.seq = static_cast<std::int64_t>(std::random_device{}()) << 20 ^ std::chrono::steady_clock::now().time_since_epoch().count();
   c.client = std::string(host.data()) + ":" + std::to_string(::getpid());
+  if (!on_behalf_of.empty()) c.client += " for " + on_behalf_of;
   c.token = token;
   c.command = command;
   c.args = args;

@@ -75,10 +75,12 @@ class LcmConsoleServer {
 
 /// The console's side: sends `command` (with `args`) and waits up to `timeout_ms` for
 /// the run's reply, sending it again every `resend_ms` (LCM over UDP loses messages).
-/// Returns the reply, or nullopt when no run answered in time.
+/// The run names the sender as this host and process, followed by `on_behalf_of` when
+/// given (the browser a GUI relays for). Returns the reply, or nullopt when no run
+/// answered in time.
 std::optional<rilbed::console_reply_t> send_console_command(lcm::LCM& lcm, const Channels& channels,
                                                             const std::string& token, const std::string& command,
                                                             const std::vector<std::string>& args, int timeout_ms,
-                                                            int resend_ms = 200);
+                                                            int resend_ms = 200, const std::string& on_behalf_of = "");
 
 }  // namespace rilbed::links

@@ -4,6 +4,8 @@
 // /rilbed/console reaches the run and comes back accepted on /rilbed/console_reply.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <fstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -13,6 +15,8 @@
 
 namespace rilbed::e2e {
 namespace {
+
+namespace fs = std::filesystem;
 
 TEST(GuiCli, ServesARunOnTheBusAndSendsItsConsoleCommands) {
   SKIP_WITHOUT_NAMESPACES();
@@ -51,6 +55,47 @@ TEST(GuiCli, ServesARunOnTheBusAndSendsItsConsoleCommands) {
   EXPECT_NE(probe.find(R"("reason":"pause")"), std::string::npos) << probe;
   EXPECT_NE(read_file(dir / "run" / "events.csv").find(",console,0,0,paused by "), std::string::npos);
   std::filesystem::remove_all(dir);
+}
+
+TEST(RunGui, ServesItsOwnRunAndADrivenRobotStopsWhenItsKeysStopAndItsDriverGoes) {
+  // `rilbed run --gui`: the panel in the run's own process (its in-process bus). A client
+  // drives emulated real robot 4 with one key-held message and leaves; the robot is
+  // stopped 300 ms later (the keys stopped), then handed back; a second client ends the run.
+  const fs::path dir = scratch_dir("run_gui");
+  const fs::path script = dir / "drive.sh";
+  std::ofstream(script) << "cd '" << dir.string() << "'\n"
+      "'" RILBED_BINARY "' run " << shipped_scenario_arg("convoy_mixed") << " --duration 120 --gui --gui-port 0 --out run --quiet > run.txt 2> run.err &\n"
+      "P=$!\n"
+      "for i in $(seq 1 400); do grep -q 'token=' run.txt && break; sleep 0.05; done\n"
+      "HOSTPORT=$(sed -n 's|.*http://\\([^/]*\\)/?token=.*|\\1|p' run.txt)\n"
+      "TOKEN=$(sed -n 's|.*?token=\\([0-9a-f]*\\).*|\\1|p' run.txt)\n"
+      "'" RILBED_WS_PROBE "' \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses --count 20 --timeout 60 "
+      "--send '/rilbed/drive={\"id\":4,\"left\":40,\"right\":40}' > drive.txt 2>&1; echo \"drive $?\" >> codes.txt\n"
+      // Wait for the hand drive's end in the run's events (a held stop, then given back).
+      "for i in $(seq 1 400); do grep -q 'robot 4 driven 0 0' run/events.csv 2>/dev/null && break; sleep 0.05; done\n"
+      "'" RILBED_WS_PROBE "' \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/status,/rilbed/console_reply --until /rilbed/console_reply "
+      "--count 1000 --timeout 60 --send '/rilbed/console={\"command\":\"exit\"}' > exit.txt 2>&1; echo \"exit $?\" >> codes.txt\n"
+      "wait $P; echo \"run $?\" >> codes.txt\n";
+  ASSERT_EQ(std::system(("/bin/sh '" + script.string() + "'").c_str()), 0);
+  const std::string codes = read_file(dir / "codes.txt");
+  const std::string printed = read_file(dir / "run.txt") + read_file(dir / "run.err");
+  for (const char* line : {"drive 0", "exit 0", "run 0"}) {
+    EXPECT_NE(codes.find(line), std::string::npos) << line << "\n" << codes << printed << read_file(dir / "drive.txt");
+  }
+  const std::string events = read_file(dir / "run" / "events.csv");
+  const std::size_t driven = events.find("robot 4 driven 40 40 for ");
+  ASSERT_NE(driven, std::string::npos) << events;
+  EXPECT_NE(events.find(" by gui 127.0.0.1:", driven), std::string::npos) << events;
+  const std::size_t stopped = events.find("robot 4 driven 0 0 for ", driven);
+  EXPECT_NE(stopped, std::string::npos) << events;
+  // One event per change of speeds, not one per renewal of the hold.
+  std::size_t holds = 0;
+  for (std::size_t at = events.find("robot 4 driven 0 0"); at != std::string::npos; at = events.find("robot 4 driven 0 0", at + 1)) ++holds;
+  EXPECT_LE(holds, 2u) << events;
+  EXPECT_NE(events.find("ended by gui 127.0.0.1:"), std::string::npos) << events;
+  EXPECT_NE(read_file(dir / "exit.txt").find(R"("accepted":true,"client")"), std::string::npos) << read_file(dir / "exit.txt");
+  EXPECT_NE(printed.find("robot 4 (emulated): last speed 0 0"), std::string::npos) << printed;
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -23,109 +23,14 @@
 #include <nlohmann/json.hpp>
 
 #include "gui_web/web_server.hpp"
+#include "ws_test_client.hpp"
 
 namespace rilbed::gui_web {
 namespace {
 
-namespace asio = boost::asio;
-namespace beast = boost::beast;
-namespace http = beast::http;
-namespace websocket = beast::websocket;
-using tcp = asio::ip::tcp;
+using namespace rilbed::gui_web::testing;
 using nlohmann::json;
-
-const std::string kToken = "0123456789abcdef0123456789abcdef";
-
-WebServerConfig config() {
-  WebServerConfig c;
-  c.port = 0;
-  c.token = kToken;
-  c.session_id = "test";
-  return c;
-}
-
-// An HTTP GET; returns the status code and body.
-std::pair<int, std::string> get(std::uint16_t port, const std::string& target) {
-  asio::io_context io;
-  beast::tcp_stream stream(io);
-  stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
-  http::request<http::empty_body> req(http::verb::get, target, 11);
-  req.set(http::field::host, "127.0.0.1");
-  http::write(stream, req);
-  beast::flat_buffer buffer;
-  http::response<http::string_body> res;
-  http::read(stream, buffer, res);
-  return {static_cast<int>(res.result_int()), res.body()};
-}
-
-// The status of a WebSocket upgrade request (101 when accepted), as a browser would send
-// it. (Beast 1.74's client does not keep the response of a declined handshake.)
-int upgrade_status(std::uint16_t port, const std::string& target, const std::string& subprotocol = "foxglove.websocket.v1",
-                   const std::string& origin = "", const std::string& host = "") {
-  asio::io_context io;
-  beast::tcp_stream stream(io);
-  stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
-  http::request<http::empty_body> req(http::verb::get, target, 11);
-  req.set(http::field::host, host.empty() ? "127.0.0.1:" + std::to_string(port) : host);
-  req.set(http::field::upgrade, "websocket");
-  req.set(http::field::connection, "upgrade");
-  req.set(http::field::sec_websocket_key, "dGhlIHNhbXBsZSBub25jZQ==");
-  req.set(http::field::sec_websocket_version, "13");
-  if (!subprotocol.empty()) req.set(http::field::sec_websocket_protocol, subprotocol);
-  if (!origin.empty()) req.set(http::field::origin, origin);
-  http::write(stream, req);
-  beast::flat_buffer buffer;
-  http::response_parser<http::empty_body> res;
-  res.skip(true);  // a 101 has no body
-  beast::error_code ec;
-  http::read_header(stream, buffer, res, ec);
-  return ec ? -1 : static_cast<int>(res.get().result_int());
-}
-
-// A Foxglove client: connects, reads the greeting.
-struct Client {
-  asio::io_context io;
-  websocket::stream<beast::tcp_stream> ws{io};
-  beast::flat_buffer buffer;
-
-  // Returns the HTTP status of a refused handshake, or 101.
-  int connect(std::uint16_t port, const std::string& target, const std::string& subprotocol = "foxglove.websocket.v1",
-              const std::string& origin = "") {
-    beast::get_lowest_layer(ws).connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
-    ws.set_option(websocket::stream_base::decorator([subprotocol, origin](websocket::request_type& r) {
-      if (!subprotocol.empty()) r.set(http::field::sec_websocket_protocol, subprotocol);
-      if (!origin.empty()) r.set(http::field::origin, origin);
-    }));
-    websocket::response_type res;
-    beast::error_code ec;
-    ws.handshake(res, "127.0.0.1:" + std::to_string(port), target, ec);
-    if (!ec) {
-      EXPECT_EQ(res[http::field::sec_websocket_protocol], "foxglove.websocket.v1");
-    }
-    return static_cast<int>(res.result_int());
-  }
-  // The next message: text as JSON, binary as raw bytes.
-  std::variant<json, std::string> next() {
-    buffer.consume(buffer.size());
-    ws.read(buffer);
-    std::string bytes = beast::buffers_to_string(buffer.data());
-    if (ws.got_text()) return json::parse(bytes);
-    return bytes;
-  }
-  json next_json() {
-    auto m = next();
-    EXPECT_TRUE(std::holds_alternative<json>(m));
-    return std::holds_alternative<json>(m) ? std::get<json>(m) : json();
-  }
-  void send_text(const json& j) {
-    ws.text(true);
-    ws.write(asio::buffer(j.dump()));
-  }
-  void send_binary(const std::string& bytes) {
-    ws.binary(true);
-    ws.write(asio::buffer(bytes));
-  }
-};
+namespace asio = boost::asio;
 
 foxglove::Channel poses_channel() {
   return {0, "/rilbed/poses", "json", "rilbed.poses", R"({"type":"object"})", "jsonschema"};
@@ -165,6 +70,62 @@ TEST(WebServer, TheTokenOpensEverythingAndNothingOpensWithoutIt) {
   taken.bind_address = "127.0.0.2";  // another address, same port: fine; the same address is not
   taken.bind_address = "127.0.0.1";
   EXPECT_THROW(WebServer(taken, {}), std::runtime_error);
+}
+
+TEST(WebServer, ThePagesLoadSetsACookieThatOpensItsFilesButNotTheWebSocket) {
+  const auto root = std::filesystem::temp_directory_path() / ("rilbed_web_cookie_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(root);
+  std::ofstream(root / "index.html") << "<script src=app.js></script>";
+  std::ofstream(root / "app.js") << "console.log(1)";
+  WebServerConfig c = config();
+  c.web_root = root;
+  WebServer server(c, {});
+  // The raw response, to see its Set-Cookie.
+  asio::io_context io;
+  beast::tcp_stream stream(io);
+  stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), server.port()));
+  http::request<http::empty_body> req(http::verb::get, "/?token=" + kToken, 11);
+  req.set(http::field::host, "127.0.0.1");
+  http::write(stream, req);
+  beast::flat_buffer buffer;
+  http::response<http::string_body> res;
+  http::read(stream, buffer, res);
+  const std::string cookie(res[http::field::set_cookie]);
+  const std::string name = "rilbed_token_" + std::to_string(server.port());
+  ASSERT_EQ(cookie.rfind(name + "=" + kToken + ";", 0), 0u) << cookie;
+  EXPECT_NE(cookie.find("HttpOnly"), std::string::npos);
+  EXPECT_NE(cookie.find("SameSite=Strict"), std::string::npos);
+  EXPECT_EQ(get(server.port(), "/app.js", "other=1; " + name + "=" + kToken).first, 200);
+  EXPECT_EQ(get(server.port(), "/app.js").first, 401);
+  EXPECT_EQ(get(server.port(), "/app.js", name + "=" + kToken.substr(1)).first, 401);
+  EXPECT_EQ(get(server.port(), "/app.js", "rilbed_token_1=" + kToken).first, 401);  // another port's name
+  std::filesystem::remove_all(root);
+}
+
+TEST(WebServer, ALatchedChannelsLastMessageGreetsEachNewSubscriber) {
+  WebServer server(config(), {});
+  const std::uint32_t latched = server.add_channel(poses_channel(), /*latched=*/true);
+  const std::uint32_t plain = server.add_channel({0, "/rilbed/events", "json", "rilbed.event", "{}", "jsonschema"});
+  server.publish(latched, 5, std::make_shared<const std::string>("{\"n\":1}"));
+  server.publish(latched, 7, std::make_shared<const std::string>("{\"n\":2}"));
+  server.publish(plain, 7, std::make_shared<const std::string>("{\"e\":1}"));
+  ASSERT_TRUE(server.flush(std::chrono::seconds(5)));
+  Client client;
+  ASSERT_EQ(client.connect(server.port(), "/ws?token=" + kToken), 101);
+  client.next_json();
+  client.next_json();
+  client.send_text({{"op", "subscribe"}, {"subscriptions", {{{"id", 1}, {"channelId", plain}}, {{"id", 2}, {"channelId", latched}}}}});
+  const auto m = client.next();
+  ASSERT_TRUE(std::holds_alternative<std::string>(m));
+  const std::string& bytes = std::get<std::string>(m);
+  ASSERT_EQ(bytes.size(), 13u + 7u);
+  EXPECT_EQ(static_cast<unsigned char>(bytes[1]), 2u);  // subscription 2: the latched channel
+  EXPECT_EQ(bytes.substr(13), "{\"n\":2}");             // its last message, not the first
+  // Nothing from the plain channel's past: the next message is a new one.
+  server.publish(plain, 9, std::make_shared<const std::string>("{\"e\":2}"));
+  const auto next = client.next();
+  ASSERT_TRUE(std::holds_alternative<std::string>(next));
+  EXPECT_EQ(std::get<std::string>(next).substr(13), "{\"e\":2}");
 }
 
 TEST(WebServer, GreetsSubscribesAndSendsData) {

@@ -1,0 +1,226 @@
+#include "gui_web/gui_service.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace rilbed::gui_web {
+
+namespace {
+
+constexpr std::size_t kMaxQueuedCommands = 16;
+
+std::string seconds_text(double s) {
+  std::ostringstream out;
+  out.precision(3);
+  out << s;
+  return out.str();
+}
+
+}  // namespace
+
+GuiService::GuiService(WebServerConfig config, ConsoleSink sink, ManualDriveConfig drive)
+    : config_(std::move(config)), sink_(std::move(sink)), drive_(drive) {
+  if (!sink_) throw std::invalid_argument("gui: no console sink");
+  if (drive_.key_timeout_ms <= 0 || drive_.tick_ms <= 0 || !(drive_.hold_wall_s > 0.0)) {
+    throw std::invalid_argument("gui: manual driving's times must be above 0");
+  }
+  WebServer::Handlers handlers;
+  handlers.on_client_message = [this](const std::string& client, const std::string& topic, const std::string&,
+                                      std::string_view payload) { return on_client_message(client, topic, payload); };
+  handlers.on_client_gone = [this](const std::string& client) { on_client_gone(client); };
+  server_ = std::make_unique<WebServer>(config_, std::move(handlers));
+  channels_ = std::make_unique<RunChannels>(*server_);
+  thread_ = std::thread([this] { loop(); });
+}
+
+GuiService::~GuiService() {
+  {
+    std::lock_guard lock(mutex_);
+    for (auto& [id, hold] : holds_) hold.ending = true;
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  thread_.join();  // sends the last stops
+  server_.reset();
+}
+
+std::string GuiService::url() const {
+  return "http://" + config_.bind_address + ":" + std::to_string(server_->port()) + "/?token=" + config_.token;
+}
+
+GuiCounters GuiService::counters() const {
+  std::lock_guard lock(mutex_);
+  return counts_;
+}
+
+// ------------------------------------------------------------------ from the browsers
+
+std::optional<std::string> GuiService::on_client_message(const std::string& client, const std::string& topic,
+                                                         std::string_view payload) {
+  if (topic == "/rilbed/drive") return on_drive_message(client, payload);
+  if (topic != "/rilbed/console") return "this server takes messages on /rilbed/console and /rilbed/drive, not " + topic;
+  const auto j = nlohmann::json::parse(payload, nullptr, false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("command") || !j["command"].is_string()) {
+    return std::string("a console message is {\"command\": \"pause\", \"args\": []}");
+  }
+  ConsoleRequest request{client, j["command"].get<std::string>(), {}};
+  if (j.contains("args")) {
+    if (!j["args"].is_array() || j["args"].size() > 8) return std::string("args must be a list of at most 8 strings");
+    for (const auto& a : j["args"]) {
+      if (!a.is_string() && !a.is_number()) return std::string("args must be strings or numbers");
+      request.args.push_back(a.is_string() ? a.get<std::string>() : a.dump());
+    }
+  }
+  std::lock_guard lock(mutex_);
+  if (requests_.size() >= kMaxQueuedCommands) return std::string("too many console commands waiting");
+  requests_.push_back(std::move(request));
+  wake_.notify_all();
+  return std::nullopt;
+}
+
+std::optional<std::string> GuiService::on_drive_message(const std::string& client, std::string_view payload) {
+  const auto j = nlohmann::json::parse(payload, nullptr, false);
+  const char* usage = "a drive message is {\"id\": 4, \"left\": 20, \"right\": 20} or {\"id\": 4, \"release\": true}";
+  if (j.is_discarded() || !j.is_object() || !j.contains("id") || !j["id"].is_number_integer()) return std::string(usage);
+  const long long id = j["id"].get<long long>();
+  if (id < 0 || id > 1'000'000) return "'" + j["id"].dump() + "' is not a robot ID";
+  const int robot = static_cast<int>(id);
+  std::lock_guard lock(mutex_);
+  if (j.value("release", false)) {
+    const auto it = holds_.find(robot);
+    if (it == holds_.end() || it->second.client != client || it->second.ending) return "robot " + std::to_string(robot) + " is not yours to release";
+    it->second.ending = true;
+    wake_.notify_all();
+    return std::nullopt;
+  }
+  if (!j.contains("left") || !j.contains("right") || !j["left"].is_number_integer() || !j["right"].is_number_integer()) {
+    return std::string(usage);
+  }
+  const long long left = j["left"].get<long long>(), right = j["right"].get<long long>();
+  if (std::llabs(left) > 127 || std::llabs(right) > 127) return std::string("wheel speeds are -127..127 (Khepera units)");
+  // One robot per client: taking another gives the first one back.
+  for (auto& [other, hold] : holds_) {
+    if (other != robot && hold.client == client) hold.ending = true;
+  }
+  Hold& hold = holds_[robot];
+  if (hold.client != client) {
+    // A new driver (or a take-over: the last driver's hold ends here, without a gap).
+    if (!hold.client.empty()) channels_->console_reply(0, true, "robot " + std::to_string(robot) + " taken over by " + client, hold.client);
+    hold = Hold{};
+    hold.client = client;
+  }
+  hold.ending = false;
+  const bool changed = hold.left != left || hold.right != right;
+  hold.left = static_cast<int>(left);
+  hold.right = static_cast<int>(right);
+  hold.last_key = Clock::now();
+  if (changed || !hold.sent) wake_.notify_all();
+  return std::nullopt;
+}
+
+void GuiService::on_client_gone(const std::string& client) {
+  std::lock_guard lock(mutex_);
+  bool any = false;
+  for (auto& [id, hold] : holds_) {
+    if (hold.client == client) any = hold.ending = true;
+  }
+  if (any) wake_.notify_all();
+}
+
+// ------------------------------------------------------------------ to the run
+
+void GuiService::loop() {
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    wake_.wait_for(lock, std::chrono::milliseconds(drive_.tick_ms));
+    // Driving first: a stop must not wait behind console commands.
+    drive_tick(lock);
+    if (stopping_ && holds_.empty()) return;
+    while (!requests_.empty() && !stopping_) {
+      ConsoleRequest request = std::move(requests_.front());
+      requests_.pop_front();
+      ++counts_.console_commands;
+      lock.unlock();
+      const ConsoleAnswer answer = sink_(request);
+      channels_->console_reply(0, answer.accepted, answer.reason, request.client);
+      lock.lock();
+      drive_tick(lock);
+    }
+  }
+}
+
+void GuiService::drive_tick(std::unique_lock<std::mutex>& lock) {
+  const auto now = Clock::now();
+  const double hold_s = drive_.hold_wall_s * std::max(1.0, rt_factor_);
+  const auto renew_after = std::chrono::duration<double>(drive_.hold_wall_s / 2);
+  // What to send, chosen under the lock, sent without it.
+  struct Order {
+    int robot;
+    std::string client;
+    int left, right;
+    bool final_stop;
+  };
+  std::vector<Order> orders;
+  for (auto it = holds_.begin(); it != holds_.end();) {
+    Hold& hold = it->second;
+    if (hold.ending) {
+      orders.push_back({it->first, hold.client, 0, 0, true});
+      it = holds_.erase(it);
+      continue;
+    }
+    const bool keys_alive = now - hold.last_key <= std::chrono::milliseconds(drive_.key_timeout_ms);
+    const std::pair<int, int> wheels = keys_alive ? std::pair{hold.left, hold.right} : std::pair{0, 0};
+    if (!hold.sent || *hold.sent != wheels || now - hold.sent_at >= renew_after) {
+      hold.sent = wheels;
+      hold.sent_at = now;
+      orders.push_back({it->first, hold.client, wheels.first, wheels.second, false});
+    }
+    ++it;
+  }
+  if (orders.empty()) return;
+  lock.unlock();
+  std::vector<std::pair<int, ConsoleAnswer>> refusals;
+  for (const Order& o : orders) {
+    const ConsoleAnswer answer = sink_({o.client, "drive",
+                                        {std::to_string(o.robot), std::to_string(o.left), std::to_string(o.right),
+                                         seconds_text(hold_s)}});
+    if (!answer.accepted) refusals.emplace_back(o.robot, answer);
+    if (o.final_stop) channels_->console_reply(0, answer.accepted, "robot " + std::to_string(o.robot) + " stopped and given back to its controller", o.client);
+  }
+  lock.lock();
+  counts_.drive_commands += orders.size();
+  for (const Order& o : orders) counts_.drive_stops += o.final_stop ? 1 : 0;
+  // A refusal (a paused run, no such robot) is told to its driver once, not every tick.
+  for (const auto& [robot, answer] : refusals) {
+    const auto it = holds_.find(robot);
+    if (it == holds_.end() || it->second.last_refusal == answer.reason) continue;
+    it->second.last_refusal = answer.reason;
+    channels_->console_reply(0, false, "drive robot " + std::to_string(robot) + ": " + answer.reason, it->second.client);
+  }
+}
+
+// ------------------------------------------------------------------ the run's reports
+
+bool GuiService::wants_steps() const { return server_->clients() > 0; }
+
+void GuiService::on_world(TimeUs t_us, const agents::WorldReport& world) { channels_->on_world(t_us, world); }
+void GuiService::on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) { channels_->on_poses(t_us, poses); }
+void GuiService::on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wheels) { channels_->on_wheels(t_us, wheels); }
+void GuiService::on_sensors(TimeUs t_us, std::span<const agents::SensorReport> sensors) {
+  channels_->on_sensors(t_us, sensors);
+}
+void GuiService::on_detections(const agents::FrameReport& frame) { channels_->on_detections(frame); }
+void GuiService::on_event(const agents::RunEvent& event) { channels_->on_event(event); }
+void GuiService::on_status(const agents::StatusReport& status) {
+  {
+    std::lock_guard lock(mutex_);
+    if (status.rt_factor > 0.0 && std::isfinite(status.rt_factor)) rt_factor_ = status.rt_factor;
+  }
+  channels_->on_status(status);
+}
+void GuiService::on_summary(TimeUs t_us, const nlohmann::json& summary) { channels_->on_summary(t_us, summary); }
+
+}  // namespace rilbed::gui_web

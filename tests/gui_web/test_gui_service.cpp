@@ -1,0 +1,267 @@
+// The panel's service with real WebSocket clients and a recording console sink: console
+// commands relayed and answered, and manual driving's dead man's switch (keys stop coming,
+// release, a socket that closes, a take-over), bad drive messages answered with a status.
+// Waits are "until it happens, or fail after a generous deadline".
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "gui_web/gui_service.hpp"
+#include "ws_test_client.hpp"
+
+namespace rilbed::gui_web {
+namespace {
+
+using namespace rilbed::gui_web::testing;
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+// Records what reaches the run, and answers as the run would.
+struct RecordingSink {
+  struct Call {
+    ConsoleRequest request;
+    Clock::time_point at;
+  };
+  std::mutex mutex;
+  std::vector<Call> calls;
+  ConsoleSink sink() {
+    return [this](const ConsoleRequest& r) {
+      std::lock_guard lock(mutex);
+      calls.push_back({r, Clock::now()});
+      if (r.command == "pause") return ConsoleAnswer{true, "pause"};
+      if (r.command == "drive" && r.args.at(0) == "99") return ConsoleAnswer{false, "this run has no robot 99"};
+      if (r.command == "drive") return ConsoleAnswer{true, "drive"};
+      return ConsoleAnswer{false, "unknown command '" + r.command + "'"};
+    };
+  }
+  std::vector<Call> snapshot() {
+    std::lock_guard lock(mutex);
+    return calls;
+  }
+  // The drives of robot `id` so far, as "L R".
+  std::vector<std::string> drives(int id) {
+    std::vector<std::string> out;
+    for (const Call& c : snapshot()) {
+      if (c.request.command == "drive" && c.request.args.at(0) == std::to_string(id)) {
+        out.push_back(c.request.args.at(1) + " " + c.request.args.at(2));
+      }
+    }
+    return out;
+  }
+};
+
+template <typename Predicate>
+bool eventually(Predicate done, std::chrono::milliseconds limit = std::chrono::seconds(10)) {
+  const auto deadline = Clock::now() + limit;
+  while (!done()) {
+    if (Clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return true;
+}
+
+// A client that has read the greeting and advertised its two topics (1: console, 2: drive).
+struct PanelClient : Client {
+  explicit PanelClient(std::uint16_t port) {
+    EXPECT_EQ(connect(port, "/ws?token=" + kToken), 101);
+    next_json();  // serverInfo
+    advertised = next_json();
+    send_text({{"op", "advertise"},
+               {"channels", {{{"id", 1}, {"topic", "/rilbed/console"}, {"encoding", "json"}, {"schemaName", ""}},
+                             {{"id", 2}, {"topic", "/rilbed/drive"}, {"encoding", "json"}, {"schemaName", ""}}}}});
+  }
+  void publish(std::uint32_t channel, const json& message) {
+    std::string frame(5, '\0');
+    frame[0] = 1;
+    for (int i = 0; i < 4; ++i) frame[1 + i] = static_cast<char>((channel >> (8 * i)) & 0xff);
+    send_binary(frame + message.dump());
+  }
+  void drive(int id, int left, int right) { publish(2, {{"id", id}, {"left", left}, {"right", right}}); }
+  // Subscribes to the run's answers (subscription 7).
+  void hear_replies() {
+    for (const auto& c : advertised["channels"]) {
+      if (c["topic"] == "/rilbed/console_reply") {
+        send_text({{"op", "subscribe"}, {"subscriptions", {{{"id", 7}, {"channelId", c["id"]}}}}});
+      }
+    }
+  }
+  // The next answer's JSON (skipping anything else).
+  json next_reply() {
+    for (;;) {
+      const auto m = next();
+      if (std::holds_alternative<std::string>(m) && std::get<std::string>(m).size() > 13 && std::get<std::string>(m)[1] == 7) {
+        return json::parse(std::get<std::string>(m).substr(13));
+      }
+    }
+  }
+  json advertised;
+};
+
+std::uint32_t channel_id(const json& advertise, const std::string& topic) {
+  for (const auto& c : advertise["channels"]) {
+    if (c["topic"] == topic) return c["id"].get<std::uint32_t>();
+  }
+  return 0;
+}
+
+TEST(GuiService, ConsoleCommandsReachTheRunAndTheirAnswersComeBack) {
+  RecordingSink run;
+  GuiService gui(config(), run.sink());
+  Client watcher;
+  ASSERT_EQ(watcher.connect(gui.server().port(), "/ws?token=" + kToken), 101);
+  watcher.next_json();
+  const std::uint32_t replies = channel_id(watcher.next_json(), "/rilbed/console_reply");
+  ASSERT_NE(replies, 0u);
+  watcher.send_text({{"op", "subscribe"}, {"subscriptions", {{{"id", 3}, {"channelId", replies}}}}});
+  ASSERT_TRUE(gui.server().flush(std::chrono::seconds(5)));
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the subscription is read after the flush's question
+
+  PanelClient panel(gui.server().port());
+  panel.publish(1, {{"command", "pause"}, {"args", json::array()}});
+  const auto m = watcher.next();
+  ASSERT_TRUE(std::holds_alternative<std::string>(m));
+  const json reply = json::parse(std::get<std::string>(m).substr(13));
+  EXPECT_EQ(reply["accepted"], true);
+  EXPECT_EQ(reply["reason"], "pause");
+  const auto calls = run.snapshot();
+  ASSERT_EQ(calls.size(), 1u);
+  EXPECT_EQ(calls[0].request.command, "pause");
+  EXPECT_EQ(reply["client"], calls[0].request.client);
+  EXPECT_EQ(gui.counters().console_commands, 1u);
+  // Not a command: an error status on the sender's socket, nothing reaches the run.
+  panel.publish(1, {{"verb", "pause"}});
+  const json status = panel.next_json();
+  EXPECT_EQ(status["op"], "status");
+  EXPECT_EQ(status["level"], 2);
+  EXPECT_EQ(run.snapshot().size(), 1u);
+}
+
+TEST(GuiService, ARobotDrivenByHandStopsWhenTheKeysStopComing) {
+  RecordingSink run;
+  ManualDriveConfig timing;  // the defaults: 300 ms
+  GuiService gui(config(), run.sink(), timing);
+  PanelClient panel(gui.server().port());
+  // Keys held for about half a second, a message every 100 ms.
+  const auto keys_from = Clock::now();
+  for (int i = 0; i < 5; ++i) {
+    panel.drive(4, 30, 30);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  const auto keys_until = Clock::now();
+  ASSERT_TRUE(eventually([&] { const auto d = run.drives(4); return !d.empty() && d.back() == "0 0"; }));
+  const auto calls = run.snapshot();
+  ASSERT_FALSE(calls.empty());
+  EXPECT_EQ(calls.front().request.args, (std::vector<std::string>{"4", "30", "30", "0.6"}));
+  EXPECT_LT(calls.front().at - keys_from, std::chrono::milliseconds(500));  // at once, not at a tick
+  // The stop came after the keys' timeout, as one of the holds (not a release).
+  Clock::time_point stopped_at{};
+  for (const auto& c : calls) {
+    if (c.request.args.at(1) == "0") {
+      stopped_at = c.at;
+      break;
+    }
+  }
+  EXPECT_GE(stopped_at - keys_until, std::chrono::milliseconds(200));
+  EXPECT_EQ(gui.counters().drive_stops, 0u);
+  // Still held: the hold is renewed standing until it is released.
+  const std::size_t before = run.drives(4).size();
+  ASSERT_TRUE(eventually([&] { return run.drives(4).size() >= before + 2; }));
+  for (const std::string& d : run.drives(4)) {
+    EXPECT_TRUE(d == "30 30" || d == "0 0") << d;
+  }
+  EXPECT_EQ(run.drives(4).back(), "0 0");
+  panel.publish(2, {{"id", 4}, {"release", true}});
+  ASSERT_TRUE(eventually([&] { return gui.counters().drive_stops == 1u; }));
+  // Given back: nothing more is sent for it.
+  const std::size_t released = run.drives(4).size();
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  EXPECT_EQ(run.drives(4).size(), released);
+  EXPECT_EQ(run.drives(4).back(), "0 0");
+}
+
+TEST(GuiService, ClosingTheDriversSocketStopsTheRobot) {
+  RecordingSink run;
+  GuiService gui(config(), run.sink());
+  {
+    PanelClient panel(gui.server().port());
+    panel.drive(5, 40, 20);
+    ASSERT_TRUE(eventually([&] { return !run.drives(5).empty(); }));
+    // Keys still "held" (a message every 100 ms) when the tab closes.
+    panel.drive(5, 40, 20);
+    panel.ws.close(boost::beast::websocket::close_code::going_away);
+  }
+  ASSERT_TRUE(eventually([&] { return gui.counters().drive_stops == 1u; }));
+  EXPECT_EQ(run.drives(5).back(), "0 0");
+}
+
+TEST(GuiService, AnotherClientTakesTheRobotOverAndTheFirstIsToldSo) {
+  RecordingSink run;
+  GuiService gui(config(), run.sink());
+  PanelClient first(gui.server().port());
+  first.hear_replies();
+  PanelClient second(gui.server().port());
+  first.drive(6, 10, 10);
+  ASSERT_TRUE(eventually([&] { return !run.drives(6).empty(); }));
+  const std::string first_name = run.snapshot().back().request.client;
+  second.drive(6, -10, 10);
+  ASSERT_TRUE(eventually([&] { const auto d = run.drives(6); return !d.empty() && d.back() == "-10 10"; }));
+  const std::string second_name = run.snapshot().back().request.client;
+  EXPECT_NE(first_name, second_name);
+  const json told = first.next_reply();
+  EXPECT_EQ(told["reason"].get<std::string>().rfind("robot 6 taken over by ", 0), 0u) << told;
+  EXPECT_EQ(told["client"].get<std::string>(), first_name);
+  // No stop between the two drivers: the robot went from one's speeds to the other's.
+  for (const std::string& d : run.drives(6)) EXPECT_NE(d, "0 0");
+  EXPECT_EQ(gui.counters().drive_stops, 0u);
+  // Bad drive messages get an error status, and reach nothing.
+  PanelClient third(gui.server().port());
+  third.publish(2, {{"id", 6}, {"left", 500}, {"right", 0}});
+  EXPECT_EQ(third.next_json()["level"], 2);
+  third.publish(2, {{"id", "six"}});
+  EXPECT_EQ(third.next_json()["level"], 2);
+  third.publish(2, {{"id", 6}, {"release", true}});  // not its robot
+  EXPECT_EQ(third.next_json()["level"], 2);
+  for (const auto& c : run.snapshot()) EXPECT_NE(c.request.args.at(1), "500");
+}
+
+TEST(GuiService, TheRunsRefusalOfADriveIsToldToTheDriverOnce) {
+  RecordingSink run;
+  GuiService gui(config(), run.sink());
+  PanelClient panel(gui.server().port());
+  panel.hear_replies();
+  for (int i = 0; i < 6; ++i) {
+    panel.drive(99, 10, 10);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  // Refused holds keep reaching the run (which may change its mind: a paused run resumes)...
+  ASSERT_TRUE(eventually([&] { return run.drives(99).size() >= 3; }));
+  // ...but the driver hears the refusal once: the next answer after it is the pause's.
+  panel.publish(1, {{"command", "pause"}});
+  const json refusal = panel.next_reply();
+  EXPECT_EQ(refusal["accepted"], false);
+  EXPECT_EQ(refusal["reason"], "drive robot 99: this run has no robot 99");
+  EXPECT_EQ(panel.next_reply()["reason"], "pause");
+}
+
+TEST(GuiService, DestroyingTheServiceStopsEveryHeldRobot) {
+  RecordingSink run;
+  {
+    GuiService gui(config(), run.sink());
+    PanelClient a(gui.server().port());
+    PanelClient b(gui.server().port());
+    a.drive(1, 20, 20);
+    b.drive(2, 20, 20);
+    ASSERT_TRUE(eventually([&] { return !run.drives(1).empty() && !run.drives(2).empty(); }));
+  }
+  EXPECT_EQ(run.drives(1).back(), "0 0");
+  EXPECT_EQ(run.drives(2).back(), "0 0");
+}
+
+}  // namespace
+}  // namespace rilbed::gui_web

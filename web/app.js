@@ -1,0 +1,624 @@
+// rilbed's control panel: a client of the run's Foxglove WebSocket (see foxglove.js).
+// It draws what the run publishes and sends console commands and manual driving back; it
+// keeps no state the run does not send, so any number of tabs show the same run.
+import { FoxgloveClient } from './foxglove.js';
+
+const params = new URLSearchParams(location.search);
+const token = params.get('token') || '';
+const wsUrl = `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/ws?token=${encodeURIComponent(token)}`;
+
+const ROBOT_DIAMETER_M = 0.055; // a Khepera
+const IR_ANGLES_RAD = [90, 45, 10, -10, -45, -90, -170, 170].map((d) => (d * Math.PI) / 180);
+const IR_RANGE_M = 0.05; // what the IR ring sees; a reading of 1023 is touching
+const TRAIL_POINTS = 400;
+const HISTORY_PERIOD_S = 0.2;
+
+const $ = (id) => document.getElementById(id);
+
+// ------------------------------------------------------------------ what the run said
+const run = {
+  world: null, status: null, poses: null, sensors: new Map(), detections: null,
+  calibration: null, image: null, imageStamp: null, ended: false,
+  trails: new Map(), // id -> [[x, y], ...] newest last
+  history: new Map(), // id -> [[t, x, y], ...] every HISTORY_PERIOD_S
+  formation: new Map(), // id -> [[t, d], ...]
+  lastHistoryT: -Infinity,
+};
+// For tests and the curious: what the page holds now.
+window.rilbed = { run, stats: { frames: 0, drawMs: 0, fps: 0 } };
+
+// ------------------------------------------------------------------ the connection
+const client = new FoxgloveClient(wsUrl);
+const connection = $('connection');
+client.onOpen = () => { connection.textContent = 'connected'; connection.className = 'pill ok'; };
+client.onClose = () => {
+  connection.textContent = 'disconnected'; connection.className = 'pill bad';
+  showBanner(run.ended ? `${bannerText()} — the server has closed.` : 'The server went away: this view no longer changes.',
+    run.ended ? 'ended' : 'gone');
+  stopDriving();
+};
+client.onStatus = (level, message) => { if (level >= 1) note(`server: ${message}`, level === 2 ? 'error' : 'warning'); };
+client.subscribe(['/rilbed/world', '/rilbed/status', '/rilbed/poses', '/rilbed/sensors', '/rilbed/detections',
+  '/rilbed/events', '/rilbed/summary', '/rilbed/console_reply', '/rilbed/camera', '/rilbed/camera_calibration']);
+client.onMessage = (topic, tNs, m) => {
+  switch (topic) {
+    case '/rilbed/world': run.world = m; fillRobotChoices(); $('scenario').textContent = m.scenario; break;
+    case '/rilbed/status': onStatus(m); break;
+    case '/rilbed/poses': onPoses(m); break;
+    case '/rilbed/sensors': for (const r of m.robots) run.sensors.set(r.id, r); break;
+    case '/rilbed/detections': run.detections = m; break;
+    case '/rilbed/events': addEvent(m); break;
+    case '/rilbed/summary': run.summary = m; break;
+    case '/rilbed/console_reply': onReply(m); break;
+    case '/rilbed/camera': onCameraFrame(m); break;
+    case '/rilbed/camera_calibration': run.calibration = m; break;
+    default: break;
+  }
+  requestDraw();
+};
+
+function onStatus(s) {
+  const reset = run.status && s.t_s < run.status.t_s - 1e-9; // a reset starts over at 0
+  if (reset) clearHistory();
+  run.status = s;
+  run.ended = s.state === 'ended';
+  if (run.ended) showBanner(bannerText(), 'ended');
+  else if (s.state === 'paused') showBanner(`Paused at t = ${s.t_s.toFixed(1)} s. Start resumes it.`, 'paused');
+  else hideBanner();
+  $('clock').textContent = `t = ${s.t_s.toFixed(1)} s`;
+  setStat('state', s.state + (s.realtime ? ` (×${fmt(s.rt_factor)})` : ' (fast)'));
+  setStat('seed', s.seed);
+  setStat('mode', s.mode);
+  setStat('robots', `${s.robots} (${s.real_robots} real)`);
+  setStat('formed', s.formed ? `yes, at ${fmt(s.formation_time_s)} s` : 'no');
+  setStat('collisions', s.collisions);
+  setStat('loop latency', `${fmt(s.loop_latency_ms)} ms`);
+  setStat('camera', s.real_robots ? `${fmt(s.camera_fps)} frames/s (${s.frames})` : '—');
+  for (const r of document.querySelectorAll('input[name=mode]')) r.checked = r.value === s.mode;
+  if (!sliderHeld) {
+    $('rt-slider').value = Math.log10(s.rt_factor || 1);
+    $('rt-value').textContent = fmt(s.rt_factor);
+  }
+  $('rt-slider').disabled = !s.realtime || s.real_robots > 0;
+  $('pause').disabled = !s.realtime || s.state !== 'running';
+  $('start').disabled = s.state !== 'paused';
+}
+
+function bannerText() {
+  const s = run.status;
+  if (!s) return 'The run has ended.';
+  return `The run has ended (${s.ended_by || 'done'}) at t = ${s.t_s.toFixed(1)} s` +
+    (s.formed ? `; the convoy formed at ${fmt(s.formation_time_s)} s.` : '; the convoy did not form.');
+}
+
+function onPoses(m) {
+  if (run.poses && m.t_s < run.poses.t_s - 1e-9) clearHistory();
+  run.poses = m;
+  for (const r of m.robots) {
+    let trail = run.trails.get(r.id);
+    if (!trail) run.trails.set(r.id, (trail = []));
+    const last = trail[trail.length - 1];
+    if (!last || Math.hypot(last[0] - r.x_m, last[1] - r.y_m) > 0.003) {
+      trail.push([r.x_m, r.y_m]);
+      if (trail.length > TRAIL_POINTS) trail.splice(0, trail.length - TRAIL_POINTS);
+    }
+  }
+  if (m.t_s - run.lastHistoryT >= HISTORY_PERIOD_S) {
+    run.lastHistoryT = m.t_s;
+    for (const r of m.robots) {
+      if (!run.history.has(r.id)) run.history.set(r.id, []);
+      run.history.get(r.id).push([m.t_s, r.x_m, r.y_m]);
+      const d = distanceAhead(r, m.robots);
+      if (!run.formation.has(r.id)) run.formation.set(r.id, []);
+      run.formation.get(r.id).push([m.t_s, r.behaviour === 'follow' ? d : null]);
+    }
+    plotsDirty = true;
+  }
+  updateAgentTable(m.robots);
+}
+
+// The distance to the nearest robot within 60 degrees of straight ahead (what a follower
+// keeps to its leader), or null.
+function distanceAhead(r, robots) {
+  let best = null;
+  for (const o of robots) {
+    if (o.id === r.id) continue;
+    const dx = o.x_m - r.x_m, dy = o.y_m - r.y_m;
+    const d = Math.hypot(dx, dy);
+    const off = Math.abs(wrap(Math.atan2(dy, dx) - r.theta_rad));
+    if (off <= Math.PI / 3 && (best === null || d < best)) best = d;
+  }
+  return best;
+}
+
+function clearHistory() {
+  run.trails.clear(); run.history.clear(); run.formation.clear(); run.lastHistoryT = -Infinity;
+  plotsDirty = true;
+}
+
+function onCameraFrame(m) {
+  const stamp = m.timestamp;
+  const img = new Image();
+  img.onload = () => { run.image = img; run.imageStamp = stamp; requestDraw(); };
+  img.src = `data:image/${m.format || 'jpeg'};base64,${m.data}`;
+}
+
+// ------------------------------------------------------------------ status, events
+function setStat(name, value) {
+  const stats = $('stats');
+  let dd = stats.querySelector(`dd[data-stat="${name}"]`);
+  if (!dd) {
+    const dt = document.createElement('dt'); dt.textContent = name;
+    dd = document.createElement('dd'); dd.dataset.stat = name;
+    stats.append(dt, dd);
+  }
+  dd.textContent = value;
+}
+
+function updateAgentTable(robots) {
+  const body = document.querySelector('#agents tbody');
+  const rows = new Map([...body.rows].map((row) => [Number(row.dataset.id), row]));
+  for (const r of robots) {
+    let row = rows.get(r.id);
+    if (!row) {
+      row = body.insertRow(); row.dataset.id = r.id;
+      for (let i = 0; i < 4; ++i) row.insertCell();
+      [...body.rows].sort((a, b) => a.dataset.id - b.dataset.id).forEach((x) => body.append(x));
+    }
+    rows.delete(r.id);
+    row.cells[0].textContent = r.id;
+    row.cells[1].textContent = r.real ? (r.seen ? 'real' : 'real, unseen') : 'virtual';
+    row.cells[2].textContent = r.behaviour;
+    const health = r.real ? (r.health || 'ok') : '—';
+    row.cells[3].textContent = health;
+    row.cells[3].className = !r.real ? '' : health === 'ok' ? 'health-ok' : /lost/.test(health) ? 'health-bad' : 'health-warn';
+  }
+  for (const row of rows.values()) row.remove();
+}
+
+function addEvent(e) {
+  const list = $('events');
+  const li = document.createElement('li');
+  li.textContent = `${e.t_s.toFixed(1)} s  ${e.kind}${e.id ? ' ' + e.id : ''}${e.other ? '/' + e.other : ''}: ${e.detail}`;
+  list.prepend(li);
+  while (list.children.length > 200) list.lastChild.remove();
+}
+
+function note(text, kind = 'info') {
+  const reply = $('reply');
+  reply.textContent = text;
+  reply.style.color = kind === 'error' ? 'var(--danger)' : kind === 'warning' ? 'var(--warn)' : '';
+}
+
+function onReply(m) {
+  note(`${m.accepted ? '✓' : '✗'} ${m.reason}`, m.accepted ? 'info' : 'error');
+  if (/taken over by/.test(m.reason) && driving.robot !== null && m.reason.includes(`robot ${driving.robot} `)) {
+    driving.robot = null; updateDriveControls();
+  }
+}
+
+function showBanner(text, kind) { const b = $('banner'); b.textContent = text; b.className = kind; b.hidden = false; }
+function hideBanner() { $('banner').hidden = true; }
+
+const fmt = (x) => (x === null || x === undefined || !isFinite(x) ? '—' : Number(x).toPrecision(3).replace(/\.?0+$/, ''));
+const wrap = (a) => Math.atan2(Math.sin(a), Math.cos(a));
+
+// ------------------------------------------------------------------ console
+function command(name, ...args) {
+  if (!client.publish('/rilbed/console', { command: name, args: args.map(String) }, 'rilbed.console')) {
+    note('not connected', 'error');
+  }
+}
+for (const b of document.querySelectorAll('#console button[data-command]')) {
+  b.addEventListener('click', () => {
+    if (b.dataset.command === 'exit' && !confirm('End the run?')) return;
+    command(b.dataset.command);
+  });
+}
+let sliderHeld = false;
+const slider = $('rt-slider');
+slider.addEventListener('input', () => { sliderHeld = true; $('rt-value').textContent = fmt(10 ** Number(slider.value)); });
+slider.addEventListener('change', () => {
+  sliderHeld = false;
+  command('rt-factor', fmt(10 ** Number(slider.value)));
+});
+for (const r of document.querySelectorAll('input[name=mode]')) r.addEventListener('change', () => command('mode', r.value));
+
+// ------------------------------------------------------------------ manual driving
+// A dead man's switch: while a key is held the page sends the speeds every 100 ms; the
+// server stops the robot when they stop for 300 ms, when this tab closes, or when another
+// client takes the robot.
+const driving = { robot: null, keys: new Set(), timer: null };
+const DRIVE_KEYS = ['ArrowUp', 'ArrowDown', 'ArrowLeft', 'ArrowRight'];
+
+function fillRobotChoices() {
+  const select = $('drive-robot');
+  const ids = (run.world?.robots || []).map((r) => `${r.id}${r.real ? ' (real)' : ''}`);
+  const now = [...select.options].map((o) => o.textContent);
+  if (ids.join() === now.join()) return;
+  const chosen = select.value;
+  select.replaceChildren(...(run.world?.robots || []).map((r) => new Option(`${r.id}${r.real ? ' (real)' : ''}`, r.id)));
+  if (chosen) select.value = chosen;
+}
+
+function wheelSpeeds() {
+  const v = Number($('drive-speed').value);
+  let forward = 0, turn = 0;
+  if (driving.keys.has('ArrowUp')) forward += 1;
+  if (driving.keys.has('ArrowDown')) forward -= 1;
+  if (driving.keys.has('ArrowLeft')) turn += 1;
+  if (driving.keys.has('ArrowRight')) turn -= 1;
+  const clamp = (x) => Math.max(-127, Math.min(127, Math.round(x)));
+  return [clamp(v * (forward - 0.6 * turn)), clamp(v * (forward + 0.6 * turn))];
+}
+
+function sendDrive() {
+  if (driving.robot === null) return;
+  const [left, right] = wheelSpeeds();
+  client.publish('/rilbed/drive', { id: driving.robot, left, right }, 'rilbed.drive');
+}
+
+function keysChanged() {
+  for (const b of document.querySelectorAll('#drive-pad button')) b.classList.toggle('held', driving.keys.has(b.dataset.key));
+  if (driving.robot === null) return;
+  if (driving.keys.size && !driving.timer) driving.timer = setInterval(sendDrive, 100);
+  if (!driving.keys.size && driving.timer) { clearInterval(driving.timer); driving.timer = null; }
+  sendDrive(); // at once: a press moves, a release stops, without waiting for the tick
+}
+
+function takeRobot() {
+  driving.robot = Number($('drive-robot').value);
+  sendDrive(); // holds it, standing (no key yet)
+  updateDriveControls();
+  $('view').focus();
+}
+
+function stopDriving() {
+  driving.keys.clear();
+  if (driving.timer) { clearInterval(driving.timer); driving.timer = null; }
+  if (driving.robot !== null && client.open) client.publish('/rilbed/drive', { id: driving.robot, release: true }, 'rilbed.drive');
+  driving.robot = null;
+  updateDriveControls();
+}
+
+function updateDriveControls() {
+  $('drive-take').disabled = driving.robot !== null;
+  $('drive-release').disabled = driving.robot === null;
+  $('drive-state').textContent = driving.robot === null ? '' : `driving robot ${driving.robot}`;
+  for (const b of document.querySelectorAll('#drive-pad button')) b.classList.toggle('held', driving.keys.has(b.dataset.key));
+}
+
+$('drive-take').addEventListener('click', takeRobot);
+$('drive-release').addEventListener('click', stopDriving);
+$('drive-speed').addEventListener('input', () => { $('drive-speed-value').textContent = $('drive-speed').value; });
+document.addEventListener('keydown', (e) => {
+  if (!DRIVE_KEYS.includes(e.key) || driving.robot === null || e.target.matches('input, select, textarea')) return;
+  e.preventDefault();
+  if (!driving.keys.has(e.key)) { driving.keys.add(e.key); keysChanged(); }
+});
+document.addEventListener('keyup', (e) => {
+  if (driving.keys.delete(e.key)) { e.preventDefault(); keysChanged(); }
+});
+window.addEventListener('blur', () => { if (driving.keys.size) { driving.keys.clear(); keysChanged(); } });
+for (const b of document.querySelectorAll('#drive-pad button')) {
+  const press = (e) => { e.preventDefault(); if (driving.robot !== null && !driving.keys.has(b.dataset.key)) { driving.keys.add(b.dataset.key); keysChanged(); } };
+  const release = () => { if (driving.keys.delete(b.dataset.key)) keysChanged(); };
+  b.addEventListener('pointerdown', press);
+  b.addEventListener('pointerup', release);
+  b.addEventListener('pointerleave', release);
+  b.addEventListener('pointercancel', release);
+}
+updateDriveControls();
+
+// ------------------------------------------------------------------ the live view
+const canvas = $('view');
+const ctx = canvas.getContext('2d');
+const overlays = {};
+for (const box of document.querySelectorAll('[data-overlay]')) {
+  overlays[box.dataset.overlay] = box.checked;
+  box.addEventListener('change', () => { overlays[box.dataset.overlay] = box.checked; requestDraw(); });
+}
+$('trail-style').addEventListener('change', requestDraw);
+// The view: zoom and pan on top of a fit of the field (or the camera image) to the canvas.
+const view = { zoom: 1, panX: 0, panY: 0 };
+$('fit').addEventListener('click', fitView);
+canvas.addEventListener('dblclick', fitView);
+function fitView() { view.zoom = 1; view.panX = 0; view.panY = 0; requestDraw(); }
+canvas.addEventListener('wheel', (e) => {
+  e.preventDefault();
+  const r = canvas.getBoundingClientRect();
+  const mx = e.clientX - r.left, my = e.clientY - r.top;
+  const k = Math.exp(-e.deltaY * 0.0015);
+  const zoom = Math.min(50, Math.max(0.2, view.zoom * k));
+  const f = zoom / view.zoom;
+  view.panX = mx - (mx - view.panX) * f;
+  view.panY = my - (my - view.panY) * f;
+  view.zoom = zoom;
+  requestDraw();
+}, { passive: false });
+let drag = null;
+canvas.addEventListener('pointerdown', (e) => { drag = { x: e.clientX, y: e.clientY }; canvas.setPointerCapture(e.pointerId); });
+canvas.addEventListener('pointermove', (e) => {
+  if (!drag) return;
+  view.panX += e.clientX - drag.x; view.panY += e.clientY - drag.y;
+  drag = { x: e.clientX, y: e.clientY };
+  requestDraw();
+});
+canvas.addEventListener('pointerup', () => { drag = null; });
+
+// Where field point (x, y) metres lands on the canvas: through the camera's homography when
+// the camera image is shown, else a fit of the field; then zoom and pan.
+function makeProjection(width, height) {
+  const useCamera = overlays.camera && run.image && run.calibration;
+  let base;
+  if (useCamera) {
+    const H = run.calibration.field_to_image;
+    const s = Math.min(width / run.calibration.width_px, height / run.calibration.height_px);
+    const ox = (width - s * run.calibration.width_px) / 2, oy = (height - s * run.calibration.height_px) / 2;
+    base = { s, ox, oy, camera: true,
+      toPx: (x, y) => { const w = H[6] * x + H[7] * y + H[8]; return [(H[0] * x + H[1] * y + H[2]) / w, (H[3] * x + H[4] * y + H[5]) / w]; } };
+  } else {
+    const fw = run.world?.width_m || 1, fh = run.world?.height_m || 1;
+    const margin = 16;
+    const s = Math.min((width - 2 * margin) / fw, (height - 2 * margin) / fh);
+    const ox = (width - s * fw) / 2, oy = (height + s * fh) / 2;
+    base = { s, ox, oy, camera: false, toPx: (x, y) => [x, -y] }; // y up on the field
+  }
+  const z = view.zoom;
+  const project = (x, y) => {
+    const [u, v] = base.toPx(x, y);
+    return [view.panX + z * (base.ox + base.s * u), view.panY + z * (base.oy + base.s * v)];
+  };
+  // Metres to pixels near a point (for radii): the projection's local scale.
+  const scaleAt = (x, y) => {
+    const [a, b] = project(x, y), [c, d] = project(x + 0.01, y);
+    return Math.hypot(c - a, d - b) / 0.01;
+  };
+  return { project, scaleAt, base, z };
+}
+
+let drawPending = false;
+function requestDraw() {
+  if (drawPending) return;
+  drawPending = true;
+  requestAnimationFrame(draw);
+}
+
+let fpsWindow = [];
+function draw(now) {
+  drawPending = false;
+  const t0 = performance.now();
+  const dpr = window.devicePixelRatio || 1;
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
+    canvas.width = Math.round(w * dpr); canvas.height = Math.round(h * dpr);
+  }
+  ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+  ctx.clearRect(0, 0, w, h);
+  const P = makeProjection(w, h);
+  if (P.base.camera) {
+    ctx.save();
+    ctx.translate(view.panX + P.z * P.base.ox, view.panY + P.z * P.base.oy);
+    ctx.scale(P.z * P.base.s, P.z * P.base.s);
+    ctx.drawImage(run.image, 0, 0);
+    ctx.restore();
+  }
+  if (run.world && overlays.field) drawField(P);
+  if (overlays.trails) drawTrails(P);
+  if (run.poses) {
+    if (overlays.tracks || overlays.ranges || overlays.beacons || overlays.ir) drawSensors(P);
+    if (overlays.robots) drawRobots(P);
+  }
+  if (overlays.detections && run.detections) drawDetections(P);
+  if (plotsDirty) drawPlots();
+  const stats = window.rilbed.stats;
+  stats.frames += 1;
+  stats.drawMs = performance.now() - t0;
+  fpsWindow.push(now);
+  while (fpsWindow.length && now - fpsWindow[0] > 1000) fpsWindow.shift();
+  stats.fps = fpsWindow.length;
+}
+
+function polyline(P, points, close) {
+  ctx.beginPath();
+  points.forEach((p, i) => { const [u, v] = P.project(p.x_m ?? p[0], p.y_m ?? p[1]); if (i) ctx.lineTo(u, v); else ctx.moveTo(u, v); });
+  if (close) ctx.closePath();
+}
+
+function drawField(P) {
+  const W = run.world;
+  for (const t of W.tracks) {
+    ctx.strokeStyle = 'rgba(40,40,40,0.35)';
+    ctx.lineWidth = Math.max(1, t.width_m * P.scaleAt(t.points[0]?.x_m ?? 0, t.points[0]?.y_m ?? 0));
+    ctx.lineJoin = 'round';
+    polyline(P, t.points, false); ctx.stroke();
+  }
+  ctx.fillStyle = 'rgba(90,90,90,0.45)'; ctx.strokeStyle = '#555'; ctx.lineWidth = 1.5;
+  for (const o of W.obstacles) { polyline(P, o, true); ctx.fill(); ctx.stroke(); }
+  ctx.strokeStyle = '#1a9e2a'; ctx.lineWidth = 2.5;
+  polyline(P, [[0, 0], [W.width_m, 0], [W.width_m, W.height_m], [0, W.height_m]], true); ctx.stroke();
+  W.beacons.forEach((b, i) => {
+    const [u, v] = P.project(b.x_m, b.y_m);
+    ctx.fillStyle = '#e0a800'; ctx.beginPath(); ctx.arc(u, v, 6, 0, 2 * Math.PI); ctx.fill();
+    ctx.fillStyle = '#000'; ctx.font = '11px system-ui'; ctx.fillText(`B${i + 1}`, u + 8, v - 6);
+  });
+}
+
+function drawTrails(P) {
+  const outline = $('trail-style').value === 'outline';
+  for (const [id, trail] of run.trails) {
+    if (trail.length < 2) continue;
+    const real = run.poses?.robots.find((r) => r.id === id)?.real;
+    ctx.strokeStyle = ctx.fillStyle = real ? 'rgba(36,86,199,0.45)' : 'rgba(210,40,40,0.4)';
+    if (outline) {
+      ctx.lineWidth = 1.5; polyline(P, trail, false); ctx.stroke();
+    } else {
+      for (let i = 0; i < trail.length; i += 2) {
+        const [u, v] = P.project(trail[i][0], trail[i][1]);
+        ctx.fillRect(u - 1, v - 1, 2, 2);
+      }
+    }
+  }
+}
+
+function drawRobots(P) {
+  for (const r of run.poses.robots) {
+    const [u, v] = P.project(r.x_m, r.y_m);
+    const radius = Math.max(3, (ROBOT_DIAMETER_M / 2) * P.scaleAt(r.x_m, r.y_m));
+    const [hu, hv] = P.project(r.x_m + Math.cos(r.theta_rad) * ROBOT_DIAMETER_M * 0.6, r.y_m + Math.sin(r.theta_rad) * ROBOT_DIAMETER_M * 0.6);
+    ctx.lineWidth = 2;
+    if (r.real) {
+      // A real robot is where the camera says: a square, faint when unseen.
+      ctx.strokeStyle = r.seen ? '#2456c7' : 'rgba(36,86,199,0.4)';
+      ctx.setLineDash(r.seen ? [] : [4, 3]);
+      ctx.strokeRect(u - radius, v - radius, 2 * radius, 2 * radius);
+      ctx.setLineDash([]);
+    } else {
+      ctx.strokeStyle = '#d22828';
+      ctx.beginPath(); ctx.arc(u, v, radius, 0, 2 * Math.PI); ctx.stroke();
+    }
+    ctx.beginPath(); ctx.moveTo(u, v); ctx.lineTo(hu, hv); ctx.stroke();
+    if (driving.robot === r.id) { ctx.strokeStyle = '#e0a800'; ctx.beginPath(); ctx.arc(u, v, radius + 5, 0, 2 * Math.PI); ctx.stroke(); }
+    if (overlays.labels) {
+      ctx.fillStyle = '#111'; ctx.font = '12px system-ui';
+      ctx.fillText(`${r.id} ${r.behaviour}${r.real && r.health && r.health !== 'ok' ? ' [' + r.health + ']' : ''}`, u + radius + 3, v - radius - 2);
+    }
+  }
+}
+
+function drawDetections(P) {
+  ctx.strokeStyle = '#00a3c4'; ctx.lineWidth = 1.5;
+  for (const d of run.detections.detections) {
+    const [u, v] = P.project(d.x_m, d.y_m);
+    const r = Math.max(4, 0.03 * P.scaleAt(d.x_m, d.y_m));
+    ctx.beginPath(); ctx.moveTo(u - r, v); ctx.lineTo(u + r, v); ctx.moveTo(u, v - r); ctx.lineTo(u, v + r); ctx.stroke();
+    const [hu, hv] = P.project(d.x_m + 0.04 * Math.cos(d.theta_rad), d.y_m + 0.04 * Math.sin(d.theta_rad));
+    ctx.beginPath(); ctx.moveTo(u, v); ctx.lineTo(hu, hv); ctx.stroke();
+  }
+}
+
+function drawSensors(P) {
+  const layouts = new Map((run.world?.robots || []).map((r) => [r.id, r.sensors]));
+  for (const r of run.poses.robots) {
+    const s = run.sensors.get(r.id);
+    if (!s) continue;
+    const layout = layouts.get(r.id) || {};
+    const c = Math.cos(r.theta_rad), sn = Math.sin(r.theta_rad);
+    const at = (fx, fy) => [r.x_m + c * fx - sn * fy, r.y_m + sn * fx + c * fy]; // robot frame to field
+    if (overlays.ir && s.proximity?.length === 8) {
+      const reach = layout.ir_range_m || IR_RANGE_M;
+      s.proximity.forEach((value, i) => {
+        const a = IR_ANGLES_RAD[i];
+        const r0 = ROBOT_DIAMETER_M / 2, r1 = r0 + reach;
+        const [x0, y0] = at(r0 * Math.cos(a), r0 * Math.sin(a));
+        const [x1, y1] = at(r1 * Math.cos(a), r1 * Math.sin(a));
+        ctx.strokeStyle = value > 0 ? `rgba(230,120,0,${0.3 + 0.7 * Math.min(1, value / 1023)})` : 'rgba(120,120,120,0.25)';
+        ctx.lineWidth = value > 0 ? 2 : 1;
+        polyline(P, [[x0, y0], [x1, y1]], false); ctx.stroke();
+      });
+    }
+    if (overlays.ranges && s.range_m?.length) {
+      s.range_m.forEach((d, i) => {
+        const g = layout.ranges?.[i];
+        if (!g) return;
+        const half = g.opening_rad / 2;
+        const reach = s.range_hit[i] ? d : g.max_m;
+        const pts = [at(0, 0)];
+        for (let k = 0; k <= 8; ++k) { const a = g.mount_rad - half + (k / 8) * 2 * half; pts.push(at(reach * Math.cos(a), reach * Math.sin(a))); }
+        ctx.fillStyle = s.range_hit[i] ? 'rgba(140,60,200,0.18)' : 'rgba(140,60,200,0.06)';
+        ctx.strokeStyle = 'rgba(140,60,200,0.5)'; ctx.lineWidth = 1;
+        polyline(P, pts, true); ctx.fill(); ctx.stroke();
+      });
+    }
+    if (overlays.beacons && s.beacon_id?.length) {
+      s.beacon_id.forEach((id, i) => {
+        const a = s.beacon_bearing_rad[i];
+        ctx.strokeStyle = 'rgba(224,168,0,0.9)'; ctx.lineWidth = 1.5; ctx.setLineDash([5, 4]);
+        polyline(P, [at(0, 0), at(0.25 * Math.cos(a), 0.25 * Math.sin(a))], false); ctx.stroke(); ctx.setLineDash([]);
+        const [u, v] = P.project(...at(0.27 * Math.cos(a), 0.27 * Math.sin(a)));
+        ctx.fillStyle = '#8a6800'; ctx.font = '10px system-ui'; ctx.fillText(`B${id}`, u, v);
+      });
+    }
+    if (overlays.tracks && s.track?.length) {
+      s.track.forEach((on, i) => {
+        const e = layout.tracks?.[i];
+        if (!e) return;
+        const pts = [];
+        for (let k = 0; k < 16; ++k) {
+          const a = (k / 16) * 2 * Math.PI;
+          const ex = e.a_m * Math.cos(a), ey = e.b_m * Math.sin(a);
+          pts.push(at(e.x_m + Math.cos(e.yaw_rad) * ex - Math.sin(e.yaw_rad) * ey, e.y_m + Math.sin(e.yaw_rad) * ex + Math.cos(e.yaw_rad) * ey));
+        }
+        ctx.fillStyle = on ? 'rgba(30,125,50,0.6)' : 'rgba(30,125,50,0.12)';
+        ctx.strokeStyle = 'rgba(30,125,50,0.8)'; ctx.lineWidth = 1;
+        polyline(P, pts, true); ctx.fill(); ctx.stroke();
+      });
+    }
+  }
+}
+
+new ResizeObserver(requestDraw).observe(canvas);
+
+// ------------------------------------------------------------------ plots
+let plotsDirty = false;
+let lastPlot = 0;
+const COLORS = ['#d22828', '#2456c7', '#1e7d32', '#b26a00', '#7b1fa2', '#00838f', '#c2185b', '#5d4037', '#455a64', '#9e9d24'];
+
+function plotCanvas(id) {
+  const c = $(id), dpr = window.devicePixelRatio || 1;
+  const w = c.clientWidth, h = c.clientHeight;
+  if (c.width !== Math.round(w * dpr)) { c.width = Math.round(w * dpr); c.height = Math.round(h * dpr); }
+  const g = c.getContext('2d');
+  g.setTransform(dpr, 0, 0, dpr, 0, 0);
+  g.clearRect(0, 0, w, h);
+  return [g, w, h];
+}
+
+function drawPlots() {
+  const now = performance.now();
+  if (now - lastPlot < 500) { setTimeout(requestDraw, 500); return; } // twice a second is plenty
+  lastPlot = now; plotsDirty = false;
+  // Formation: distance to the robot ahead, followers only.
+  {
+    const [g, w, h] = plotCanvas('formation-plot');
+    let tMax = 1, dMax = 0.3;
+    for (const s of run.formation.values()) for (const [t, d] of s) { tMax = Math.max(tMax, t); if (d !== null) dMax = Math.max(dMax, d); }
+    const L = 36, B = 20;
+    axes(g, w, h, L, B, `${tMax.toFixed(0)} s`, `${dMax.toFixed(2)} m`);
+    let k = 0;
+    for (const [id, s] of run.formation) {
+      g.strokeStyle = COLORS[k++ % COLORS.length]; g.lineWidth = 1.2; g.beginPath();
+      let pen = false;
+      for (const [t, d] of s) {
+        if (d === null) { pen = false; continue; }
+        const x = L + (t / tMax) * (w - L - 4), y = h - B - (d / dMax) * (h - B - 4);
+        if (pen) g.lineTo(x, y); else g.moveTo(x, y);
+        pen = true;
+      }
+      g.stroke();
+      g.fillStyle = g.strokeStyle; g.fillText(String(id), w - 4 - 14 * (run.formation.size - k + 1), 12);
+    }
+  }
+  // Trajectories: every robot's path over the field.
+  {
+    const [g, w, h] = plotCanvas('trajectory-plot');
+    const fw = run.world?.width_m || 1, fh = run.world?.height_m || 1;
+    const s = Math.min((w - 8) / fw, (h - 8) / fh), ox = (w - s * fw) / 2, oy = (h + s * fh) / 2;
+    g.strokeStyle = '#1a9e2a'; g.strokeRect(ox, oy - s * fh, s * fw, s * fh);
+    let k = 0;
+    for (const [id, pts] of run.history) {
+      g.strokeStyle = COLORS[k++ % COLORS.length]; g.lineWidth = 1.2; g.beginPath();
+      pts.forEach(([, x, y], i) => { const u = ox + s * x, v = oy - s * y; if (i) g.lineTo(u, v); else g.moveTo(u, v); });
+      g.stroke();
+      const last = pts[pts.length - 1];
+      if (last) { g.fillStyle = g.strokeStyle; g.fillText(String(id), ox + s * last[1] + 3, oy - s * last[2] - 3); }
+    }
+  }
+}
+
+function axes(g, w, h, L, B, xLabel, yLabel) {
+  g.strokeStyle = '#999'; g.lineWidth = 1;
+  g.beginPath(); g.moveTo(L, 4); g.lineTo(L, h - B); g.lineTo(w - 4, h - B); g.stroke();
+  g.fillStyle = '#666'; g.font = '10px system-ui';
+  g.fillText('0', L - 10, h - B + 12); g.fillText(xLabel, w - 30, h - B + 12); g.fillText(yLabel, 2, 12);
+}
