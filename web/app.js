@@ -396,6 +396,7 @@ function draw(now) {
   ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
   ctx.clearRect(0, 0, w, h);
   const P = makeProjection(w, h);
+  window.rilbed.project = P.project; // field metres -> canvas CSS pixels, as drawn now (for tests)
   if (P.base.camera) {
     ctx.save();
     ctx.translate(view.panX + P.z * P.base.ox, view.panY + P.z * P.base.oy);
