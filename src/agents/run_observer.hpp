@@ -5,6 +5,7 @@
 // must return quickly (publishing is a send, never a wait for a receiver).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -65,8 +66,19 @@ struct FrameReport {
   std::span<const DetectionReport> detections;
 };
 
+/// The overhead camera of a run with real robots: how its frames map onto the field.
+struct CameraReport {
+  int width_px = 0;   ///< frame size
+  int height_px = 0;
+  /// Homogeneous undistorted pixels (u, v, 1) to homogeneous field metres, row-major.
+  std::array<double, 9> image_to_field{1, 0, 0, 0, 1, 0, 0, 0, 1};
+  bool lens_distortion = false;  ///< frames are distorted (the homography applies after undistortion)
+  std::string source;            ///< "emulated", "device 0", or the footage's path
+};
+
 /// The world a run takes place in.
 struct WorldReport {
+  std::optional<CameraReport> camera;  ///< runs with a camera
   std::string scenario;
   FieldDrawing field;          ///< size, obstacles, tracks, beacons, which robots are real
   bool walls = true;           ///< the field's edges are walls
@@ -118,6 +130,12 @@ class RunObserver {
   virtual bool wants_frame_images() const { return false; }
   /// Every camera frame, 8-bit grey or BGR, when wants_frame_images(); valid during the call.
   virtual void on_frame_image(TimeUs /*t_us*/, std::int64_t /*frame*/, const cv::Mat& /*image*/) {}
+  /// Whether it wants the camera's frames as JPEG bytes (on_frame_jpeg) when they come
+  /// that way (from a bus, or a publisher's local subscribers): no decoding, no copy.
+  virtual bool wants_frame_jpegs() const { return false; }
+  /// A camera frame as JPEG, when wants_frame_jpegs(); `jpeg` is valid during the call.
+  virtual void on_frame_jpeg(TimeUs /*t_us*/, std::int64_t /*frame*/, int /*width_px*/, int /*height_px*/,
+                             std::span<const std::uint8_t> /*jpeg*/) {}
   /// Each event as it is recorded (the rows of events.csv).
   virtual void on_event(const RunEvent& /*event*/) {}
   /// At the start, once per simulated second, and when the run ends (state "ended").

@@ -104,6 +104,17 @@ class VisionModel final : public sim::AtomicModel<TimeUs> {  // state: time to t
   }
   long frames() const { return frames_.load(std::memory_order_relaxed); }
   long sightings() const { return sightings_; }
+  /// What viewers need to draw the field over its frames.
+  CameraReport camera_report(const std::string& source) const {
+    const vision::FieldCalibration& c = tracker_.calibration();
+    CameraReport r;
+    r.width_px = c.image_size.width;
+    r.height_px = c.image_size.height;
+    for (int i = 0; i < 9; ++i) r.image_to_field[static_cast<std::size_t>(i)] = c.homography(i / 3, i % 3);
+    r.lens_distortion = c.lens.has_value();
+    r.source = source;
+    return r;
+  }
 
  private:
   void report(const cv::Mat& frame, const std::vector<vision::FieldObservation>& seen, double process_ms) {
@@ -747,7 +758,13 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   setup.period_us = scenario.control_period_us;
   setup.scenario = &scenario;
   setup.wall_start = wall_start;
-  if (options.observer) setup.world_report = world_report(scenario, real_ids);
+  if (options.observer) {
+    setup.world_report = world_report(scenario, real_ids);
+    if (camera) {
+      const CameraSpec& cam = *scenario.camera;
+      setup.world_report.camera = camera->camera_report(cam.emulate ? "emulated" : cam.device ? "device " + std::to_string(*cam.device) : cam.file);
+    }
+  }
   sim::FastClock fast_clock;
   sim::RealTimeClock real_clock(options.rt_factor);
   if (options.realtime) setup.clock = &real_clock;

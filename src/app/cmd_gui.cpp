@@ -98,7 +98,8 @@ int gui_command(const GuiArgs& args) {
   std::vector<std::unique_ptr<links::LcmSubscription>> subscriptions;
   long bad = 0;
   for (const std::string* c : {&run_channels.world, &run_channels.poses, &run_channels.events, &run_channels.status,
-                               &run_channels.summary, &run_channels.wheels, &run_channels.sensors, &run_channels.detections}) {
+                               &run_channels.summary, &run_channels.wheels, &run_channels.sensors, &run_channels.detections,
+                               &run_channels.camera, &run_channels.frames}) {
     subscriptions.push_back(std::make_unique<links::LcmSubscription>(*lcm, *c, [&](const std::string& ch, const void* d, std::size_t n) {
       if (const auto problem = decoder.decode(ch, d, n)) {
         if (++bad <= 5) spdlog::warn("gui: {} (skipped)", *problem);

@@ -354,6 +354,8 @@ int run_command(const RunArgs& args) {
       po.in_process = !network_bus;
       po.log = recording.get();
       po.frames = args.record_frames;
+      // The panel shows the camera at most 10 frames a second; they go to it alone.
+      if (gui) po.local_frame_period_ms = static_cast<int>(1000.0 / gui_web::kMaxCameraFps);
       links::LcmRunPublisher publisher(*bus, channels, po);
       std::unique_ptr<agents::RunFolderWriter> folder;
       if (o.out_dir) {

@@ -213,6 +213,13 @@ void GuiService::on_sensors(TimeUs t_us, std::span<const agents::SensorReport> s
   channels_->on_sensors(t_us, sensors);
 }
 void GuiService::on_detections(const agents::FrameReport& frame) { channels_->on_detections(frame); }
+void GuiService::on_frame_jpeg(TimeUs t_us, std::int64_t, int, int, std::span<const std::uint8_t> jpeg) {
+  if (server_->clients() == 0) return;
+  const auto now = Clock::now();
+  if (now < next_camera_frame_) return;
+  next_camera_frame_ = now + std::chrono::microseconds(static_cast<long>(1e6 / kMaxCameraFps));
+  channels_->camera_frame(t_us, jpeg);
+}
 void GuiService::on_event(const agents::RunEvent& event) { channels_->on_event(event); }
 void GuiService::on_status(const agents::StatusReport& status) {
   {

@@ -68,6 +68,9 @@ struct ManualDriveConfig {
   double hold_wall_s = 0.6;
 };
 
+/// Camera frames at most this often to the viewers (the limit: 10 per second).
+inline constexpr double kMaxCameraFps = 10.0;
+
 /// What the service counted.
 struct GuiCounters {
   std::uint64_t console_commands = 0;  ///< console commands handed to the sink
@@ -97,6 +100,9 @@ class GuiService final : public agents::RunObserver {
   void on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wheels) override;
   void on_sensors(TimeUs t_us, std::span<const agents::SensorReport> sensors) override;
   void on_detections(const agents::FrameReport& frame) override;
+  bool wants_frame_jpegs() const override { return true; }
+  /// Passes at most max_camera_fps frames a second on, and only while someone watches.
+  void on_frame_jpeg(TimeUs t_us, std::int64_t frame, int width_px, int height_px, std::span<const std::uint8_t> jpeg) override;
   void on_event(const agents::RunEvent& event) override;
   void on_status(const agents::StatusReport& status) override;
   void on_summary(TimeUs t_us, const nlohmann::json& summary) override;
@@ -131,6 +137,7 @@ class GuiService final : public agents::RunObserver {
   std::deque<ConsoleRequest> requests_;
   std::map<int, Hold> holds_;  // by robot ID
   double rt_factor_ = 1.0;
+  Clock::time_point next_camera_frame_{};  // the RunObserver thread only
   GuiCounters counts_;
   bool stopping_ = false;
   std::thread thread_;

@@ -1,6 +1,8 @@
 #include "gui_web/run_channels.hpp"
 
+#include <array>
 #include <cmath>
+#include <optional>
 
 namespace rilbed::gui_web {
 
@@ -69,6 +71,40 @@ std::string scene_schema() {
   return object_schema("foxglove.SceneUpdate", {{"deletions", array_of(deletion)}, {"entities", array_of(entity_s)}});
 }
 
+// Base64 (RFC 4648, with padding), as JSON carries a Foxglove `bytes` field.
+std::string base64(std::span<const std::uint8_t> bytes) {
+  static constexpr char kDigits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  std::size_t i = 0;
+  for (; i + 3 <= bytes.size(); i += 3) {
+    const std::uint32_t v = (std::uint32_t{bytes[i]} << 16) | (std::uint32_t{bytes[i + 1]} << 8) | bytes[i + 2];
+    out += kDigits[v >> 18];
+    out += kDigits[(v >> 12) & 63];
+    out += kDigits[(v >> 6) & 63];
+    out += kDigits[v & 63];
+  }
+  if (const std::size_t rest = bytes.size() - i; rest > 0) {
+    const std::uint32_t v = (std::uint32_t{bytes[i]} << 16) | (rest == 2 ? std::uint32_t{bytes[i + 1]} << 8 : 0u);
+    out += kDigits[v >> 18];
+    out += kDigits[(v >> 12) & 63];
+    out += rest == 2 ? kDigits[(v >> 6) & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+// The inverse of a 3x3 homography (row-major), or nullopt when it is singular.
+std::optional<std::array<double, 9>> inverse(const std::array<double, 9>& m) {
+  const double a = m[0], b = m[1], c = m[2], d = m[3], e = m[4], f = m[5], g = m[6], h = m[7], k = m[8];
+  const double A = e * k - f * h, B = -(d * k - f * g), C = d * h - e * g;
+  const double det = a * A + b * B + c * C;
+  if (!std::isfinite(det) || std::abs(det) < 1e-300) return std::nullopt;
+  return std::array<double, 9>{A / det, -(b * k - c * h) / det, (b * f - c * e) / det,
+                               B / det, (a * k - c * g) / det,  -(a * f - c * d) / det,
+                               C / det, -(a * h - b * g) / det, (a * e - b * d) / det};
+}
+
 foxglove::Channel channel(const std::string& topic, const std::string& schema_name, const std::string& schema) {
   return {0, topic, "json", schema_name, schema, "jsonschema"};
 }
@@ -112,6 +148,15 @@ RunChannels::RunChannels(WebServer& server) : server_(server) {
       object_schema("rilbed.event", {{"t_s", number()}, {"kind", text()}, {"id", integer()}, {"other", integer()}, {"detail", text()}})));
   summary_ = server_.add_channel(channel("/rilbed/summary", "rilbed.summary", object_schema("rilbed.summary", json::object())));
   scene_ = server_.add_channel(channel("/rilbed/scene", "foxglove.SceneUpdate", scene_schema()), /*latched=*/true);
+  const json time_s = object_of({{"sec", integer()}, {"nsec", integer()}});
+  camera_ = server_.add_channel(channel("/rilbed/camera", "foxglove.CompressedImage",
+      object_schema("foxglove.CompressedImage", {{"timestamp", time_s}, {"frame_id", text()},
+                                                 {"data", {{"type", "string"}, {"contentEncoding", "base64"}}},
+                                                 {"format", text()}})));
+  camera_calibration_ = server_.add_channel(channel("/rilbed/camera_calibration", "rilbed.camera",
+      object_schema("rilbed.camera", {{"t_s", number()}, {"width_px", integer()}, {"height_px", integer()},
+                                      {"image_to_field", array_of(number())}, {"field_to_image", array_of(number())},
+                                      {"lens_distortion", boolean()}, {"source", text()}})), /*latched=*/true);
   console_reply_ = server_.add_channel(channel("/rilbed/console_reply", "rilbed.console_reply",
       object_schema("rilbed.console_reply", {{"t_s", number()}, {"accepted", boolean()}, {"reason", text()}, {"client", text()}})));
 }
@@ -182,6 +227,14 @@ json RunChannels::scene_json(TimeUs t_us, std::span<const agents::PoseReport> po
 
 void RunChannels::on_world(TimeUs t_us, const agents::WorldReport& world) {
   world_report_ = world;
+  if (world.camera) {
+    const agents::CameraReport& c = *world.camera;
+    const auto to_image = inverse(c.image_to_field);
+    send(camera_calibration_, t_us,
+         {{"t_s", seconds(t_us)}, {"width_px", c.width_px}, {"height_px", c.height_px}, {"image_to_field", c.image_to_field},
+          {"field_to_image", to_image ? json(*to_image) : json(nullptr)}, {"lens_distortion", c.lens_distortion},
+          {"source", c.source}});
+  }
   send(world_, t_us, world_json(t_us, world));
 }
 
@@ -232,6 +285,10 @@ void RunChannels::on_event(const agents::RunEvent& e) {
 void RunChannels::on_status(const agents::StatusReport& status) { send(status_, status.t_us, status_json(status)); }
 
 void RunChannels::on_summary(TimeUs t_us, const nlohmann::json& summary) { send(summary_, t_us, summary); }
+
+void RunChannels::camera_frame(TimeUs t_us, std::span<const std::uint8_t> jpeg) {
+  send(camera_, t_us, {{"timestamp", time_of(t_us)}, {"frame_id", "camera"}, {"data", base64(jpeg)}, {"format", "jpeg"}});
+}
 
 void RunChannels::console_reply(TimeUs t_us, bool accepted, const std::string& reason, const std::string& client) {
   send(console_reply_, t_us, {{"t_s", seconds(t_us)}, {"accepted", accepted}, {"reason", reason}, {"client", client}});

@@ -5,7 +5,10 @@
 //   /rilbed/detections, /rilbed/events  (rilbed.* schemas, the LCM messages' fields)
 //   /rilbed/scene       (foxglove.SceneUpdate: the field and every robot, frame "field")
 //   /rilbed/console_reply  (the run's answers to console commands sent from a browser)
-// The world, status, poses and scene are latched: a viewer that joins gets the
+//   /rilbed/camera      (foxglove.CompressedImage: the camera's frames, JPEG, frame "camera")
+//   /rilbed/camera_calibration  (rilbed.camera: frame size, image_to_field and
+//                        field_to_image homographies, row-major)
+// The world, status, poses, scene and camera calibration are latched: a viewer that joins gets the
 // last of each at once (a paused run sends nothing new).
 // Times are simulated seconds (t_s); the binary header's time is the same in nanoseconds.
 #pragma once
@@ -33,6 +36,9 @@ class RunChannels final : public agents::RunObserver {
   void on_event(const agents::RunEvent& event) override;
   void on_status(const agents::StatusReport& status) override;
   void on_summary(TimeUs t_us, const nlohmann::json& summary) override;
+  /// A camera frame (JPEG) as foxglove.CompressedImage on /rilbed/camera. Call at the rate
+  /// viewers should get them: each is base64 text of about 4/3 of the JPEG's size.
+  void camera_frame(TimeUs t_us, std::span<const std::uint8_t> jpeg);
   /// The run's answer to a console command from a client (accepted, and why or what).
   void console_reply(TimeUs t_us, bool accepted, const std::string& reason, const std::string& client);
 
@@ -50,6 +56,7 @@ class RunChannels final : public agents::RunObserver {
 
   WebServer& server_;
   std::uint32_t world_, status_, poses_, wheels_, sensors_, detections_, events_, scene_, console_reply_, summary_;
+  std::uint32_t camera_ = 0, camera_calibration_ = 0;
   std::optional<agents::WorldReport> world_report_;
 };
 

@@ -42,6 +42,7 @@ Channels Channels::with_prefix(const std::string& prefix) {
   c.sensors = prefix + c.sensors;
   c.detections = prefix + c.detections;
   c.frames = prefix + c.frames;
+  c.camera = prefix + c.camera;
   return c;
 }
 
@@ -198,6 +199,17 @@ rilbed::detections_t to_lcm(const agents::FrameReport& f) {
   return m;
 }
 
+rilbed::camera_t to_lcm(TimeUs t_us, const agents::CameraReport& c) {
+  rilbed::camera_t m;
+  m.utime = t_us;
+  m.width_px = c.width_px;
+  m.height_px = c.height_px;
+  std::copy(c.image_to_field.begin(), c.image_to_field.end(), std::begin(m.image_to_field));
+  m.lens_distortion = c.lens_distortion;
+  m.source = c.source;
+  return m;
+}
+
 rilbed::frame_t to_lcm(TimeUs t_us, std::int64_t frame, const cv::Mat& image, int quality) {
   rilbed::frame_t m;
   m.utime = t_us;
@@ -350,7 +362,22 @@ std::optional<std::string> RunReportDecoder::decode(const std::string& channel, 
   } else if (channel == channels_.world) {
     rilbed::world_t m;
     if (!decode_checked(data, size, m)) return bad("world_t");
-    observer_.on_world(m.utime, from_lcm(m));
+    agents::WorldReport world = from_lcm(m);
+    world.camera = camera_;
+    observer_.on_world(m.utime, world);
+  } else if (channel == channels_.camera) {
+    rilbed::camera_t m;
+    if (!decode_checked(data, size, m)) return bad("camera_t");
+    if (m.width_px <= 0 || m.height_px <= 0 || m.width_px > 100000 || m.height_px > 100000) {
+      return channel + ": a camera of " + std::to_string(m.width_px) + " x " + std::to_string(m.height_px) + " pixels";
+    }
+    agents::CameraReport c;
+    c.width_px = m.width_px;
+    c.height_px = m.height_px;
+    std::copy(std::begin(m.image_to_field), std::end(m.image_to_field), c.image_to_field.begin());
+    c.lens_distortion = m.lens_distortion != 0;
+    c.source = m.source;
+    camera_ = c;
   } else if (channel == channels_.wheels) {
     rilbed::wheels_t m;
     if (!decode_checked(data, size, m)) return bad("wheels_t");
@@ -376,10 +403,15 @@ std::optional<std::string> RunReportDecoder::decode(const std::string& channel, 
     }
     observer_.on_detections({m.utime, m.frame, m.process_ms, detections_});
   } else if (channel == channels_.frames) {
-    if (!observer_.wants_frame_images()) return std::nullopt;
+    if (!observer_.wants_frame_images() && !observer_.wants_frame_jpegs()) return std::nullopt;
     rilbed::frame_t m;
     if (!decode_checked(data, size, m)) return bad("frame_t");
     if (m.format != "jpeg") return channel + ": frame " + std::to_string(m.frame) + " is '" + m.format + "', not jpeg";
+    if (observer_.wants_frame_jpegs()) {
+      if (m.width_px <= 0 || m.height_px <= 0) return channel + ": frame " + std::to_string(m.frame) + " has no size";
+      observer_.on_frame_jpeg(m.utime, m.frame, m.width_px, m.height_px, m.data);
+      if (!observer_.wants_frame_images()) return std::nullopt;
+    }
     cv::Mat image;
     try {
       image = cv::imdecode(m.data, cv::IMREAD_UNCHANGED);
@@ -477,6 +509,14 @@ class LcmRunPublisher::Fanout final : public agents::RunObserver {
       if (o.wants_frame_images()) o.on_frame_image(t, n, image);
     });
   }
+  bool wants_frame_jpegs() const override {
+    return std::any_of(observers.begin(), observers.end(), [](auto* o) { return o->wants_frame_jpegs(); });
+  }
+  void on_frame_jpeg(TimeUs t, std::int64_t n, int w, int h, std::span<const std::uint8_t> jpeg) override {
+    each([&](auto& o) {
+      if (o.wants_frame_jpegs()) o.on_frame_jpeg(t, n, w, h, jpeg);
+    });
+  }
   void on_event(const agents::RunEvent& e) override { each([&](auto& o) { o.on_event(e); }); }
   void on_status(const agents::StatusReport& s) override { each([&](auto& o) { o.on_status(s); }); }
   void on_summary(TimeUs t, const nlohmann::json& j) override { each([&](auto& o) { o.on_summary(t, j); }); }
@@ -508,7 +548,7 @@ std::unique_ptr<LcmSubscription> LcmRunPublisher::subscribe(const std::string& c
 }
 
 template <typename Message>
-void LcmRunPublisher::publish(const std::string& channel, const Message& message) {
+void LcmRunPublisher::publish(const std::string& channel, const Message& message, bool local_only) {
   std::lock_guard lock(mutex_);
   // Encoded once: the same bytes go on the bus, into the log and to the local subscribers.
   const int room = message.getEncodedSize();
@@ -519,6 +559,10 @@ void LcmRunPublisher::publish(const std::string& channel, const Message& message
   ChannelCount& c = counts_[channel];
   if (size < 0) {
     ++c.failures;
+    return;
+  }
+  if (local_only) {
+    if (local_decoder_) local_decoder_->decode(channel, buffer_.data(), static_cast<std::size_t>(size));
     return;
   }
   if (channel == channels_.world) last_world_.assign(buffer_.begin(), buffer_.begin() + size);
@@ -570,7 +614,10 @@ void LcmRunPublisher::repeat_end() {
 }
 
 void LcmRunPublisher::on_world(TimeUs t_us, const agents::WorldReport& world) {
-  if (heard()) publish(channels_.world, to_lcm(t_us, world));
+  if (!heard()) return;
+  // The camera first: a viewer draws the world over the camera's frames.
+  if (world.camera) publish(channels_.camera, to_lcm(t_us, *world.camera));
+  publish(channels_.world, to_lcm(t_us, world));
 }
 
 void LcmRunPublisher::on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) {
@@ -596,7 +643,16 @@ void LcmRunPublisher::on_detections(const agents::FrameReport& frame) {
 }
 
 void LcmRunPublisher::on_frame_image(TimeUs t_us, std::int64_t frame, const cv::Mat& image) {
-  if (heard()) publish(channels_.frames, to_lcm(t_us, frame, image, options_.jpeg_quality));
+  if (options_.frames) {
+    if (heard()) publish(channels_.frames, to_lcm(t_us, frame, image, options_.jpeg_quality));
+    return;
+  }
+  // Only for the local subscribers (a web panel), and only as often as they show them.
+  if (options_.local_frame_period_ms <= 0 || !fanout_ || !fanout_->wants_frame_jpegs()) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (now < next_local_frame_) return;
+  next_local_frame_ = now + std::chrono::milliseconds(options_.local_frame_period_ms);
+  publish(channels_.frames, to_lcm(t_us, frame, image, options_.jpeg_quality), /*local_only=*/true);
 }
 
 void LcmRunPublisher::on_event(const agents::RunEvent& event) {

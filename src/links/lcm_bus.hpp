@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <atomic>
+#include <chrono>
 #include <functional>
 #include <map>
 #include <memory>
@@ -21,6 +22,7 @@
 #include "agents/run_observer.hpp"
 #include "rilbed/detections_t.hpp"
 #include "rilbed/event_t.hpp"
+#include "rilbed/camera_t.hpp"
 #include "rilbed/frame_t.hpp"
 #include "rilbed/poses_t.hpp"
 #include "rilbed/sensors_t.hpp"
@@ -62,6 +64,7 @@ struct Channels {
   std::string sensors = "RILBED_SENSORS";  ///< rilbed::sensors_t, every control step
   std::string detections = "RILBED_DETECTIONS";  ///< rilbed::detections_t, every camera frame
   std::string frames = "RILBED_FRAMES";    ///< rilbed::frame_t (JPEG), every camera frame, only when asked for
+  std::string camera = "RILBED_CAMERA";    ///< rilbed::camera_t, before each world_t of a run with a camera
   std::string console = "RILBED_CONSOLE";  ///< rilbed::console_command_t, from consoles
   std::string console_reply = "RILBED_CONSOLE_REPLY";  ///< rilbed::console_reply_t, the run's answers
   /// The same names behind `prefix`.
@@ -89,6 +92,8 @@ void fill(rilbed::sensors_t& message, TimeUs t_us, std::span<const agents::Senso
 rilbed::detections_t to_lcm(const agents::FrameReport& frame);
 /// A camera frame as JPEG of `quality` (1..100); an empty image gives size 0.
 rilbed::frame_t to_lcm(TimeUs t_us, std::int64_t frame, const cv::Mat& image, int quality);
+/// The camera's mapping onto the field.
+rilbed::camera_t to_lcm(TimeUs t_us, const agents::CameraReport& camera);
 
 /// Hands the messages of a run's channels, as raw bytes from a bus or a log, to a
 /// RunObserver as the run reported them. Messages on other channels are ignored.
@@ -116,6 +121,7 @@ class RunReportDecoder {
   std::vector<agents::DetectionReport> detections_;
   bool summary_seen_ = false;
   std::optional<rilbed::status_t> last_status_;
+  std::optional<agents::CameraReport> camera_;  // the last camera_t, for the next world_t
 };
 
 /// Reads an LCM log (the format lcm-logger and `rilbed run --record` write) with every
@@ -171,6 +177,10 @@ class LcmRunPublisher final : public agents::RunObserver {
     lcm::LogFile* log = nullptr;   ///< also write every message here (not owned)
     bool frames = false;           ///< publish the camera frames themselves (RILBED_FRAMES, JPEG)
     int jpeg_quality = 90;         ///< of those frames; higher is larger and closer to the camera's
+    /// Hand the local subscribers that want them (a web panel) a frame at most this often,
+    /// wall milliseconds, without putting it on the bus or in the log; 0: never. Each
+    /// costs a JPEG encoding (about 2 ms for 640 x 480).
+    int local_frame_period_ms = 0;
   };
   LcmRunPublisher(lcm::LCM& lcm, Channels channels, Options options);
   ~LcmRunPublisher() override;
@@ -199,7 +209,7 @@ class LcmRunPublisher final : public agents::RunObserver {
   void on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wheels) override;
   void on_sensors(TimeUs t_us, std::span<const agents::SensorReport> sensors) override;
   void on_detections(const agents::FrameReport& frame) override;
-  bool wants_frame_images() const override { return options_.frames; }
+  bool wants_frame_images() const override { return options_.frames || options_.local_frame_period_ms > 0; }
   void on_frame_image(TimeUs t_us, std::int64_t frame, const cv::Mat& image) override;
   void on_event(const agents::RunEvent& event) override;
   void on_status(const agents::StatusReport& status) override;
@@ -213,7 +223,7 @@ class LcmRunPublisher final : public agents::RunObserver {
   // other processes may listen on.
   bool heard() const { return !options_.in_process || bus_subscribers_ > 0 || options_.log || fanout_; }
   template <typename Message>
-  void publish(const std::string& channel, const Message& message);
+  void publish(const std::string& channel, const Message& message, bool local_only = false);
 
   lcm::LCM& lcm_;
   Channels channels_;
@@ -229,6 +239,7 @@ class LcmRunPublisher final : public agents::RunObserver {
   std::unique_ptr<RunReportDecoder> local_decoder_;
   std::atomic<int> bus_subscribers_{0};
   std::vector<std::uint8_t> last_world_, last_status_, last_summary_;  // their bytes, to publish again
+  std::chrono::steady_clock::time_point next_local_frame_{};
   mutable std::mutex mutex_;
   std::map<std::string, ChannelCount> counts_;
 };

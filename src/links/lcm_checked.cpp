@@ -194,6 +194,15 @@ void fields(Walk& w, const rilbed::frame_t*) {
   w.skip(static_cast<std::size_t>(n));
 }
 
+void fields(Walk& w, const rilbed::camera_t*) {
+  w.i64();
+  w.i32();
+  w.i32();
+  w.skip(9 * 8);
+  w.i8();
+  w.string();
+}
+
 }  // namespace
 
 template <typename Message>
@@ -215,5 +224,6 @@ template bool well_formed<rilbed::wheels_t>(const void*, std::size_t);
 template bool well_formed<rilbed::sensors_t>(const void*, std::size_t);
 template bool well_formed<rilbed::detections_t>(const void*, std::size_t);
 template bool well_formed<rilbed::frame_t>(const void*, std::size_t);
+template bool well_formed<rilbed::camera_t>(const void*, std::size_t);
 
 }  // namespace rilbed::links

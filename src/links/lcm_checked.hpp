@@ -19,6 +19,7 @@
 #include "rilbed/console_reply_t.hpp"
 #include "rilbed/detections_t.hpp"
 #include "rilbed/event_t.hpp"
+#include "rilbed/camera_t.hpp"
 #include "rilbed/frame_t.hpp"
 #include "rilbed/poses_t.hpp"
 #include "rilbed/sensors_t.hpp"

@@ -57,11 +57,11 @@ const std::vector<std::string>& channel_names() {
   static const std::vector<std::string> names = [] {
     const links::Channels c = links::Channels::with_prefix("");
     return std::vector<std::string>{c.poses,   c.events,     c.status, c.world,         c.summary,
-                                    c.wheels,  c.sensors,    c.detections, c.frames, "RILBED_UNKNOWN"};
+                                    c.wheels,  c.sensors,    c.detections, c.frames, c.camera, "RILBED_UNKNOWN"};
   }();
   return names;
 }
-enum Pick { kPoses, kEvents, kStatus, kWorld, kSummary, kWheels, kSensors, kDetections, kFrames, kUnknown, kPicks };
+enum Pick { kPoses, kEvents, kStatus, kWorld, kSummary, kWheels, kSensors, kDetections, kFrames, kCamera, kUnknown, kPicks };
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
@@ -77,6 +77,7 @@ bool has_nul(const rilbed::wheels_t&) { return false; }
 bool has_nul(const rilbed::sensors_t&) { return false; }
 bool has_nul(const rilbed::detections_t&) { return false; }
 bool has_nul(const rilbed::frame_t& m) { return has_nul(m.format); }
+bool has_nul(const rilbed::camera_t& m) { return has_nul(m.source); }
 bool has_nul(const rilbed::poses_t& m) {
   for (const rilbed::robot_pose_t& r : m.robots) {
     if (has_nul(r.behaviour) || has_nul(r.health)) return true;
@@ -303,7 +304,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     FUZZ_CHECK(seen.calls.total() == 0);
     FUZZ_CHECK(problem->rfind(g_channel + ": ", 0) == 0);
   } else {
-    FUZZ_CHECK(seen.calls.total() == (pick == kUnknown ? 0 : 1));
+    // A camera is kept for the next world (which carries it): no call of its own.
+    FUZZ_CHECK(seen.calls.total() == (pick == kUnknown || pick == kCamera ? 0 : 1));
   }
   FUZZ_CHECK(decoder.summary_seen() == (seen.calls.summary == 1));
   FUZZ_CHECK(decoder.last_status().has_value() == (seen.calls.status == 1));
@@ -361,6 +363,30 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         FUZZ_CHECK(seen.last_image_size == cv::Size(m.width_px, m.height_px));
         check_round_trip(m, message, length);
       }
+      break;
+    }
+    case kCamera: {
+      // Accepted exactly when the bytes are a camera_t of a plausible size; the next world
+      // then carries what it said.
+      rilbed::camera_t m;
+      if (problem && refused_before_decoding<rilbed::camera_t>(message, length)) break;
+      const bool readable = generated_decode(message, length, m);
+      const bool plausible = m.width_px > 0 && m.height_px > 0 && m.width_px <= 100000 && m.height_px <= 100000;
+      if (problem) {
+        FUZZ_CHECK(!readable || !plausible);
+        break;
+      }
+      FUZZ_CHECK(readable && plausible);
+      check_round_trip(m, message, length);
+      rilbed::world_t world;
+      std::vector<std::uint8_t> bytes(static_cast<std::size_t>(world.getEncodedSize()));
+      FUZZ_CHECK(world.encode(bytes.data(), 0, static_cast<int>(bytes.size())) > 0);
+      FUZZ_CHECK(!decoder.decode(links::Channels::with_prefix("").world, bytes.data(), bytes.size()));
+      FUZZ_CHECK(seen.calls.world == 1 && seen.last_world.camera.has_value());
+      const agents::CameraReport& c = *seen.last_world.camera;
+      FUZZ_CHECK(c.width_px == m.width_px && c.height_px == m.height_px && c.lens_distortion == (m.lens_distortion != 0));
+      for (int i = 0; i < 9; ++i) FUZZ_CHECK(same_bits(c.image_to_field[static_cast<std::size_t>(i)], m.image_to_field[i]));
+      FUZZ_CHECK(c.source == m.source);
       break;
     }
     case kUnknown:
