@@ -3,6 +3,7 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <csignal>
 #include <cstdlib>
 #include <exception>
 #include <iostream>
@@ -23,6 +24,9 @@ int main(int argc, char** argv) {
   // Logs go to stderr so that CSV written to stdout stays clean.
   spdlog::set_default_logger(spdlog::stderr_color_mt("rilbed"));
   spdlog::set_pattern("rilbed: %^%l%$: %v");
+  // A reader that went away (`rilbed run ... | head`, a demo's pipe closed by Ctrl-C) must
+  // not kill a run before it has stopped its real robots: writes to it fail instead.
+  std::signal(SIGPIPE, SIG_IGN);
   // rilbed reports unreadable inputs itself, naming them; OpenCV's backend warnings
   // (GStreamer, V4L2, FFmpeg) would only repeat that. RILBED_OPENCV_LOG=1 shows them.
   if (std::getenv("RILBED_OPENCV_LOG") == nullptr) {
