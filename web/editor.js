@@ -1,0 +1,1301 @@
+// rilbed's scenario editor (issue 17): place, move, rotate and delete robots, obstacles,
+// tracks and beacons on a canvas of the field, and save the scenario YAML that
+// `rilbed run` reads (scenarios/README.md is the contract).
+//
+// The editor edits the parsed YAML object itself (`ed.doc`), never a model of its own:
+// whatever it does not show (camera, safety, sensors, controller params, a real robot's
+// link, moving obstacles, `ids: 4-5` ranges...) is saved as it was loaded. A robot of an
+// `ids:` group with a random pose sits in the tray under the field; dragging it onto the
+// field takes it out of its group as an entry of its own with that pose.
+//
+// "Start from this run" builds a scenario from what the live page holds (app.js's
+// window.rilbed.run: /rilbed/world and /rilbed/poses); "Poses from run" puts the run's
+// current poses into the scenario being edited.
+import { load, dump, visit, COLLECTION_STYLE, VISIT_SKIP } from './node_modules/js-yaml/dist/js-yaml.mjs';
+
+const $ = (id) => document.getElementById(id);
+
+const ROBOT_RADIUS_M = 0.0275; // a Khepera
+const CONTROLLERS = ['convoy', 'wander', 'track_follow', 'beacon_homing', 'none'];
+// The params each controller takes (src/agents/simulation.cpp make_controller): a
+// controller given one it does not take stops the run, so a change of controller drops them.
+const CONTROLLER_PARAMS = {
+  convoy: [], none: [], wander: ['speed_mps'], track_follow: ['speed_mps', 'max_value'],
+  beacon_homing: ['beacon_id', 'speed_mps'],
+  goto: ['x_m', 'y_m', 'theta_deg', 'speed_mps', 'tolerance_m', 'tolerance_deg'],
+};
+// A track_follow robot needs track sensor elements: three across its front, as in
+// scenarios/track_following.yaml.
+const DEFAULT_TRACK_SENSORS = [0.012, 0, -0.012].map((y) => ({
+  mount_x_m: 0.02, mount_y_m: y, height_mm: 8, inclination_deg: 0, cone_angle_deg: 30, precision: 16,
+  coverage_percent: 15, max_value: 255, error_level_percent: 5,
+}));
+const DEFAULT_FIELD = { width_m: 1.5, height_m: 1.2 };
+const TRAY_HEIGHT_PX = 46;
+const MARGIN_PX = 22;
+const HANDLE_PX = 7;
+const UNDO_DEPTH = 100;
+
+// ------------------------------------------------------------------ state
+const ed = {
+  doc: null,                // the scenario object: what is saved
+  header: '',               // the loaded file's leading comment lines, kept on save
+  tool: 'select',
+  sel: null,                // {type: robot|obstacle|track|beacon, index, id?, tray?, vertex?}
+  draft: null,              // {type: obstacle|track, points: [[x, y], ...]} while drawing
+  drag: null,
+  mouse: null,              // [u, v] on the canvas
+  undo: [], redo: [],
+  yaml: '',
+};
+
+const canvas = $('editor-canvas');
+const ctx = canvas.getContext('2d');
+
+// ------------------------------------------------------------------ numbers and ids
+const round3 = (v) => { const r = Math.round(v * 1000) / 1000; return r === 0 ? 0 : r; };
+const round1 = (v) => { const r = Math.round(v * 10) / 10; return r === 0 ? 0 : r; };
+const wrapDeg = (d) => { let a = ((d + 180) % 360 + 360) % 360 - 180; if (a === -180) a = 180; return round1(a); };
+const deg = (rad) => (rad * 180) / Math.PI;
+const rad = (d) => (d * Math.PI) / 180;
+const isNum = (v) => typeof v === 'number' && Number.isFinite(v);
+const isPoint = (p) => Array.isArray(p) && p.length === 2 && isNum(p[0]) && isNum(p[1]);
+const isPose = (p) => Array.isArray(p) && p.length === 3 && p.every(isNum);
+const snapOn = () => $('editor-snap').checked;
+const snap = (v) => (snapOn() ? Math.round(v * 100) / 100 : round3(v));
+const clone = (v) => (v === undefined ? undefined : JSON.parse(JSON.stringify(v)));
+
+// `ids:` as rilbed reads it (src/core/id_list.hpp): "1-8", "2,4,9-12", or a number.
+function parseIds(v) {
+  if (Number.isInteger(v)) return [v];
+  if (typeof v !== 'string') return null;
+  const out = new Set();
+  for (const part of v.split(',')) {
+    const m = /^\s*(\d+)\s*(?:-\s*(\d+)\s*)?$/.exec(part);
+    if (!m) return null;
+    const a = Number(m[1]), b = m[2] === undefined ? a : Number(m[2]);
+    if (b < a || b - a > 100000) return null;
+    for (let k = a; k <= b; ++k) out.add(k);
+  }
+  return [...out].sort((a, b) => a - b);
+}
+function formatIds(ids) {
+  const s = [...ids].sort((a, b) => a - b), parts = [];
+  for (let i = 0; i < s.length;) {
+    let j = i;
+    while (j + 1 < s.length && s[j + 1] === s[j] + 1) ++j;
+    parts.push(j > i ? `${s[i]}-${s[j]}` : `${s[i]}`);
+    i = j + 1;
+  }
+  return parts.join(',');
+}
+function entryIds(e) {
+  if (!e || typeof e !== 'object') return [];
+  if (e.id !== undefined) return Number.isInteger(e.id) ? [e.id] : [];
+  return parseIds(e.ids) || [];
+}
+// A copy of `obj` with key `from` replaced by `to` (value `value`) in the same place.
+function renameKey(obj, from, to, value) {
+  const out = {};
+  for (const [k, v] of Object.entries(obj)) {
+    if (k === from) out[to] = value; else if (k !== to) out[k] = v;
+  }
+  if (!(from in obj)) out[to] = value;
+  return out;
+}
+
+// ------------------------------------------------------------------ the scenario's items
+const list = (key) => (Array.isArray(ed.doc?.[key]) ? ed.doc[key] : []);
+const field = () => {
+  const f = ed.doc?.field && typeof ed.doc.field === 'object' ? ed.doc.field : {};
+  return { w: isNum(f.width_m) && f.width_m > 0 ? f.width_m : DEFAULT_FIELD.width_m,
+    h: isNum(f.height_m) && f.height_m > 0 ? f.height_m : DEFAULT_FIELD.height_m, walls: f.walls !== false };
+};
+function ensureList(key) {
+  if (!Array.isArray(ed.doc[key])) ed.doc[key] = [];
+  return ed.doc[key];
+}
+
+// Every robot: placed ones (one id, a pose) and the tray's (random poses).
+function robotItems() {
+  const out = [];
+  list('robots').forEach((e, index) => {
+    const ids = entryIds(e);
+    if (ids.length === 1 && isPose(e.pose)) {
+      out.push({ index, id: ids[0], placed: true, x: e.pose[0], y: e.pose[1], th: e.pose[2], e });
+    } else {
+      for (const id of ids) out.push({ index, id, placed: false, e });
+    }
+  });
+  return out;
+}
+const obstaclePoints = (o) => (Array.isArray(o?.polygon) ? o.polygon.filter(isPoint) : []);
+const trackPoints = (t) => (Array.isArray(t?.points) ? t.points.filter(isPoint) : []);
+const nextRobotId = () => Math.max(0, ...robotItems().map((r) => r.id)) + 1;
+const nextBeaconId = () => Math.max(0, ...list('beacons').map((b) => (Number.isInteger(b?.id) ? b.id : 0))) + 1;
+function uniqueName(key, stem) {
+  const names = new Set(list(key).map((x) => x?.name));
+  for (let k = list(key).length + 1; ; ++k) if (!names.has(`${stem}${k}`)) return `${stem}${k}`;
+}
+
+// ------------------------------------------------------------------ YAML
+// Short collections in flow style (`[0.3, 0.3]`, `{width_m: 1.5, height_m: 1.2}`), as
+// the shipped scenarios are written; lists of points always on one line.
+function flowLength(n) {
+  if (n.kind === 'scalar') return n.value.length + (/[\s:,[\]{}#'"]|^$/.test(n.value) ? 2 : 0);
+  if (n.kind === 'sequence') return 2 + n.items.reduce((a, it) => a + flowLength(it) + 2, 0);
+  if (n.kind === 'mapping') return 2 + n.items.reduce((a, it) => a + flowLength(it.key) + 2 + flowLength(it.value) + 2, 0);
+  return 10;
+}
+const scalarsOnly = (n) => n.kind === 'scalar' || (n.kind === 'sequence' && n.items.every((i) => i.kind === 'scalar'));
+const FLOW_WIDTH = 120;
+function toYaml(doc) {
+  const block = new WeakSet(); // the items of a list whose items do not all fit a line each
+  const fits = (node, depth) => flowLength(node) + 2 * depth + 24 <= FLOW_WIDTH;
+  return dump(doc, {
+    lineWidth: -1, noRefs: true,
+    transform: (docs) => visit(docs, (node, c) => {
+      if ((node.kind !== 'sequence' && node.kind !== 'mapping') || c.depth === 0 || block.has(node)) return undefined;
+      const points = node.kind === 'sequence' && node.items.length > 0 && node.items.every((i) => i.kind === 'sequence' && i.items.every((j) => j.kind === 'scalar'));
+      const leaves = node.kind === 'mapping' && node.items.every((i) => scalarsOnly(i.value));
+      const listOfCollections = node.kind === 'sequence' && node.items.some((i) => i.kind !== 'scalar') && !points;
+      if (listOfCollections) {
+        // One style for all the items of a list: each on a line if each fits, else all in block style.
+        const flowItem = (i) => i.kind === 'scalar' || (i.kind === 'mapping' && i.items.every((k) => scalarsOnly(k.value))) || fits(i, c.depth + 1);
+        if (!node.items.every(flowItem)) for (const i of node.items) block.add(i);
+        return undefined;
+      }
+      if (points || leaves || fits(node, c.depth)) {
+        node.style = COLLECTION_STYLE.FLOW;
+        return VISIT_SKIP;
+      }
+      return undefined;
+    }),
+  });
+}
+function sameValue(a, b) {
+  if (a === b) return true;
+  if (typeof a !== typeof b || a === null || b === null || typeof a !== 'object') return false;
+  if (Array.isArray(a) !== Array.isArray(b)) return false;
+  const ka = Object.keys(a), kb = Object.keys(b);
+  return ka.length === kb.length && ka.every((k) => Object.prototype.hasOwnProperty.call(b, k) && sameValue(a[k], b[k]));
+}
+function scenarioText() {
+  let text;
+  try {
+    text = toYaml(ed.doc);
+    if (!sameValue(load(text), JSON.parse(JSON.stringify(ed.doc)))) text = dump(ed.doc, { lineWidth: -1, noRefs: true });
+  } catch (e) {
+    text = dump(ed.doc, { lineWidth: -1, noRefs: true });
+  }
+  return ed.header + text;
+}
+
+// ------------------------------------------------------------------ changes and undo
+function checkpoint() {
+  ed.undo.push(JSON.stringify(ed.doc));
+  if (ed.undo.length > UNDO_DEPTH) ed.undo.shift();
+  ed.redo = [];
+  updateButtons();
+}
+function undo(back = true) {
+  const from = back ? ed.undo : ed.redo, to = back ? ed.redo : ed.undo;
+  if (!from.length) return;
+  to.push(JSON.stringify(ed.doc));
+  ed.doc = JSON.parse(from.pop());
+  ed.sel = null; ed.draft = null;
+  changed(true);
+}
+// After any change of the document: redraw, the form, the problems, the YAML.
+function changed(rebuildForm = false) {
+  if (rebuildForm) renderForm(); else refreshForm();
+  ed.yaml = scenarioText();
+  $('editor-yaml').value = ed.yaml;
+  showProblems();
+  updateButtons();
+  requestDraw();
+}
+function setDoc(doc, header, message) {
+  ed.doc = doc; ed.header = header || '';
+  ed.undo = []; ed.redo = []; ed.sel = null; ed.draft = null;
+  setTool('select');
+  syncScenarioInputs();
+  changed(true);
+  status(message);
+}
+function status(message, bad = false) {
+  const s = $('editor-status');
+  s.textContent = message || '';
+  s.classList.toggle('editor-bad', bad);
+}
+function updateButtons() {
+  $('editor-undo').disabled = !ed.undo.length;
+  $('editor-redo').disabled = !ed.redo.length;
+  $('editor-delete').disabled = !ed.sel;
+}
+
+// ------------------------------------------------------------------ edits
+function setPose(e, pose) { e.pose = [round3(pose[0]), round3(pose[1]), wrapDeg(pose[2])]; }
+
+// Gives robot `id` of entry `index` a pose; an `ids:` group gives the robot up to an entry
+// of its own right after it. Returns the robot's entry index.
+function placeRobot(index, id, x, y, th) {
+  const robots = ensureList('robots');
+  const e = robots[index];
+  const ids = entryIds(e);
+  if (ids.length <= 1) { setPose(e, [x, y, th]); return index; }
+  const single = {};
+  for (const [k, v] of Object.entries(e)) {
+    if (k === 'ids') single.id = id; else if (k !== 'pose') single[k] = clone(v); else single.pose = null;
+  }
+  setPose(single, [x, y, th]);
+  const rest = ids.filter((k) => k !== id);
+  robots[index] = rest.length === 1 ? renameKey(e, 'ids', 'id', rest[0]) : renameKey(e, 'ids', 'ids', formatIds(rest));
+  // Before its group when it was the group's first, else after: entries stay in ID order.
+  const at = id < rest[0] ? index : index + 1;
+  robots.splice(at, 0, single);
+  return at;
+}
+// Takes robot `id` out of entry `index` (the whole entry when it is its only robot).
+function removeRobot(index, id) {
+  const robots = ensureList('robots');
+  const rest = entryIds(robots[index]).filter((k) => k !== id);
+  if (!rest.length) robots.splice(index, 1);
+  else robots[index] = rest.length === 1 ? renameKey(robots[index], 'ids', 'id', rest[0]) : renameKey(robots[index], 'ids', 'ids', formatIds(rest));
+}
+function setController(e, name) {
+  e.controller = name;
+  const allowed = CONTROLLER_PARAMS[name];
+  if (e.params && typeof e.params === 'object') {
+    for (const k of Object.keys(e.params)) if (!allowed || !allowed.includes(k)) delete e.params[k];
+    if (!Object.keys(e.params).length) delete e.params;
+  }
+  if (name === 'track_follow' || name === 'beacon_homing') {
+    if (!e.sensors || typeof e.sensors !== 'object') e.sensors = {};
+    if (name === 'track_follow' && !Array.isArray(e.sensors.track)) e.sensors.track = clone(DEFAULT_TRACK_SENSORS);
+    if (name === 'beacon_homing' && !e.sensors.beacon_finder) e.sensors.beacon_finder = { field_of_view_deg: 360 };
+  }
+}
+const stashedLinks = new WeakMap(); // an entry made virtual keeps its link here, should it be made real again
+function setKind(index, kind) {
+  const e = ensureList('robots')[index];
+  if (kind === 'real') {
+    e.kind = 'real';
+    if (!e.link) e.link = stashedLinks.get(e) || { emulate: true };
+    if (!ed.doc.camera) ed.doc.camera = { emulate: true };
+  } else {
+    if (e.link) stashedLinks.set(e, e.link);
+    delete e.link;
+    if (e.kind !== undefined) e.kind = 'virtual';
+  }
+}
+function newRobot(x, y) {
+  const idWanted = Number($('editor-new-robot-id').value);
+  const taken = new Set(robotItems().map((r) => r.id));
+  const id = Number.isInteger(idWanted) && idWanted >= 1 && !taken.has(idWanted) ? idWanted : nextRobotId();
+  const e = { id };
+  if ($('editor-new-kind').value === 'real') e.kind = 'real';
+  e.pose = null;
+  setPose(e, [x, y, Number($('editor-new-robot-theta').value) || 0]);
+  setController(e, $('editor-new-controller').value);
+  const robots = ensureList('robots');
+  robots.push(e);
+  if (e.kind === 'real') setKind(robots.length - 1, 'real');
+  $('editor-new-robot-id').value = '';
+  return robots.length - 1;
+}
+function newBeacon(x, y) {
+  const idWanted = Number($('editor-new-beacon-id').value);
+  const taken = new Set(list('beacons').map((b) => b?.id));
+  const id = Number.isInteger(idWanted) && !taken.has(idWanted) && $('editor-new-beacon-id').value !== '' ? idWanted : nextBeaconId();
+  const num = (inputId, fallback) => { const v = Number($(inputId).value); return isNum(v) && $(inputId).value !== '' ? v : fallback; };
+  const b = {
+    id, position: [snap(x), snap(y)], facing_deg: wrapDeg(num('editor-new-beacon-facing', 0)),
+    aperture_deg: num('editor-new-beacon-aperture', 360), range_m: num('editor-new-beacon-range', 2),
+  };
+  ensureList('beacons').push(b);
+  $('editor-new-beacon-id').value = '';
+  return ensureList('beacons').length - 1;
+}
+function finishDraft() {
+  const d = ed.draft;
+  if (!d) return;
+  // A double click's two clicks each added a point: drop points on top of the one before.
+  const pts = [];
+  for (const p of d.points) {
+    const last = pts[pts.length - 1];
+    if (!last || Math.hypot(p[0] - last[0], p[1] - last[1]) * layout().s > 4) pts.push(p);
+  }
+  const need = d.type === 'obstacle' ? 3 : 2;
+  if (pts.length < need) {
+    status(`${d.type === 'obstacle' ? 'An obstacle' : 'A track'} needs at least ${need} points: keep clicking (Esc cancels).`, true);
+    ed.draft.points = pts;
+    requestDraw();
+    return;
+  }
+  checkpoint();
+  if (d.type === 'obstacle') {
+    ensureList('obstacles').push({ name: uniqueName('obstacles', 'obstacle'), polygon: pts });
+    ed.sel = { type: 'obstacle', index: ed.doc.obstacles.length - 1 };
+  } else {
+    const width = Number($('editor-new-track-width').value);
+    const t = { name: uniqueName('tracks', 'track'), points: pts, width_m: isNum(width) && width > 0 ? width : 0.02,
+      closed: $('editor-new-track-closed').checked };
+    ensureList('tracks').push(t);
+    ed.sel = { type: 'track', index: ed.doc.tracks.length - 1 };
+  }
+  ed.draft = null;
+  setTool('select');
+  status(`Added ${ed.sel.type} ${ed.sel.index + 1} (${pts.length} points).`);
+  changed(true);
+}
+function deleteSelection() {
+  const s = ed.sel;
+  if (!s) return;
+  checkpoint();
+  if (s.type === 'robot') {
+    removeRobot(s.index, s.id);
+    status(`Deleted robot ${s.id}.`);
+  } else {
+    const key = `${s.type}s`, item = list(key)[s.index];
+    const pts = s.type === 'obstacle' ? item?.polygon : item?.points;
+    const min = s.type === 'obstacle' ? 3 : 2;
+    if (s.vertex !== undefined && Array.isArray(pts) && pts.length > min) {
+      pts.splice(s.vertex, 1);
+      ed.sel = { type: s.type, index: s.index };
+      status(`Deleted point ${s.vertex + 1} of ${s.type} ${s.index + 1}.`);
+      changed(true);
+      return;
+    }
+    list(key).splice(s.index, 1);
+    if (!list(key).length) delete ed.doc[key];
+    status(`Deleted ${s.type} ${s.type === 'beacon' ? item?.id : s.index + 1}.`);
+  }
+  ed.sel = null;
+  changed(true);
+}
+// The selection's rotation: robots and beacons turn in place, polygons and tracks about
+// their centroid. `from` is the item as it was when the rotation began.
+function rotateSelection(from, byDeg) {
+  const s = ed.sel;
+  if (s.type === 'robot') {
+    const e = ed.doc.robots[s.index];
+    if (isPose(e.pose)) setPose(e, [e.pose[0], e.pose[1], from + byDeg]);
+  } else if (s.type === 'beacon') {
+    ed.doc.beacons[s.index].facing_deg = wrapDeg(from + byDeg);
+  } else {
+    const item = list(`${s.type}s`)[s.index];
+    const key = s.type === 'obstacle' ? 'polygon' : 'points';
+    const [cx, cy] = centroid(from);
+    const c = Math.cos(rad(byDeg)), sn = Math.sin(rad(byDeg));
+    item[key] = from.map(([x, y]) => [round3(cx + c * (x - cx) - sn * (y - cy)), round3(cy + sn * (x - cx) + c * (y - cy))]);
+  }
+}
+const centroid = (pts) => [pts.reduce((a, p) => a + p[0], 0) / pts.length, pts.reduce((a, p) => a + p[1], 0) / pts.length];
+function rotationOf(s) {
+  if (s.type === 'robot') return ed.doc.robots[s.index].pose[2];
+  if (s.type === 'beacon') return isNum(ed.doc.beacons[s.index].facing_deg) ? ed.doc.beacons[s.index].facing_deg : 0;
+  return clone(s.type === 'obstacle' ? obstaclePoints(ed.doc.obstacles[s.index]) : trackPoints(ed.doc.tracks[s.index]));
+}
+
+// ------------------------------------------------------------------ from the run
+function runOf() {
+  const run = window.rilbed?.run;
+  if (!run?.world) { status('No run is connected (no /rilbed/world yet): nothing to start from.', true); return null; }
+  return run;
+}
+function startFromRun() {
+  const run = runOf();
+  if (!run) return;
+  const W = run.world;
+  const pts = (ps) => ps.map((p) => [round3(p.x_m), round3(p.y_m)]);
+  const doc = {
+    name: `${W.scenario || 'run'}_edited`,
+    description: `Edited from the run of ${W.scenario || 'a scenario'} at t = ${(run.poses?.t_s ?? W.t_s ?? 0).toFixed(1)} s.`,
+  };
+  if (run.status?.mode === 'central' || run.status?.mode === 'distributed') doc.mode = run.status.mode;
+  doc.field = { width_m: W.width_m, height_m: W.height_m, walls: W.walls !== false };
+  doc.duration_s = 120;
+  if (W.obstacles?.length) doc.obstacles = W.obstacles.map((o, i) => ({ name: `obstacle${i + 1}`, polygon: pts(o) }));
+  if (W.tracks?.length) {
+    doc.tracks = W.tracks.map((t, i) => {
+      let p = pts(t.points);
+      const closed = p.length > 3 && p[0][0] === p[p.length - 1][0] && p[0][1] === p[p.length - 1][1];
+      if (closed) p = p.slice(0, -1);
+      return { name: `track${i + 1}`, points: p, width_m: t.width_m, closed };
+    });
+  }
+  if (W.beacons?.length) doc.beacons = W.beacons.map((b, i) => ({ id: i + 1, position: [round3(b.x_m), round3(b.y_m)] }));
+  const poses = new Map((run.poses?.robots || []).map((r) => [r.id, r]));
+  doc.robots = (W.robots || []).map((r) => {
+    const e = { id: r.id };
+    if (r.real) { e.kind = 'real'; e.link = { emulate: true }; }
+    const p = poses.get(r.id);
+    e.pose = p ? [round3(p.x_m), round3(p.y_m), wrapDeg(deg(p.theta_rad))] : 'random';
+    e.controller = 'convoy';
+    return e;
+  });
+  if (doc.robots.some((r) => r.kind === 'real')) doc.camera = { emulate: true };
+  const placed = doc.robots.filter((r) => isPose(r.pose)).map((r) => r.pose);
+  const nudged = nudgeApart(placed, doc.field.walls, W.width_m, W.height_m, (doc.obstacles || []).map((o) => o.polygon));
+  setDoc(doc, '', `Started from the run of ${W.scenario}: ${doc.robots.length} robots at their poses of t = ` +
+    `${(run.poses?.t_s ?? 0).toFixed(1)} s${nudged ? ` (${nudged} moved apart by a millimetre or two: they touched)` : ''}. The run does not say its robots' controllers and sensors, its beacons' ` +
+    'IDs, apertures and ranges, nor real robots\' links: they are defaults here (convoy; 360°, 2 m; emulated). ' +
+    'To keep a file\'s, load it and use "Poses from run".');
+}
+// The run's poses as start poses: robots that touch (a wall, an obstacle, each other) in
+// the run would overlap by a rounding's fraction of a millimetre, which rilbed run refuses:
+// such robots are moved apart by a millimetre or two. Returns how many moved.
+function nudgeApart(poses, walls, W, H, obstacles) {
+  const R = ROBOT_RADIUS_M, gap = 0.001;
+  const start = poses.map((p) => [p[0], p[1]]);
+  for (let pass = 0; pass < 30; ++pass) {
+    let moved = false;
+    for (const p of poses) {
+      if (walls) {
+        const x = Math.min(Math.max(p[0], R + gap), W - R - gap), y = Math.min(Math.max(p[1], R + gap), H - R - gap);
+        if (x !== p[0] || y !== p[1]) { p[0] = x; p[1] = y; moved = true; }
+      }
+      for (const pts of obstacles) {
+        for (let k = 0; k < pts.length; ++k) {
+          const a = pts[k], b = pts[(k + 1) % pts.length];
+          const d = distToSegment(p, a, b);
+          if (d >= R + gap / 2 || pointInPolygon(p, pts)) continue;
+          const dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy || 1;
+          const t = Math.max(0, Math.min(1, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2));
+          const nx = p[0] - a[0] - t * dx, ny = p[1] - a[1] - t * dy, n = Math.hypot(nx, ny) || 1;
+          p[0] += (nx / n) * (R + gap - d); p[1] += (ny / n) * (R + gap - d);
+          moved = true;
+        }
+      }
+    }
+    for (let i = 0; i < poses.length; ++i) {
+      for (let j = i + 1; j < poses.length; ++j) {
+        const a = poses[i], b = poses[j];
+        const d = Math.hypot(b[0] - a[0], b[1] - a[1]);
+        if (d >= 2 * R + gap / 2) continue;
+        const ux = d > 1e-9 ? (b[0] - a[0]) / d : 1, uy = d > 1e-9 ? (b[1] - a[1]) / d : 0, push = (2 * R + gap - d) / 2;
+        a[0] -= ux * push; a[1] -= uy * push; b[0] += ux * push; b[1] += uy * push;
+        moved = true;
+      }
+    }
+    for (const p of poses) { p[0] = round3(p[0]); p[1] = round3(p[1]); }
+    if (!moved) break;
+  }
+  return poses.filter((p, i) => p[0] !== round3(start[i][0]) || p[1] !== round3(start[i][1])).length;
+}
+function posesFromRun() {
+  const run = runOf();
+  if (!run) return;
+  if (!run.poses) { status('The run has sent no poses yet.', true); return; }
+  checkpoint();
+  const F = field();
+  const ids = new Set(robotItems().map((r) => r.id));
+  const taken = run.poses.robots.filter((p) => ids.has(p.id));
+  const poses = taken.map((p) => [round3(p.x_m), round3(p.y_m), wrapDeg(deg(p.theta_rad))]);
+  // (Robots of the scenario the run does not have keep their places, and are kept clear of.)
+  const others = robotItems().filter((r) => r.placed && !taken.some((p) => p.id === r.id)).map((r) => [r.x, r.y, r.th]);
+  const nudged = nudgeApart([...poses, ...others], F.walls, F.w, F.h, list('obstacles').map(obstaclePoints));
+  taken.forEach((p, k) => {
+    const r = robotItems().find((x) => x.id === p.id);
+    placeRobot(r.index, r.id, ...poses[k]);
+  });
+  ed.sel = null;
+  changed(true);
+  status(`Took the poses of ${taken.length} robots from the run at t = ${run.poses.t_s.toFixed(1)} s` +
+    `${nudged ? ` (${nudged} moved apart by a millimetre or two: they touched)` : ''}.`);
+}
+
+// ------------------------------------------------------------------ load and save
+function loadText(text, name) {
+  let doc;
+  try {
+    doc = load(text);
+  } catch (e) {
+    status(`${name}: not valid YAML: ${String(e.message).split('\n')[0]}`, true);
+    return;
+  }
+  if (!doc || typeof doc !== 'object' || Array.isArray(doc)) {
+    status(`${name}: not a scenario (a mapping of keys is expected)`, true);
+    return;
+  }
+  // The file's leading comment lines (what it is, how to run it) are kept on save.
+  const header = (/^(?:[ \t]*#[^\n]*\n|[ \t]*\n)*/.exec(text)[0] || '').replace(/\s*$/, '');
+  setDoc(doc, header ? `${header}\n` : '', '');
+  status(`Loaded ${name}: ${robotItems().length} robots, ${list('obstacles').length} obstacles, ` +
+    `${list('tracks').length} tracks, ${list('beacons').length} beacons.`);
+  ed.loadedName = name;
+  ed.loads = (ed.loads || 0) + 1;
+}
+function save() {
+  if (ed.draft) finishDraft();
+  const text = scenarioText();
+  $('editor-yaml').value = text;
+  const a = $('editor-download');
+  if (a.href) URL.revokeObjectURL(a.href);
+  a.href = URL.createObjectURL(new Blob([text], { type: 'text/yaml' }));
+  a.download = 'scenario.yaml';
+  a.click();
+  const problems = findProblems();
+  status(problems.length ? `Saved scenario.yaml, with ${problems.length} problem(s) listed below that rilbed run may refuse.`
+    : 'Saved scenario.yaml.', problems.length > 0);
+  ed.saves = (ed.saves || 0) + 1;
+}
+function newScenario() {
+  setDoc({ name: 'new_scenario', field: { ...DEFAULT_FIELD }, duration_s: 60, robots: [] }, '',
+    'A new, empty scenario: add robots (rilbed run needs at least one).');
+}
+
+// ------------------------------------------------------------------ problems
+// What rilbed run would refuse, as far as the editor can tell (the run has the last word).
+function findProblems() {
+  const out = [];
+  const F = field();
+  const robots = robotItems();
+  if (!robots.length) out.push('robots: rilbed run needs at least one robot.');
+  const seen = new Set();
+  for (const r of robots) {
+    if (seen.has(r.id)) out.push(`robot ${r.id} is defined twice.`);
+    seen.add(r.id);
+  }
+  list('robots').forEach((e, i) => {
+    if (!entryIds(e).length) out.push(`robots[${i}]: no valid id or ids.`);
+    if (e.kind === 'real' && !e.link) out.push(`robots[${i}]: a real robot needs a link.`);
+    if (e.controller === 'track_follow' && !Array.isArray(e.sensors?.track)) out.push(`robots[${i}]: track_follow needs sensors: track.`);
+    if (e.controller === 'beacon_homing' && !e.sensors?.beacon_finder) out.push(`robots[${i}]: beacon_homing needs sensors: beacon_finder.`);
+  });
+  if (list('robots').some((e) => e.kind === 'real') && !ed.doc.camera) out.push('camera: real robots need a camera.');
+  const convoy = robots.filter((r) => (r.e.controller ?? 'convoy') === 'convoy').map((r) => r.id).sort((a, b) => a - b);
+  if (convoy.some((id, k) => id !== k + 1)) out.push(`convoy robots must be numbered 1..N; they are ${formatIds(convoy)}.`);
+  const placed = robots.filter((r) => r.placed);
+  for (const r of placed) {
+    if (F.walls && (r.x < ROBOT_RADIUS_M || r.y < ROBOT_RADIUS_M || r.x > F.w - ROBOT_RADIUS_M || r.y > F.h - ROBOT_RADIUS_M)) {
+      out.push(`robot ${r.id} overlaps a wall.`);
+    }
+    list('obstacles').forEach((o, i) => {
+      const pts = obstaclePoints(o);
+      if (pointInPolygon([r.x, r.y], pts)) out.push(`robot ${r.id} is inside obstacle ${i + 1}${o.name ? ` (${o.name})` : ''}.`);
+      else if (pts.some((p, k) => distToSegment([r.x, r.y], p, pts[(k + 1) % pts.length]) < ROBOT_RADIUS_M)) {
+        out.push(`robot ${r.id} overlaps obstacle ${i + 1}${o.name ? ` (${o.name})` : ''}.`);
+      }
+    });
+  }
+  for (let i = 0; i < placed.length; ++i) {
+    for (let j = i + 1; j < placed.length; ++j) {
+      if (Math.hypot(placed[i].x - placed[j].x, placed[i].y - placed[j].y) < 2 * ROBOT_RADIUS_M) {
+        out.push(`robots ${placed[i].id} and ${placed[j].id} overlap.`);
+      }
+    }
+  }
+  list('obstacles').forEach((o, i) => { if (obstaclePoints(o).length < 3) out.push(`obstacle ${i + 1} needs at least 3 points.`); });
+  list('tracks').forEach((t, i) => { if (trackPoints(t).length < 2) out.push(`track ${i + 1} needs at least 2 points.`); });
+  const beaconIds = new Set();
+  list('beacons').forEach((b, i) => {
+    if (beaconIds.has(b.id)) out.push(`beacon ${b.id} is defined twice.`);
+    beaconIds.add(b.id);
+    if (b.aperture_deg !== undefined && !(b.aperture_deg > 0 && b.aperture_deg <= 360)) out.push(`beacon ${i + 1}: aperture_deg must be in (0, 360].`);
+    if (b.range_m !== undefined && !(b.range_m > 0)) out.push(`beacon ${i + 1}: range_m must be above 0.`);
+  });
+  return out;
+}
+function showProblems() {
+  const ul = $('editor-problems');
+  ul.replaceChildren(...findProblems().map((p) => { const li = document.createElement('li'); li.textContent = p; return li; }));
+}
+
+// ------------------------------------------------------------------ geometry
+function layout() {
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  const F = field();
+  const s = Math.max(1e-6, Math.min((w - 2 * MARGIN_PX) / F.w, (h - TRAY_HEIGHT_PX - 2 * MARGIN_PX) / F.h));
+  const ox = (w - s * F.w) / 2, oy = MARGIN_PX + s * F.h;
+  return { w, h, s, ox, oy, trayTop: h - TRAY_HEIGHT_PX };
+}
+const toPx = (L, x, y) => [L.ox + L.s * x, L.oy - L.s * y];
+const toField = (L, u, v) => [(u - L.ox) / L.s, (L.oy - v) / L.s];
+function pointInPolygon([x, y], pts) {
+  let inside = false;
+  for (let i = 0, j = pts.length - 1; i < pts.length; j = i++) {
+    const [xi, yi] = pts[i], [xj, yj] = pts[j];
+    if ((yi > y) !== (yj > y) && x < ((xj - xi) * (y - yi)) / (yj - yi) + xi) inside = !inside;
+  }
+  return inside;
+}
+function distToSegment([px, py], [ax, ay], [bx, by]) {
+  const dx = bx - ax, dy = by - ay, l2 = dx * dx + dy * dy;
+  const t = l2 ? Math.max(0, Math.min(1, ((px - ax) * dx + (py - ay) * dy) / l2)) : 0;
+  return Math.hypot(px - ax - t * dx, py - ay - t * dy);
+}
+function trayPosition(L, k) { return [MARGIN_PX + 100 + k * 30, L.trayTop + TRAY_HEIGHT_PX / 2]; }
+function trayRobots() { return robotItems().filter((r) => !r.placed); }
+// Where the selection's rotation handle is on the canvas, or null.
+function rotateHandle(L, s = ed.sel) {
+  if (!s) return null;
+  if (s.type === 'robot') {
+    const e = ed.doc.robots[s.index];
+    if (!e || !isPose(e.pose) || entryIds(e).length !== 1) return null;
+    const [u, v] = toPx(L, e.pose[0], e.pose[1]);
+    const d = Math.max(6, ROBOT_RADIUS_M * L.s) + 16, a = rad(e.pose[2]);
+    return [u + d * Math.cos(a), v - d * Math.sin(a)];
+  }
+  if (s.type === 'beacon') {
+    const b = ed.doc.beacons[s.index];
+    if (!b || !isPoint(b.position)) return null;
+    const [u, v] = toPx(L, ...b.position), a = rad(isNum(b.facing_deg) ? b.facing_deg : 0);
+    return [u + 24 * Math.cos(a), v - 24 * Math.sin(a)];
+  }
+  const pts = s.type === 'obstacle' ? obstaclePoints(ed.doc.obstacles[s.index]) : trackPoints(ed.doc.tracks[s.index]);
+  if (!pts.length) return null;
+  const px = pts.map((p) => toPx(L, ...p));
+  const [cu] = toPx(L, ...centroid(pts));
+  return [cu, Math.min(...px.map((p) => p[1])) - 24];
+}
+function selectedPoints(s = ed.sel) {
+  if (!s || (s.type !== 'obstacle' && s.type !== 'track')) return null;
+  const item = list(`${s.type}s`)[s.index];
+  return s.type === 'obstacle' ? obstaclePoints(item) : trackPoints(item);
+}
+
+// What is under canvas point (u, v): the selection's handles first, then the items from
+// the top of the drawing down.
+function hitTest(u, v) {
+  const L = layout();
+  const near = (p, r) => p && Math.hypot(p[0] - u, p[1] - v) <= r;
+  if (ed.sel) {
+    if (near(rotateHandle(L), HANDLE_PX + 2)) return { ...ed.sel, handle: 'rotate' };
+    const pts = selectedPoints();
+    if (pts) {
+      const i = pts.findIndex((p) => near(toPx(L, ...p), HANDLE_PX + 1));
+      if (i >= 0) return { type: ed.sel.type, index: ed.sel.index, vertex: i, handle: 'vertex' };
+    }
+  }
+  const tray = trayRobots();
+  for (let k = 0; k < tray.length; ++k) {
+    if (near(trayPosition(L, k), 12)) return { type: 'robot', index: tray[k].index, id: tray[k].id, tray: true };
+  }
+  let best = null;
+  for (const r of robotItems().filter((x) => x.placed)) {
+    const [ru, rv] = toPx(L, r.x, r.y), d = Math.hypot(ru - u, rv - v);
+    if (d <= Math.max(8, ROBOT_RADIUS_M * L.s) && (!best || d < best.d)) best = { d, r };
+  }
+  if (best) return { type: 'robot', index: best.r.index, id: best.r.id };
+  const beacons = list('beacons');
+  for (let i = beacons.length - 1; i >= 0; --i) {
+    if (isPoint(beacons[i].position) && near(toPx(L, ...beacons[i].position), 10)) return { type: 'beacon', index: i };
+  }
+  const f = toField(L, u, v);
+  const obstacles = list('obstacles');
+  for (let i = obstacles.length - 1; i >= 0; --i) {
+    const pts = obstaclePoints(obstacles[i]);
+    if (pts.length >= 3 && (pointInPolygon(f, pts) || pts.some((p, k) => distToSegment(f, p, pts[(k + 1) % pts.length]) * L.s <= 5))) {
+      return { type: 'obstacle', index: i };
+    }
+  }
+  const tracks = list('tracks');
+  for (let i = tracks.length - 1; i >= 0; --i) {
+    const t = tracks[i], pts = trackPoints(t);
+    const reach = Math.max(6, ((isNum(t.width_m) ? t.width_m : 0.02) * L.s) / 2 + 2);
+    const n = t.closed ? pts.length : pts.length - 1;
+    for (let k = 0; k < n; ++k) if (distToSegment(f, pts[k], pts[(k + 1) % pts.length]) * L.s <= reach) return { type: 'track', index: i };
+  }
+  return null;
+}
+
+// ------------------------------------------------------------------ drawing
+let drawPending = false;
+function requestDraw() {
+  if (drawPending) return;
+  drawPending = true;
+  requestAnimationFrame(() => { drawPending = false; draw(); });
+}
+function draw() {
+  if (!ed.doc || !canvas.clientWidth) return;
+  const dpr = window.devicePixelRatio || 1;
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
+    canvas.width = Math.round(w * dpr); canvas.height = Math.round(h * dpr);
+  }
+  ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+  ctx.clearRect(0, 0, w, h);
+  const L = layout(), F = field();
+  const P = (x, y) => toPx(L, x, y);
+  const path = (pts, close) => {
+    ctx.beginPath();
+    pts.forEach((p, i) => { const [u, v] = P(p[0], p[1]); if (i) ctx.lineTo(u, v); else ctx.moveTo(u, v); });
+    if (close) ctx.closePath();
+  };
+  const selected = (type, index) => ed.sel && ed.sel.type === type && ed.sel.index === index;
+  // The field and a 10 cm grid.
+  const [x0, y0] = P(0, F.h);
+  ctx.fillStyle = '#fff'; ctx.fillRect(x0, y0, F.w * L.s, F.h * L.s);
+  ctx.strokeStyle = '#eef0f3'; ctx.lineWidth = 1;
+  ctx.beginPath();
+  for (let x = 0.1; x < F.w - 1e-9; x += 0.1) { const [u] = P(x, 0); ctx.moveTo(u, y0); ctx.lineTo(u, y0 + F.h * L.s); }
+  for (let y = 0.1; y < F.h - 1e-9; y += 0.1) { const [, v] = P(0, y); ctx.moveTo(x0, v); ctx.lineTo(x0 + F.w * L.s, v); }
+  ctx.stroke();
+  ctx.strokeStyle = F.walls ? '#1a9e2a' : '#8aa';
+  ctx.lineWidth = F.walls ? 2.5 : 1;
+  ctx.setLineDash(F.walls ? [] : [6, 4]);
+  ctx.strokeRect(x0, y0, F.w * L.s, F.h * L.s);
+  ctx.setLineDash([]);
+  ctx.fillStyle = '#888'; ctx.font = '10px system-ui';
+  ctx.fillText(`${F.w} × ${F.h} m`, x0 + F.w * L.s - 60, y0 - 6);
+  // Tracks.
+  list('tracks').forEach((t, i) => {
+    const pts = trackPoints(t);
+    if (pts.length < 1) return;
+    ctx.strokeStyle = selected('track', i) ? 'rgba(36,86,199,0.55)' : 'rgba(40,40,40,0.4)';
+    ctx.lineWidth = Math.max(2, (isNum(t.width_m) ? t.width_m : 0.02) * L.s);
+    ctx.lineJoin = 'round'; ctx.lineCap = 'round';
+    path(pts, t.closed === true); ctx.stroke();
+  });
+  // Moving obstacles: shown, not edited.
+  ctx.setLineDash([4, 3]); ctx.strokeStyle = '#999'; ctx.lineWidth = 1;
+  for (const m of list('moving_obstacles')) {
+    if (!isPoint(m?.position)) continue;
+    const [u, v] = P(...m.position);
+    if (m.shape === 'polygon' && Array.isArray(m.vertices)) {
+      path(m.vertices.filter(isPoint).map(([x, y]) => [x + m.position[0], y + m.position[1]]), true); ctx.stroke();
+    } else {
+      ctx.beginPath(); ctx.arc(u, v, Math.max(3, (isNum(m.radius_m) ? m.radius_m : 0.05) * L.s), 0, 2 * Math.PI); ctx.stroke();
+    }
+    if (isPoint(m.velocity_mps)) { ctx.beginPath(); ctx.moveTo(u, v); ctx.lineTo(u + 200 * m.velocity_mps[0], v - 200 * m.velocity_mps[1]); ctx.stroke(); }
+  }
+  ctx.setLineDash([]);
+  // Obstacles.
+  list('obstacles').forEach((o, i) => {
+    const pts = obstaclePoints(o);
+    if (!pts.length) return;
+    ctx.fillStyle = 'rgba(90,90,90,0.45)';
+    ctx.strokeStyle = selected('obstacle', i) ? '#2456c7' : '#555';
+    ctx.lineWidth = selected('obstacle', i) ? 2.5 : 1.5;
+    path(pts, true); ctx.fill(); ctx.stroke();
+  });
+  // Beacons: the aperture out to its range, faint; a stronger short wedge.
+  list('beacons').forEach((b, i) => {
+    if (!isPoint(b?.position)) return;
+    const [u, v] = P(...b.position);
+    const facing = rad(isNum(b.facing_deg) ? b.facing_deg : 0);
+    const ap = rad(isNum(b.aperture_deg) ? Math.min(360, b.aperture_deg) : 360);
+    const wedge = (r) => {
+      ctx.beginPath();
+      if (ap >= 2 * Math.PI - 1e-9) { ctx.arc(u, v, r, 0, 2 * Math.PI); return; }
+      ctx.moveTo(u, v); ctx.arc(u, v, r, -(facing - ap / 2), -(facing + ap / 2), true); ctx.closePath();
+    };
+    ctx.save();
+    if (F.walls) { ctx.beginPath(); ctx.rect(x0, y0, F.w * L.s, F.h * L.s); ctx.clip(); } // the walls stop its light
+    ctx.fillStyle = 'rgba(224,168,0,0.07)'; wedge((isNum(b.range_m) ? b.range_m : 2) * L.s); ctx.fill();
+    ctx.restore();
+    ctx.fillStyle = 'rgba(224,168,0,0.35)'; wedge(22); ctx.fill();
+    ctx.fillStyle = selected('beacon', i) ? '#2456c7' : '#e0a800';
+    ctx.beginPath(); ctx.arc(u, v, 6, 0, 2 * Math.PI); ctx.fill();
+    ctx.fillStyle = '#000'; ctx.font = '11px system-ui'; ctx.fillText(`B${b.id}`, u + 8, v - 8);
+  });
+  // Robots on the field.
+  for (const r of robotItems().filter((x) => x.placed)) drawRobot(r, ...P(r.x, r.y), Math.max(5, ROBOT_RADIUS_M * L.s), selected('robot', r.index));
+  // The tray: robots with random poses.
+  ctx.fillStyle = '#f1f3f6'; ctx.fillRect(0, L.trayTop, w, TRAY_HEIGHT_PX);
+  ctx.fillStyle = '#6b7684'; ctx.font = '11px system-ui';
+  ctx.fillText('random pose:', MARGIN_PX, L.trayTop + TRAY_HEIGHT_PX / 2 + 4);
+  const tray = trayRobots();
+  tray.forEach((r, k) => {
+    const [u, v] = trayPosition(L, k);
+    drawRobot({ ...r, th: 90 }, u, v, 10, ed.sel?.type === 'robot' && ed.sel.index === r.index && ed.sel.id === r.id, true);
+  });
+  if (!tray.length) ctx.fillText('(none: every robot has a pose; drag one here to make its pose random)', MARGIN_PX + 100, L.trayTop + TRAY_HEIGHT_PX / 2 + 4);
+  // The selection's handles.
+  if (ed.sel) {
+    const pts = selectedPoints();
+    if (pts) {
+      pts.forEach((p, k) => {
+        const [u, v] = P(...p);
+        ctx.fillStyle = ed.sel.vertex === k ? '#2456c7' : '#fff'; ctx.strokeStyle = '#2456c7'; ctx.lineWidth = 1.5;
+        ctx.fillRect(u - HANDLE_PX / 2 - 1, v - HANDLE_PX / 2 - 1, HANDLE_PX + 2, HANDLE_PX + 2);
+        ctx.strokeRect(u - HANDLE_PX / 2 - 1, v - HANDLE_PX / 2 - 1, HANDLE_PX + 2, HANDLE_PX + 2);
+      });
+    }
+    const hnd = rotateHandle(L);
+    if (hnd) {
+      const c = ed.sel.type === 'robot' ? P(...ed.doc.robots[ed.sel.index].pose.slice(0, 2))
+        : ed.sel.type === 'beacon' ? P(...ed.doc.beacons[ed.sel.index].position) : [hnd[0], hnd[1] + 24];
+      ctx.strokeStyle = '#2456c7'; ctx.lineWidth = 1; ctx.setLineDash([3, 2]);
+      ctx.beginPath(); ctx.moveTo(...c); ctx.lineTo(...hnd); ctx.stroke(); ctx.setLineDash([]);
+      ctx.fillStyle = '#fff'; ctx.lineWidth = 2;
+      ctx.beginPath(); ctx.arc(hnd[0], hnd[1], HANDLE_PX, 0, 2 * Math.PI); ctx.fill(); ctx.stroke();
+      ctx.beginPath(); ctx.arc(hnd[0], hnd[1], 3.5, 0.3, 5.2); ctx.stroke(); // a "turn" mark
+    }
+  }
+  // The shape being drawn.
+  if (ed.draft) {
+    const pts = ed.draft.points.slice();
+    if (ed.mouse) pts.push(toField(L, ...ed.mouse).map(snap));
+    ctx.strokeStyle = '#2456c7'; ctx.lineWidth = 1.5; ctx.setLineDash([5, 3]);
+    path(pts, ed.draft.type === 'obstacle' && pts.length > 2); ctx.stroke(); ctx.setLineDash([]);
+    ctx.fillStyle = '#2456c7';
+    for (const p of ed.draft.points) { const [u, v] = P(...p); ctx.fillRect(u - 3, v - 3, 6, 6); }
+  }
+  // A tray robot being dragged onto the field.
+  if (ed.drag?.mode === 'place' && ed.mouse) {
+    ctx.globalAlpha = 0.6;
+    drawRobot({ ...ed.drag.robot, th: 90 }, ...ed.mouse, Math.max(5, ROBOT_RADIUS_M * L.s), true);
+    ctx.globalAlpha = 1;
+  }
+}
+function drawRobot(r, u, v, radius, isSelected, inTray = false) {
+  const real = r.e?.kind === 'real';
+  ctx.lineWidth = 2;
+  ctx.strokeStyle = isSelected ? '#2456c7' : real ? '#1d6fb8' : '#d22828';
+  ctx.fillStyle = isSelected ? 'rgba(36,86,199,0.15)' : 'rgba(255,255,255,0.8)';
+  if (real) {
+    ctx.fillRect(u - radius, v - radius, 2 * radius, 2 * radius);
+    ctx.strokeRect(u - radius, v - radius, 2 * radius, 2 * radius);
+  } else {
+    ctx.beginPath(); ctx.arc(u, v, radius, 0, 2 * Math.PI); ctx.fill(); ctx.stroke();
+  }
+  if (!inTray) {
+    const a = rad(r.th);
+    ctx.beginPath(); ctx.moveTo(u, v); ctx.lineTo(u + radius * 1.2 * Math.cos(a), v - radius * 1.2 * Math.sin(a)); ctx.stroke();
+  }
+  ctx.fillStyle = '#111'; ctx.font = '11px system-ui';
+  if (inTray) { ctx.textAlign = 'center'; ctx.fillText(String(r.id), u, v + 4); ctx.textAlign = 'start'; }
+  else ctx.fillText(`${r.id}${r.e?.controller && r.e.controller !== 'convoy' ? ` ${r.e.controller}` : ''}`, u + radius + 3, v - radius - 1);
+}
+
+// ------------------------------------------------------------------ pointer and keys
+function canvasPoint(e) {
+  const r = canvas.getBoundingClientRect();
+  return [e.clientX - r.left, e.clientY - r.top];
+}
+canvas.addEventListener('pointerdown', (e) => {
+  if (e.button !== 0 || !ed.doc) return;
+  canvas.focus();
+  canvas.setPointerCapture(e.pointerId);
+  const [u, v] = canvasPoint(e);
+  const L = layout();
+  const [x, y] = toField(L, u, v);
+  ed.mouse = [u, v];
+  if (ed.tool === 'obstacle' || ed.tool === 'track') {
+    if (!ed.draft || ed.draft.type !== ed.tool) ed.draft = { type: ed.tool, points: [] };
+    ed.draft.points.push([snap(x), snap(y)]);
+    requestDraw();
+    return;
+  }
+  if (ed.tool === 'robot' || ed.tool === 'beacon') {
+    if (v >= L.trayTop) return;
+    checkpoint();
+    const index = ed.tool === 'robot' ? newRobot(snap(x), snap(y)) : newBeacon(x, y);
+    ed.sel = ed.tool === 'robot' ? { type: 'robot', index, id: ed.doc.robots[index].id } : { type: 'beacon', index };
+    // Dragging on while the button is down aims it.
+    ed.drag = { mode: 'aim', start: [u, v], moved: false };
+    status(`Added ${ed.sel.type} ${ed.sel.type === 'robot' ? ed.sel.id : ed.doc.beacons[index].id}; drag to aim it.`);
+    changed(true);
+    return;
+  }
+  const hit = hitTest(u, v);
+  if (!hit) {
+    ed.sel = null;
+    changed(true);
+    return;
+  }
+  const { handle, ...sel } = hit;
+  ed.sel = sel;
+  const before = JSON.stringify(ed.doc);
+  if (handle === 'rotate') {
+    ed.drag = { mode: 'rotate', before, from: rotationOf(sel), a0: handleAngle(L, u, v, sel) };
+  } else if (handle === 'vertex') {
+    ed.drag = { mode: 'vertex', before, start: [x, y], from: clone(selectedPoints()[hit.vertex]) };
+  } else if (sel.tray) {
+    ed.drag = { mode: 'place', before, robot: trayRobots().find((r) => r.index === sel.index && r.id === sel.id) };
+  } else {
+    ed.drag = { mode: 'move', before, start: [x, y], from: clone(positionOf(sel)) };
+  }
+  changed(true);
+});
+canvas.addEventListener('pointermove', (e) => {
+  const [u, v] = canvasPoint(e);
+  ed.mouse = [u, v];
+  const d = ed.drag;
+  if (!d) {
+    const hit = ed.tool === 'select' ? hitTest(u, v) : null;
+    canvas.style.cursor = ed.tool !== 'select' ? 'crosshair' : !hit ? 'default' : hit.handle === 'rotate' ? 'alias' : 'move';
+    if (ed.draft) requestDraw();
+    return;
+  }
+  const L = layout();
+  const [x, y] = toField(L, u, v);
+  if (d.mode === 'aim') {
+    if (Math.hypot(u - d.start[0], v - d.start[1]) < 6 && !d.moved) return;
+    d.moved = true;
+    const a = wrapDeg(deg(Math.atan2(-(v - d.start[1]), u - d.start[0])));
+    if (ed.sel.type === 'robot') { const p = ed.doc.robots[ed.sel.index].pose; setPose(ed.doc.robots[ed.sel.index], [p[0], p[1], a]); }
+    else ed.doc.beacons[ed.sel.index].facing_deg = a;
+  } else if (d.mode === 'rotate') {
+    noteChange(d);
+    // A robot or a beacon faces the pointer; a polygon or a track turns as far as the pointer has.
+    const a = handleAngle(L, u, v, ed.sel);
+    if (ed.sel.type === 'robot' || ed.sel.type === 'beacon') rotateSelection(0, snapOn() ? Math.round(a / 5) * 5 : a);
+    else rotateSelection(d.from, a - d.a0);
+  } else if (d.mode === 'vertex') {
+    noteChange(d);
+    const pts = ed.sel.type === 'obstacle' ? ed.doc.obstacles[ed.sel.index].polygon : ed.doc.tracks[ed.sel.index].points;
+    pts[ed.sel.vertex] = [snap(x), snap(y)];
+  } else if (d.mode === 'move') {
+    noteChange(d);
+    moveSelection(d.from, x - d.start[0], y - d.start[1]);
+  }
+  refreshForm();
+  requestDraw();
+});
+canvas.addEventListener('pointerup', (e) => {
+  const d = ed.drag;
+  ed.drag = null;
+  if (!d) return;
+  const [u, v] = canvasPoint(e);
+  const L = layout();
+  if (d.mode === 'place') {
+    const [x, y] = toField(L, u, v);
+    if (v < L.trayTop && d.robot) {
+      noteChange(d);
+      const index = placeRobot(d.robot.index, d.robot.id, snap(x), snap(y), 90);
+      ed.sel = { type: 'robot', index, id: d.robot.id };
+      status(`Placed robot ${d.robot.id} at (${snap(x)}, ${snap(y)}).`);
+    }
+    changed(true);
+    return;
+  }
+  if (d.mode === 'move' && ed.sel?.type === 'robot' && v >= L.trayTop && d.changed) {
+    // Dropped in the tray: the robot's pose becomes random again.
+    ed.doc.robots[ed.sel.index].pose = 'random';
+    status(`Robot ${ed.sel.id} now starts at a random pose.`);
+    ed.sel = { ...ed.sel, tray: true };
+    changed(true);
+    return;
+  }
+  if (d.changed || d.mode === 'aim') changed(true);
+});
+// The first change of a drag puts the document as it was before on the undo stack.
+function noteChange(d) {
+  if (d.changed) return;
+  d.changed = true;
+  ed.undo.push(d.before);
+  if (ed.undo.length > UNDO_DEPTH) ed.undo.shift();
+  ed.redo = [];
+}
+function handleAngle(L, u, v, s) {
+  let c;
+  if (s.type === 'robot') c = toPx(L, ...ed.doc.robots[s.index].pose.slice(0, 2));
+  else if (s.type === 'beacon') c = toPx(L, ...ed.doc.beacons[s.index].position);
+  else c = toPx(L, ...centroid(selectedPoints(s)));
+  return deg(Math.atan2(-(v - c[1]), u - c[0]));
+}
+function positionOf(s) {
+  if (s.type === 'robot') return ed.doc.robots[s.index].pose;
+  if (s.type === 'beacon') return ed.doc.beacons[s.index].position;
+  return selectedPoints(s);
+}
+function moveSelection(from, dx, dy) {
+  const s = ed.sel;
+  if (snapOn()) { dx = Math.round(dx * 100) / 100; dy = Math.round(dy * 100) / 100; }
+  if (s.type === 'robot') setPose(ed.doc.robots[s.index], [snap(from[0] + dx), snap(from[1] + dy), from[2]]);
+  else if (s.type === 'beacon') ed.doc.beacons[s.index].position = [snap(from[0] + dx), snap(from[1] + dy)];
+  else {
+    const moved = from.map(([x, y]) => [round3(x + dx), round3(y + dy)]);
+    if (s.type === 'obstacle') ed.doc.obstacles[s.index].polygon = moved; else ed.doc.tracks[s.index].points = moved;
+  }
+}
+canvas.addEventListener('dblclick', (e) => {
+  if (ed.draft) { e.preventDefault(); finishDraft(); }
+});
+// Shift + wheel turns the robot (or beacon, obstacle, track) under the pointer, 5° a notch.
+canvas.addEventListener('wheel', (e) => {
+  if (!e.shiftKey || !ed.doc) return;
+  const [u, v] = canvasPoint(e);
+  const hit = hitTest(u, v);
+  const target = hit && !hit.tray && !hit.handle ? hit : hit?.handle ? { type: hit.type, index: hit.index, id: hit.id } : null;
+  if (!target) return;
+  e.preventDefault();
+  const delta = e.deltaY || e.deltaX;
+  if (!delta) return;
+  checkpoint();
+  ed.sel = target;
+  rotateSelection(rotationOf(target), delta < 0 ? 5 : -5);
+  changed(true);
+}, { passive: false });
+canvas.addEventListener('keydown', (e) => {
+  const key = e.key;
+  let handled = true;
+  if (key === 'Enter') finishDraft();
+  else if (key === 'Escape') { if (ed.draft) ed.draft = null; else ed.sel = null; setTool('select'); changed(true); }
+  else if ((key === 'Delete' || key === 'Backspace') && ed.draft) { ed.draft.points.pop(); requestDraw(); }
+  else if (key === 'Delete' || key === 'Backspace') deleteSelection();
+  else if ((e.ctrlKey || e.metaKey) && key.toLowerCase() === 'z') undo(!e.shiftKey);
+  else if ((e.ctrlKey || e.metaKey) && key.toLowerCase() === 'y') undo(false);
+  else if (key.startsWith('Arrow') && ed.sel && !ed.sel.tray) {
+    const step = e.shiftKey ? 0.01 : 0.001;
+    const [dx, dy] = { ArrowLeft: [-step, 0], ArrowRight: [step, 0], ArrowUp: [0, step], ArrowDown: [0, -step] }[key];
+    checkpoint();
+    const from = clone(positionOf(ed.sel));
+    if (ed.sel.vertex !== undefined) {
+      const pts = ed.sel.type === 'obstacle' ? ed.doc.obstacles[ed.sel.index].polygon : ed.doc.tracks[ed.sel.index].points;
+      pts[ed.sel.vertex] = [round3(pts[ed.sel.vertex][0] + dx), round3(pts[ed.sel.vertex][1] + dy)];
+    } else if (ed.sel.type === 'robot' || ed.sel.type === 'beacon') {
+      const p = positionOf(ed.sel);
+      const moved = [round3(p[0] + dx), round3(p[1] + dy)];
+      if (ed.sel.type === 'robot') setPose(ed.doc.robots[ed.sel.index], [...moved, p[2]]); else ed.doc.beacons[ed.sel.index].position = moved;
+    } else moveSelection(from, dx, dy);
+    changed();
+  } else if (!e.ctrlKey && !e.metaKey && !e.altKey && { v: 1, r: 1, o: 1, t: 1, b: 1 }[key]) {
+    setTool({ v: 'select', r: 'robot', o: 'obstacle', t: 'track', b: 'beacon' }[key]);
+  } else handled = false;
+  if (handled) { e.preventDefault(); e.stopPropagation(); } // not the page's manual driving
+});
+
+// ------------------------------------------------------------------ tools
+function setTool(tool) {
+  if (tool !== 'obstacle' && tool !== 'track') ed.draft = null;
+  else if (ed.draft && ed.draft.type !== tool) ed.draft = null;
+  ed.tool = tool;
+  for (const r of document.querySelectorAll('input[name="editor-tool"]')) r.checked = r.value === tool;
+  for (const span of document.querySelectorAll('#editor-tool-options [data-tool]')) span.hidden = !span.dataset.tool.split(' ').includes(tool);
+  $('editor-hint').textContent = {
+    select: 'Click to select, drag to move; drag the round handle to rotate (or shift + wheel); drag square handles to move a ' +
+      'point; Delete removes the selection (or the chosen point); arrows nudge by 1 mm (shift: 1 cm); ctrl+z undoes. ' +
+      'Drag a robot from the tray onto the field to give it a pose.',
+    robot: 'Click on the field to place a robot; keep the button down and drag to aim it.',
+    obstacle: 'Click the vertices; double-click or Enter closes the polygon; Backspace removes the last point; Esc cancels.',
+    track: 'Click the points; double-click or Enter ends the track; Backspace removes the last point; Esc cancels.',
+    beacon: 'Click on the field to place a beacon; keep the button down and drag to aim it.',
+  }[tool];
+  canvas.style.cursor = tool === 'select' ? 'default' : 'crosshair';
+  requestDraw();
+}
+for (const r of document.querySelectorAll('input[name="editor-tool"]')) {
+  r.addEventListener('change', () => { if (r.checked) { setTool(r.value); canvas.focus(); } });
+}
+
+// ------------------------------------------------------------------ the property form
+// Each row: [label, get, set, {type, options, step}]; a change is one undo step.
+let formRows = [];
+function numberField(label, get, set, step = 0.001, extra = {}) { return { label, get, set, type: 'number', step, ...extra }; }
+function formFor(s) {
+  const rows = [];
+  if (!s) {
+    return { title: 'Scenario', rows: [], note: 'Name, duration and field are in the bar above. Select an item to edit it.' };
+  }
+  if (s.type === 'robot') {
+    const e = () => ed.doc.robots[s.index];
+    const group = entryIds(e()).length > 1;
+    if (group) {
+      rows.push({ label: 'ids (the group)', type: 'text', get: () => String(e().ids), set: (v) => { if (parseIds(v)?.length) e().ids = v.trim(); } });
+    } else {
+      rows.push(numberField('id', () => entryIds(e())[0], (v) => {
+        if (!Number.isInteger(v) || v < 1) return;
+        ed.doc.robots[s.index] = renameKey(e(), e().id !== undefined ? 'id' : 'ids', 'id', v); s.id = v;
+      }, 1, { min: 1 }));
+    }
+    rows.push({ label: 'kind', type: 'select', options: ['virtual', 'real'], get: () => (e().kind === 'real' ? 'real' : 'virtual'), set: (v) => setKind(s.index, v) });
+    const controllers = [...CONTROLLERS];
+    const current = () => e().controller ?? 'convoy';
+    if (!controllers.includes(current())) controllers.push(current());
+    rows.push({ label: 'controller', type: 'select', options: controllers, get: current, set: (v) => setController(e(), v) });
+    if (isPose(e().pose) && !group) {
+      rows.push(numberField('x_m', () => e().pose[0], (v) => setPose(e(), [v, e().pose[1], e().pose[2]])));
+      rows.push(numberField('y_m', () => e().pose[1], (v) => setPose(e(), [e().pose[0], v, e().pose[2]])));
+      rows.push(numberField('theta_deg', () => e().pose[2], (v) => setPose(e(), [e().pose[0], e().pose[1], v]), 1));
+    }
+    const kept = Object.keys(e()).filter((k) => !['id', 'ids', 'kind', 'controller', 'pose'].includes(k));
+    return {
+      title: `Robot ${s.id}${group ? ` (of group ${e().ids})` : ''}`, rows,
+      note: `${isPose(e().pose) && !group ? '' : 'Random pose: drag it from the tray onto the field to place it' +
+        `${group ? ' (it then leaves its group)' : ''}. `}${group ? 'kind and controller apply to the whole group. ' : ''}` +
+        `${kept.length ? `Kept as loaded: ${kept.join(', ')}.` : ''}`,
+      actions: isPose(e().pose) && !group ? [['random pose', () => { e().pose = 'random'; s.tray = true; }]] : [],
+    };
+  }
+  if (s.type === 'beacon') {
+    const b = () => ed.doc.beacons[s.index];
+    rows.push(numberField('id', () => b().id, (v) => { if (Number.isInteger(v)) b().id = v; }, 1));
+    rows.push(numberField('x_m', () => b().position[0], (v) => { b().position = [round3(v), b().position[1]]; }));
+    rows.push(numberField('y_m', () => b().position[1], (v) => { b().position = [b().position[0], round3(v)]; }));
+    rows.push(numberField('facing_deg', () => b().facing_deg ?? 0, (v) => { b().facing_deg = wrapDeg(v); }, 1));
+    rows.push(numberField('aperture_deg', () => b().aperture_deg ?? 360, (v) => { if (v > 0 && v <= 360) b().aperture_deg = v; }, 1, { min: 1, max: 360 }));
+    rows.push(numberField('range_m', () => b().range_m ?? 2, (v) => { if (v > 0) b().range_m = v; }, 0.01, { min: 0.01 }));
+    return { title: `Beacon ${b().id}`, rows };
+  }
+  const key = s.type === 'obstacle' ? 'polygon' : 'points';
+  const item = () => list(`${s.type}s`)[s.index];
+  rows.push({ label: 'name', type: 'text', get: () => item().name ?? '', set: (v) => { if (v) item().name = v; else delete item().name; } });
+  if (s.type === 'track') {
+    rows.push(numberField('width_m', () => item().width_m ?? 0.02, (v) => { if (v > 0) item().width_m = v; }, 0.001, { min: 0.001 }));
+    rows.push({ label: 'closed', type: 'checkbox', get: () => item().closed === true, set: (v) => { item().closed = v; } });
+  }
+  (item()[key] || []).forEach((p, k) => {
+    rows.push({ label: `point ${k + 1}`, type: 'pair',
+      get: () => item()[key][k], set: (v) => { item()[key][k] = v; } });
+  });
+  return { title: `${s.type === 'obstacle' ? 'Obstacle' : 'Track'} ${s.index + 1}`, rows,
+    note: 'Drag the square handles to move its points; select one and press Delete to remove it.' };
+}
+function renderForm() {
+  const form = $('editor-form');
+  form.replaceChildren();
+  if (ed.sel && !selectionExists()) ed.sel = null;
+  const spec = formFor(ed.sel);
+  const h = document.createElement('h3');
+  h.textContent = spec.title;
+  form.append(h);
+  formRows = [];
+  for (const row of spec.rows) {
+    const label = document.createElement('label');
+    label.className = 'editor-row';
+    const span = document.createElement('span');
+    span.textContent = row.label;
+    label.append(span);
+    const inputs = [];
+    const apply = (value) => { checkpoint(); row.set(value); changed(true); };
+    if (row.type === 'select') {
+      const sel = document.createElement('select');
+      for (const o of row.options) sel.append(new Option(o, o));
+      sel.addEventListener('change', () => apply(sel.value));
+      inputs.push(sel);
+    } else if (row.type === 'checkbox') {
+      const box = document.createElement('input');
+      box.type = 'checkbox';
+      box.addEventListener('change', () => apply(box.checked));
+      inputs.push(box);
+    } else if (row.type === 'pair') {
+      for (let k = 0; k < 2; ++k) {
+        const input = document.createElement('input');
+        input.type = 'number'; input.step = '0.001';
+        input.addEventListener('change', () => {
+          const v = Number(input.value);
+          if (input.value === '' || !isNum(v)) return;
+          const p = [...row.get()];
+          p[k] = round3(v);
+          apply(p);
+        });
+        inputs.push(input);
+      }
+    } else {
+      const input = document.createElement('input');
+      input.type = row.type;
+      if (row.step) input.step = String(row.step);
+      if (row.min !== undefined) input.min = String(row.min);
+      if (row.max !== undefined) input.max = String(row.max);
+      input.addEventListener('change', () => {
+        if (row.type === 'number') {
+          const v = Number(input.value);
+          if (input.value === '' || !isNum(v)) { refreshForm(); return; }
+          apply(v);
+        } else apply(input.value);
+      });
+      inputs.push(input);
+    }
+    inputs.forEach((i, k) => { i.name = `${row.label}${inputs.length > 1 ? ['_x', '_y'][k] : ''}`.replace(/\W+/g, '_'); });
+    label.append(...inputs);
+    form.append(label);
+    formRows.push({ row, inputs });
+  }
+  for (const [text, act] of spec.actions || []) {
+    const b = document.createElement('button');
+    b.type = 'button'; b.textContent = text;
+    b.addEventListener('click', () => { checkpoint(); act(); changed(true); });
+    form.append(b);
+  }
+  if (spec.note) {
+    const p = document.createElement('p');
+    p.className = 'muted small';
+    p.textContent = spec.note;
+    form.append(p);
+  }
+  refreshForm();
+  updateButtons();
+}
+function refreshForm() {
+  if (ed.sel && !selectionExists()) { renderForm(); return; }
+  for (const { row, inputs } of formRows) {
+    let v;
+    try { v = row.get(); } catch { continue; }
+    if (row.type === 'pair') inputs.forEach((i, k) => { if (document.activeElement !== i) i.value = v?.[k] ?? ''; });
+    else if (row.type === 'checkbox') inputs[0].checked = !!v;
+    else if (document.activeElement !== inputs[0]) inputs[0].value = v ?? '';
+  }
+}
+function selectionExists() {
+  const s = ed.sel;
+  if (s.type === 'robot') return entryIds(ed.doc.robots?.[s.index]).includes(s.id);
+  return !!list(`${s.type}s`)[s.index];
+}
+$('editor-form').addEventListener('submit', (e) => e.preventDefault());
+
+// The scenario's own fields (the bar above the canvas).
+const scenarioInputs = {
+  'editor-name': { get: () => ed.doc.name ?? '', set: (v) => { if (v) ed.doc.name = v; else delete ed.doc.name; } },
+  'editor-duration': { get: () => ed.doc.duration_s ?? '', set: (v) => { const n = Number(v); if (v === '') delete ed.doc.duration_s; else if (n > 0) ed.doc.duration_s = n; } },
+  'editor-width': { get: () => ed.doc.field?.width_m ?? '', set: (v) => setField('width_m', v) },
+  'editor-height': { get: () => ed.doc.field?.height_m ?? '', set: (v) => setField('height_m', v) },
+  'editor-walls': { get: () => ed.doc.field?.walls !== false, set: (v) => { if (v && ed.doc.field) delete ed.doc.field.walls; else if (!v) { ed.doc.field = ed.doc.field || {}; ed.doc.field.walls = false; } } },
+};
+function setField(key, v) {
+  const n = Number(v);
+  if (v === '' || !(n > 0)) return;
+  if (!ed.doc.field || typeof ed.doc.field !== 'object') ed.doc.field = {};
+  ed.doc.field[key] = n;
+}
+function syncScenarioInputs() {
+  for (const [id, io] of Object.entries(scenarioInputs)) {
+    const input = $(id);
+    if (input.type === 'checkbox') input.checked = io.get(); else input.value = io.get();
+  }
+}
+for (const [id, io] of Object.entries(scenarioInputs)) {
+  $(id).addEventListener('change', () => {
+    checkpoint();
+    io.set($(id).type === 'checkbox' ? $(id).checked : $(id).value.trim());
+    syncScenarioInputs();
+    changed();
+  });
+}
+
+// ------------------------------------------------------------------ the panel's buttons
+for (const id of ['editor-new-controller']) {
+  for (const c of CONTROLLERS) $(id).append(new Option(c, c));
+}
+$('editor-from-run').addEventListener('click', startFromRun);
+$('editor-poses-from-run').addEventListener('click', posesFromRun);
+$('editor-new').addEventListener('click', newScenario);
+$('editor-save').addEventListener('click', save);
+$('editor-delete').addEventListener('click', () => { deleteSelection(); canvas.focus(); });
+$('editor-undo').addEventListener('click', () => undo(true));
+$('editor-redo').addEventListener('click', () => undo(false));
+$('editor-file').addEventListener('change', async () => {
+  const file = $('editor-file').files[0];
+  if (!file) return;
+  loadText(await file.text(), file.name);
+  $('editor-file').value = '';
+});
+const panel = $('editor-panel');
+panel.open = localStorage.getItem('rilbed-editor-open') === '1';
+panel.addEventListener('toggle', () => {
+  localStorage.setItem('rilbed-editor-open', panel.open ? '1' : '0');
+  if (panel.open) requestDraw();
+});
+new ResizeObserver(requestDraw).observe(canvas);
+
+newScenario();
+status('');
+
+// For tests and the curious: the editor's document and its canvas geometry.
+window.rilbedEditor = {
+  get doc() { return ed.doc; },
+  get yaml() { return ed.yaml; },
+  get selection() { return ed.sel; },
+  get tool() { return ed.tool; },
+  get saves() { return ed.saves || 0; },
+  get loadedName() { return ed.loadedName; },
+  get loads() { return ed.loads || 0; },
+  project: (x, y) => toPx(layout(), x, y),               // field metres -> canvas CSS pixels
+  trayPosition: (id) => { const k = trayRobots().findIndex((r) => r.id === id); return k < 0 ? null : trayPosition(layout(), k); },
+  rotateHandle: () => rotateHandle(layout()),
+  problems: findProblems,
+};

@@ -1,0 +1,510 @@
+#!/usr/bin/env node
+// The web panel's scenario editor (issue 17, web/editor.js) in a real browser: Debian's
+// Chromium, driven by playwright-core, against `rilbed run --gui`.
+//
+//   node web/tests/editor_test.js RILBED [ARTEFACT_DIR]
+//
+// Runs `RILBED run scenarios/convoy_sim.yaml --realtime --duration 300 --gui --gui-port 0
+// --out TMPDIR`, opens the page and checks, with mouse and keys on the editor's canvas:
+//   1. "Start from this run" fills the editor with the run's field and its robots at
+//      their current poses;
+//   2. an obstacle (four clicks, the last a double-click), one of its vertices dragged;
+//      a track (three clicks and Enter); a beacon (pressed and dragged to aim it, with
+//      the id, aperture and range of the tool's options); a robot (one click, controller
+//      wander); robot 3 dragged elsewhere and turned by its handle; robot 5 turned by
+//      shift + wheel; robot 8 clicked and deleted with the Delete key;
+//   3. Save downloads scenario.yaml, the text the page shows, with every one of those
+//      at the place the mouse put it (within 3 mm, 1.5 degrees), and `RILBED run
+//      SAVED --fast --duration 2` accepts it (exit 0);
+//   4. each scenarios/*.yaml loaded through the file input and saved unchanged parses
+//      (js-yaml) to an object deep-equal to the original's, and `RILBED run` accepts it
+//      (--fast --duration 1, plus --all-virtual when it has real robots);
+// and that the page logged no console error and threw nothing. A screenshot of the
+// editor goes to $RILBED_ARTIFACTS, else ARTEFACT_DIR (CTest passes BUILD/web-artifacts),
+// else a temp folder; its path is printed. Every wait polls with a deadline; on any
+// failure it says what it was waiting for, shows the end of rilbed's output, kills
+// rilbed and the browser and exits 1. CTest runs it as web_editor (label e2e); `./run
+// test` installs its npm packages (web/tests and web/: the page's js-yaml) and Chromium.
+'use strict';
+
+const { spawn, spawnSync } = require('node:child_process');
+const fs = require('node:fs');
+const os = require('node:os');
+const path = require('node:path');
+const assert = require('node:assert');
+
+const NAME = 'editor_test';
+const CHROMIUM = '/usr/bin/chromium';
+const DEADLINE_MS = 30000;
+const WEB = path.resolve(__dirname, '..');
+const SCENARIOS = path.resolve(__dirname, '../../scenarios');
+const TOLERANCE_M = 0.003;
+const TOLERANCE_DEG = 1.5;
+
+let checks = 0;
+function ok(what) {
+  checks += 1;
+  console.log(`ok ${checks} - ${what}`);
+}
+class TestFailure extends Error {}
+function fail(message) { throw new TestFailure(message); }
+function check(condition, message) { if (!condition) fail(message); }
+
+// ---------------------------------------------------------------- the npm packages
+function requirePackages() {
+  const need = [
+    [path.join(__dirname, 'node_modules'), 'playwright-core', 'web/tests'],
+    [path.join(WEB, 'node_modules'), 'js-yaml', 'web (the page loads js-yaml from web/node_modules)'],
+  ];
+  const loaded = {};
+  for (const [dir, name, where] of need) {
+    const missing = `${dir} is missing or incomplete (${name}): run ./run test (it installs the npm packages of ${where})`;
+    if (!fs.existsSync(dir)) {
+      console.error(`${NAME}: FAIL: ${missing}`);
+      process.exit(1);
+    }
+    try {
+      loaded[name] = require(require.resolve(name, { paths: [path.dirname(dir)] }));
+    } catch (e) {
+      console.error(`${NAME}: FAIL: ${missing} (${e.message})`);
+      process.exit(1);
+    }
+  }
+  return { playwright: loaded['playwright-core'], yaml: loaded['js-yaml'] };
+}
+
+// ---------------------------------------------------------------- waiting on rilbed
+const waiters = new Set();
+let aborted = null;
+function poke() {
+  for (const w of [...waiters]) {
+    const value = w.condition();
+    if (value) { w.finish(); w.resolve(value); }
+  }
+}
+function abort(message) {
+  if (aborted) return;
+  aborted = message;
+  for (const w of [...waiters]) { w.finish(); w.reject(new TestFailure(`${message} while waiting for ${w.what}`)); }
+}
+function waitFor(what, condition, ms = DEADLINE_MS) {
+  return new Promise((resolve, reject) => {
+    if (aborted) { reject(new TestFailure(`${aborted} while waiting for ${what}`)); return; }
+    const w = { what, condition, resolve, reject };
+    const timer = setTimeout(() => { waiters.delete(w); reject(new TestFailure(`timed out after ${ms / 1000} s waiting for ${what}`)); }, ms);
+    w.finish = () => { clearTimeout(timer); waiters.delete(w); };
+    waiters.add(w);
+    poke();
+  });
+}
+
+class Child {
+  constructor(binary, args) {
+    this.stdoutLines = [];
+    this.stderrTail = [];
+    this.exit = null;
+    this.proc = spawn(binary, args, { stdio: ['ignore', 'pipe', 'pipe'] });
+    this.proc.on('error', (e) => { this.exit = { code: null, signal: null, error: e }; abort(`rilbed could not be started (${e.message})`); });
+    const lineReader = (onLine) => {
+      let partial = '';
+      return (chunk) => {
+        partial += chunk.toString('utf8');
+        const parts = partial.split('\n');
+        partial = parts.pop();
+        for (const l of parts) onLine(l);
+        poke();
+      };
+    };
+    this.proc.stdout.on('data', lineReader((l) => { this.stdoutLines.push(l); if (this.stdoutLines.length > 200) this.stdoutLines.shift(); }));
+    this.proc.stderr.on('data', lineReader((l) => { this.stderrTail.push(l); if (this.stderrTail.length > 40) this.stderrTail.shift(); }));
+    this.proc.on('exit', (code, signal) => {
+      this.exit = { code, signal };
+      if (!this.exitExpected) abort(`rilbed exited unexpectedly (${signal ? `killed by ${signal}` : `exit code ${code}`})`);
+      poke();
+    });
+  }
+  async kill() {
+    if (this.exit || !this.proc.pid) return;
+    this.exitExpected = true;
+    const exited = new Promise((resolve) => this.proc.once('exit', resolve));
+    this.proc.kill('SIGTERM');
+    const timer = setTimeout(() => this.proc.kill('SIGKILL'), 5000);
+    await exited;
+    clearTimeout(timer);
+  }
+  tails() {
+    return `--- rilbed's stdout (last lines) ---\n${this.stdoutLines.slice(-20).join('\n')}\n` +
+      `--- rilbed's stderr (last lines) ---\n${this.stderrTail.join('\n')}\n---`;
+  }
+}
+
+// `RILBED run FILE ARGS...`, which must exit 0 within the deadline.
+function runAccepts(binary, file, args, outDir) {
+  const r = spawnSync(binary, ['run', file, ...args, '--quiet', '--out', outDir], { encoding: 'utf8', timeout: 60000 });
+  check(r.status === 0, `rilbed run ${path.basename(file)} ${args.join(' ')} ended with ${r.error ? r.error.message : r.signal || `exit code ${r.status}`}:\n` +
+    `${(r.stdout || '').slice(-1500)}\n${(r.stderr || '').slice(-1500)}\n--- the file ---\n${fs.readFileSync(file, 'utf8')}`);
+}
+
+// ---------------------------------------------------------------- the test
+async function main(state) {
+  const [binary, artefactArg] = process.argv.slice(2);
+  if (!binary) {
+    console.error(`usage: node ${path.basename(__filename)} RILBED [ARTEFACT_DIR]`);
+    process.exit(2);
+  }
+  check(fs.existsSync(binary), `no rilbed binary at ${binary} (build it first: ./run build)`);
+  check(fs.existsSync(CHROMIUM), `no ${CHROMIUM}: install Debian's chromium (./run test does)`);
+  const { playwright, yaml } = requirePackages();
+  state.tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'rilbed-web-editor-'));
+  state.artifacts = process.env.RILBED_ARTIFACTS || artefactArg || fs.mkdtempSync(path.join(os.tmpdir(), 'rilbed-web-artifacts-'));
+  fs.mkdirSync(state.artifacts, { recursive: true });
+
+  const scenario = path.join(SCENARIOS, 'convoy_sim.yaml');
+  const args = ['run', scenario, '--realtime', '--duration', '300', '--gui', '--gui-port', '0', '--out', path.join(state.tmp, 'run')];
+  console.log(`# starting ${binary} ${args.join(' ')}`);
+  const child = new Child(binary, args);
+  state.child = child;
+  const urlPattern = /(http:\/\/127\.0\.0\.1:\d+\/\?token=[^\s&#]+)/;
+  const [, url] = await waitFor('the line with http://127.0.0.1:PORT/?token=TOKEN on rilbed\'s stdout',
+    () => child.stdoutLines.map((l) => urlPattern.exec(l)).find((m) => m));
+  ok('rilbed serves the page');
+
+  const browser = await playwright.chromium.launch({ executablePath: CHROMIUM, args: ['--no-sandbox'] });
+  state.browser = browser;
+  const context = await browser.newContext({ viewport: { width: 1400, height: 1000 }, acceptDownloads: true });
+  context.setDefaultTimeout(DEADLINE_MS);
+  const page = await context.newPage();
+  state.page = page;
+  state.pageErrors = [];
+  page.on('console', (m) => { if (m.type() === 'error') state.pageErrors.push(`console error: ${m.text()}`); });
+  page.on('pageerror', (e) => state.pageErrors.push(`uncaught: ${e.message}`));
+  const until = (what, fn, arg) => page.waitForFunction(fn, arg, { timeout: DEADLINE_MS, polling: 50 })
+    .then((h) => h.jsonValue())
+    .catch((e) => fail(`timed out after ${DEADLINE_MS / 1000} s waiting for ${what} (${e.message.split('\n')[0]})`));
+  const doc = () => page.evaluate(() => JSON.parse(JSON.stringify(window.rilbedEditor.doc)));
+
+  await page.goto(url);
+  await until('the page to hold the run\'s world and poses, and the editor to start',
+    () => window.rilbed?.run?.world && window.rilbed.run.poses?.robots?.length && window.rilbedEditor);
+  await page.click('#editor-panel > summary');
+  await until('the editor panel to open', () => document.getElementById('editor-panel').open);
+  ok('the page shows the run; the editor panel opens');
+
+  // 1. Start from this run.
+  // (The click and the poses it took in one go: the run moves on.)
+  await page.locator('#editor-from-run').scrollIntoViewIfNeeded();
+  const runPoses = await page.evaluate(() => { document.getElementById('editor-from-run').click(); return window.rilbed.run.poses; });
+  const started = await until('the editor to hold the run\'s 8 robots at poses',
+    () => { const d = window.rilbedEditor.doc; return d.robots?.length === 8 && d.robots.every((r) => Array.isArray(r.pose)) && JSON.parse(JSON.stringify(d)); });
+  check(started.field.width_m === 1.5 && started.field.height_m === 1.2, `the editor's field is ${JSON.stringify(started.field)}, not 1.5 x 1.2`);
+  for (const r of started.robots) {
+    const p = runPoses.robots.find((q) => q.id === r.id);
+    check(p && Math.abs(p.x_m - r.pose[0]) < 0.001 && Math.abs(p.y_m - r.pose[1]) < 0.001,
+      `robot ${r.id} is at ${JSON.stringify(r.pose)} in the editor, at ${p && [p.x_m, p.y_m]} in the run's poses (t ${runPoses.t_s})`);
+  }
+  ok(`"Start from this run": field 1.5 x 1.2 m, robots ${started.robots.map((r) => r.id).join(',')} at the run's poses of t = ${runPoses.t_s.toFixed(1)} s`);
+
+  // The canvas, wholly in view; field metres to page pixels.
+  const canvas = page.locator('#editor-canvas');
+  await canvas.evaluate((el) => el.scrollIntoView({ block: 'center' }));
+  // (Where the canvas is, asked again for every point: nothing should move it, but if
+  // something did, the clicks still land where meant.)
+  const canvasBox = async () => {
+    const b = await canvas.boundingBox();
+    check(b && b.y >= 0 && b.y + b.height <= 1000, `the editor's canvas is not wholly in view: ${JSON.stringify(b)}`);
+    return b;
+  };
+  let box = await canvasBox();
+  const at = async (x, y) => {
+    box = await canvasBox();
+    const [u, v] = await page.evaluate(([a, b]) => window.rilbedEditor.project(a, b), [x, y]);
+    return [box.x + u, box.y + v];
+  };
+  const mouse = page.mouse;
+  const clickAt = async (x, y) => { const [u, v] = await at(x, y); await mouse.click(u, v); };
+  const dragPx = async ([u0, v0], [u1, v1]) => { await mouse.move(u0, v0); await mouse.down(); await mouse.move(u1, v1, { steps: 8 }); await mouse.up(); };
+
+  // Free places: away from every robot and from what the test has put down.
+  const taken = started.robots.map((r) => ({ x: r.pose[0], y: r.pose[1], r: 0.03 }));
+  const freeSpot = (clearance, what) => {
+    for (let y = 0.15; y <= 1.05; y += 0.05) {
+      for (let x = 0.15; x <= 1.35; x += 0.05) {
+        if (taken.every((t) => Math.hypot(t.x - x, t.y - y) >= clearance + t.r)) return [Math.round(x * 100) / 100, Math.round(y * 100) / 100];
+      }
+    }
+    return fail(`no free place for ${what} among ${JSON.stringify(taken)}`);
+  };
+  const near = (a, b, tol = TOLERANCE_M) => Math.abs(a - b) <= tol;
+  const nearPoint = (p, q) => Array.isArray(p) && near(p[0], q[0]) && near(p[1], q[1]);
+  const angleOff = (a, b) => Math.abs(((a - b + 540) % 360) - 180);
+
+  // 2a. An obstacle: a 10 cm square, four clicks (the last a double-click).
+  const [ox, oy] = freeSpot(0.16, 'the obstacle');
+  taken.push({ x: ox, y: oy, r: 0.13 });
+  const square = [[ox - 0.05, oy - 0.05], [ox + 0.05, oy - 0.05], [ox + 0.05, oy + 0.05], [ox - 0.05, oy + 0.05]];
+  await page.check('input[name="editor-tool"][value="obstacle"]');
+  for (const p of square.slice(0, 3)) await clickAt(...p);
+  { const [u, v] = await at(...square[3]); await mouse.dblclick(u, v); }
+  await until('the obstacle to be added and selected', () => window.rilbedEditor.doc.obstacles?.length === 1 && window.rilbedEditor.selection?.type === 'obstacle');
+  let d = await doc();
+  check(d.obstacles[0].polygon.length === 4 && d.obstacles[0].polygon.every((p, i) => nearPoint(p, square[i])),
+    `the obstacle is ${JSON.stringify(d.obstacles[0].polygon)}, not the square ${JSON.stringify(square)} clicked`);
+  ok(`obstacle added by four clicks (the last a double-click): ${JSON.stringify(d.obstacles[0].polygon)}`);
+  // ... and its third vertex dragged 2 cm right and 1 cm up.
+  const moved = [ox + 0.07, oy + 0.06];
+  await dragPx(await at(...square[2]), await at(...moved));
+  await until('the obstacle\'s third vertex to move', ([x, y]) => {
+    const p = window.rilbedEditor.doc.obstacles[0].polygon[2];
+    return Math.abs(p[0] - x) < 0.003 && Math.abs(p[1] - y) < 0.003;
+  }, moved);
+  square[2] = moved;
+  ok(`the obstacle's third vertex dragged to ${JSON.stringify(moved)}`);
+
+  // 2b. A track: three clicks and Enter, 3 cm wide, open.
+  const track = [[0.2, 0.12], [0.7, 0.2], [1.3, 0.12]];
+  await page.check('input[name="editor-tool"][value="track"]');
+  await page.fill('#editor-new-track-width', '0.03');
+  for (const p of track) await clickAt(...p);
+  await page.keyboard.press('Enter');
+  await until('the track to be added', () => window.rilbedEditor.doc.tracks?.length === 1);
+  d = await doc();
+  check(d.tracks[0].points.length === 3 && d.tracks[0].points.every((p, i) => nearPoint(p, track[i])) && d.tracks[0].width_m === 0.03 &&
+    d.tracks[0].closed === false, `the track is ${JSON.stringify(d.tracks[0])}, not ${JSON.stringify(track)} 0.03 m wide, open`);
+  ok(`track added by three clicks and Enter: ${JSON.stringify(d.tracks[0])}`);
+
+  // 2c. A beacon: id 5, aperture 120°, range 1.5 m, pressed and dragged up-right to face 45°.
+  const beacon = freeSpot(0.08, 'the beacon');
+  taken.push({ x: beacon[0], y: beacon[1], r: 0.03 });
+  await page.check('input[name="editor-tool"][value="beacon"]');
+  await page.fill('#editor-new-beacon-id', '5');
+  await page.fill('#editor-new-beacon-aperture', '120');
+  await page.fill('#editor-new-beacon-range', '1.5');
+  {
+    const [u, v] = await at(...beacon);
+    await dragPx([u, v], [u + 40, v - 40]);
+  }
+  await until('the beacon to be added', () => window.rilbedEditor.doc.beacons?.length === 1);
+  d = await doc();
+  const b = d.beacons[0];
+  check(b.id === 5 && nearPoint(b.position, beacon) && b.aperture_deg === 120 && b.range_m === 1.5 && angleOff(b.facing_deg, 45) <= TOLERANCE_DEG,
+    `the beacon is ${JSON.stringify(b)}, not id 5 at ${JSON.stringify(beacon)}, aperture 120, range 1.5, facing 45`);
+  ok(`beacon added by a press and a drag to aim it: ${JSON.stringify(b)}`);
+
+  // 2d. A robot: one click, controller wander; it gets the next id, 9.
+  const robot9 = freeSpot(0.09, 'robot 9');
+  taken.push({ x: robot9[0], y: robot9[1], r: 0.03 });
+  await page.check('input[name="editor-tool"][value="robot"]');
+  await page.selectOption('#editor-new-controller', 'wander');
+  await clickAt(...robot9);
+  await until('robot 9 to be added', () => window.rilbedEditor.doc.robots.some((r) => r.id === 9));
+  d = await doc();
+  const r9 = d.robots.find((r) => r.id === 9);
+  check(nearPoint(r9.pose, robot9) && r9.controller === 'wander' && r9.kind === undefined,
+    `robot 9 is ${JSON.stringify(r9)}, not a virtual wanderer at ${JSON.stringify(robot9)}`);
+  ok(`robot added by a click: ${JSON.stringify(r9)}`);
+
+  // 2e. Robot 3 dragged to a free place (select tool), then turned by its handle to 135°.
+  await page.check('input[name="editor-tool"][value="select"]');
+  const r3 = d.robots.find((r) => r.id === 3);
+  const to3 = freeSpot(0.09, 'robot 3');
+  taken.push({ x: to3[0], y: to3[1], r: 0.03 });
+  await dragPx(await at(r3.pose[0], r3.pose[1]), await at(...to3));
+  await until('robot 3 to move', ([x, y]) => {
+    const r = window.rilbedEditor.doc.robots.find((q) => q.id === 3);
+    return Math.abs(r.pose[0] - x) < 0.003 && Math.abs(r.pose[1] - y) < 0.003;
+  }, to3);
+  d = await doc();
+  check(d.robots.find((r) => r.id === 3).pose[2] === r3.pose[2], `dragging robot 3 turned it: ${JSON.stringify(d.robots.find((r) => r.id === 3))}`);
+  ok(`robot 3 dragged from (${r3.pose[0]}, ${r3.pose[1]}) to ${JSON.stringify(to3)}, heading kept (${r3.pose[2]}°)`);
+  const handle = await page.evaluate(() => window.rilbedEditor.rotateHandle());
+  check(handle, 'robot 3 is selected but has no rotation handle');
+  {
+    const [cu, cv] = await at(...to3); // (and box, now)
+    const a = (135 * Math.PI) / 180;
+    await dragPx([box.x + handle[0], box.y + handle[1]], [cu + 50 * Math.cos(a), cv - 50 * Math.sin(a)]);
+  }
+  await until('robot 3 to turn to 135°', () => {
+    const r = window.rilbedEditor.doc.robots.find((q) => q.id === 3);
+    return Math.abs(((r.pose[2] - 135 + 540) % 360) - 180) <= 1.5;
+  });
+  d = await doc();
+  const r3b = d.robots.find((r) => r.id === 3);
+  check(nearPoint(r3b.pose, to3), `turning robot 3 moved it: ${JSON.stringify(r3b)}`);
+  ok(`robot 3 turned by dragging its handle: pose ${JSON.stringify(r3b.pose)}`);
+
+  // 2f. Robot 5 turned by shift + wheel: 5° a notch, wheel up turns left.
+  const r5 = d.robots.find((r) => r.id === 5);
+  {
+    const [u, v] = await at(r5.pose[0], r5.pose[1]);
+    await mouse.move(u, v);
+    await page.keyboard.down('Shift');
+    await mouse.wheel(0, -100);
+    await page.keyboard.up('Shift');
+  }
+  const want5 = ((r5.pose[2] + 5 + 540) % 360) - 180;
+  await until('robot 5 to turn by 5° on shift + wheel', (w) => {
+    const r = window.rilbedEditor.doc.robots.find((q) => q.id === 5);
+    return Math.abs(((r.pose[2] - w + 540) % 360) - 180) < 0.05;
+  }, want5);
+  ok(`robot 5 turned by shift + wheel from ${r5.pose[2]}° to ${want5.toFixed(1)}°`);
+
+  // 2g. Robot 8 clicked and deleted with the Delete key.
+  const r8 = d.robots.find((r) => r.id === 8);
+  await clickAt(r8.pose[0], r8.pose[1]);
+  await until('robot 8 to be selected', () => window.rilbedEditor.selection?.type === 'robot' && window.rilbedEditor.selection.id === 8);
+  await page.keyboard.press('Delete');
+  await until('robot 8 to be deleted', () => !window.rilbedEditor.doc.robots.some((r) => r.id === 8));
+  ok('robot 8 clicked and deleted with the Delete key');
+
+  // The editor, as a person sees it: the obstacle selected, its handles showing.
+  await clickAt(ox - 0.03, oy - 0.03);
+  await until('the obstacle to be selected', () => window.rilbedEditor.selection?.type === 'obstacle');
+  const shot = path.join(state.artifacts, 'editor.png');
+  await page.locator('#editor').screenshot({ path: shot });
+  ok(`screenshot of the editor: ${shot}`);
+
+  // 3. Save: the download, the text shown, what it holds, and rilbed run accepting it.
+  const save = async (what) => {
+    const [download] = await Promise.all([
+      page.waitForEvent('download', { timeout: DEADLINE_MS }).catch((e) => fail(`no download after Save (${what}): ${e.message.split('\n')[0]}`)),
+      page.click('#editor-save'),
+    ]);
+    check(download.suggestedFilename() === 'scenario.yaml', `the download is named ${download.suggestedFilename()}, not scenario.yaml`);
+    const file = path.join(state.tmp, `saved-${what}.yaml`);
+    await download.saveAs(file);
+    const text = fs.readFileSync(file, 'utf8');
+    const shown = await page.inputValue('#editor-yaml');
+    check(text === shown, `the file saved (${what}) is not the text the page shows:\n${text}\n--- shown ---\n${shown}`);
+    return { file, text };
+  };
+  const saved = await save('edited');
+  const s = yaml.load(saved.text);
+  check(s.obstacles?.length === 1 && s.obstacles[0].polygon.every((p, i) => nearPoint(p, square[i])),
+    `saved obstacles ${JSON.stringify(s.obstacles)}, expected ${JSON.stringify(square)}`);
+  check(s.tracks?.length === 1 && s.tracks[0].points.every((p, i) => nearPoint(p, track[i])) && s.tracks[0].width_m === 0.03,
+    `saved tracks ${JSON.stringify(s.tracks)}, expected ${JSON.stringify(track)}`);
+  check(s.beacons?.length === 1 && s.beacons[0].id === 5 && nearPoint(s.beacons[0].position, beacon) && s.beacons[0].aperture_deg === 120 &&
+    s.beacons[0].range_m === 1.5 && angleOff(s.beacons[0].facing_deg, 45) <= TOLERANCE_DEG, `saved beacons ${JSON.stringify(s.beacons)}`);
+  const ids = s.robots.map((r) => r.id).sort((a, b) => a - b);
+  check(JSON.stringify(ids) === '[1,2,3,4,5,6,7,9]', `saved robots ${ids}, expected 1-7 and 9`);
+  const s3 = s.robots.find((r) => r.id === 3), s5 = s.robots.find((r) => r.id === 5), s9 = s.robots.find((r) => r.id === 9);
+  check(nearPoint(s3.pose, to3) && angleOff(s3.pose[2], 135) <= TOLERANCE_DEG, `saved robot 3 ${JSON.stringify(s3)}`);
+  check(angleOff(s5.pose[2], want5) < 0.05 && nearPoint(s5.pose, r5.pose), `saved robot 5 ${JSON.stringify(s5)}`);
+  check(nearPoint(s9.pose, robot9) && s9.controller === 'wander', `saved robot 9 ${JSON.stringify(s9)}`);
+  ok(`the saved scenario.yaml (${saved.text.split('\n').length} lines) holds the obstacle, track, beacon and robot 9 where ` +
+     'the mouse put them, robot 3 moved and turned, robot 5 turned, no robot 8');
+  runAccepts(binary, saved.file, ['--fast', '--duration', '2'], path.join(state.tmp, 'run-edited'));
+  ok('rilbed run SAVED --fast --duration 2 exits 0');
+
+  // 4. Every shipped scenario, loaded and saved unchanged.
+  const files = fs.readdirSync(SCENARIOS).filter((f) => f.endsWith('.yaml')).sort();
+  check(files.length > 0, `no scenarios in ${SCENARIOS}`);
+  for (const f of files) {
+    const original = path.join(SCENARIOS, f);
+    const loadsBefore = await page.evaluate(() => window.rilbedEditor.loads);
+    await page.setInputFiles('#editor-file', original);
+    await until(`the editor to load ${f}`, ([n, name]) => window.rilbedEditor.loads > n && window.rilbedEditor.loadedName === name, [loadsBefore, f]);
+    const out = await save(path.basename(f, '.yaml'));
+    const a = yaml.load(fs.readFileSync(original, 'utf8'));
+    const c = yaml.load(out.text);
+    try {
+      assert.deepStrictEqual(c, a);
+    } catch (e) {
+      fail(`${f} loaded and saved is not the same scenario:\n${e.message.slice(0, 3000)}`);
+    }
+    const real = (a.robots || []).some((r) => r.kind === 'real');
+    runAccepts(binary, out.file, ['--fast', '--duration', '1', ...(real ? ['--all-virtual'] : [])], path.join(state.tmp, `run-${f}`));
+    ok(`${f}: loaded, saved unchanged (js-yaml: deep-equal), rilbed run accepts it${real ? ' (--all-virtual)' : ''}`);
+  }
+
+  // 5. A group split by dragging one of its robots from the tray: convoy_mixed's real
+  // robots 4-5, robot 4 put at (0.3, 0.3) (an entry of its own, before 5's: ID order); robot
+  // 8 of group 6-8 deleted with the button.
+  {
+    const loadsBefore = await page.evaluate(() => window.rilbedEditor.loads);
+    await page.setInputFiles('#editor-file', path.join(SCENARIOS, 'convoy_mixed.yaml'));
+    await until('the editor to load convoy_mixed.yaml again', (n) => window.rilbedEditor.loads > n, loadsBefore);
+    const tray4 = await page.evaluate(() => window.rilbedEditor.trayPosition(4));
+    check(tray4, 'robot 4 of convoy_mixed.yaml (ids 4-5, pose random) is not in the tray');
+    box = await canvasBox();
+    await dragPx([box.x + tray4[0], box.y + tray4[1]], await at(0.3, 0.3));
+    await until('robot 4 to leave its group with a pose', () => window.rilbedEditor.doc.robots.some((r) => r.id === 4 && Array.isArray(r.pose)));
+    const tray8 = await page.evaluate(() => window.rilbedEditor.trayPosition(8));
+    await mouse.click(box.x + tray8[0], box.y + tray8[1]);
+    await until('robot 8 to be selected in the tray', () => window.rilbedEditor.selection?.id === 8);
+    await page.click('#editor-delete');
+    await until('robot 8 to be deleted', () => !window.rilbedEditor.trayPosition(8));
+    const out = await save('split');
+    const got = yaml.load(out.text).robots;
+    const want = [
+      { ids: '1-3', pose: 'random', controller: 'convoy', noise: { slip_sd: 0.02 } },
+      { id: 4, kind: 'real', link: { emulate: true }, pose: [0.3, 0.3, 90], controller: 'convoy' },
+      { id: 5, kind: 'real', link: { emulate: true }, pose: 'random', controller: 'convoy' },
+      { ids: '6-7', pose: 'random', controller: 'convoy', noise: { slip_sd: 0.02 } },
+    ];
+    check(got.length === 4 && nearPoint(got[1].pose, [0.3, 0.3]), `the split robots are ${JSON.stringify(got)}`);
+    got[1].pose = [0.3, 0.3, got[1].pose[2]];
+    try {
+      assert.deepStrictEqual(got, want);
+    } catch (e) {
+      fail(`convoy_mixed.yaml with robot 4 placed and 8 deleted: robots ${JSON.stringify(got)}, expected ${JSON.stringify(want)}`);
+    }
+    runAccepts(binary, out.file, ['--fast', '--duration', '1', '--all-virtual'], path.join(state.tmp, 'run-split'));
+    ok(`robot 4 dragged from the tray splits ids 4-5 (its link kept), robot 8 deleted by the button leaves ids 6-7; rilbed run accepts it: ${JSON.stringify(got)}`);
+  }
+
+  // 6. "Poses from run" on convoy_sim.yaml: every robot its own entry at the run's pose,
+  // its kind, noise and sensors kept.
+  {
+    const loadsBefore = await page.evaluate(() => window.rilbedEditor.loads);
+    await page.setInputFiles('#editor-file', path.join(SCENARIOS, 'convoy_sim.yaml'));
+    await until('the editor to load convoy_sim.yaml again', (n) => window.rilbedEditor.loads > n, loadsBefore);
+    await page.click('#editor-poses-from-run');
+    await until('every robot to have a pose', () => window.rilbedEditor.doc.robots.length === 8 && window.rilbedEditor.doc.robots.every((r) => Array.isArray(r.pose)));
+    const out = await save('poses');
+    const original = yaml.load(fs.readFileSync(path.join(SCENARIOS, 'convoy_sim.yaml'), 'utf8')).robots[0];
+    const { ids: _ids, pose: _pose, ...rest } = original;
+    const got = yaml.load(out.text).robots;
+    got.forEach((r, k) => {
+      const { id, pose, ...others } = r;
+      check(id === k + 1 && Array.isArray(pose) && pose.length === 3, `robot entry ${k}: ${JSON.stringify(r)}`);
+      try {
+        assert.deepStrictEqual(others, rest);
+      } catch (e) {
+        fail(`robot ${id} after "Poses from run" is ${JSON.stringify(r)}: its other keys are not ${JSON.stringify(rest)}`);
+      }
+    });
+    runAccepts(binary, out.file, ['--fast', '--duration', '1'], path.join(state.tmp, 'run-poses'));
+    ok(`"Poses from run" on convoy_sim.yaml: robots 1-8 each at the run's pose, kind, noise and sensors kept; rilbed run accepts it`);
+  }
+
+  check(state.pageErrors.length === 0, `the page logged errors:\n${state.pageErrors.join('\n')}`);
+  ok('the page logged no console error and threw nothing');
+}
+
+async function run() {
+  const state = {};
+  let failure = null;
+  const t0 = Date.now();
+  try {
+    await main(state);
+  } catch (e) {
+    failure = e;
+  }
+  if (failure && state.page && state.artifacts) {
+    const shot = path.join(state.artifacts, 'editor-failure.png');
+    await state.page.screenshot({ path: shot, fullPage: true }).then(() => console.error(`# failure screenshot: ${shot}`)).catch(() => {});
+  }
+  if (state.browser) await state.browser.close().catch(() => {});
+  if (state.child) await state.child.kill();
+  if (failure) {
+    console.error(`${NAME}: FAIL: ${failure instanceof TestFailure ? failure.message : failure.stack}`);
+    if (state.pageErrors?.length) console.error(`page errors:\n${state.pageErrors.join('\n')}`);
+    if (state.child) console.error(state.child.tails());
+    process.exit(1);
+  }
+  if (state.tmp) fs.rmSync(state.tmp, { recursive: true, force: true });
+  console.log(`${NAME}: PASS (${checks} checks, ${((Date.now() - t0) / 1000).toFixed(1)} s)`);
+}
+
+run();
