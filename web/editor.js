@@ -204,7 +204,9 @@ function undo(back = true) {
   to.push(JSON.stringify(ed.doc));
   ed.doc = JSON.parse(from.pop());
   ed.sel = null; ed.draft = null;
+  syncScenarioInputs();
   changed(true);
+  status(back ? 'Undone.' : 'Redone.');
 }
 // After any change of the document: redraw, the form, the problems, the YAML.
 function changed(rebuildForm = false) {
@@ -277,12 +279,24 @@ function setController(e, name) {
   }
 }
 const stashedLinks = new WeakMap(); // an entry made virtual keeps its link here, should it be made real again
+// Sets obj[key] in place, placed after the first of `after` that obj has (else before
+// `before`, else last), so that a key the editor adds reads where a person would write it.
+function putKey(obj, key, value, after = [], before = null) {
+  const entries = Object.entries(obj).filter(([k]) => k !== key);
+  let i = -1;
+  for (const a of after) { i = entries.findIndex(([k]) => k === a); if (i >= 0) { i += 1; break; } }
+  if (i < 0 && before) i = entries.findIndex(([k]) => k === before);
+  if (i < 0) i = entries.length;
+  entries.splice(i, 0, [key, value]);
+  for (const k of Object.keys(obj)) delete obj[k];
+  for (const [k, v] of entries) obj[k] = v;
+}
 function setKind(index, kind) {
   const e = ensureList('robots')[index];
   if (kind === 'real') {
-    e.kind = 'real';
-    if (!e.link) e.link = stashedLinks.get(e) || { emulate: true };
-    if (!ed.doc.camera) ed.doc.camera = { emulate: true };
+    putKey(e, 'kind', 'real', ['id', 'ids']);
+    if (!e.link) putKey(e, 'link', stashedLinks.get(e) || { emulate: true }, ['kind']);
+    if (!ed.doc.camera) putKey(ed.doc, 'camera', { emulate: true }, [], 'robots');
   } else {
     if (e.link) stashedLinks.set(e, e.link);
     delete e.link;
@@ -1243,6 +1257,8 @@ function setField(key, v) {
   ed.doc.field[key] = n;
 }
 function syncScenarioInputs() {
+  $('editor-width').placeholder = String(DEFAULT_FIELD.width_m);
+  $('editor-height').placeholder = String(DEFAULT_FIELD.height_m);
   for (const [id, io] of Object.entries(scenarioInputs)) {
     const input = $(id);
     if (input.type === 'checkbox') input.checked = io.get(); else input.value = io.get();

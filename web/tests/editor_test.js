@@ -14,7 +14,7 @@
 //      wander); robot 3 dragged elsewhere and turned by its handle; robot 5 turned by
 //      shift + wheel; robot 8 clicked and deleted with the Delete key;
 //   3. Save downloads scenario.yaml, the text the page shows, with every one of those
-//      at the place the mouse put it (within 3 mm, 1.5 degrees), and `RILBED run
+//      at the place the mouse put it (within 4 mm, 1.5 degrees), and `RILBED run
 //      SAVED --fast --duration 2` accepts it (exit 0);
 //   4. each scenarios/*.yaml loaded through the file input and saved unchanged parses
 //      (js-yaml) to an object deep-equal to the original's, and `RILBED run` accepts it
@@ -38,7 +38,7 @@ const CHROMIUM = '/usr/bin/chromium';
 const DEADLINE_MS = 30000;
 const WEB = path.resolve(__dirname, '..');
 const SCENARIOS = path.resolve(__dirname, '../../scenarios');
-const TOLERANCE_M = 0.003;
+const TOLERANCE_M = 0.004;     // a pixel of the canvas is about 2 mm of the field
 const TOLERANCE_DEG = 1.5;
 
 let checks = 0;
@@ -255,7 +255,7 @@ async function main(state) {
   await dragPx(await at(...square[2]), await at(...moved));
   await until('the obstacle\'s third vertex to move', ([x, y]) => {
     const p = window.rilbedEditor.doc.obstacles[0].polygon[2];
-    return Math.abs(p[0] - x) < 0.003 && Math.abs(p[1] - y) < 0.003;
+    return Math.abs(p[0] - x) < 0.004 && Math.abs(p[1] - y) < 0.004;
   }, moved);
   square[2] = moved;
   ok(`the obstacle's third vertex dragged to ${JSON.stringify(moved)}`);
@@ -311,7 +311,7 @@ async function main(state) {
   await dragPx(await at(r3.pose[0], r3.pose[1]), await at(...to3));
   await until('robot 3 to move', ([x, y]) => {
     const r = window.rilbedEditor.doc.robots.find((q) => q.id === 3);
-    return Math.abs(r.pose[0] - x) < 0.003 && Math.abs(r.pose[1] - y) < 0.003;
+    return Math.abs(r.pose[0] - x) < 0.004 && Math.abs(r.pose[1] - y) < 0.004;
   }, to3);
   d = await doc();
   check(d.robots.find((r) => r.id === 3).pose[2] === r3.pose[2], `dragging robot 3 turned it: ${JSON.stringify(d.robots.find((r) => r.id === 3))}`);
