@@ -1,0 +1,625 @@
+#!/usr/bin/env node
+// The web panel in a real browser (issue 17): Debian's Chromium, driven by playwright-core,
+// against `rilbed run --gui` with emulated real robots.
+//
+//   node web/tests/browser_test.js RILBED MIXED_SCENARIO SIM_SCENARIO [ARTEFACT_DIR]
+//
+// MIXED_SCENARIO is scenarios/convoy_mixed.yaml: the test writes a copy of it to a temp
+// folder whose robots are its own (1-3 a virtual convoy, 4 real and standing still at a
+// known pose so that the page can drive it, 5 real, 6-8 virtual, all but the convoy
+// standing still) and runs `RILBED run COPY --realtime --duration 300 --gui --gui-port 0
+// --out TMPDIR`. SIM_SCENARIO (scenarios/convoy_sim.yaml, no real robots) is run the same
+// way for the real-time factor, which real robots pin to 1. It checks:
+//   1. the page loads with the token (without it: 401), connects, shows the run;
+//   2. the live view draws every robot where /rilbed/poses (and the run's own
+//      trajectories.csv) says it is: red (#d22828) strokes around a virtual robot, blue
+//      (#2456c7) around a real one, neither far from every robot;
+//   3. Pause pauses (banner, status, events.csv "paused by gui"), Start resumes;
+//   4. the real-time factor slider is disabled with real robots and sets the factor of a
+//      run without them (status rt_factor 2, the clock running about twice as fast);
+//   5. manual driving: Take robot 4, hold ArrowUp: it drives forward; let go: it stops
+//      (events.csv "robot 4 driven 0 0");
+//   6. closing the tab while driving stops the robot (seen from a second page);
+//   7. Exit (confirmed) ends the run: the banner says so, rilbed exits 0 and says
+//      "robot 4 (emulated): last speed 0 0";
+// and that no page logged a console error or threw, all the test long. Screenshots of
+// the important moments go to $RILBED_ARTIFACTS, else ARTEFACT_DIR (CTest passes
+// BUILD/web-artifacts), else a temp folder; their paths are printed. Every wait polls
+// with a deadline; on any failure it says what it was waiting for, shows the end of
+// rilbed's output, kills rilbed and the browser and exits 1. CTest runs it as
+// web_browser (label e2e); `./run test` installs its npm packages and Chromium.
+'use strict';
+
+const { spawn } = require('node:child_process');
+const fs = require('node:fs');
+const os = require('node:os');
+const path = require('node:path');
+
+const NAME = 'browser_test';
+const CHROMIUM = '/usr/bin/chromium';
+const DEADLINE_MS = 30000;       // every wait (the machine may be slow, or under ASan)
+const WATCHDOG_MS = 280000;      // the whole test (CTest's TIMEOUT is 300 s)
+const VIRTUAL_RGB = [0xd2, 0x28, 0x28];
+const REAL_RGB = [0x24, 0x56, 0xc7];
+const COLOUR_TOLERANCE = 40;     // per channel: antialiasing and the camera image under the strokes
+const ROBOT_RADIUS_M = 0.0275;   // a Khepera
+const DRIVEN = 4;                // the robot the page drives
+const DRIVEN_POSE = [0.25, 0.6, 0]; // x_m, y_m, theta_deg: room ahead of it (the field is 1.5 m wide)
+const STILL_M = 0.003;           // two readings 0.5 s apart closer than this: standing
+const MOVED_M = 0.02;            // a clear move
+const STOP_WITHIN_S = 5;         // a stop is seen about 1 s after the key (0.5 s of it the two readings)
+
+let checks = 0;
+function ok(what) {
+  checks += 1;
+  console.log(`ok ${checks} - ${what}`);
+}
+
+class TestFailure extends Error {}
+function fail(message) {
+  throw new TestFailure(message);
+}
+function check(condition, message) {
+  if (!condition) fail(message);
+}
+const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
+const dist = (a, b) => Math.hypot(a.x - b.x, a.y - b.y);
+const mm = (m) => `${(m * 1000).toFixed(1)} mm`;
+
+// ---------------------------------------------------------------- the npm packages, Chromium
+function requirePlaywright() {
+  const modules = path.join(__dirname, 'node_modules');
+  const missing = `${modules} is missing or incomplete: run ./run test (it installs the npm packages)`;
+  if (!fs.existsSync(modules)) fail(missing);
+  let playwright;
+  try {
+    playwright = require('playwright-core');
+  } catch (e) {
+    fail(`${missing} (${e.message})`);
+  }
+  if (!fs.existsSync(CHROMIUM)) fail(`no ${CHROMIUM}: run ./run test (it installs Debian's chromium)`);
+  return playwright;
+}
+
+// ---------------------------------------------------------------- the scenarios
+// The mixed scenario's copy: its field, timing, camera and safety as shipped, its robots
+// this test's own. Robot 4 has no controller (the page drives it) and a known pose; the
+// others but the convoy stand still, so that nothing drives into robot 4 or its view.
+function mixedScenarioCopy(text) {
+  const lines = text.split('\n');
+  const start = lines.findIndex((l) => /^robots\s*:/.test(l));
+  check(start >= 0, 'the mixed scenario has no robots: section');
+  let end = start + 1;
+  while (end < lines.length && (/^\s/.test(lines[end]) || lines[end] === '' || /^#/.test(lines[end]))) end++;
+  const robots = `robots:
+  - ids: 1-3
+    pose: random
+    controller: convoy
+    noise: {slip_sd: 0.02}
+  - id: ${DRIVEN}
+    kind: real
+    link: {emulate: true}
+    pose: [${DRIVEN_POSE.join(', ')}]
+    controller: none
+  - id: 5
+    kind: real
+    link: {emulate: true}
+    pose: random
+    controller: none
+  - ids: 6-8
+    pose: random
+    controller: none`;
+  return [...lines.slice(0, start), robots, ...lines.slice(end)].join('\n');
+}
+
+// ---------------------------------------------------------------- rilbed, the children
+let aborted = null;  // set when a child exits unexpectedly: every wait ends
+class Child {
+  constructor(label, binary, args) {
+    this.label = label;
+    this.stdoutLines = [];
+    this.stderrTail = [];
+    this.exit = null;  // {code, signal} once it exited
+    this.proc = spawn(binary, args, { stdio: ['ignore', 'pipe', 'pipe'] });
+    this.proc.on('error', (e) => {
+      this.exit = { code: null, signal: null, error: e };
+      aborted = aborted || `${label} could not be started (${e.message})`;
+    });
+    const lineReader = (onLine) => {
+      let partial = '';
+      return (chunk) => {
+        partial += chunk.toString('utf8');
+        const parts = partial.split('\n');
+        partial = parts.pop();
+        for (const l of parts) onLine(l);
+      };
+    };
+    this.proc.stdout.on('data', lineReader((l) => this.stdoutLines.push(l)));
+    this.proc.stderr.on('data', lineReader((l) => {
+      this.stderrTail.push(l);
+      if (this.stderrTail.length > 40) this.stderrTail.shift();
+    }));
+    this.proc.on('exit', (code, signal) => {
+      this.exit = { code, signal };
+      if (!this.exitExpected) aborted = aborted || `${label} exited unexpectedly (${describeExit(this.exit)})`;
+    });
+  }
+  // Ends it (SIGTERM, then SIGKILL after 5 s) unless it has exited.
+  async kill() {
+    if (this.exit || !this.proc.pid) return;
+    this.exitExpected = true;
+    const exited = new Promise((resolve) => this.proc.once('exit', resolve));
+    this.proc.kill('SIGTERM');
+    const timer = setTimeout(() => this.proc.kill('SIGKILL'), 5000);
+    await exited;
+    clearTimeout(timer);
+  }
+  tails() {
+    const out = this.stdoutLines.slice(-20).join('\n');
+    const err = this.stderrTail.join('\n');
+    return `--- ${this.label}'s stdout (last lines) ---\n${out}\n--- ${this.label}'s stderr (last lines) ---\n${err}\n---`;
+  }
+}
+function describeExit(e) {
+  if (e.error) return e.error.message;
+  return e.signal ? `killed by ${e.signal}` : `exit code ${e.code}`;
+}
+
+// ---------------------------------------------------------------- waiting
+// Tries `condition` (sync or async) every `everyMs` until it returns something other than
+// undefined, null or false, and returns that; fails after `ms`, saying what it waited for
+// and, if given, what `describe()` says it saw last.
+async function poll(what, condition, { ms = DEADLINE_MS, everyMs = 100, describe = null } = {}) {
+  const end = Date.now() + ms;
+  for (;;) {
+    if (aborted) fail(`${aborted} while waiting for ${what}`);
+    const value = await condition();
+    if (value !== undefined && value !== null && value !== false) return value;
+    if (Date.now() > end) {
+      let seen = '';
+      if (describe) {
+        try { seen = ` (last seen: ${await describe()})`; } catch (e) { seen = ` (${e.message})`; }
+      }
+      fail(`timed out after ${ms / 1000} s waiting for ${what}${seen}`);
+    }
+    await sleep(everyMs);
+  }
+}
+
+// Starts `rilbed run` with the GUI and returns {child, runDir, url, port, token}.
+async function startRun(state, label, binary, scenario, extra = []) {
+  const runDir = path.join(state.tmp, label);
+  const args = ['run', scenario, '--realtime', '--duration', '300', '--gui', '--gui-port', '0', '--out', runDir, ...extra];
+  console.log(`# starting ${binary} ${args.join(' ')}`);
+  const child = new Child(label, binary, args);
+  state.children.push(child);
+  const urlPattern = /(http:\/\/127\.0\.0\.1:(\d+)\/\?token=([^\s&#]+))/;
+  const [, url, port, token] = await poll(`the line with http://127.0.0.1:PORT/?token=TOKEN on ${label}'s stdout`,
+    () => child.stdoutLines.map((l) => urlPattern.exec(l)).find((m) => m));
+  return { child, runDir, url, port: Number(port), token };
+}
+
+// events.csv's lines (flushed by the run at every event).
+function events(runDir) {
+  const file = path.join(runDir, 'events.csv');
+  return fs.existsSync(file) ? fs.readFileSync(file, 'utf8').split('\n').filter((l) => l) : [];
+}
+function waitForEvent(run, what, test) {
+  return poll(`a line ${what} in ${path.join(run.runDir, 'events.csv')}`, () => events(run.runDir).find(test),
+    { everyMs: 200, describe: () => events(run.runDir).slice(-6).join(' | ') });
+}
+// The robot's drive events ("robot 4 driven L R for S s by gui ...") as [index, left, right, line].
+function driveEvents(runDir, id) {
+  const re = new RegExp(`,console,${id},0,robot ${id} driven (-?\\d+) (-?\\d+) for `);
+  return events(runDir).map((l, i) => [i, re.exec(l), l]).filter(([, m]) => m).map(([i, m, l]) => [i, Number(m[1]), Number(m[2]), l]);
+}
+
+// Waits until robot `id`'s drive events after the first `from` are a drive at `speed`
+// both wheels followed, last, by a stop (0 0); returns those two lines.
+function driveThenStop(runDir, id, from, speed) {
+  return poll(`events.csv to record robot ${id} driven ${speed} ${speed}, then (last) driven 0 0`, () => {
+    const d = driveEvents(runDir, id).slice(from);
+    const go = d.findIndex(([, l, r]) => l === speed && r === speed);
+    const last = d[d.length - 1];
+    return go >= 0 && d.length - 1 > go && last[1] === 0 && last[2] === 0 && [d[go][3], last[3]];
+  }, { everyMs: 200, describe: () => driveEvents(runDir, id).slice(from).map((d) => d[3]).join(' | ') || 'none' });
+}
+
+// ---------------------------------------------------------------- the page
+// A page on `url` whose console errors and uncaught exceptions are collected in
+// state.pageErrors, and whose confirm dialogs are accepted.
+async function openPage(state, context, label, url) {
+  const page = await context.newPage();
+  page.on('console', (m) => {
+    if (m.type() === 'error') {
+      const where = m.location() && m.location().url ? ` at ${m.location().url}:${m.location().lineNumber}` : '';
+      state.pageErrors.push(`${label}: console error: ${m.text()}${where}`);
+    }
+  });
+  page.on('pageerror', (e) => state.pageErrors.push(`${label}: uncaught: ${e.stack || e.message}`));
+  page.on('crash', () => state.pageErrors.push(`${label}: the page crashed`));
+  page.on('dialog', (d) => { state.dialogs.push(`${label}: ${d.type()} "${d.message()}"`); d.accept(); });
+  const response = await page.goto(url, { timeout: DEADLINE_MS });
+  check(response && response.status() === 200, `${label}: GET ${url} answered ${response && response.status()}`);
+  await poll(`${label} to connect and show the run (connection pill "connected", world, status and poses received)`,
+    () => page.evaluate(() => document.getElementById('connection').textContent === 'connected' &&
+      window.rilbed && window.rilbed.run.world && window.rilbed.run.status && window.rilbed.run.poses && true),
+    { describe: () => page.evaluate(() => `connection "${document.getElementById('connection').textContent}", ` +
+      `world ${!!window.rilbed?.run.world}, status ${!!window.rilbed?.run.status}, poses ${!!window.rilbed?.run.poses}`) });
+  return page;
+}
+
+async function screenshot(state, page, name) {
+  const file = path.join(state.artifacts, `browser-${name}.png`);
+  await page.screenshot({ path: file, fullPage: true });
+  state.screenshots.push(file);
+  console.log(`# screenshot ${file}`);
+}
+
+const statusOf = (page) => page.evaluate(() => window.rilbed.run.status);
+const poseOf = (page, id) => page.evaluate((id) => {
+  const p = window.rilbed.run.poses;
+  const r = p && p.robots.find((q) => q.id === id);
+  return r ? { t: p.t_s, x: r.x_m, y: r.y_m, theta: r.theta_rad, seen: r.seen, health: r.health } : null;
+}, id);
+
+// Waits until robot `id` stands: two readings 0.5 s apart (of fresh poses) closer than STILL_M.
+async function waitStill(page, id, what) {
+  const started = Date.now();
+  let last = '';
+  const pose = await poll(`robot ${id} to stand still (${what}): two readings 0.5 s apart within ${mm(STILL_M)}`, async () => {
+    const a = await poseOf(page, id);
+    await sleep(500);
+    const b = await poseOf(page, id);
+    if (!a || !b) return null;
+    last = `(${a.x.toFixed(4)}, ${a.y.toFixed(4)}) at t ${a.t.toFixed(2)} s, then (${b.x.toFixed(4)}, ${b.y.toFixed(4)}) at t ${b.t.toFixed(2)} s`;
+    return b.t > a.t && dist(a, b) < STILL_M && b;
+  }, { everyMs: 0, describe: () => last });
+  return { pose, seconds: (Date.now() - started) / 1000 };
+}
+
+// Samples the live view around every robot: in one animation frame, each robot's
+// projected position and the count of pixels of the virtual and the real colour within
+// 1.6 radii (+ 4 px) of it, and the same for the spot of the field farthest from every robot.
+function sampleView(page) {
+  return page.evaluate(async ({ VIRTUAL_RGB, REAL_RGB, COLOUR_TOLERANCE, ROBOT_RADIUS_M }) => {
+    await new Promise((resolve) => requestAnimationFrame(() => requestAnimationFrame(resolve)));
+    const R = window.rilbed;
+    const canvas = document.getElementById('view');
+    const dpr = window.devicePixelRatio || 1;
+    const image = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height);
+    const like = (d, i, rgb) => rgb.every((c, k) => Math.abs(d[i + k] - c) <= COLOUR_TOLERANCE) && d[i + 3] > 200;
+    const count = (x_m, y_m) => {
+      const [u, v] = R.project(x_m, y_m);
+      const [u2, v2] = R.project(x_m + 0.01, y_m);
+      const radiusCss = ROBOT_RADIUS_M * Math.hypot(u2 - u, v2 - v) / 0.01;
+      const half = (1.6 * radiusCss + 4) * dpr;
+      const cx = u * dpr, cy = v * dpr;
+      let virtual = 0, real = 0;
+      for (let y = Math.max(0, Math.floor(cy - half)); y <= Math.min(image.height - 1, Math.ceil(cy + half)); y++) {
+        for (let x = Math.max(0, Math.floor(cx - half)); x <= Math.min(image.width - 1, Math.ceil(cx + half)); x++) {
+          const i = 4 * (y * image.width + x);
+          if (like(image.data, i, VIRTUAL_RGB)) virtual++;
+          else if (like(image.data, i, REAL_RGB)) real++;
+        }
+      }
+      const inside = u >= 0 && v >= 0 && u <= canvas.clientWidth && v <= canvas.clientHeight;
+      return { u, v, radiusCss, virtual, real, inside };
+    };
+    const poses = R.run.poses;
+    const robots = poses.robots.map((r) => ({ id: r.id, real: r.real, seen: r.seen, x: r.x_m, y: r.y_m, ...count(r.x_m, r.y_m) }));
+    // The free spot: a grid point of the field (5 cm from its edges) farthest from every robot.
+    const W = R.run.world;
+    let free = null;
+    for (let x = 0.1; x <= W.width_m - 0.1; x += 0.05) {
+      for (let y = 0.1; y <= W.height_m - 0.1; y += 0.05) {
+        const d = Math.min(...poses.robots.map((r) => Math.hypot(r.x_m - x, r.y_m - y)));
+        if (!free || d > free.d) free = { x, y, d };
+      }
+    }
+    free = { ...free, ...count(free.x, free.y) };
+    return { t: poses.t_s, dpr, width: canvas.width, height: canvas.height, cssWidth: canvas.clientWidth,
+      cssHeight: canvas.clientHeight, camera: !!(R.run.image && R.run.calibration), robots, free };
+  }, { VIRTUAL_RGB, REAL_RGB, COLOUR_TOLERANCE, ROBOT_RADIUS_M });
+}
+
+// trajectories.csv's rows (t_s,id,x_m,y_m,theta_deg,behaviour) by robot.
+function trajectories(runDir) {
+  const file = path.join(runDir, 'trajectories.csv');
+  const byId = new Map();
+  if (!fs.existsSync(file)) return byId;
+  for (const line of fs.readFileSync(file, 'utf8').split('\n').slice(1)) {
+    const [t, id, x, y] = line.split(',').map(Number);
+    if (!Number.isFinite(y)) continue;
+    if (!byId.has(id)) byId.set(id, []);
+    byId.get(id).push({ t, x, y });
+  }
+  return byId;
+}
+
+// ---------------------------------------------------------------- the test
+async function main(state) {
+  const [binary, mixedScenario, simScenario, artefactArg] = process.argv.slice(2);
+  if (!binary || !mixedScenario || !simScenario) {
+    console.error(`usage: node ${path.basename(__filename)} RILBED MIXED_SCENARIO SIM_SCENARIO [ARTEFACT_DIR]`);
+    process.exit(2);
+  }
+  const { chromium } = requirePlaywright();
+  check(fs.existsSync(binary), `no rilbed binary at ${binary} (build it first: ./run build)`);
+  check(fs.existsSync(mixedScenario), `no scenario at ${mixedScenario}`);
+  check(fs.existsSync(simScenario), `no scenario at ${simScenario}`);
+
+  state.tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'rilbed-web-browser-'));
+  state.artifacts = process.env.RILBED_ARTIFACTS || artefactArg || fs.mkdtempSync(path.join(os.tmpdir(), 'rilbed-web-artifacts-'));
+  fs.mkdirSync(state.artifacts, { recursive: true });
+  for (const f of fs.readdirSync(state.artifacts)) {
+    if (/^browser-.*\.png$/.test(f)) fs.rmSync(path.join(state.artifacts, f));
+  }
+  console.log(`# screenshots go to ${state.artifacts}`);
+
+  const scenario = path.join(state.tmp, 'convoy_mixed_driven.yaml');
+  fs.writeFileSync(scenario, mixedScenarioCopy(fs.readFileSync(mixedScenario, 'utf8')));
+  console.log(`# ${scenario}: ${mixedScenario} with robot ${DRIVEN} real, controller none, at ` +
+    `(${DRIVEN_POSE[0]} m, ${DRIVEN_POSE[1]} m, ${DRIVEN_POSE[2]} deg); 1-3 a convoy; 5 real, 6-8 virtual, standing`);
+
+  const mixed = await startRun(state, 'mixed', binary, scenario);
+  console.log(`# the page: ${mixed.url.replace(mixed.token, 'TOKEN')}`);
+
+  state.browser = await chromium.launch({ executablePath: CHROMIUM, args: ['--no-sandbox'], timeout: DEADLINE_MS });
+  // A device pixel ratio of 2: the view's canvas must be sized and sampled in device pixels.
+  const context = await state.browser.newContext({ viewport: { width: 1280, height: 900 }, deviceScaleFactor: 2 });
+  context.setDefaultTimeout(DEADLINE_MS);
+
+  // ------------------------------------------------ 1. the page, the token
+  const base = `http://127.0.0.1:${mixed.port}`;
+  for (const url of [`${base}/`, `${base}/?token=0123456789abcdef0123456789abcdef`, `${base}/app.js`]) {
+    const response = await fetch(url);
+    check(response.status === 401, `GET ${url.replace(base, '')} without the token answered ${response.status}, not 401`);
+  }
+  const page = await openPage(state, context, 'page 1', mixed.url);
+  const title = await page.title();
+  const shown = await page.evaluate(() => ({
+    scenario: document.getElementById('scenario').textContent,
+    options: [...document.querySelectorAll('#drive-robot option')].map((o) => o.textContent),
+  }));
+  const world = await page.evaluate(() => window.rilbed.run.world);
+  check(title === 'rilbed', `the page's title is "${title}"`);
+  check(shown.scenario === world.scenario && world.scenario === 'convoy_mixed',
+    `the page shows scenario "${shown.scenario}", /rilbed/world says "${world.scenario}"`);
+  check(world.robots.length === 8, `/rilbed/world has ${world.robots.length} robots, not 8`);
+  await poll('the agents table to list the 8 robots', () => page.evaluate(() => document.querySelectorAll('#agents tbody tr').length === 8));
+  check(shown.options.join() === '1,2,3,4 (real),5 (real),6,7,8', `the robots to drive are ${shown.options.join(', ')}`);
+  ok(`the page loads with the token (title "${title}", scenario "${shown.scenario}", robots to drive ` +
+     `${shown.options.join(', ')}); without it / and /app.js answer 401, as does a wrong token`);
+
+  // ------------------------------------------------ 2. the robots where the run says
+  await poll('both real robots to be seen by the camera (poses: seen)', () => page.evaluate(() =>
+    window.rilbed.run.poses.robots.filter((r) => r.real).every((r) => r.seen)));
+  const view = await poll('a sample of the live view with every robot drawn in its colour', async () => {
+    const v = await sampleView(page);
+    state.lastView = v;
+    return v.robots.every((r) => r.inside && (r.real ? r.real > 10 : r.virtual > 10)) && v;
+  }, { everyMs: 300, describe: () => JSON.stringify(state.lastView) });
+  check(view.dpr === 2 && view.width === Math.round(view.cssWidth * 2), `the canvas is ${view.width} device pixels for ` +
+    `${view.cssWidth} CSS pixels at a device pixel ratio of ${view.dpr}`);
+  check(view.free.d > 0.1, `the spot farthest from every robot is only ${view.free.d.toFixed(3)} m from one`);
+  check(view.free.virtual === 0 && view.free.real === 0, `the free spot (${view.free.x.toFixed(2)}, ${view.free.y.toFixed(2)}) m, ` +
+    `${view.free.d.toFixed(2)} m from every robot, has ${view.free.virtual} red and ${view.free.real} blue pixels`);
+  const driven0 = view.robots.find((r) => r.id === DRIVEN);
+  check(Math.hypot(driven0.x - DRIVEN_POSE[0], driven0.y - DRIVEN_POSE[1]) < 0.02,
+    `robot ${DRIVEN} is at (${driven0.x.toFixed(3)}, ${driven0.y.toFixed(3)}), not at its start (${DRIVEN_POSE[0]}, ${DRIVEN_POSE[1]})`);
+  // The run's own record: trajectories.csv at the time of that sample (flushed about once a second).
+  const rows = await poll(`trajectories.csv to reach t = ${view.t.toFixed(2)} s for every robot`, () => {
+    const byId = trajectories(mixed.runDir);
+    return view.robots.every((r) => (byId.get(r.id) || []).some((s) => s.t >= view.t)) && byId;
+  });
+  const offsets = view.robots.map((r) => {
+    const nearest = rows.get(r.id).reduce((a, b) => (Math.abs(b.t - view.t) < Math.abs(a.t - view.t) ? b : a));
+    return { id: r.id, dt: Math.abs(nearest.t - view.t), d: dist(r, nearest) };
+  });
+  for (const o of offsets) {
+    check(o.dt < 0.15 && o.d < 0.015, `robot ${o.id}: the page has it ${mm(o.d)} from trajectories.csv's row ` +
+      `${o.dt.toFixed(3)} s from the page's poses (t ${view.t.toFixed(2)} s)`);
+  }
+  await screenshot(state, page, '01-live-view');
+  ok(`the live view (${view.camera ? 'the camera image under it' : 'no camera image'}, ${view.width}x${view.height} device pixels at ratio ${view.dpr}) draws ` +
+     `every robot where the run says: ${view.robots.map((r) => `${r.id} ${r.real ? 'blue' : 'red'} ${r.real ? r.real : r.virtual} px ` +
+     `at (${r.u.toFixed(0)}, ${r.v.toFixed(0)})`).join(', ')}; none at the free spot (${view.free.x.toFixed(2)}, ` +
+     `${view.free.y.toFixed(2)}) m; within ${mm(Math.max(...offsets.map((o) => o.d)))} of trajectories.csv`);
+
+  // ------------------------------------------------ 3. Pause, Start
+  const banner = () => page.evaluate(() => {
+    const b = document.getElementById('banner');
+    return { hidden: b.hidden, text: b.textContent, kind: b.className, state: window.rilbed.run.status.state,
+      pause: document.getElementById('pause').disabled, start: document.getElementById('start').disabled };
+  });
+  check(!(await banner()).pause, 'the Pause button is disabled in a running real-time run');
+  await page.click('#pause');
+  const paused = await poll('status "paused" and the banner saying so after Pause', async () => {
+    const b = await banner();
+    return b.state === 'paused' && !b.hidden && /Paused/.test(b.text) && !b.start && b;
+  }, { describe: async () => JSON.stringify(await banner()) });
+  const pausedLine = await waitForEvent(mixed, '",console,0,0,paused by gui 127.0.0.1:..."', (l) => /,console,0,0,paused by gui 127\.0\.0\.1:\d+$/.test(l));
+  const t1 = (await statusOf(page)).t_s;
+  await sleep(1000);
+  const t2 = (await statusOf(page)).t_s;
+  check(t2 === t1, `the clock ran on while paused (t ${t1} s, then ${t2} s)`);
+  await screenshot(state, page, '02-paused');
+  await page.click('#start');
+  await poll('status "running" and no banner after Start', async () => {
+    const b = await banner();
+    return b.state === 'running' && b.hidden && b;
+  }, { describe: async () => JSON.stringify(await banner()) });
+  const resumedLine = await waitForEvent(mixed, '",console,0,0,resumed by gui ..."', (l) => /,console,0,0,resumed by gui 127\.0\.0\.1:\d+$/.test(l));
+  await poll('the clock to run on after Start', async () => (await statusOf(page)).t_s > t2 + 0.2);
+  ok(`Pause: banner "${paused.text}", status paused, clock standing at ${t1.toFixed(1)} s, events.csv "${pausedLine}"; ` +
+     `Start: running again, banner hidden, "${resumedLine}"`);
+
+  // ------------------------------------------------ 4. the real-time factor
+  const mixedSlider = await page.evaluate(() => ({ disabled: document.getElementById('rt-slider').disabled,
+    factor: window.rilbed.run.status.rt_factor, real: window.rilbed.run.status.real_robots }));
+  check(mixedSlider.disabled, `the real-time factor slider is enabled in a run with ${mixedSlider.real} real robots`);
+  check(mixedSlider.factor === 1, `the run with real robots runs at a factor of ${mixedSlider.factor}`);
+  const sim = await startRun(state, 'sim', binary, simScenario);
+  const simContext = await state.browser.newContext({ viewport: { width: 1280, height: 900 } });
+  simContext.setDefaultTimeout(DEADLINE_MS);
+  const simPage = await openPage(state, simContext, 'sim page', sim.url);
+  await poll('the slider to be enabled in the run without real robots', () => simPage.evaluate(() => !document.getElementById('rt-slider').disabled));
+  const before = await statusOf(simPage);
+  check(before.rt_factor === 1 && before.real_robots === 0, `the sim run starts at factor ${before.rt_factor} with ${before.real_robots} real robots`);
+  await simPage.locator('#rt-slider').fill(String(Math.log10(2).toFixed(2)));  // 0.30: 10^0.3 = 1.995, shown and sent as 2
+  const factorLine = await waitForEvent(sim, '"real-time factor 2 set by gui ..."', (l) => /,console,0,0,real-time factor 2 set by gui /.test(l));
+  // The clock (the poses' time, 10 a second): about twice as fast as the wall's.
+  const simT = () => simPage.evaluate(() => window.rilbed.run.poses.t_s);
+  const w0 = Date.now(), s0 = await simT();
+  await poll('4 s of wall time with the sim run\'s clock', () => Date.now() - w0 >= 4000);
+  const w1 = Date.now(), s1 = await simT();
+  const ratio = (s1 - s0) / ((w1 - w0) / 1000);
+  check(ratio > 1.6 && ratio < 2.4, `the sim run's clock ran ${(s1 - s0).toFixed(2)} s in ${((w1 - w0) / 1000).toFixed(2)} s of wall time (x${ratio.toFixed(2)}), not about x2`);
+  // What the run says and the page shows (the status, sent about once a second).
+  const fast = await poll('status rt_factor 2 after the slider, shown on the page (slider "2", state "running (×2)")', async () => {
+    const s = await simPage.evaluate(() => ({ rt_factor: window.rilbed.run.status.rt_factor,
+      shown: document.getElementById('rt-value').textContent, slider: document.getElementById('rt-slider').value,
+      state: document.querySelector('dd[data-stat="state"]').textContent }));
+    state.lastSim = s;
+    return Math.abs(s.rt_factor - 2) < 0.01 && s.shown === '2' && s.state === 'running (×2)' && s;
+  }, { describe: () => JSON.stringify(state.lastSim) });
+  await screenshot(state, simPage, '03-rt-factor-2');
+  sim.child.exitExpected = true;
+  await simPage.click('#exit');
+  const simExit = await poll('the sim run to exit after Exit', () => sim.child.exit);
+  check(simExit.code === 0, `the sim run ended with ${describeExit(simExit)}`);
+  await simContext.close();
+  ok(`the real-time factor slider is disabled with real robots (factor ${mixedSlider.factor}); in ${path.basename(simScenario)} ` +
+     `it set factor ${fast.rt_factor} (status; the page shows "${fast.shown}" and "${fast.state}"; events.csv "${factorLine}"), the clock ran x${ratio.toFixed(2)}; that run exited 0 by Exit`);
+
+  // ------------------------------------------------ 5. manual driving
+  await page.selectOption('#drive-robot', String(DRIVEN));
+  await page.click('#drive-take');
+  const driveState = await page.evaluate(() => document.getElementById('drive-state').textContent);
+  check(driveState === `driving robot ${DRIVEN}`, `after Take the page says "${driveState}"`);
+  const speed = Number(await page.evaluate(() => document.getElementById('drive-speed').value));
+  const p0 = (await waitStill(page, DRIVEN, 'before driving')).pose;
+  const drivesBefore = driveEvents(mixed.runDir, DRIVEN).length;
+  await page.keyboard.down('ArrowUp');
+  const heldFrom = Date.now();
+  await poll('robot 4 to move forward by more than 2 cm while ArrowUp is held', async () => {
+    const p = await poseOf(page, DRIVEN);
+    return (p.x - p0.x) * Math.cos(p0.theta) + (p.y - p0.y) * Math.sin(p0.theta) > MOVED_M;
+  }, { describe: async () => JSON.stringify(await poseOf(page, DRIVEN)) });
+  const heldButton = await page.evaluate(() => document.querySelector('#drive-pad button[data-key=ArrowUp]').classList.contains('held'));
+  check(heldButton, 'the ▲ button is not highlighted while ArrowUp is held');
+  await screenshot(state, page, '04-driving');
+  await poll('1.5 s of holding ArrowUp', () => Date.now() - heldFrom >= 1500);
+  const p1 = await poseOf(page, DRIVEN);
+  await page.keyboard.up('ArrowUp');
+  const released = Date.now();
+  const forward = (p1.x - p0.x) * Math.cos(p0.theta) + (p1.y - p0.y) * Math.sin(p0.theta);
+  check(forward > MOVED_M, `robot ${DRIVEN} moved ${mm(forward)} forward in ${((released - heldFrom) / 1000).toFixed(1)} s`);
+  const still = await waitStill(page, DRIVEN, 'after ArrowUp is let go');
+  const stoppedIn = (Date.now() - released) / 1000;
+  check(stoppedIn < STOP_WITHIN_S, `robot ${DRIVEN} stood only ${stoppedIn.toFixed(1)} s after ArrowUp was let go`);
+  const [goLine, stopLine] = await driveThenStop(mixed.runDir, DRIVEN, drivesBefore, speed);
+  const coasted = dist(p1, still.pose);
+  ok(`manual driving: Take robot ${DRIVEN}, ArrowUp held ${((released - heldFrom) / 1000).toFixed(1)} s: ${mm(forward)} forward; ` +
+     `let go: standing within ${stoppedIn.toFixed(1)} s (${mm(coasted)} after the key), events.csv "${goLine}" then "${stopLine}"`);
+  await screenshot(state, page, '05-driven');
+
+  // ------------------------------------------------ 6. closing the tab while driving
+  await page.click('#drive-release');
+  const releasedState = await page.evaluate(() => ({ state: document.getElementById('drive-state').textContent,
+    take: document.getElementById('drive-take').disabled, release: document.getElementById('drive-release').disabled }));
+  check(releasedState.state === '' && !releasedState.take && releasedState.release,
+    `after Release the driving controls are ${JSON.stringify(releasedState)}`);
+  await waitForEvent(mixed, `"robot ${DRIVEN} stopped and given back" (the release)`, (l) => new RegExp(`,behaviour,${DRIVEN},0,console -> `).test(l));
+  const page2 = await openPage(state, context, 'page 2', mixed.url);
+  await page2.selectOption('#drive-robot', String(DRIVEN));
+  await page2.click('#drive-take');
+  const q0 = (await waitStill(page, DRIVEN, 'before page 2 drives it')).pose;
+  const drivesBefore2 = driveEvents(mixed.runDir, DRIVEN).length;
+  await page2.keyboard.down('ArrowUp');
+  await poll('robot 4 (seen from page 1) to move while page 2 holds ArrowUp', async () => dist(await poseOf(page, DRIVEN), q0) > 0.01,
+    { describe: async () => JSON.stringify(await poseOf(page, DRIVEN)) });
+  await page2.close();  // the key still down
+  const closed = Date.now();
+  const still2 = await waitStill(page, DRIVEN, 'after page 2 closed while driving');
+  const stoppedIn2 = (Date.now() - closed) / 1000;
+  check(stoppedIn2 < STOP_WITHIN_S, `robot ${DRIVEN} stood only ${stoppedIn2.toFixed(1)} s after its driver's tab closed`);
+  const [goLine2, stopLine2] = await driveThenStop(mixed.runDir, DRIVEN, drivesBefore2, speed);
+  ok(`closing the tab that drives robot ${DRIVEN} (page 2, ArrowUp down) stops it: page 1 sees it standing ` +
+     `within ${stoppedIn2.toFixed(1)} s of the close, ${mm(dist(q0, still2.pose))} from where page 2 started it; events.csv "${goLine2}" then "${stopLine2}"`);
+
+  // ------------------------------------------------ 7. Exit
+  mixed.child.exitExpected = true;
+  const dialogsBefore = state.dialogs.length;
+  await page.click('#exit');
+  const ended = await poll('the banner to say that the run has ended', async () => {
+    const b = await banner();
+    return !b.hidden && b.kind === 'ended' && /The run has ended/.test(b.text) && b;
+  }, { describe: async () => JSON.stringify(await banner()) });
+  check(state.dialogs.length === dialogsBefore + 1 && /End the run\?/.test(state.dialogs[dialogsBefore]),
+    `Exit asked ${JSON.stringify(state.dialogs.slice(dialogsBefore))}, not one confirm "End the run?"`);
+  const exit = await poll('rilbed to exit after Exit', () => mixed.child.exit);
+  check(exit.code === 0, `rilbed ended with ${describeExit(exit)}, not exit code 0`);
+  const lastSpeed = mixed.child.stdoutLines.find((l) => l.includes(`robot ${DRIVEN} (emulated): last speed`));
+  check(lastSpeed === `robot ${DRIVEN} (emulated): last speed 0 0`, `rilbed's output says "${lastSpeed}", not "robot ${DRIVEN} (emulated): last speed 0 0"`);
+  const endedLine = await waitForEvent(mixed, '"ended by gui ..."', (l) => /,console,0,0,ended by gui /.test(l));
+  await poll('the page to see the server close', () => page.evaluate(() => document.getElementById('connection').textContent === 'disconnected'));
+  const finalBanner = await banner();
+  check(/The run has ended/.test(finalBanner.text), `once the server closed, the banner says "${finalBanner.text}"`);
+  await screenshot(state, page, '06-ended');
+  ok(`Exit (confirm "End the run?" accepted): banner "${finalBanner.text}", rilbed exited 0 saying "${lastSpeed}", events.csv "${endedLine}"`);
+
+  // ------------------------------------------------ no errors on any page, all along
+  check(state.pageErrors.length === 0, `the pages logged ${state.pageErrors.length} errors:\n  ${state.pageErrors.join('\n  ')}`);
+  ok(`no console error and no uncaught exception on any page (${state.dialogs.length} dialogs, all confirms accepted)`);
+}
+
+async function run() {
+  const state = { children: [], pageErrors: [], dialogs: [], screenshots: [] };
+  let failure = null;
+  const watchdog = setTimeout(() => {
+    aborted = `${NAME} ran longer than ${WATCHDOG_MS / 1000} s`;
+    console.error(`${NAME}: FAIL: ${aborted}`);
+    for (const c of state.children) if (!c.exit) c.proc.kill('SIGKILL');
+    process.exit(1);
+  }, WATCHDOG_MS);
+  const started = Date.now();
+  try {
+    await main(state);
+  } catch (e) {
+    failure = e;
+  }
+  if (failure && state.browser) {
+    // What the pages looked like when it failed.
+    for (const context of state.browser.contexts()) {
+      for (const [i, p] of context.pages().entries()) {
+        try { await screenshot(state, p, `failure-${state.browser.contexts().indexOf(context)}-${i}`); } catch (_) { /* closed */ }
+      }
+    }
+  }
+  if (state.browser) await Promise.race([state.browser.close().catch(() => {}), sleep(10000)]);
+  clearTimeout(watchdog);
+  if (failure) {
+    const message = failure instanceof TestFailure ? failure.message : (failure.stack || String(failure));
+    console.error(`${NAME}: FAIL: ${message}`);
+    if (state.pageErrors.length) console.error(`${NAME}: the pages' errors so far:\n  ${state.pageErrors.join('\n  ')}`);
+    for (const child of state.children) {
+      console.error(child.tails());
+      await child.kill();
+    }
+    if (state.tmp) console.error(`${NAME}: the runs' folders are kept in ${state.tmp}`);
+    console.log(`${checks} passed, 1 failed (${((Date.now() - started) / 1000).toFixed(1)} s)`);
+    process.exit(1);
+  }
+  for (const child of state.children) await child.kill();
+  console.log(`# screenshots: ${state.screenshots.join(' ')}`);
+  fs.rmSync(state.tmp, { recursive: true, force: true });
+  console.log(`${checks} passed, 0 failed (${((Date.now() - started) / 1000).toFixed(1)} s)`);
+  process.exit(0);
+}
+
+for (const signal of ['SIGINT', 'SIGTERM']) {
+  process.on(signal, () => { aborted = `${NAME} got ${signal}`; });
+}
+run();
