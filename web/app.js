@@ -37,7 +37,16 @@ client.onClose = () => {
     run.ended ? 'ended' : 'gone');
   stopDriving();
 };
-client.onStatus = (level, message) => { if (level >= 1) note(`server: ${message}`, level === 2 ? 'error' : 'warning'); };
+client.onStatus = (level, message) => {
+  if (level >= 1) note(`server: ${message}`, level === 2 ? 'error' : 'warning');
+  // Another panel took our robot: we drive it no more (the server told us alone).
+  if (driving.robot !== null && message.startsWith(`robot ${driving.robot} taken over by `)) {
+    driving.keys.clear();
+    if (driving.timer) { clearInterval(driving.timer); driving.timer = null; }
+    driving.robot = null;
+    updateDriveControls();
+  }
+};
 client.subscribe(['/rilbed/world', '/rilbed/status', '/rilbed/poses', '/rilbed/sensors', '/rilbed/detections',
   '/rilbed/events', '/rilbed/summary', '/rilbed/console_reply', '/rilbed/camera', '/rilbed/camera_calibration']);
 client.onMessage = (topic, tNs, m) => {
@@ -192,15 +201,19 @@ function note(text, kind = 'info') {
 
 function onReply(m) {
   note(`${m.accepted ? '✓' : '✗'} ${m.reason}`, m.accepted ? 'info' : 'error');
-  if (/taken over by/.test(m.reason) && driving.robot !== null && m.reason.includes(`robot ${driving.robot} `)) {
-    driving.robot = null; updateDriveControls();
-  }
 }
 
 function showBanner(text, kind) { const b = $('banner'); b.textContent = text; b.className = kind; b.hidden = false; }
 function hideBanner() { $('banner').hidden = true; }
 
-const fmt = (x) => (x === null || x === undefined || !isFinite(x) ? '—' : Number(x).toPrecision(3).replace(/\.?0+$/, ''));
+// Three significant digits, without trailing zeros after the point (100 stays 100).
+const fmt = (x) => {
+  if (x === null || x === undefined || !isFinite(x)) return '—';
+  const v = Number(x);
+  if (Math.abs(v) >= 999.5) return String(Math.round(v));
+  const t = v.toPrecision(3);
+  return t.includes('.') ? t.replace(/0+$/, '').replace(/\.$/, '') : t;
+};
 const wrap = (a) => Math.atan2(Math.sin(a), Math.cos(a));
 
 // ------------------------------------------------------------------ console
@@ -541,21 +554,21 @@ function drawSensors(P) {
       });
     }
     if (overlays.tracks && s.track?.length) {
-      s.track.forEach((on, i) => {
-        const e = layout.tracks?.[i];
-        if (!e) return;
-        const pts = [];
-        for (let k = 0; k < 16; ++k) {
-          const a = (k / 16) * 2 * Math.PI;
-          const ex = e.a_m * Math.cos(a), ey = e.b_m * Math.sin(a);
-          pts.push(at(e.x_m + Math.cos(e.yaw_rad) * ex - Math.sin(e.yaw_rad) * ey, e.y_m + Math.sin(e.yaw_rad) * ex + Math.cos(e.yaw_rad) * ey));
+      // Each element's floor segments (where its light falls), filled when it sees tape.
+      s.track.forEach((value, i) => {
+        const points = layout.tracks?.[i];
+        if (!points?.length) return;
+        ctx.fillStyle = value > 0 ? 'rgba(30,125,50,0.85)' : 'rgba(30,125,50,0.25)';
+        const r = Math.max(1.5, 0.002 * P.scaleAt(r0x(), r0y()));
+        for (const p of points) {
+          const [u, v] = P.project(...at(p.x_m, p.y_m));
+          ctx.beginPath(); ctx.arc(u, v, r, 0, 2 * Math.PI); ctx.fill();
         }
-        ctx.fillStyle = on ? 'rgba(30,125,50,0.6)' : 'rgba(30,125,50,0.12)';
-        ctx.strokeStyle = 'rgba(30,125,50,0.8)'; ctx.lineWidth = 1;
-        polyline(P, pts, true); ctx.fill(); ctx.stroke();
       });
     }
   }
+  function r0x() { return run.world ? run.world.width_m / 2 : 0; }
+  function r0y() { return run.world ? run.world.height_m / 2 : 0; }
 }
 
 new ResizeObserver(requestDraw).observe(canvas);

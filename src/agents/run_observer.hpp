@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <span>
 #include <string>
@@ -76,9 +77,29 @@ struct CameraReport {
   std::string source;            ///< "emulated", "device 0", or the footage's path
 };
 
+/// One robot's sensors as a viewer draws them; robot frame (x forward, y left), metres,
+/// angles counter-clockwise from forward.
+struct SensorGeometry {
+  double ir_range_m = 0.0;  ///< the IR ring's reach; 0: none
+  struct Range {
+    double mount_rad = 0.0, opening_rad = 0.0, max_m = 0.0;
+    bool operator==(const Range&) const = default;
+  };
+  std::vector<Range> ranges;       ///< ultrasonic, in reading order
+  bool beacon_finder = false;
+  double beacon_fov_rad = 0.0;
+  /// Each track sensor's floor segments (their centres), in reading order.
+  std::vector<std::vector<Vec2>> track_points_m;
+  bool operator==(const SensorGeometry&) const = default;
+};
+
 /// The world a run takes place in.
 struct WorldReport {
   std::optional<CameraReport> camera;  ///< runs with a camera
+  /// Distinct sensor geometries, and each robot's (robot ID -> index); may be empty (a
+  /// recording from before they were published).
+  std::vector<SensorGeometry> sensor_geometries;
+  std::map<int, int> sensor_geometry_of;
   std::string scenario;
   FieldDrawing field;          ///< size, obstacles, tracks, beacons, which robots are real
   bool walls = true;           ///< the field's edges are walls

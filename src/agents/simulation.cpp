@@ -15,6 +15,7 @@
 #include "agents/run_control.hpp"
 #include "agents/run_models.hpp"
 #include "core/id_list.hpp"
+#include "environment/track_sensor.hpp"
 #include "sim/clock.hpp"
 #include "sim/coordinator.hpp"
 #include "sim/coupled.hpp"
@@ -255,7 +256,7 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     st.seed = s_.options->seed;
     st.mode = central_ ? "central" : "distributed";
     st.realtime = s_.options->realtime;
-    st.rt_factor = s_.options->rt_factor;
+    st.rt_factor = s_.clock ? s_.clock->factor() : s_.options->rt_factor;
     st.state = state;
     st.ended_by = s_.result->ended_by;
     st.robots = static_cast<int>(s_.agents.size());
@@ -558,12 +559,31 @@ FieldDrawing field_drawing(const Scenario& scenario, const std::vector<int>& rea
   return drawing;
 }
 
+// A robot's sensors as a viewer draws them.
+SensorGeometry sensor_geometry(const environment::SensorSuiteConfig& c) {
+  SensorGeometry g;
+  if (c.proximity) g.ir_range_m = c.proximity->range_m;
+  for (const auto& r : c.range_finders) g.ranges.push_back({r.mount_angle_rad, r.opening_angle_rad, r.max_range_m});
+  if (c.beacon_finder) {
+    g.beacon_finder = true;
+    g.beacon_fov_rad = c.beacon_finder->field_of_view_rad;
+  }
+  for (const auto& t : c.track_sensors) g.track_points_m.push_back(environment::track_footprint(t).points_m);
+  return g;
+}
+
 WorldReport world_report(const Scenario& scenario, const std::vector<int>& real_ids) {
   WorldReport w;
   w.scenario = scenario.name;
   w.field = field_drawing(scenario, real_ids);
   w.walls = scenario.map.field.boundary_walls;
-  for (const RobotSpec& r : scenario.robots) w.robot_ids.push_back(r.id);
+  for (const RobotSpec& r : scenario.robots) {
+    w.robot_ids.push_back(r.id);
+    const SensorGeometry g = sensor_geometry(r.sensors);
+    auto it = std::find(w.sensor_geometries.begin(), w.sensor_geometries.end(), g);
+    if (it == w.sensor_geometries.end()) it = w.sensor_geometries.insert(it, g);
+    w.sensor_geometry_of[r.id] = static_cast<int>(it - w.sensor_geometries.begin());
+  }
   return w;
 }
 

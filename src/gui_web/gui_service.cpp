@@ -108,7 +108,10 @@ std::optional<std::string> GuiService::on_drive_message(const std::string& clien
   Hold& hold = holds_[robot];
   if (hold.client != client) {
     // A new driver (or a take-over: the last driver's hold ends here, without a gap).
-    if (!hold.client.empty()) channels_->console_reply(0, true, "robot " + std::to_string(robot) + " taken over by " + client, hold.client);
+    // Told to the last driver alone (a status on its socket): its page lets go of the robot.
+    if (!hold.client.empty()) {
+      server_->tell(hold.client, foxglove::Level::kWarning, "robot " + std::to_string(robot) + " taken over by " + client);
+    }
     hold = Hold{};
     hold.client = client;
   }

@@ -119,7 +119,13 @@ RunChannels::RunChannels(WebServer& server) : server_(server) {
       object_schema("rilbed.world", {{"t_s", number()}, {"scenario", text()}, {"width_m", number()}, {"height_m", number()},
                                      {"walls", boolean()}, {"obstacles", array_of(polyline)},
                                      {"tracks", array_of(object_of({{"points", polyline}, {"width_m", number()}}))},
-                                     {"beacons", polyline}, {"robots", array_of(object_of({{"id", integer()}, {"real", boolean()}}))}})), /*latched=*/true);
+                                     {"beacons", polyline},
+                                     {"robots", array_of(object_of({{"id", integer()}, {"real", boolean()},
+                                                                    {"sensors", object_of({{"ir_range_m", number()},
+                                                                                           {"ranges", array_of(object_of({{"mount_rad", number()}, {"opening_rad", number()}, {"max_m", number()}}))},
+                                                                                           {"beacon_finder", boolean()},
+                                                                                           {"beacon_fov_rad", number()},
+                                                                                           {"tracks", array_of(polyline)}})}}))}})), /*latched=*/true);
   status_ = server_.add_channel(channel("/rilbed/status", "rilbed.status",
       object_schema("rilbed.status", {{"t_s", number()}, {"wall_s", number()}, {"scenario", text()}, {"seed", integer()},
                                       {"mode", text()}, {"realtime", boolean()}, {"rt_factor", number()}, {"state", text()},
@@ -176,8 +182,25 @@ json RunChannels::world_json(TimeUs t_us, const agents::WorldReport& w) {
   for (const auto& o : w.field.obstacles) obstacles.push_back(points(o));
   json tracks = json::array();
   for (const auto& [ps, width_m] : w.field.tracks) tracks.push_back({{"points", points(ps)}, {"width_m", width_m}});
+  // Each distinct sensor geometry once, as JSON; each robot refers to its own.
+  std::vector<json> geometries;
+  for (const agents::SensorGeometry& g : w.sensor_geometries) {
+    json ranges = json::array();
+    for (const auto& r : g.ranges) ranges.push_back({{"mount_rad", r.mount_rad}, {"opening_rad", r.opening_rad}, {"max_m", r.max_m}});
+    json tracks = json::array();
+    for (const auto& element : g.track_points_m) tracks.push_back(points(element));
+    geometries.push_back({{"ir_range_m", g.ir_range_m}, {"ranges", ranges}, {"beacon_finder", g.beacon_finder},
+                          {"beacon_fov_rad", g.beacon_fov_rad}, {"tracks", tracks}});
+  }
   json robots = json::array();
-  for (const int id : w.robot_ids) robots.push_back({{"id", id}, {"real", w.field.real_robot_ids.contains(id)}});
+  for (const int id : w.robot_ids) {
+    json robot = {{"id", id}, {"real", w.field.real_robot_ids.contains(id)}};
+    const auto it = w.sensor_geometry_of.find(id);
+    if (it != w.sensor_geometry_of.end() && it->second >= 0 && static_cast<std::size_t>(it->second) < geometries.size()) {
+      robot["sensors"] = geometries[static_cast<std::size_t>(it->second)];
+    }
+    robots.push_back(std::move(robot));
+  }
   return {{"t_s", seconds(t_us)}, {"scenario", w.scenario}, {"width_m", w.field.width_m}, {"height_m", w.field.height_m},
           {"walls", w.walls}, {"obstacles", obstacles}, {"tracks", tracks}, {"beacons", points(w.field.beacons)}, {"robots", robots}};
 }

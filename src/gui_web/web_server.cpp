@@ -161,6 +161,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   const std::string& name() const { return name_; }
   // Nothing queued or being written.
   bool idle() const { return queue_.empty() && !writing_; }
+  // A status message for this client alone.
+  void tell(foxglove::Level level, const std::string& message) { send_text(foxglove::status(level, message)); }
 
   void start(http::request<http::string_body> request) {
     ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
@@ -536,6 +538,15 @@ void WebServer::publish(std::uint32_t channel, std::uint64_t t_ns, std::shared_p
 }
 
 std::size_t WebServer::clients() const { return impl_->client_count.load(); }
+
+void WebServer::tell(const std::string& client, foxglove::Level level, const std::string& message) {
+  Impl& m = *impl_;
+  asio::post(m.io, [&m, client, level, message] {
+    for (const auto& s : m.sessions) {
+      if (s->name() == client) s->tell(level, message);
+    }
+  });
+}
 
 bool WebServer::flush(std::chrono::milliseconds timeout) {
   Impl& m = *impl_;

@@ -84,6 +84,8 @@ class WebServer {
   /// Waits until everything published so far has been written to every client (or
   /// dropped for one that did not keep up), at most `timeout`; returns whether it was.
   bool flush(std::chrono::milliseconds timeout);
+  /// Sends a status message to one client (by the name Handlers get), if still there.
+  void tell(const std::string& client, foxglove::Level level, const std::string& message);
   /// Clients connected now.
   std::size_t clients() const;
   WebServerCounters counters() const;

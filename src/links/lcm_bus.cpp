@@ -43,6 +43,7 @@ Channels Channels::with_prefix(const std::string& prefix) {
   c.detections = prefix + c.detections;
   c.frames = prefix + c.frames;
   c.camera = prefix + c.camera;
+  c.sensor_layout = prefix + c.sensor_layout;
   return c;
 }
 
@@ -210,6 +211,39 @@ rilbed::camera_t to_lcm(TimeUs t_us, const agents::CameraReport& c) {
   return m;
 }
 
+rilbed::sensor_layout_t sensor_layout(TimeUs t_us, const agents::WorldReport& world) {
+  rilbed::sensor_layout_t m;
+  m.utime = t_us;
+  for (const agents::SensorGeometry& g : world.sensor_geometries) {
+    rilbed::sensor_geometry_t out;
+    out.ir_range_m = g.ir_range_m;
+    for (const auto& r : g.ranges) {
+      out.range_mount_rad.push_back(r.mount_rad);
+      out.range_opening_rad.push_back(r.opening_rad);
+      out.range_max_m.push_back(r.max_m);
+    }
+    out.num_ranges = static_cast<std::int32_t>(g.ranges.size());
+    out.beacon_finder = g.beacon_finder;
+    out.beacon_fov_rad = g.beacon_fov_rad;
+    for (std::size_t k = 0; k < g.track_points_m.size(); ++k) {
+      for (const Vec2& p : g.track_points_m[k]) {
+        out.track_sensor.push_back(static_cast<std::int32_t>(k));
+        out.track_x_m.push_back(p.x);
+        out.track_y_m.push_back(p.y);
+      }
+    }
+    out.num_track_points = static_cast<std::int32_t>(out.track_sensor.size());
+    m.geometries.push_back(std::move(out));
+  }
+  m.num_geometries = static_cast<std::int32_t>(m.geometries.size());
+  for (const auto& [id, index] : world.sensor_geometry_of) {
+    m.robot_ids.push_back(id);
+    m.geometry_of.push_back(index);
+  }
+  m.num_robots = static_cast<std::int32_t>(m.robot_ids.size());
+  return m;
+}
+
 rilbed::frame_t to_lcm(TimeUs t_us, std::int64_t frame, const cv::Mat& image, int quality) {
   rilbed::frame_t m;
   m.utime = t_us;
@@ -364,7 +398,43 @@ std::optional<std::string> RunReportDecoder::decode(const std::string& channel, 
     if (!decode_checked(data, size, m)) return bad("world_t");
     agents::WorldReport world = from_lcm(m);
     world.camera = camera_;
+    world.sensor_geometries = sensor_geometries_;
+    world.sensor_geometry_of = sensor_geometry_of_;
     observer_.on_world(m.utime, world);
+  } else if (channel == channels_.sensor_layout) {
+    rilbed::sensor_layout_t m;
+    if (!decode_checked(data, size, m)) return bad("sensor_layout_t");
+    std::vector<agents::SensorGeometry> geometries;
+    for (const rilbed::sensor_geometry_t& g : m.geometries) {
+      agents::SensorGeometry out;
+      out.ir_range_m = g.ir_range_m;
+      for (std::size_t k = 0; k < g.range_mount_rad.size(); ++k) {
+        out.ranges.push_back({g.range_mount_rad[k], g.range_opening_rad[k], g.range_max_m[k]});
+      }
+      out.beacon_finder = g.beacon_finder != 0;
+      out.beacon_fov_rad = g.beacon_fov_rad;
+      for (std::size_t k = 0; k < g.track_sensor.size(); ++k) {
+        const std::int32_t element = g.track_sensor[k];
+        // Elements in reading order, each point naming its own: a jump ahead is a bad message.
+        if (element < 0 || static_cast<std::size_t>(element) > out.track_points_m.size() ||
+            (static_cast<std::size_t>(element) + 1 < out.track_points_m.size())) {
+          return channel + ": track point " + std::to_string(k) + " names element " + std::to_string(element) + " out of order";
+        }
+        if (static_cast<std::size_t>(element) == out.track_points_m.size()) out.track_points_m.emplace_back();
+        out.track_points_m.back().push_back({g.track_x_m[k], g.track_y_m[k]});
+      }
+      geometries.push_back(std::move(out));
+    }
+    std::map<int, int> of;
+    for (std::size_t k = 0; k < m.robot_ids.size(); ++k) {
+      if (m.geometry_of[k] < 0 || m.geometry_of[k] >= m.num_geometries) {
+        return channel + ": robot " + std::to_string(m.robot_ids[k]) + " has geometry " + std::to_string(m.geometry_of[k]) +
+               " of " + std::to_string(m.num_geometries);
+      }
+      of[m.robot_ids[k]] = m.geometry_of[k];
+    }
+    sensor_geometries_ = std::move(geometries);
+    sensor_geometry_of_ = std::move(of);
   } else if (channel == channels_.camera) {
     rilbed::camera_t m;
     if (!decode_checked(data, size, m)) return bad("camera_t");
@@ -617,6 +687,7 @@ void LcmRunPublisher::on_world(TimeUs t_us, const agents::WorldReport& world) {
   if (!heard()) return;
   // The camera first: a viewer draws the world over the camera's frames.
   if (world.camera) publish(channels_.camera, to_lcm(t_us, *world.camera));
+  if (!world.sensor_geometries.empty()) publish(channels_.sensor_layout, sensor_layout(t_us, world));
   publish(channels_.world, to_lcm(t_us, world));
 }
 

@@ -23,6 +23,7 @@
 #include "rilbed/detections_t.hpp"
 #include "rilbed/event_t.hpp"
 #include "rilbed/camera_t.hpp"
+#include "rilbed/sensor_layout_t.hpp"
 #include "rilbed/frame_t.hpp"
 #include "rilbed/poses_t.hpp"
 #include "rilbed/sensors_t.hpp"
@@ -65,6 +66,7 @@ struct Channels {
   std::string detections = "RILBED_DETECTIONS";  ///< rilbed::detections_t, every camera frame
   std::string frames = "RILBED_FRAMES";    ///< rilbed::frame_t (JPEG), every camera frame, only when asked for
   std::string camera = "RILBED_CAMERA";    ///< rilbed::camera_t, before each world_t of a run with a camera
+  std::string sensor_layout = "RILBED_SENSOR_LAYOUT";  ///< rilbed::sensor_layout_t, before each world_t
   std::string console = "RILBED_CONSOLE";  ///< rilbed::console_command_t, from consoles
   std::string console_reply = "RILBED_CONSOLE_REPLY";  ///< rilbed::console_reply_t, the run's answers
   /// The same names behind `prefix`.
@@ -94,6 +96,8 @@ rilbed::detections_t to_lcm(const agents::FrameReport& frame);
 rilbed::frame_t to_lcm(TimeUs t_us, std::int64_t frame, const cv::Mat& image, int quality);
 /// The camera's mapping onto the field.
 rilbed::camera_t to_lcm(TimeUs t_us, const agents::CameraReport& camera);
+/// The robots' sensor geometry (from a world's sensor_geometries and sensor_geometry_of).
+rilbed::sensor_layout_t sensor_layout(TimeUs t_us, const agents::WorldReport& world);
 
 /// Hands the messages of a run's channels, as raw bytes from a bus or a log, to a
 /// RunObserver as the run reported them. Messages on other channels are ignored.
@@ -122,6 +126,8 @@ class RunReportDecoder {
   bool summary_seen_ = false;
   std::optional<rilbed::status_t> last_status_;
   std::optional<agents::CameraReport> camera_;  // the last camera_t, for the next world_t
+  std::vector<agents::SensorGeometry> sensor_geometries_;  // the last sensor_layout_t, for the next world_t
+  std::map<int, int> sensor_geometry_of_;
 };
 
 /// Reads an LCM log (the format lcm-logger and `rilbed run --record` write) with every

@@ -203,6 +203,23 @@ void fields(Walk& w, const rilbed::camera_t*) {
   w.string();
 }
 
+void fields(Walk& w, const rilbed::sensor_geometry_t*) {
+  w.f64();
+  const std::int32_t ranges = w.count(w.i32(), 3 * 8);
+  w.skip(static_cast<std::size_t>(ranges) * 3 * 8);
+  w.i8();
+  w.f64();
+  const std::int32_t points = w.count(w.i32(), 4 + 2 * 8);
+  w.skip(static_cast<std::size_t>(points) * (4 + 2 * 8));
+}
+void fields(Walk& w, const rilbed::sensor_layout_t*) {
+  w.i64();
+  const std::int32_t geometries = w.count(w.i32(), 8 + 4 + 1 + 8 + 4);  // the smallest geometry
+  for (std::int32_t k = 0; k < geometries && w.ok(); ++k) fields(w, static_cast<const rilbed::sensor_geometry_t*>(nullptr));
+  const std::int32_t robots = w.count(w.i32(), 2 * 4);
+  w.skip(static_cast<std::size_t>(robots) * 2 * 4);
+}
+
 }  // namespace
 
 template <typename Message>
@@ -225,5 +242,6 @@ template bool well_formed<rilbed::sensors_t>(const void*, std::size_t);
 template bool well_formed<rilbed::detections_t>(const void*, std::size_t);
 template bool well_formed<rilbed::frame_t>(const void*, std::size_t);
 template bool well_formed<rilbed::camera_t>(const void*, std::size_t);
+template bool well_formed<rilbed::sensor_layout_t>(const void*, std::size_t);
 
 }  // namespace rilbed::links

@@ -20,6 +20,7 @@
 #include "rilbed/detections_t.hpp"
 #include "rilbed/event_t.hpp"
 #include "rilbed/camera_t.hpp"
+#include "rilbed/sensor_layout_t.hpp"
 #include "rilbed/frame_t.hpp"
 #include "rilbed/poses_t.hpp"
 #include "rilbed/sensors_t.hpp"

@@ -57,11 +57,11 @@ const std::vector<std::string>& channel_names() {
   static const std::vector<std::string> names = [] {
     const links::Channels c = links::Channels::with_prefix("");
     return std::vector<std::string>{c.poses,   c.events,     c.status, c.world,         c.summary,
-                                    c.wheels,  c.sensors,    c.detections, c.frames, c.camera, "RILBED_UNKNOWN"};
+                                    c.wheels,  c.sensors,    c.detections, c.frames, c.camera, c.sensor_layout, "RILBED_UNKNOWN"};
   }();
   return names;
 }
-enum Pick { kPoses, kEvents, kStatus, kWorld, kSummary, kWheels, kSensors, kDetections, kFrames, kCamera, kUnknown, kPicks };
+enum Pick { kPoses, kEvents, kStatus, kWorld, kSummary, kWheels, kSensors, kDetections, kFrames, kCamera, kSensorLayout, kUnknown, kPicks };
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
@@ -78,6 +78,7 @@ bool has_nul(const rilbed::sensors_t&) { return false; }
 bool has_nul(const rilbed::detections_t&) { return false; }
 bool has_nul(const rilbed::frame_t& m) { return has_nul(m.format); }
 bool has_nul(const rilbed::camera_t& m) { return has_nul(m.source); }
+bool has_nul(const rilbed::sensor_layout_t&) { return false; }
 bool has_nul(const rilbed::poses_t& m) {
   for (const rilbed::robot_pose_t& r : m.robots) {
     if (has_nul(r.behaviour) || has_nul(r.health)) return true;
@@ -305,7 +306,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     FUZZ_CHECK(problem->rfind(g_channel + ": ", 0) == 0);
   } else {
     // A camera is kept for the next world (which carries it): no call of its own.
-    FUZZ_CHECK(seen.calls.total() == (pick == kUnknown || pick == kCamera ? 0 : 1));
+    FUZZ_CHECK(seen.calls.total() == (pick == kUnknown || pick == kCamera || pick == kSensorLayout ? 0 : 1));
   }
   FUZZ_CHECK(decoder.summary_seen() == (seen.calls.summary == 1));
   FUZZ_CHECK(decoder.last_status().has_value() == (seen.calls.status == 1));
@@ -387,6 +388,48 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       FUZZ_CHECK(c.width_px == m.width_px && c.height_px == m.height_px && c.lens_distortion == (m.lens_distortion != 0));
       for (int i = 0; i < 9; ++i) FUZZ_CHECK(same_bits(c.image_to_field[static_cast<std::size_t>(i)], m.image_to_field[i]));
       FUZZ_CHECK(c.source == m.source);
+      break;
+    }
+    case kSensorLayout: {
+      // Accepted exactly when the bytes are a sensor_layout_t whose robots name geometries
+      // it has and whose track points come element by element; the next world carries it.
+      rilbed::sensor_layout_t m;
+      if (problem && refused_before_decoding<rilbed::sensor_layout_t>(message, length)) break;
+      const bool readable = generated_decode(message, length, m);
+      bool consistent = readable;
+      for (std::size_t k = 0; consistent && k < m.geometry_of.size(); ++k) {
+        consistent = m.geometry_of[k] >= 0 && m.geometry_of[k] < m.num_geometries;
+      }
+      for (const auto& g : m.geometries) {
+        std::int32_t next = 0;
+        for (const std::int32_t e : g.track_sensor) {
+          if (e == next) ++next;
+          else if (e != next - 1) consistent = false;
+        }
+      }
+      if (problem) {
+        FUZZ_CHECK(!consistent);
+        break;
+      }
+      FUZZ_CHECK(consistent);
+      check_round_trip(m, message, length);
+      rilbed::world_t world;
+      std::vector<std::uint8_t> bytes(static_cast<std::size_t>(world.getEncodedSize()));
+      FUZZ_CHECK(world.encode(bytes.data(), 0, static_cast<int>(bytes.size())) > 0);
+      FUZZ_CHECK(!decoder.decode(links::Channels::with_prefix("").world, bytes.data(), bytes.size()));
+      FUZZ_CHECK(seen.calls.world == 1);
+      const agents::WorldReport& w = seen.last_world;
+      FUZZ_CHECK(w.sensor_geometries.size() == m.geometries.size());
+      std::set<std::int32_t> ids(m.robot_ids.begin(), m.robot_ids.end());
+      FUZZ_CHECK(w.sensor_geometry_of.size() == ids.size());
+      for (std::size_t k = 0; k < m.geometries.size(); ++k) {
+        const auto& in = m.geometries[k];
+        const auto& out = w.sensor_geometries[k];
+        FUZZ_CHECK(out.ranges.size() == in.range_mount_rad.size() && out.beacon_finder == (in.beacon_finder != 0));
+        std::size_t points = 0;
+        for (const auto& element : out.track_points_m) points += element.size();
+        FUZZ_CHECK(points == in.track_sensor.size());
+      }
       break;
     }
     case kUnknown:

@@ -222,8 +222,12 @@ TEST(WebServer, ClientMessagesReachTheOwnerAndBadOnesGetAStatus) {
   if (!ec) {
     big.buffer.consume(big.buffer.size());
     big.ws.read(big.buffer, ec);
-    EXPECT_EQ(ec, websocket::error::closed) << ec.message();
-    EXPECT_EQ(big.ws.reason().code, websocket::close_code::too_big);
+    EXPECT_TRUE(ec) << "the oversized message's socket stayed open";
+    // The close frame (1009), or, when the server's close met the rest of our unread
+    // bytes, a reset before it arrived: either way that socket is gone.
+    if (ec == websocket::error::closed) {
+      EXPECT_EQ(big.ws.reason().code, websocket::close_code::too_big);
+    }
   }
   for (int i = 0; i < 200 && strict.clients() > 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
   EXPECT_EQ(strict.clients(), 0u);  // its socket closed
