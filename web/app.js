@@ -33,9 +33,11 @@ const connection = $('connection');
 client.onOpen = () => { connection.textContent = 'connected'; connection.className = 'pill ok'; };
 client.onClose = () => {
   connection.textContent = 'disconnected'; connection.className = 'pill bad';
-  showBanner(run.ended ? `${bannerText()} — the server has closed.` : 'The server went away: this view no longer changes.',
+  showBanner(run.ended ? `${bannerText()} The server has closed.` : 'The server went away: this view no longer changes.',
     run.ended ? 'ended' : 'gone');
   stopDriving();
+  // Nothing to steer any more.
+  for (const c of document.querySelectorAll('#console button, #console input, #driving button, #driving select')) c.disabled = true;
 };
 client.onStatus = (level, message) => {
   if (level >= 1) note(`server: ${message}`, level === 2 ? 'error' : 'warning');
@@ -91,6 +93,9 @@ function onStatus(s) {
   $('rt-slider').disabled = !s.realtime || s.real_robots > 0;
   $('pause').disabled = !s.realtime || s.state !== 'running';
   $('start').disabled = s.state !== 'paused';
+  if (run.ended) {
+    for (const c of document.querySelectorAll('#console button, #console input, #driving button')) c.disabled = true;
+  }
 }
 
 function bannerText() {
