@@ -381,8 +381,9 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     record_subteams(t, team);
     const bool was_holding = formation_.holding();
     if (formation_.update(t, team)) {
-      record({t, "formed", 0, 0,
-                              "convoy formed; the hold began at " + std::to_string(us_to_seconds(*formation_.formation_time_us())) + " s"});
+      std::ostringstream text;  // "6.1 s", not std::to_string's "6.100000 s"
+      text << "convoy formed; the hold began at " << us_to_seconds(*formation_.formation_time_us()) << " s";
+      record({t, "formed", 0, 0, text.str()});
     }
     if (was_holding && !formation_.holding() && formation_.formed()) {
       record({t, "broken", 0, 0, "the formed convoy broke"});
