@@ -158,7 +158,8 @@ void GuiService::loop() {
 void GuiService::drive_tick(std::unique_lock<std::mutex>& lock) {
   const auto now = Clock::now();
   const double hold_s = drive_.hold_wall_s * std::max(1.0, rt_factor_);
-  const auto renew_after = std::chrono::duration<double>(drive_.hold_wall_s / 2);
+  // A third: a renewal may come a whole third late (a busy machine) before the hold lapses.
+  const auto renew_after = std::chrono::duration<double>(drive_.hold_wall_s / 3);
   // What to send, chosen under the lock, sent without it.
   struct Order {
     int robot;

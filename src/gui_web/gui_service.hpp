@@ -62,7 +62,7 @@ struct ManualDriveConfig {
   /// How often the service looks at the drivers and renews their holds.
   int tick_ms = 100;
   /// Each hold on the run lasts this long (wall seconds, scaled by the run's real-time
-  /// factor) and is renewed at half of it: the longest a robot drives on after the
+  /// factor) and is renewed at a third of it: the longest a robot drives on after the
   /// service itself dies. Shorter costs more commands (and a robot that stutters on a
   /// late renewal).
   double hold_wall_s = 0.6;
