@@ -37,6 +37,7 @@ struct GuiArgs {
   int port = 8080;
   std::string run_token;  // the run's console token (default: its token file)
   std::string web_root = RILBED_WEB_ROOT;
+  std::vector<std::string> allowed_origins;  // web clients served from elsewhere
 };
 
 // The console sink of `rilbed gui`: each command goes to the run over LCM with the run's
@@ -83,6 +84,7 @@ int gui_command(const GuiArgs& args) {
   config.token = links::make_run_token();
   config.session_id = config.token.substr(0, 8);
   if (std::filesystem::is_directory(args.web_root)) config.web_root = args.web_root;
+  config.allowed_origins = args.allowed_origins;
   if (args.bind != "127.0.0.1") {
     spdlog::warn("gui: serving on {}: anyone who can reach it and has the URL's token can watch and steer the run", args.bind);
   }
@@ -131,6 +133,9 @@ void add_gui_command(CLI::App& app) {
       ->default_val("127.0.0.1");
   cmd->add_option("--token", args->run_token, "The run's console token (default: from the run's token file)");
   cmd->add_option("--web-root", args->web_root, "The page's files")->default_val(args->web_root);
+  cmd->add_option("--gui-allow-origin", args->allowed_origins,
+                  "Also let in browsers' WebSockets from this Origin (a web client served elsewhere, "
+                  "e.g. https://app.foxglove.dev); repeatable");
   cmd->callback([args] { exit_code() = gui_command(*args); });
 }
 

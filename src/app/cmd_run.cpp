@@ -95,6 +95,7 @@ struct RunArgs {
   int gui_port = 8080;
   std::string gui_bind = "127.0.0.1";
   std::string web_root = RILBED_WEB_ROOT;
+  std::vector<std::string> gui_allowed_origins;  // web clients served from elsewhere
 };
 
 // The console sink of `rilbed run --gui`: a browser's command acts on this run's own
@@ -448,6 +449,7 @@ int run_command(const RunArgs& args) {
     config.token = token.empty() ? links::make_run_token() : token;
     config.session_id = config.token.substr(0, 8);
     if (std::filesystem::is_directory(args.web_root)) config.web_root = args.web_root;
+    config.allowed_origins = args.gui_allowed_origins;
     if (args.gui_bind != "127.0.0.1") {
       spdlog::warn("gui: serving on {}: anyone who can reach it and has the URL's token can watch and steer the run", args.gui_bind);
     }
@@ -559,6 +561,9 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--gui-bind", args->gui_bind, "With --gui: address to serve on (anything but 127.0.0.1 opens it to the network)")
       ->default_val("127.0.0.1");
   cmd->add_option("--web-root", args->web_root, "With --gui: the page's files")->default_val(args->web_root);
+  cmd->add_option("--gui-allow-origin", args->gui_allowed_origins,
+                  "With --gui: also let in browsers' WebSockets from this Origin (a web client served elsewhere, "
+                  "e.g. https://app.foxglove.dev); repeatable");
   cmd->add_flag("--quiet", args->quiet, "No per-second status (realtime) or per-run lines (batch)");
   cmd->callback([args] { exit_code() = run_command(*args); });
 }
