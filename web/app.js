@@ -1,6 +1,7 @@
 // rilbed's control panel: a client of the run's Foxglove WebSocket (see foxglove.js).
 // It draws what the run publishes and sends console commands and manual driving back; it
 // keeps no state the run does not send, so any number of tabs show the same run.
+import { prepareCanvas } from './canvas.js';
 import { FoxgloveClient } from './foxglove.js';
 
 const params = new URLSearchParams(location.search);
@@ -406,13 +407,7 @@ let fpsWindow = [];
 function draw(now) {
   drawPending = false;
   const t0 = performance.now();
-  const dpr = window.devicePixelRatio || 1;
-  const w = canvas.clientWidth, h = canvas.clientHeight;
-  if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
-    canvas.width = Math.round(w * dpr); canvas.height = Math.round(h * dpr);
-  }
-  ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
-  ctx.clearRect(0, 0, w, h);
+  const [, w, h] = prepareCanvas(canvas);
   const P = makeProjection(w, h);
   window.rilbed.project = P.project; // field metres -> canvas CSS pixels, as drawn now (for tests)
   if (P.base.camera) {
@@ -583,15 +578,7 @@ let plotsDirty = false;
 let lastPlot = 0;
 const COLORS = ['#d22828', '#2456c7', '#1e7d32', '#b26a00', '#7b1fa2', '#00838f', '#c2185b', '#5d4037', '#455a64', '#9e9d24'];
 
-function plotCanvas(id) {
-  const c = $(id), dpr = window.devicePixelRatio || 1;
-  const w = c.clientWidth, h = c.clientHeight;
-  if (c.width !== Math.round(w * dpr)) { c.width = Math.round(w * dpr); c.height = Math.round(h * dpr); }
-  const g = c.getContext('2d');
-  g.setTransform(dpr, 0, 0, dpr, 0, 0);
-  g.clearRect(0, 0, w, h);
-  return [g, w, h];
-}
+function plotCanvas(id) { return prepareCanvas($(id)); }
 
 function drawPlots() {
   const now = performance.now();

@@ -12,6 +12,7 @@
 // window.rilbed.run: /rilbed/world and /rilbed/poses); "Poses from run" puts the run's
 // current poses into the scenario being edited.
 import { load, dump, visit, COLLECTION_STYLE, VISIT_SKIP } from './node_modules/js-yaml/dist/js-yaml.mjs';
+import { prepareCanvas } from './canvas.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -724,13 +725,7 @@ function requestDraw() {
 }
 function draw() {
   if (!ed.doc || !canvas.clientWidth) return;
-  const dpr = window.devicePixelRatio || 1;
-  const w = canvas.clientWidth, h = canvas.clientHeight;
-  if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
-    canvas.width = Math.round(w * dpr); canvas.height = Math.round(h * dpr);
-  }
-  ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
-  ctx.clearRect(0, 0, w, h);
+  const [, w, h] = prepareCanvas(canvas);
   const L = layout(), F = field();
   const P = (x, y) => toPx(L, x, y);
   const path = (pts, close) => {
