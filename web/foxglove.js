@@ -1,6 +1,6 @@
 // A small client of the Foxglove WebSocket protocol (foxglove.websocket.v1), enough for
 // rilbed's page: advertised channels, subscriptions, JSON message data, client channels,
-// status messages. No build step, no dependency.
+// status messages, parameters. No build step, no dependency.
 //
 //   const client = new FoxgloveClient(url);
 //   client.onChannels = (channels) => ...;     // every advertised channel so far (Map topic -> channel)
@@ -9,6 +9,11 @@
 //   client.onClose = (event) => ...;
 //   client.subscribe(['/rilbed/poses']);
 //   client.publish('/rilbed/console', {command: 'pause', args: []});
+//   client.onServerInfo = (info) => ...;      // info.capabilities: 'parameters', 'parametersSubscribe', ...
+//   client.onParameterValues = (parameters, id) => ...; // every parameterValues ([{name, value}], id or undefined)
+//   await client.getParameters([]);           // [{name, value}, ...] (no names: all)
+//   await client.setParameters([{name: 'vision.contrast', value: 1.5}]); // the values after it (refused: unchanged)
+//   client.subscribeParameterUpdates(['vision.contrast']); // onParameterValues whenever they change
 
 export const SUBPROTOCOL = 'foxglove.websocket.v1';
 
@@ -23,6 +28,8 @@ export class FoxgloveClient {
     this.clientChannels = new Map(); // topic -> client channel id
     this.nextClientChannelId = 1;
     this.serverInfo = null;
+    this.parameterRequests = new Map(); // request id -> {resolve, reject}
+    this.nextRequestId = 1;
     this.decoder = new TextDecoder();
     this.encoder = new TextEncoder();
     this.onChannels = () => {};
@@ -30,14 +37,24 @@ export class FoxgloveClient {
     this.onStatus = () => {};
     this.onOpen = () => {};
     this.onClose = () => {};
+    this.onServerInfo = () => {};
+    this.onParameterValues = () => {};
     this.ws = new WebSocket(url, [SUBPROTOCOL]);
     this.ws.binaryType = 'arraybuffer';
     this.ws.onopen = () => this.onOpen();
-    this.ws.onclose = (event) => this.onClose(event);
+    this.ws.onclose = (event) => {
+      // No answer will come: the requests waiting for one fail.
+      for (const { reject } of this.parameterRequests.values()) reject(new Error('the connection closed'));
+      this.parameterRequests.clear();
+      this.onClose(event);
+    };
     this.ws.onmessage = (event) => this.receive(event.data);
   }
 
   get open() { return this.ws.readyState === WebSocket.OPEN; }
+
+  // Whether the server's serverInfo lists this capability ('parameters', ...).
+  can(capability) { return !!this.serverInfo?.capabilities?.includes(capability); }
 
   close() { this.ws.close(); }
 
@@ -70,6 +87,7 @@ export class FoxgloveClient {
     switch (m.op) {
       case 'serverInfo':
         this.serverInfo = m;
+        this.onServerInfo(m);
         break;
       case 'advertise':
         for (const c of m.channels || []) {
@@ -96,9 +114,50 @@ export class FoxgloveClient {
       case 'status':
         this.onStatus(m.level, m.message);
         break;
+      case 'parameterValues': {
+        const parameters = Array.isArray(m.parameters) ? m.parameters : [];
+        this.onParameterValues(parameters, m.id);
+        const request = m.id === undefined ? undefined : this.parameterRequests.get(m.id);
+        if (request) {
+          this.parameterRequests.delete(m.id);
+          request.resolve(parameters);
+        }
+        break;
+      }
       default:
-        break; // removeStatus, parameterValues, ...: not used
+        break; // removeStatus, time, ...: not used
     }
+  }
+
+  // getParameters / setParameters: a Promise of the parameterValues that answers it (the
+  // same id), rejected if the connection is not open or closes first.
+  requestParameters(op, fields) {
+    if (!this.open) return Promise.reject(new Error('not connected'));
+    const id = `p${this.nextRequestId++}`;
+    return new Promise((resolve, reject) => {
+      this.parameterRequests.set(id, { resolve, reject });
+      this.ws.send(JSON.stringify({ op, ...fields, id }));
+    });
+  }
+
+  // The values of these parameters (none named: all of them), as [{name, value}].
+  getParameters(names = []) { return this.requestParameters('getParameters', { parameterNames: names }); }
+
+  // Sets [{name, value}, ...] in one request; resolves to the values after it (on a
+  // refusal the server's status says why and the values are the unchanged ones).
+  setParameters(parameters) { return this.requestParameters('setParameters', { parameters }); }
+
+  // onParameterValues (without an id) whenever one of these changes, whoever changed it.
+  subscribeParameterUpdates(names) {
+    if (!this.open) return false;
+    this.ws.send(JSON.stringify({ op: 'subscribeParameterUpdates', parameterNames: names }));
+    return true;
+  }
+
+  unsubscribeParameterUpdates(names) {
+    if (!this.open) return false;
+    this.ws.send(JSON.stringify({ op: 'unsubscribeParameterUpdates', parameterNames: names }));
+    return true;
   }
 
   // Subscribes to these topics now or as soon as they are advertised.
