@@ -39,9 +39,11 @@ client.onClose = () => {
   stopDriving();
   // Nothing to steer any more.
   for (const c of document.querySelectorAll('#console button, #console input, #driving button, #driving select')) c.disabled = true;
+  updateVisionControls();
 };
 client.onStatus = (level, message) => {
   if (level >= 1) note(`server: ${message}`, level === 2 ? 'error' : 'warning');
+  visionStatus(level, message);
   // Another panel took our robot: we drive it no more (the server told us alone).
   if (driving.robot !== null && message.startsWith(`robot ${driving.robot} taken over by `)) {
     driving.keys.clear();
@@ -58,7 +60,7 @@ client.onMessage = (topic, tNs, m) => {
     case '/rilbed/status': onStatus(m); break;
     case '/rilbed/poses': onPoses(m); break;
     case '/rilbed/sensors': for (const r of m.robots) run.sensors.set(r.id, r); break;
-    case '/rilbed/detections': run.detections = m; break;
+    case '/rilbed/detections': run.detections = m; showFound(m); break;
     case '/rilbed/events': addEvent(m); break;
     case '/rilbed/summary': run.summary = m; break;
     case '/rilbed/console_reply': onReply(m); break;
@@ -97,6 +99,7 @@ function onStatus(s) {
   if (run.ended) {
     for (const c of document.querySelectorAll('#console button, #console input, #driving button')) c.disabled = true;
   }
+  updateVisionControls();
 }
 
 function bannerText() {
@@ -328,6 +331,226 @@ for (const b of document.querySelectorAll('#drive-pad button')) {
   b.addEventListener('pointercancel', release);
 }
 updateDriveControls();
+
+// ------------------------------------------------------------------ vision settings
+// The camera pipeline's settings are the run's parameters (Foxglove's getParameters /
+// setParameters / subscribeParameterUpdates). A slider sends what it is moved to, a few
+// times a second at most, the newest value winning; the readouts, and the sliders once let
+// go, show what the run answers, so a refusal or another client's change shows at once.
+const VISION_PERIOD_MS = 250;
+const VISION = [
+  { key: 'brightness', label: 'brightness (grey levels)', min: -128, max: 128, step: 1, whole: true, def: 0,
+    tip: 'Grey levels added to every pixel before detection (after contrast); the camera view shows the result. ' +
+      'Raising it lightens a dark image; too far and a light floor and the markers\' white clip to 255, and their edges go.' },
+  { key: 'contrast', label: 'contrast (gain)', min: 0.2, max: 5, log: true, def: 1,
+    tip: 'Gain about mid-grey 128, applied before brightness; the camera view shows the result. Raising it parts a washed-out ' +
+      'marker\'s black from its white; too far and dark and light parts clip to 0 and 255, and the floor\'s noise grows with it.' },
+  { key: 'threshold', label: 'threshold (grey levels)', min: 1, max: 255, step: 1, whole: true, def: 24,
+    tip: 'The least local contrast for a pixel to count as dark or bright in the marker search. Raising it ignores floor mottling ' +
+      'and shadows and searches less; too high and faint, blurred or badly lit markers are missed.' },
+  { key: 'min_diameter_px', label: 'min diameter (px)', min: 6, max: 4000, log: true, whole: true, def: 18,
+    tip: 'The smallest marker diameter looked for. Raising it skips small blobs (a faster search, fewer false finds); ' +
+      'markers that look smaller than this, far from the camera or in a low resolution, are missed.' },
+  { key: 'max_diameter_px', label: 'max diameter (px)', min: 6, max: 4000, log: true, whole: true, def: 480,
+    tip: 'The largest marker diameter looked for; it must stay above the minimum. Raising it finds markers close to the camera, ' +
+      'at the cost of a longer search over large regions.' },
+  { key: 'min_score', label: 'min score (0–1)', min: 0, max: 1, step: 0.01, def: 0.75,
+    tip: 'The least decoding similarity for a marker to take an ID. Raising it avoids wrong IDs; too high and worn, blurred ' +
+      'or tilted markers get none (at 1 hardly any marker does).' },
+].map((p) => ({ ...p, name: `vision.${p.key}` }));
+const VISION_NAMES = VISION.map((p) => p.name);
+
+const vision = {
+  available: false, reason: 'asking the run for its vision settings…',
+  values: {},           // name -> the run's value (what parameterValues said last)
+  pending: new Map(),   // name -> a value not sent yet (newest wins)
+  inFlight: new Map(),  // name -> requests sent and not answered
+  sent: new Map(),      // name -> the value last sent
+  held: new Set(),      // sliders being moved
+  lastSent: -Infinity, timer: null,
+  refusal: null,        // {at, names, reason}: the last request the run refused
+  lastError: null,      // {at, message}: the server's last error status
+};
+
+// Slider position <-> value: contrast and the diameters on a log scale.
+const toSlider = (p, v) => (p.log ? Math.log10(v) : v);
+function fromSlider(p, x) {
+  let v = p.log ? 10 ** x : x;
+  v = p.whole ? Math.round(v) : Number(v.toFixed(2));
+  return Math.min(p.max, Math.max(p.min, v));
+}
+// Up to four significant digits, no trailing zeros (1.5, 0.75, 480).
+const fmtParam = (v) => (typeof v === 'number' && isFinite(v) ? String(Number(v.toPrecision(4))) : '—');
+
+for (const p of VISION) {
+  const row = document.createElement('label');
+  row.className = 'vision-param'; row.title = p.tip; row.dataset.param = p.name;
+  const text = document.createElement('span'); text.textContent = p.label;
+  const input = document.createElement('input');
+  input.type = 'range'; input.id = `vision-${p.key}`; input.setAttribute('aria-label', p.label);
+  input.min = toSlider(p, p.min); input.max = toSlider(p, p.max); input.step = p.log ? 'any' : p.step;
+  input.value = toSlider(p, p.def);
+  const out = document.createElement('output'); out.textContent = '—';
+  row.append(text, input, out);
+  $('vision-params').append(row);
+  p.input = input; p.output = out;
+  input.addEventListener('input', () => { vision.held.add(p.name); wishVision(p.name, fromSlider(p, Number(input.value))); });
+  input.addEventListener('change', () => {
+    vision.held.delete(p.name);
+    const value = fromSlider(p, Number(input.value));
+    if (value !== vision.sent.get(p.name) || vision.values[p.name] !== value) wishVision(p.name, value);
+    else showVisionValues(); // already the run's: the slider may follow it again
+  });
+}
+$('vision-defaults').addEventListener('click', () => { for (const p of VISION) wishVision(p.name, p.def); });
+
+function wishVision(name, value) {
+  if (vision.pending.get(name) === value) return;
+  vision.pending.set(name, value);
+  if (vision.timer) return;
+  vision.timer = setTimeout(flushVision, Math.max(0, vision.lastSent + VISION_PERIOD_MS - performance.now()));
+}
+
+function flushVision() {
+  vision.timer = null;
+  if (!vision.pending.size) return;
+  const parameters = [...vision.pending].map(([name, value]) => ({ name, value }));
+  vision.pending.clear();
+  vision.lastSent = performance.now();
+  setVision(parameters).catch(() => {}); // a closed connection says so on the page already
+}
+
+// One setParameters request (all or nothing); resolves to {values, refused, reason}.
+async function setVision(parameters) {
+  for (const { name, value } of parameters) {
+    vision.inFlight.set(name, (vision.inFlight.get(name) || 0) + 1);
+    vision.sent.set(name, value);
+  }
+  const sentAt = performance.now();
+  try {
+    const after = await client.setParameters(parameters);
+    applyVisionValues(after);
+    const refused = parameters.filter(({ name, value }) => {
+      const now = after.find((a) => a.name === name)?.value;
+      return typeof now !== 'number' || Math.abs(now - value) > 1e-9 * Math.max(1, Math.abs(value));
+    });
+    if (refused.length) {
+      const recent = vision.lastError && vision.lastError.at >= sentAt - 50 ? vision.lastError.message : null;
+      vision.refusal = { at: performance.now(), names: refused.map((p) => p.name), reason: recent };
+      showVisionRefusal();
+    } else {
+      vision.refusal = null;
+      $('vision-reply').textContent = '';
+    }
+    return { values: { ...vision.values }, refused: refused.map((p) => p.name), reason: vision.refusal?.reason ?? null };
+  } catch (e) {
+    visionReply(`✗ ${e.message}`, 'error');
+    throw e;
+  } finally {
+    for (const { name } of parameters) vision.inFlight.set(name, vision.inFlight.get(name) - 1);
+    showVisionValues();
+  }
+}
+
+function showVisionRefusal() {
+  const r = vision.refusal;
+  const kept = r.names.map((n) => `${n.slice('vision.'.length)} ${fmtParam(vision.values[n])}`).join(', ');
+  visionReply(`✗ ${r.reason || 'refused'} (kept ${kept})`, 'error');
+}
+
+function visionReply(text, kind) {
+  const reply = $('vision-reply');
+  reply.textContent = text;
+  reply.style.color = kind === 'error' ? 'var(--danger)' : '';
+}
+
+// The server's error statuses: the reason for a refusal, which may come just after its answer.
+function visionStatus(level, message) {
+  if (level < 2) return;
+  vision.lastError = { at: performance.now(), message };
+  if (vision.refusal && !vision.refusal.reason && performance.now() - vision.refusal.at < 2000) {
+    vision.refusal.reason = message;
+    showVisionRefusal();
+  }
+}
+
+// A parameter without a value (or null) is gone: the run has lost its camera. One that
+// comes later (the run's first status with its camera) makes the section usable.
+function applyVisionValues(parameters) {
+  for (const { name, value } of parameters) {
+    if (!VISION_NAMES.includes(name)) continue;
+    if (typeof value === 'number') vision.values[name] = value;
+    else if (value === undefined || value === null) delete vision.values[name];
+  }
+  const available = VISION_NAMES.some((n) => n in vision.values);
+  if (available !== vision.available) {
+    vision.available = available;
+    if (!available) vision.reason = 'No camera in this run: nothing to tune.';
+    updateVisionControls();
+  }
+  showVisionValues();
+}
+
+function showVisionValues() {
+  for (const p of VISION) {
+    const v = vision.values[p.name];
+    p.output.textContent = fmtParam(v);
+    // A slider follows the run unless it is being moved or has a value on its way.
+    if (v !== undefined && !vision.held.has(p.name) && !vision.pending.has(p.name) && !(vision.inFlight.get(p.name) > 0)) {
+      p.input.value = toSlider(p, v);
+    }
+  }
+  const all = VISION.every((p) => vision.values[p.name] !== undefined);
+  $('vision-yaml').textContent = all ? `vision: {${VISION.map((p) => `${p.key}: ${fmtParam(vision.values[p.name])}`).join(', ')}}` : '';
+  $('vision-yaml').parentElement.hidden = !all;
+}
+
+function updateVisionControls() {
+  const usable = vision.available && client.open && !run.ended;
+  $('vision').classList.toggle('unavailable', !vision.available);
+  $('vision-reason').hidden = vision.available;
+  $('vision-reason').textContent = vision.reason;
+  for (const c of document.querySelectorAll('#vision input, #vision button')) {
+    c.disabled = !usable || (c.type === 'range' && vision.values[c.closest('[data-param]').dataset.param] === undefined);
+  }
+}
+
+function showFound(m) {
+  const ids = m.detections.map((d) => d.id).sort((a, b) => a - b);
+  const text = `found ${ids.length ? `${ids.length} (ID ${ids.join(', ')})` : 'no marker'} in ${fmt(m.process_ms)} ms`;
+  const found = $('vision-found');
+  if (found.textContent !== text) found.textContent = text;
+}
+
+client.onServerInfo = async () => {
+  if (!client.can('parameters')) {
+    vision.reason = 'This server has no settings to tune (no "parameters" capability).';
+    updateVisionControls();
+    return;
+  }
+  // Every parameterValues (answers and updates) goes to the section. Subscribed first, so
+  // that settings the run comes to have after the answer (its camera starting) show too.
+  client.onParameterValues = (parameters) => applyVisionValues(parameters);
+  if (client.can('parametersSubscribe')) client.subscribeParameterUpdates(VISION_NAMES);
+  try {
+    await client.getParameters(VISION_NAMES);
+    if (!vision.available) vision.reason = 'No camera in this run: nothing to tune.';
+  } catch (e) {
+    if (!vision.available) vision.reason = `The run did not say its vision settings (${e.message}).`;
+  }
+  updateVisionControls();
+};
+updateVisionControls();
+
+// For tests: the settings as the run last said, and requests as the sliders make them.
+window.rilbed.vision = {
+  get values() { return { ...vision.values }; },
+  get available() { return vision.available; },
+  get reason() { return vision.reason; },
+  get refusal() { return vision.refusal && { names: vision.refusal.names, reason: vision.refusal.reason }; },
+  set: (values) => setVision(Object.entries(values).map(([key, value]) => ({ name: key.startsWith('vision.') ? key : `vision.${key}`, value }))),
+  defaults: Object.fromEntries(VISION.map((p) => [p.key, p.def])),
+};
 
 // ------------------------------------------------------------------ the live view
 const canvas = $('view');
