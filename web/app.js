@@ -432,7 +432,7 @@ async function setVision(parameters) {
     applyVisionValues(after);
     const refused = parameters.filter(({ name, value }) => {
       const now = after.find((a) => a.name === name)?.value;
-      return typeof now !== 'number' || Math.abs(now - value) > 1e-9 * Math.max(1, Math.abs(value));
+      return typeof now !== 'number' || Math.abs(now - value) > 1e-6 * Math.max(1, Math.abs(value));
     });
     if (refused.length) {
       const recent = vision.lastError && vision.lastError.at >= sentAt - 50 ? vision.lastError.message : null;
