@@ -1,6 +1,6 @@
 // Steering a run while it runs, from another thread (a console on the LCM bus): pause,
 // resume, change the real-time factor, end it, start it over, switch the convoy's mode,
-// drive one robot by hand for a while. The run attaches itself for as long as it
+// drive one robot by hand for a while, tune the camera's vision settings. The run attaches itself for as long as it
 // runs; the actions reach it as external events of its DEVS run (Coordinator::inject), so
 // they are applied on the run's own thread between two steps and recorded as events.
 #pragma once
@@ -10,19 +10,23 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace rilbed::agents {
 
 /// One action on a run.
 struct ControlAction {
   /// kRefused records a command the console refused (a wrong token), as an event.
-  enum class Kind { kPause, kResume, kRtFactor, kExit, kReset, kMode, kDrive, kRefused };
+  enum class Kind { kPause, kResume, kRtFactor, kExit, kReset, kMode, kDrive, kVision, kRefused };
   Kind kind = Kind::kPause;
   double rt_factor = 1.0;  ///< kRtFactor: the new factor
   bool central = false;    ///< kMode: true for central mode, false for distributed
   int robot_id = 0;        ///< kDrive: the robot
   int left = 0, right = 0; ///< kDrive: wheel speeds, Khepera units (+-127, 8 mm/s each)
   double duration_s = 0.0; ///< kDrive: for this long (simulated seconds), then its controller again
+  /// kVision: settings by name (vision::kVisionSettingNames) and value, all or none applied
+  std::vector<std::pair<std::string, double>> vision;
   std::string who;         ///< who asked (for the run's events)
   std::string what;        ///< kRefused: the command and why it was refused
 };

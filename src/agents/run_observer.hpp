@@ -23,6 +23,7 @@
 #include "core/geometry.hpp"
 #include "core/time.hpp"
 #include "environment/sensor_readings.hpp"
+#include "vision/vision_settings.hpp"
 
 namespace rilbed::agents {
 
@@ -125,6 +126,8 @@ struct StatusReport {
   double loop_latency_ms = 0.0;  ///< realtime: the most the control loop fell behind the wall clock in the last second
   double camera_fps = 0.0;       ///< camera frames processed per wall second over the last second
   std::int64_t frames = 0;       ///< camera frames processed so far
+  /// The camera's vision settings now; none for a run without a camera.
+  std::optional<vision::VisionSettings> vision;
 };
 
 /// Receives what a run reports. Every member has an empty default. A run reports each

@@ -407,7 +407,7 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source) {
   s.robots = read_robots(top);
   if (top.has("camera")) {
     const Reader c = top.child("camera");
-    c.allow({"emulate", "device", "file", "calibration", "fps", "marker_diameter_m", "family"});
+    c.allow({"emulate", "device", "file", "calibration", "fps", "marker_diameter_m", "family", "vision"});
     CameraSpec cam;
     cam.line = top.line_of("camera");
     cam.emulate = c.boolean("emulate", false);
@@ -417,6 +417,16 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source) {
     cam.fps = c.positive("fps", cam.fps);
     cam.marker_diameter_m = c.positive("marker_diameter_m", cam.marker_diameter_m);
     cam.family = c.text("family", cam.family);
+    if (c.has("vision")) {
+      const Reader v = c.child("vision");
+      v.allow({"brightness", "contrast", "threshold", "min_diameter_px", "max_diameter_px", "min_score"});
+      for (const std::string_view setting : vision::kVisionSettingNames) {
+        const std::string name(setting);
+        if (!v.has(name)) continue;
+        if (auto why = vision::set_vision_setting(cam.vision, name, v.number(name, 0.0))) v.fail_key(name, *why);
+      }
+      if (auto why = vision::check_vision_settings(cam.vision)) c.fail_key("vision", *why);
+    }
     const int sources = (cam.emulate ? 1 : 0) + (cam.device ? 1 : 0) + (cam.file.empty() ? 0 : 1);
     if (sources != 1) top.fail_key("camera", "give exactly one of `emulate: true`, `device: N` or `file: PATH`");
     if (!cam.emulate && cam.calibration.empty()) c.fail_key("calibration", "a real camera needs its field calibration file");

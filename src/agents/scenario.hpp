@@ -20,6 +20,7 @@
 #include "environment/robot_state.hpp"
 #include "environment/sensor_suite.hpp"
 #include "environment/static_map.hpp"
+#include "vision/vision_settings.hpp"
 
 namespace rilbed::agents {
 
@@ -66,6 +67,9 @@ struct CameraSpec {
   double fps = 30.0;             ///< frames per second (emulated, or the rate a file is replayed at)
   double marker_diameter_m = 0.05;  ///< outer diameter of the printed markers
   std::string family = "6ucp";   ///< marker family
+  /// The vision settings the run starts with (`vision: {brightness: 0, contrast: 1, ...}`,
+  /// what the web panel shows for the settings a person tuned).
+  vision::VisionSettings vision;
   int line = 0;
 };
 

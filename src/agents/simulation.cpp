@@ -101,9 +101,13 @@ class VisionModel final : public sim::AtomicModel<TimeUs> {  // state: time to t
       world_.set_observed_pose(o.id, o.pose, t_us_);
       ++sightings_;
     }
-    if (observer_) report(*frame, seen, process_ms);
+    if (observer_) report(tracker_.seen_frame(), seen, process_ms);
   }
   long frames() const { return frames_.load(std::memory_order_relaxed); }
+  /// The vision settings in use; set_vision() changes them from the next frame on (the
+  /// run's thread only).
+  const vision::VisionSettings& vision() const { return tracker_.settings(); }
+  void set_vision(const vision::VisionSettings& settings) { tracker_.set_settings(settings); }
   long sightings() const { return sightings_; }
   /// What viewers need to draw the field over its frames.
   CameraReport camera_report(const std::string& source) const {
@@ -166,6 +170,7 @@ std::shared_ptr<VisionModel> make_camera(const Scenario& scenario, const RunOpti
     auto camera = std::make_shared<vision::EmulatedOverheadCamera>(scenario.map.field.width_m, scenario.map.field.height_m,
                                                                    family, config);
     vision::FieldTracker tracker(family, real_ids, camera->calibration());
+    tracker.set_settings(cam.vision);
     auto markers = options.emulated_markers;
     const double diameter = cam.marker_diameter_m;
     VisionModel::Grab grab = [camera, markers, diameter]() -> std::optional<cv::Mat> {
@@ -181,6 +186,7 @@ std::shared_ptr<VisionModel> make_camera(const Scenario& scenario, const RunOpti
   if (!opened.ok()) throw ScenarioError(where + ": " + opened.error);
   std::shared_ptr<vision::FrameSource> source = std::move(opened.source);
   vision::FieldTracker tracker(family, real_ids, *calibration.calibration);
+  tracker.set_settings(cam.vision);
   VisionModel::Grab grab = [source]() -> std::optional<cv::Mat> {
     for (;;) {
       vision::FrameResult r = source->next();
@@ -267,6 +273,7 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     st.loop_latency_ms = worst_latency_ms_;
     st.camera_fps = camera_fps_;
     st.frames = s_.camera ? s_.camera->frames() : 0;
+    if (s_.camera) st.vision = s_.camera->vision();
     return st;
   }
 
@@ -449,6 +456,7 @@ class ControlModel final : public sim::AtomicModel<std::vector<ConsoleOrder>> { 
     MonitorModel* monitor = nullptr;
     sim::RealTimeClock* clock = nullptr;  // null in a fast run
     RunObserver* observer = nullptr;
+    VisionModel* camera = nullptr;        // the overhead camera, if any (its settings)
   };
   explicit ControlModel(Setup setup)
       : sim::AtomicModel<std::vector<ConsoleOrder>>("control", {}),
@@ -524,6 +532,23 @@ class ControlModel final : public sim::AtomicModel<std::vector<ConsoleOrder>> { 
         text << "robot " << a.robot_id << " driven " << a.left << " " << a.right << " for " << a.duration_s << " s by "
              << a.who;
         s_.monitor->record_event({t_us_, "console", a.robot_id, 0, text.str()});
+        break;
+      }
+      case ControlAction::Kind::kVision: {
+        if (!s_.camera) break;  // checked before: the run has a camera
+        vision::VisionSettings settings = s_.camera->vision();
+        std::ostringstream text;
+        text << "vision";
+        for (const auto& [name, value] : a.vision) {
+          if (vision::set_vision_setting(settings, name, value)) return;  // checked before
+          text << " " << name << " " << value;
+        }
+        if (vision::check_vision_settings(settings)) return;
+        s_.camera->set_vision(settings);
+        text << " set by " << a.who;
+        s_.monitor->record_event({t_us_, "console", 0, 0, text.str()});
+        // Viewers see the new settings at once, not at the next second's status.
+        if (s_.observer) s_.observer->on_status(s_.monitor->status(t_us_, s_.clock && s_.clock->paused() ? "paused" : "running"));
         break;
       }
       case ControlAction::Kind::kRefused:
@@ -801,7 +826,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   sim::Port<ControlAction>* control_in = nullptr;
   if (options.control) {
     auto& control = root->emplace<ControlModel>(
-        ControlModel::Setup{agents, &monitor, options.realtime ? &real_clock : nullptr, options.observer});
+        ControlModel::Setup{agents, &monitor, options.realtime ? &real_clock : nullptr, options.observer, camera.get()});
     control_in = &root->add_input<ControlAction>("control");
     root->couple(*control_in, control.input());
     for (AgentModel* a : agents) root->couple(control.orders(), *a->find_input("console"));
@@ -817,8 +842,13 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
     const bool has_convoy = !convoy_ids.empty();
     std::set<int> ids;
     for (const RobotSpec& r : scenario.robots) ids.insert(r.id);
+    // The settings as the accepted actions leave them. RunControl checks and hands on one
+    // action at a time, so the checks see them in the order the run applies them.
+    std::optional<vision::VisionSettings> vision_now;
+    if (camera) vision_now = camera->vision();
     options.control->attach(
-        [&paused, &central_now, realtime, has_real, has_convoy, ids](const ControlAction& a) -> std::optional<std::string> {
+        [&paused, &central_now, realtime, has_real, has_convoy, ids, vision_now](const ControlAction& a) mutable
+        -> std::optional<std::string> {
           switch (a.kind) {
             case ControlAction::Kind::kPause:
               if (!realtime) return "a fast run cannot be paused (it is not paced to the clock)";
@@ -844,6 +874,17 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
               if (std::abs(a.left) > 127 || std::abs(a.right) > 127) return "wheel speeds are -127..127 (Khepera units)";
               if (!(a.duration_s > 0.0) || !std::isfinite(a.duration_s)) return "the seconds must be above 0";
               return std::nullopt;
+            case ControlAction::Kind::kVision: {
+              if (!vision_now) return std::string("this run has no camera, so no vision settings");
+              if (a.vision.empty()) return std::string("no vision setting given");
+              vision::VisionSettings s = *vision_now;
+              for (const auto& [name, value] : a.vision) {
+                if (auto why = vision::set_vision_setting(s, name, value)) return why;
+              }
+              if (auto why = vision::check_vision_settings(s)) return why;
+              vision_now = s;
+              return std::nullopt;
+            }
             case ControlAction::Kind::kExit:
             case ControlAction::Kind::kReset:
             case ControlAction::Kind::kRefused:

@@ -1,5 +1,6 @@
 // `rilbed console --lcm URL COMMAND`: steers a running run over its LCM bus: pause,
-// resume, exit, reset, rt-factor F, mode central|distributed, drive ID LEFT RIGHT --for S.
+// resume, exit, reset, rt-factor F, mode central|distributed, drive ID LEFT RIGHT --for S,
+// vision NAME VALUE... (the camera's vision settings).
 // Every command carries the run's token (from --token, or the run's token file when this
 // user can read it) and gets an answer; the exit status is 0
 // when the run accepted it, 1 when it refused it (the reason is printed) or no run
@@ -77,7 +78,8 @@ int console_command(const ConsoleArgs& args) {
 void add_console_command(CLI::App& app) {
   auto args = std::make_shared<ConsoleArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "console", "Steer a running run over its LCM bus: pause | resume | exit | rt-factor F (needs the run's token)");
+      "console", "Steer a running run over its LCM bus: pause | resume | exit | reset | rt-factor F | mode | drive | "
+                 "vision (needs the run's token)");
   cmd->add_option("--lcm", args->url, "LCM URL of the run's bus")->required();
   cmd->add_option("--channel-prefix", args->prefix, "The run's channel prefix");
   cmd->add_option("--token", args->token, "The run's token (default: from the run's token file, if you can read it)");
@@ -85,8 +87,10 @@ void add_console_command(CLI::App& app) {
       ->check(CLI::PositiveNumber)->default_val(1000);
   cmd->add_option("command", args->words,
                   "pause | resume | exit | reset | rt-factor F | mode central|distributed | drive ID LEFT RIGHT --for S "
-                  "(wheel speeds in Khepera units, -127..127, 8 mm/s each)")
-      ->required()->expected(1, 4);
+                  "(wheel speeds in Khepera units, -127..127, 8 mm/s each) | vision NAME VALUE [NAME VALUE]... "
+                  "(brightness -128..128, contrast 0.2..5, threshold 1..255, min_diameter_px and max_diameter_px "
+                  "6..4000, min_score 0..1)")
+      ->required()->expected(1, 13);
   cmd->add_option("--for", args->for_s, "With drive: seconds (simulated) to drive, then the robot's controller again")
       ->check(CLI::PositiveNumber);
   cmd->callback([args] { exit_code() = console_command(*args); });

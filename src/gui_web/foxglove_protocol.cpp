@@ -124,11 +124,17 @@ std::variant<ClientText, std::string> parse_client_advertise(Fields& f) {
   return done(f, std::move(a));
 }
 
+std::vector<std::string> parameter_names(Fields& f) {
+  std::vector<std::string> names;
+  if (const json* list = f.array("parameterNames")) {
+    for (std::size_t i = 0; i < list->size() && !f.problem(); ++i) names.push_back(f.string((*list)[i], item("parameterNames", i)));
+  }
+  return names;
+}
+
 std::variant<ClientText, std::string> parse_get_parameters(Fields& f) {
   GetParameters g;
-  if (const json* list = f.array("parameterNames")) {
-    for (std::size_t i = 0; i < list->size() && !f.problem(); ++i) g.names.push_back(f.string((*list)[i], item("parameterNames", i)));
-  }
+  g.names = parameter_names(f);
   g.id = f.optional_string("id");
   return done(f, std::move(g));
 }
@@ -181,6 +187,8 @@ std::variant<ClientText, std::string> parse_client_text(std::string_view text) {
   }
   if (op == "getParameters") return parse_get_parameters(f);
   if (op == "setParameters") return parse_set_parameters(f);
+  if (op == "subscribeParameterUpdates") return done(f, SubscribeParameterUpdates{parameter_names(f)});
+  if (op == "unsubscribeParameterUpdates") return done(f, UnsubscribeParameterUpdates{parameter_names(f)});
   std::string shown = op.substr(0, 64);
   for (char& c : shown) {
     if (static_cast<unsigned char>(c) < 0x20) c = '?';

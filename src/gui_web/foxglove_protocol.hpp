@@ -77,7 +77,14 @@ struct SetParameters {
   std::vector<Parameter> parameters;
   std::optional<std::string> id;
 };
-using ClientText = std::variant<Subscribe, Unsubscribe, ClientAdvertise, ClientUnadvertise, GetParameters, SetParameters>;
+struct SubscribeParameterUpdates {
+  std::vector<std::string> names;
+};
+struct UnsubscribeParameterUpdates {
+  std::vector<std::string> names;
+};
+using ClientText = std::variant<Subscribe, Unsubscribe, ClientAdvertise, ClientUnadvertise, GetParameters, SetParameters,
+                                SubscribeParameterUpdates, UnsubscribeParameterUpdates>;
 
 /// A client's binary Client Message Data frame: a message on one of its channels. The
 /// payload is a view into the frame.

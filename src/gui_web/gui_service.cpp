@@ -11,6 +11,14 @@ namespace rilbed::gui_web {
 namespace {
 
 constexpr std::size_t kMaxQueuedCommands = 16;
+constexpr std::string_view kVisionPrefix = "vision.";
+
+std::string number_text(double v) {
+  std::ostringstream out;
+  out.precision(17);
+  out << v;
+  return out.str();
+}
 
 std::string seconds_text(double s) {
   std::ostringstream out;
@@ -31,6 +39,8 @@ GuiService::GuiService(WebServerConfig config, ConsoleSink sink, ManualDriveConf
   handlers.on_client_message = [this](const std::string& client, const std::string& topic, const std::string&,
                                       std::string_view payload) { return on_client_message(client, topic, payload); };
   handlers.on_client_gone = [this](const std::string& client) { on_client_gone(client); };
+  handlers.on_set_parameters = [this](const std::string& client, const std::vector<foxglove::Parameter>& parameters,
+                                      const std::optional<std::string>& id) { on_set_parameters(client, parameters, id); };
   server_ = std::make_unique<WebServer>(config_, std::move(handlers));
   channels_ = std::make_unique<RunChannels>(*server_);
   thread_ = std::thread([this] { loop(); });
@@ -66,9 +76,9 @@ std::optional<std::string> GuiService::on_client_message(const std::string& clie
   if (j.is_discarded() || !j.is_object() || !j.contains("command") || !j["command"].is_string()) {
     return std::string("a console message is {\"command\": \"pause\", \"args\": []}");
   }
-  ConsoleRequest request{client, j["command"].get<std::string>(), {}};
+  ConsoleRequest request{client, j["command"].get<std::string>(), {}, std::nullopt, std::nullopt};
   if (j.contains("args")) {
-    if (!j["args"].is_array() || j["args"].size() > 8) return std::string("args must be a list of at most 8 strings");
+    if (!j["args"].is_array() || j["args"].size() > 12) return std::string("args must be a list of at most 12 strings");
     for (const auto& a : j["args"]) {
       if (!a.is_string() && !a.is_number()) return std::string("args must be strings or numbers");
       request.args.push_back(a.is_string() ? a.get<std::string>() : a.dump());
@@ -124,6 +134,52 @@ std::optional<std::string> GuiService::on_drive_message(const std::string& clien
   return std::nullopt;
 }
 
+void GuiService::on_set_parameters(const std::string& client, const std::vector<foxglove::Parameter>& parameters,
+                                   const std::optional<std::string>& id) {
+  ConsoleRequest request{client, "vision", {}, std::vector<std::string>{}, id};
+  std::optional<std::string> refusal;
+  for (const foxglove::Parameter& p : parameters) {
+    request.parameters->push_back(p.name);
+    if (refusal) continue;
+    if (p.name.rfind(kVisionPrefix, 0) != 0) {
+      refusal = "unknown parameter '" + p.name.substr(0, 64) + "' (this server's are vision.*)";
+    } else if (!p.value.is_number()) {
+      refusal = p.name + " must be a number";
+    } else {
+      request.args.push_back(p.name.substr(kVisionPrefix.size()));
+      request.args.push_back(number_text(p.value.get<double>()));
+    }
+  }
+  if (!refusal && parameters.empty()) refusal = "no parameter to set";
+  std::lock_guard lock(mutex_);
+  if (!refusal && requests_.size() >= kMaxQueuedCommands) refusal = "too many console commands waiting";
+  if (refusal) {
+    server_->tell(client, foxglove::Level::kError, *refusal);
+    server_->answer_parameters(client, *request.parameters, id);
+    return;
+  }
+  requests_.push_back(std::move(request));
+  wake_.notify_all();
+}
+
+void GuiService::answer(const ConsoleRequest& request, const ConsoleAnswer& answer) {
+  if (!request.parameters) {
+    channels_->console_reply(0, answer.accepted, answer.reason, request.client);
+    return;
+  }
+  if (answer.accepted) {
+    // The run has them now; its next status says so again.
+    std::vector<foxglove::Parameter> values;
+    for (std::size_t i = 0; i + 1 < request.args.size(); i += 2) {
+      values.push_back({std::string(kVisionPrefix) + request.args[i], std::stod(request.args[i + 1])});
+    }
+    server_->set_parameters(std::move(values));
+  } else {
+    server_->tell(request.client, foxglove::Level::kError, "vision settings refused: " + answer.reason);
+  }
+  server_->answer_parameters(request.client, *request.parameters, request.parameters_id);
+}
+
 void GuiService::on_client_gone(const std::string& client) {
   std::lock_guard lock(mutex_);
   bool any = false;
@@ -147,8 +203,7 @@ void GuiService::loop() {
       requests_.pop_front();
       ++counts_.console_commands;
       lock.unlock();
-      const ConsoleAnswer answer = sink_(request);
-      channels_->console_reply(0, answer.accepted, answer.reason, request.client);
+      answer(request, sink_(request));
       lock.lock();
       drive_tick(lock);
     }
@@ -190,7 +245,9 @@ void GuiService::drive_tick(std::unique_lock<std::mutex>& lock) {
   for (const Order& o : orders) {
     const ConsoleAnswer answer = sink_({o.client, "drive",
                                         {std::to_string(o.robot), std::to_string(o.left), std::to_string(o.right),
-                                         seconds_text(hold_s)}});
+                                         seconds_text(hold_s)},
+                                        std::nullopt,
+                                        std::nullopt});
     if (!answer.accepted) refusals.emplace_back(o.robot, answer);
     if (o.final_stop) channels_->console_reply(0, answer.accepted, "robot " + std::to_string(o.robot) + " stopped and given back to its controller", o.client);
   }
@@ -229,6 +286,16 @@ void GuiService::on_status(const agents::StatusReport& status) {
   {
     std::lock_guard lock(mutex_);
     if (status.rt_factor > 0.0 && std::isfinite(status.rt_factor)) rt_factor_ = status.rt_factor;
+  }
+  if (status.vision || had_vision_) {
+    std::vector<foxglove::Parameter> values;
+    for (const std::string_view name : vision::kVisionSettingNames) {
+      nlohmann::json value;  // null: gone with the camera
+      if (status.vision) value = *vision::vision_setting(*status.vision, name);
+      values.push_back({std::string(kVisionPrefix) + std::string(name), std::move(value)});
+    }
+    server_->set_parameters(std::move(values));
+    had_vision_ = status.vision.has_value();
   }
   channels_->on_status(status);
 }

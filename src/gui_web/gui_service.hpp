@@ -9,6 +9,12 @@
 //   /rilbed/drive    {"id": 4, "left": 20, "right": 20}    while a key is held (every <= 100 ms)
 //                    {"id": 4, "release": true}             hands the robot back to its controller
 //
+// Vision settings are the Foxglove protocol's parameters, "vision.<name>" (see
+// vision::kVisionSettingNames), present while the run has a camera: setParameters becomes
+// a `vision NAME VALUE...` console command (all or none), its answer a parameterValues
+// with the request's id (and the refusal as a status); every status of the run brings the
+// values it has, and subscribers hear of each change.
+//
 // Manual driving is a dead man's switch. A client that drives robot N holds it: the robot
 // goes at the client's speeds while its key-held messages keep coming, and stands still
 // once they have stopped for `key_timeout_ms` (a key released, a tab frozen). The hold ends,
@@ -42,6 +48,9 @@ struct ConsoleRequest {
   std::string client;  ///< who asked (the server's name for the socket, "127.0.0.1:50312")
   std::string command;
   std::vector<std::string> args;
+  /// For a setParameters: the parameters' names, to answer with parameterValues.
+  std::optional<std::vector<std::string>> parameters;
+  std::optional<std::string> parameters_id;  ///< and the request's id
 };
 
 /// The run's answer.
@@ -123,6 +132,9 @@ class GuiService final : public agents::RunObserver {
   std::optional<std::string> on_client_message(const std::string& client, const std::string& topic, std::string_view payload);
   std::optional<std::string> on_drive_message(const std::string& client, std::string_view payload);
   void on_client_gone(const std::string& client);
+  void on_set_parameters(const std::string& client, const std::vector<foxglove::Parameter>& parameters,
+                         const std::optional<std::string>& id);
+  void answer(const ConsoleRequest& request, const ConsoleAnswer& answer);
   void loop();
   void drive_tick(std::unique_lock<std::mutex>& lock);
 
@@ -138,6 +150,7 @@ class GuiService final : public agents::RunObserver {
   std::map<int, Hold> holds_;  // by robot ID
   double rt_factor_ = 1.0;
   Clock::time_point next_camera_frame_{};  // the RunObserver thread only
+  bool had_vision_ = false;                // the RunObserver thread only: the last status had settings
   GuiCounters counts_;
   bool stopping_ = false;
   std::thread thread_;

@@ -118,6 +118,28 @@ struct WebServer::Impl {
   // The last message of each latched channel (the server's thread only).
   std::map<std::uint32_t, std::pair<std::uint64_t, std::shared_ptr<const std::string>>> latest;
   std::atomic<std::size_t> client_count{0};
+  // The parameters' current values, by name (the server's thread only).
+  std::map<std::string, nlohmann::json> parameters;
+
+  std::vector<std::string> capabilities() const {
+    std::vector<std::string> c{"clientPublish"};
+    if (handlers.on_set_parameters) {
+      c.push_back("parameters");
+      c.push_back("parametersSubscribe");
+    }
+    return c;
+  }
+  // The current values of `names` (every parameter when empty; unknown names left out).
+  std::vector<foxglove::Parameter> parameter_values(const std::vector<std::string>& names) const {
+    std::vector<foxglove::Parameter> out;
+    if (names.empty()) {
+      for (const auto& [name, value] : parameters) out.push_back({name, value});
+    }
+    for (const std::string& name : names) {
+      if (const auto it = parameters.find(name); it != parameters.end()) out.push_back({name, it->second});
+    }
+    return out;
+  }
 
   void count(std::uint64_t WebServerCounters::*field, std::uint64_t n = 1) {
     std::lock_guard lock(mutex);
@@ -173,7 +195,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     ws_.read_message_max(server_.config.max_message_bytes);
     ws_.async_accept(request, [self = shared_from_this()](beast::error_code ec) {
       if (ec) return self->close();
-      self->send_text(foxglove::server_info(self->server_.config.name, {"clientPublish"}, {"json"}, self->server_.config.session_id));
+      self->send_text(foxglove::server_info(self->server_.config.name, self->server_.capabilities(), {"json"},
+                                            self->server_.config.session_id));
       const auto channels = self->server_.channels_now();
       self->send_text(foxglove::advertise(channels));
       self->read();
@@ -338,12 +361,48 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void handle(const foxglove::ClientUnadvertise& m) {
     for (const std::uint32_t id : m.channel_ids) client_channels_.erase(id);
   }
-  void handle(const foxglove::GetParameters&) {
-    refuse(foxglove::Level::kError, "Operation 'getParameters' not supported as server capability 'parameters' is missing");
+  void handle(const foxglove::GetParameters& m) {
+    if (!server_.handlers.on_set_parameters) {
+      return refuse(foxglove::Level::kError, "Operation 'getParameters' not supported as server capability 'parameters' is missing");
+    }
+    answer_parameters(m.names, m.id);
   }
-  void handle(const foxglove::SetParameters&) {
-    refuse(foxglove::Level::kError, "Operation 'setParameters' not supported as server capability 'parameters' is missing");
+  void handle(const foxglove::SetParameters& m) {
+    if (!server_.handlers.on_set_parameters) {
+      return refuse(foxglove::Level::kError, "Operation 'setParameters' not supported as server capability 'parameters' is missing");
+    }
+    // The owner answers (answer_parameters) once it has tried them.
+    server_.handlers.on_set_parameters(name_, m.parameters, m.id);
   }
+  void handle(const foxglove::SubscribeParameterUpdates& m) {
+    if (!server_.handlers.on_set_parameters) {
+      return refuse(foxglove::Level::kError,
+                    "Operation 'subscribeParameterUpdates' not supported as server capability 'parametersSubscribe' is missing");
+    }
+    for (const std::string& name : m.names) {
+      if (parameter_subscriptions_.size() >= foxglove::kMaxItems) return refuse(foxglove::Level::kError, "Too many parameter subscriptions");
+      parameter_subscriptions_.insert(name);
+    }
+  }
+  void handle(const foxglove::UnsubscribeParameterUpdates& m) {
+    for (const std::string& name : m.names) parameter_subscriptions_.erase(name);
+  }
+
+ public:
+  // parameterValues of `names` (all when empty) to this client, with the request's id.
+  void answer_parameters(const std::vector<std::string>& names, const std::optional<std::string>& id) {
+    send_text(foxglove::parameter_values(server_.parameter_values(names), id));
+  }
+  // parameterValues of those of `changed` this client subscribed to, if any.
+  void parameters_changed(const std::vector<foxglove::Parameter>& changed) {
+    std::vector<foxglove::Parameter> mine;
+    for (const foxglove::Parameter& p : changed) {
+      if (parameter_subscriptions_.contains(p.name)) mine.push_back(p);
+    }
+    if (!mine.empty()) send_text(foxglove::parameter_values(mine, std::nullopt));
+  }
+
+ private:
 
   void on_binary(std::span<const std::uint8_t> bytes) {
     auto parsed = foxglove::parse_client_binary(bytes);
@@ -366,6 +425,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   beast::flat_buffer buffer_;
   std::map<std::uint32_t, std::uint32_t> sub_to_channel_, channel_to_sub_;
   std::map<std::uint32_t, foxglove::ClientChannel> client_channels_;
+  std::set<std::string> parameter_subscriptions_;
   std::deque<Out> queue_;
   std::size_t queued_bytes_ = 0;
   bool writing_ = false;
@@ -544,6 +604,36 @@ void WebServer::tell(const std::string& client, foxglove::Level level, const std
   asio::post(m.io, [&m, client, level, message] {
     for (const auto& s : m.sessions) {
       if (s->name() == client) s->tell(level, message);
+    }
+  });
+}
+
+void WebServer::set_parameters(std::vector<foxglove::Parameter> values) {
+  Impl& m = *impl_;
+  asio::post(m.io, [&m, values = std::move(values)] {
+    std::vector<foxglove::Parameter> changed;
+    for (const foxglove::Parameter& p : values) {
+      const auto it = m.parameters.find(p.name);
+      if (p.value.is_null()) {
+        if (it == m.parameters.end()) continue;
+        m.parameters.erase(it);
+      } else if (it != m.parameters.end() && it->second == p.value) {
+        continue;
+      } else {
+        m.parameters[p.name] = p.value;
+      }
+      changed.push_back(p);
+    }
+    if (changed.empty()) return;
+    for (const auto& s : m.sessions) s->parameters_changed(changed);
+  });
+}
+
+void WebServer::answer_parameters(const std::string& client, std::vector<std::string> names, std::optional<std::string> id) {
+  Impl& m = *impl_;
+  asio::post(m.io, [&m, client, names = std::move(names), id = std::move(id)] {
+    for (const auto& s : m.sessions) {
+      if (s->name() == client) s->answer_parameters(names, id);
     }
   });
 }

@@ -63,6 +63,13 @@ class WebServer {
         on_client_message;
     /// A client's socket closed (for a dead man's switch).
     std::function<void(const std::string& client)> on_client_gone;
+    /// A client asks to set parameters (setParameters, with its request id if any). The
+    /// owner tries them and answers with answer_parameters(), and set_parameters() for
+    /// what changed. Null: the server has no parameters ("parameters" and
+    /// "parametersSubscribe" are not among its capabilities).
+    std::function<void(const std::string& client, const std::vector<foxglove::Parameter>& parameters,
+                       const std::optional<std::string>& id)>
+        on_set_parameters;
   };
 
   /// Binds and starts serving. Throws std::invalid_argument for an empty token and
@@ -84,6 +91,14 @@ class WebServer {
   /// Waits until everything published so far has been written to every client (or
   /// dropped for one that did not keep up), at most `timeout`; returns whether it was.
   bool flush(std::chrono::milliseconds timeout);
+  /// The parameters' current values, replacing those of the same names (a null value
+  /// removes one); each client subscribed to one that changed gets a parameterValues.
+  /// getParameters is answered from these. Never blocks.
+  void set_parameters(std::vector<foxglove::Parameter> values);
+  /// Sends one client (by the name Handlers get) the current values of `names` (every
+  /// parameter when empty; unknown names left out) with its request's `id`: the answer
+  /// to a setParameters, after any set_parameters() made before this call.
+  void answer_parameters(const std::string& client, std::vector<std::string> names, std::optional<std::string> id);
   /// Sends a status message to one client (by the name Handlers get), if still there.
   void tell(const std::string& client, foxglove::Level level, const std::string& message);
   /// Clients connected now.

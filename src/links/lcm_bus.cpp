@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <limits>
 #include <type_traits>
+#include <utility>
 
 namespace rilbed::links {
 
@@ -43,6 +44,7 @@ Channels Channels::with_prefix(const std::string& prefix) {
   c.detections = prefix + c.detections;
   c.frames = prefix + c.frames;
   c.camera = prefix + c.camera;
+  c.vision = prefix + c.vision;
   c.sensor_layout = prefix + c.sensor_layout;
   return c;
 }
@@ -197,6 +199,18 @@ rilbed::detections_t to_lcm(const agents::FrameReport& f) {
     x.theta_rad = d.pose.heading_rad;
     m.detections.push_back(x);
   }
+  return m;
+}
+
+rilbed::vision_settings_t to_lcm(TimeUs t_us, const vision::VisionSettings& s) {
+  rilbed::vision_settings_t m;
+  m.utime = t_us;
+  m.brightness = s.brightness;
+  m.contrast = s.contrast;
+  m.threshold = s.threshold;
+  m.min_diameter_px = s.min_diameter_px;
+  m.max_diameter_px = s.max_diameter_px;
+  m.min_score = s.min_score;
   return m;
 }
 
@@ -392,7 +406,9 @@ std::optional<std::string> RunReportDecoder::decode(const std::string& channel, 
     rilbed::status_t m;
     if (!decode_checked(data, size, m)) return bad("status_t");
     last_status_ = m;
-    observer_.on_status(from_lcm(m));
+    agents::StatusReport status = from_lcm(m);
+    status.vision = std::exchange(vision_, std::nullopt);
+    observer_.on_status(status);
   } else if (channel == channels_.world) {
     rilbed::world_t m;
     if (!decode_checked(data, size, m)) return bad("world_t");
@@ -435,6 +451,18 @@ std::optional<std::string> RunReportDecoder::decode(const std::string& channel, 
     }
     sensor_geometries_ = std::move(geometries);
     sensor_geometry_of_ = std::move(of);
+  } else if (channel == channels_.vision) {
+    rilbed::vision_settings_t m;
+    if (!decode_checked(data, size, m)) return bad("vision_settings_t");
+    vision::VisionSettings s;
+    s.brightness = m.brightness;
+    s.contrast = m.contrast;
+    s.threshold = m.threshold;
+    s.min_diameter_px = m.min_diameter_px;
+    s.max_diameter_px = m.max_diameter_px;
+    s.min_score = m.min_score;
+    if (auto why = vision::check_vision_settings(s)) return channel + ": " + *why;
+    vision_ = s;
   } else if (channel == channels_.camera) {
     rilbed::camera_t m;
     if (!decode_checked(data, size, m)) return bad("camera_t");
@@ -732,6 +760,8 @@ void LcmRunPublisher::on_event(const agents::RunEvent& event) {
 
 void LcmRunPublisher::on_status(const agents::StatusReport& status) {
   if (!heard()) return;
+  // The settings first: a decoder hands them on with the status that follows.
+  if (status.vision) publish(channels_.vision, to_lcm(status.t_us, *status.vision));
   publish(channels_.status, to_lcm(status));
   if (options_.log) std::fflush(options_.log->getFilePtr());  // a run cut short keeps its log up to the last second
 }

@@ -28,6 +28,7 @@
 #include "rilbed/poses_t.hpp"
 #include "rilbed/sensors_t.hpp"
 #include "rilbed/status_t.hpp"
+#include "rilbed/vision_settings_t.hpp"
 #include "rilbed/summary_t.hpp"
 #include "rilbed/wheels_t.hpp"
 #include "rilbed/world_t.hpp"
@@ -67,6 +68,7 @@ struct Channels {
   std::string frames = "RILBED_FRAMES";    ///< rilbed::frame_t (JPEG), every camera frame, only when asked for
   std::string camera = "RILBED_CAMERA";    ///< rilbed::camera_t, before each world_t of a run with a camera
   std::string sensor_layout = "RILBED_SENSOR_LAYOUT";  ///< rilbed::sensor_layout_t, before each world_t
+  std::string vision = "RILBED_VISION";    ///< rilbed::vision_settings_t, before each status_t of a run with a camera
   std::string console = "RILBED_CONSOLE";  ///< rilbed::console_command_t, from consoles
   std::string console_reply = "RILBED_CONSOLE_REPLY";  ///< rilbed::console_reply_t, the run's answers
   /// The same names behind `prefix`.
@@ -96,6 +98,8 @@ rilbed::detections_t to_lcm(const agents::FrameReport& frame);
 rilbed::frame_t to_lcm(TimeUs t_us, std::int64_t frame, const cv::Mat& image, int quality);
 /// The camera's mapping onto the field.
 rilbed::camera_t to_lcm(TimeUs t_us, const agents::CameraReport& camera);
+/// The camera's vision settings.
+rilbed::vision_settings_t to_lcm(TimeUs t_us, const vision::VisionSettings& settings);
 /// The robots' sensor geometry (from a world's sensor_geometries and sensor_geometry_of).
 rilbed::sensor_layout_t sensor_layout(TimeUs t_us, const agents::WorldReport& world);
 
@@ -128,6 +132,7 @@ class RunReportDecoder {
   std::optional<agents::CameraReport> camera_;  // the last camera_t, for the next world_t
   std::vector<agents::SensorGeometry> sensor_geometries_;  // the last sensor_layout_t, for the next world_t
   std::map<int, int> sensor_geometry_of_;
+  std::optional<vision::VisionSettings> vision_;  // the last vision_settings_t, for the next status_t
 };
 
 /// Reads an LCM log (the format lcm-logger and `rilbed run --record` write) with every

@@ -203,6 +203,13 @@ void fields(Walk& w, const rilbed::camera_t*) {
   w.string();
 }
 
+void fields(Walk& w, const rilbed::vision_settings_t*) {
+  w.i64();
+  w.skip(2 * 8);
+  w.i32();
+  w.skip(3 * 8);
+}
+
 void fields(Walk& w, const rilbed::sensor_geometry_t*) {
   w.f64();
   const std::int32_t ranges = w.count(w.i32(), 3 * 8);
@@ -243,5 +250,6 @@ template bool well_formed<rilbed::detections_t>(const void*, std::size_t);
 template bool well_formed<rilbed::frame_t>(const void*, std::size_t);
 template bool well_formed<rilbed::camera_t>(const void*, std::size_t);
 template bool well_formed<rilbed::sensor_layout_t>(const void*, std::size_t);
+template bool well_formed<rilbed::vision_settings_t>(const void*, std::size_t);
 
 }  // namespace rilbed::links

@@ -25,6 +25,7 @@
 #include "rilbed/poses_t.hpp"
 #include "rilbed/sensors_t.hpp"
 #include "rilbed/status_t.hpp"
+#include "rilbed/vision_settings_t.hpp"
 #include "rilbed/summary_t.hpp"
 #include "rilbed/wheels_t.hpp"
 #include "rilbed/world_t.hpp"

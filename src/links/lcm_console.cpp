@@ -1,6 +1,7 @@
 #include "links/lcm_console.hpp"
 
 #include "links/lcm_checked.hpp"
+#include "vision/vision_settings.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -143,8 +144,28 @@ std::variant<agents::ControlAction, std::string> parse_console_command(const ril
     a.duration_s = s;
     return a;
   }
+  if (c.command == "vision") {
+    if (args == 0 || args % 2 != 0 || args > 2 * vision::kVisionSettingNames.size()) {
+      return std::string("'vision' takes NAME VALUE pairs (brightness, contrast, threshold, min_diameter_px, "
+                         "max_diameter_px, min_score)");
+    }
+    vision::VisionSettings ranges;  // each value checked against its range here, the whole by the run
+    for (std::size_t i = 0; i < args; i += 2) {
+      const std::string& name = c.args[i];
+      char* end = nullptr;
+      const double value = std::strtod(c.args[i + 1].c_str(), &end);
+      if (end == c.args[i + 1].c_str() || *end != '\0') return "'" + c.args[i + 1] + "' is not a number";
+      if (auto why = vision::set_vision_setting(ranges, name, value)) return *why;
+      for (const auto& [earlier, v] : a.vision) {
+        if (earlier == name) return "'" + name + "' is given twice";
+      }
+      a.vision.emplace_back(name, value);
+    }
+    a.kind = agents::ControlAction::Kind::kVision;
+    return a;
+  }
   return "unknown command '" + c.command + "' (pause, resume, exit, reset, rt-factor F, mode central|distributed, "
-         "drive ID LEFT RIGHT --for S)";
+         "drive ID LEFT RIGHT --for S, vision NAME VALUE...)";
 }
 
 namespace {

@@ -63,9 +63,13 @@ struct BlobDetector::Fill {
   bool too_large = false;
 };
 
-BlobDetector::BlobDetector(BlobDetectorConfig config) : config_(config) {
-  config_.tile_px = std::max(2, config_.tile_px);
-  config_.min_diameter_px = std::max(6.0, config_.min_diameter_px);
+BlobDetector::BlobDetector(BlobDetectorConfig config) { set_config(config); }
+
+void BlobDetector::set_config(BlobDetectorConfig config) {
+  config.tile_px = std::max(2, config.tile_px);
+  config.min_diameter_px = std::max(6.0, config.min_diameter_px);
+  if (config.tile_px != config_.tile_px) size_ = cv::Size();  // the tiles are laid out again
+  config_ = config;
 }
 
 void BlobDetector::prepare(const cv::Mat& grey) {

@@ -106,6 +106,8 @@ class BlobDetector {
   std::vector<Blob> detect(const cv::Mat& grey) { return detect(grey, cv::Rect(0, 0, grey.cols, grey.rows)); }
 
   const BlobDetectorConfig& config() const { return config_; }
+  /// New knobs from the next frame on (a person tuning the search while it runs).
+  void set_config(BlobDetectorConfig config);
   /// Flood fills started since the last call of this function (work done, for stats).
   int take_fill_count() { return std::exchange(fill_count_, 0); }
 

@@ -5,7 +5,9 @@
 namespace rilbed::vision {
 
 FieldTracker::FieldTracker(MarkerFamily family, std::vector<int> ids, FieldCalibration calibration, TrackerConfig config)
-    : tracker_(std::move(family), std::move(ids), config), calibration_(std::move(calibration)) {
+    : tracker_(std::move(family), std::move(ids), config),
+      calibration_(std::move(calibration)),
+      settings_(vision_settings_of(config)) {
   if (const std::string problem = validate_field_calibration(calibration_); !problem.empty()) {
     throw std::invalid_argument("field calibration: " + problem);
   }
@@ -17,8 +19,9 @@ std::vector<FieldObservation> FieldTracker::process(const cv::Mat& frame) {
                                 " pixels, but the field calibration is for " + std::to_string(calibration_.image_size.width) +
                                 "x" + std::to_string(calibration_.image_size.height));
   }
+  seen_ = adjust_frame(frame, settings_, adjusted_);
   std::vector<FieldObservation> out;
-  for (const MarkerDetection& d : tracker_.process(frame)) {
+  for (const MarkerDetection& d : tracker_.process(seen_)) {
     FieldObservation o;
     o.id = d.id;
     o.pose.position_m = pixel_to_field(calibration_, d.u, d.v);
@@ -28,6 +31,12 @@ std::vector<FieldObservation> FieldTracker::process(const cv::Mat& frame) {
     out.push_back(o);
   }
   return out;
+}
+
+void FieldTracker::set_settings(const VisionSettings& settings) {
+  if (auto why = check_vision_settings(settings)) throw std::invalid_argument("vision settings: " + *why);
+  settings_ = settings;
+  tracker_.set_config(with_vision_settings(tracker_.config(), settings));
 }
 
 }  // namespace rilbed::vision

@@ -80,10 +80,24 @@ MarkerTracker::MarkerTracker(MarkerFamily family, std::vector<int> ids, TrackerC
       detector_(config.blobs),
       decoder_(family_, decoder_ids(family_, ids_), config.decoder),
       confirm_decoder_(family_, ids_, confirm_config(config)) {
+  index_decoder();
+}
+
+void MarkerTracker::index_decoder() {
+  decoder_index_.clear();
   for (int id : ids_) {
     const auto& all = decoder_.ids();
     decoder_index_.push_back(static_cast<int>(std::find(all.begin(), all.end(), id) - all.begin()));
   }
+}
+
+void MarkerTracker::set_config(const TrackerConfig& config) {
+  config_ = config;
+  detector_.set_config(config.blobs);
+  decoder_ = Decoder(family_, decoder_ids(family_, ids_), config.decoder);
+  confirm_decoder_ = Decoder(family_, ids_, confirm_config(config));
+  index_decoder();
+  reset();
 }
 
 void MarkerTracker::reset() {

@@ -152,6 +152,12 @@ class MarkerTracker {
   /// The IDs this tracker assigns.
   const std::vector<int>& ids() const { return ids_; }
   const TrackerConfig& config() const { return config_; }
+  /// New knobs from the next frame on (a person tuning the pipeline while it runs). The
+  /// tracks are forgotten, so that the next frame finds every marker afresh under the new
+  /// knobs (a tracked marker is only spot-checked, not held to the size limits and the
+  /// least score again); that frame costs a full search. Rebuilds the decoders (a
+  /// fraction of a millisecond).
+  void set_config(const TrackerConfig& config);
 
  private:
   struct Track {
@@ -188,6 +194,8 @@ class MarkerTracker {
   // The tracked marker re-found by the edge fit around its prediction, confirmed.
   std::optional<MarkerDetection> confirm_by_edges(const cv::Mat& grey, const Track& track);
   cv::Mat to_grey(const cv::Mat& frame);
+  // decoder_index_ for decoder_.
+  void index_decoder();
 
   MarkerFamily family_;
   std::vector<int> ids_;

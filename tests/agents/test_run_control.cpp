@@ -106,6 +106,19 @@ TEST(RunControl, DriveTakesARobotByHandThenGivesItBack) {
   EXPECT_GE(by_hand, 13);
 }
 
+TEST(RunControl, ARunWithoutACameraHasNoVisionSettings) {
+  RunControl control;
+  Script script;
+  ControlAction tune = action(ControlAction::Kind::kVision);
+  tune.vision = {{"contrast", 1.5}};
+  script.actions = {{500'000, tune}};
+  run_with(shipped("convoy_sim"), script, control, 2.0);
+  ASSERT_EQ(script.answers.size(), 1u);
+  EXPECT_EQ(script.answers[0], "this run has no camera, so no vision settings");
+  ASSERT_FALSE(script.statuses.empty());
+  for (const StatusReport& s : script.statuses) EXPECT_FALSE(s.vision.has_value());
+}
+
 TEST(RunControl, ModeSwitchesBothWaysAndTheConvoyStillForms) {
   RunControl control;
   Script script;

@@ -135,6 +135,24 @@ TEST(Scenario, RealRobotsCarryTheirLink) {
       << uncalibrated;
 }
 
+TEST(Scenario, TheCameraStartsWithTheVisionSettingsGiven) {
+  const std::string real = "robots:\n  - id: 4\n    kind: real\n    link: {emulate: true}\n";
+  const Scenario s = parse_scenario("camera: {emulate: true, vision: {contrast: 1.5, threshold: 30, min_score: 0.7}}\n" + real, "v.yaml");
+  ASSERT_TRUE(s.camera.has_value());
+  vision::VisionSettings expected;
+  expected.contrast = 1.5;
+  expected.threshold = 30;
+  expected.min_score = 0.7;
+  EXPECT_EQ(s.camera->vision, expected);
+  EXPECT_EQ(parse_scenario("camera: {emulate: true}\n" + real, "v.yaml").camera->vision, vision::VisionSettings{});
+  const std::string range = error_of("camera: {emulate: true, vision: {contrast: 9}}\n" + real);
+  EXPECT_NE(range.find("camera.vision.contrast: contrast 9 is outside 0.2..5"), std::string::npos) << range;
+  const std::string sizes = error_of("camera: {emulate: true, vision: {min_diameter_px: 500}}\n" + real);
+  EXPECT_NE(sizes.find("min_diameter_px 500 is not below max_diameter_px 480"), std::string::npos) << sizes;
+  const std::string unknown = error_of("camera: {emulate: true, vision: {gamma: 2}}\n" + real);
+  EXPECT_NE(unknown.find("gamma"), std::string::npos) << unknown;
+}
+
 TEST(Scenario, RandomPosesAreFreeAndReproducible) {
   const Scenario s = parse_scenario(kMinimal, "tiny.yaml");
   std::mt19937_64 a(5), b(5), c(6);

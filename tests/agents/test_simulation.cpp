@@ -187,7 +187,9 @@ TEST(Simulation, StatusLineOncePerSimulatedSecond) {
       const double t_s = std::stod(lines[k].substr(2));
       EXPECT_GE(t_s, static_cast<double>(k) - 0.05) << lines[k];
       EXPECT_LT(t_s, static_cast<double>(k) + us_to_seconds(period_us) + 0.05) << lines[k];
-      if (k > 0) EXPECT_NE(lines[k].substr(0, lines[k].find(' ')), lines[k - 1].substr(0, lines[k - 1].find(' ')));
+      if (k > 0) {
+        EXPECT_NE(lines[k].substr(0, lines[k].find(' ')), lines[k - 1].substr(0, lines[k - 1].find(' ')));
+      }
     }
   }
 }

@@ -226,13 +226,18 @@ TEST(LcmCli, TheConsoleDrivesARobotSwitchesTheModeAndResetsTheRun) {
       "set +e\n"
       "for i in $(seq 1 100); do \"$R\" console --lcm \"$URL\" --timeout-ms 200 --token x pause 2>/dev/null; "
       "grep -q 'refused' run.err && break; sleep 0.1; done\n"
-      // A real (emulated) robot driven by hand, backwards on one wheel.
-      "\"$R\" console --lcm \"$URL\" drive 4 30 -30 --for 1 > d1.txt 2>&1; echo \"drive $?\" >> codes.txt\n"
+      // A real (emulated) robot driven by hand, backwards on one wheel. The console answers
+      // before the run has placed its robots and started: ask until the run itself answers.
+      "for i in $(seq 1 300); do \"$R\" console --lcm \"$URL\" drive 4 30 -30 --for 1 > d1.txt 2>&1; c=$?; "
+      "grep -q 'no run is running' d1.txt || break; sleep 0.1; done\n"
+      "echo \"drive $c\" >> codes.txt\n"
       "\"$R\" console --lcm \"$URL\" drive 42 30 30 --for 1 > d2.txt 2>&1; echo \"drive-none $?\" >> codes.txt\n"
       "\"$R\" console --lcm \"$URL\" drive 4 30 30 > d3.txt 2>&1; echo \"drive-nofor $?\" >> codes.txt\n"
       "\"$R\" console --lcm \"$URL\" mode central > m1.txt 2>&1; echo \"central $?\" >> codes.txt\n"
       "\"$R\" console --lcm \"$URL\" mode central > m2.txt 2>&1; echo \"central-again $?\" >> codes.txt\n"
       "\"$R\" console --lcm \"$URL\" mode distributed > m3.txt 2>&1; echo \"distributed $?\" >> codes.txt\n"
+      "\"$R\" console --lcm \"$URL\" vision threshold 30 contrast 1.2 > v1.txt 2>&1; echo \"vision $?\" >> codes.txt\n"
+      "\"$R\" console --lcm \"$URL\" vision contrast 9 > v2.txt 2>&1; echo \"vision-bad $?\" >> codes.txt\n"
       "\"$R\" console --lcm \"$URL\" reset > r1.txt 2>&1; echo \"reset $?\" >> codes.txt\n"
       // The run starts over (its real robots placed again): ask until the new one answers.
       "for i in $(seq 1 300); do \"$R\" console --lcm \"$URL\" --timeout-ms 300 exit > e1.txt 2>&1 && break; sleep 0.1; done\n"
@@ -242,13 +247,14 @@ TEST(LcmCli, TheConsoleDrivesARobotSwitchesTheModeAndResetsTheRun) {
   ASSERT_EQ(status, 0) << read_file(dir / "ns.log");
   const std::string codes = read_file(dir / "codes.txt");
   for (const char* line : {"drive 0", "drive-none 1", "drive-nofor 2", "central 0", "central-again 1", "distributed 0",
-                           "reset 0", "exit 0", "run 0", "replay 0"}) {
+                           "vision 0", "vision-bad 1", "reset 0", "exit 0", "run 0", "replay 0"}) {
     EXPECT_NE(codes.find(line), std::string::npos) << line << "\n" << codes << read_file(dir / "run.err");
   }
   EXPECT_NE(read_file(dir / "d1.txt").find("accepted: drive 4 30 -30 1"), std::string::npos) << read_file(dir / "d1.txt");
   EXPECT_NE(read_file(dir / "d2.txt").find("refused: this run has no robot 42"), std::string::npos);
   EXPECT_NE(read_file(dir / "d3.txt").find("drive takes ID LEFT RIGHT and --for SECONDS"), std::string::npos);
   EXPECT_NE(read_file(dir / "m2.txt").find("refused: the convoy is in central mode already"), std::string::npos);
+  EXPECT_NE(read_file(dir / "v2.txt").find("refused: contrast 9 is outside 0.2..5"), std::string::npos) << read_file(dir / "v2.txt");
   const std::string err = read_file(dir / "run.err");
   EXPECT_NE(err.find("reset from the console: the run starts over"), std::string::npos) << err;
   // The folder holds the run that went on to its end; the recording holds both.
@@ -262,7 +268,7 @@ TEST(LcmCli, TheConsoleDrivesARobotSwitchesTheModeAndResetsTheRun) {
   std::ifstream rec(dir / "rec.lcm", std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(rec)), std::istreambuf_iterator<char>());
   for (const char* text : {"robot 4 driven 30 -30 for 1 s by ", "mode central set by ", "mode distributed set by ",
-                           "reset by "}) {
+                           "vision threshold 30 contrast 1.2 set by ", "reset by ", "RILBED_VISION"}) {
     EXPECT_NE(bytes.find(text), std::string::npos) << text;
   }
   fs::remove_all(dir);
@@ -278,8 +284,10 @@ TEST(LcmCli, TheConsoleSteersARunAndPauseStopsItsRealRobots) {
       // The run answers once it is up: ask until it does (a refused command proves it is there).
       "for i in $(seq 1 100); do \"$R\" console --lcm \"$URL\" --timeout-ms 200 --token x pause 2>/dev/null; "
       "grep -q 'refused' run.err && break; sleep 0.1; done\n"
-      "sleep 2\n"
-      "\"$R\" console --lcm \"$URL\" pause > c1.txt 2>&1; echo \"pause $?\" >> codes.txt\n"
+      // The console answers before the run has placed its robots: pause once the run itself answers.
+      "for i in $(seq 1 300); do \"$R\" console --lcm \"$URL\" pause > c1.txt 2>&1; c=$?; "
+      "grep -q 'no run is running' c1.txt || break; sleep 0.1; done\n"
+      "echo \"pause $c\" >> codes.txt\n"
       "sleep 1.5\n"
       "\"$R\" console --lcm \"$URL\" resume > c2.txt 2>&1; echo \"resume $?\" >> codes.txt\n"
       "\"$R\" console --lcm \"$URL\" rt-factor 2 > c3.txt 2>&1; echo \"rt $?\" >> codes.txt\n"

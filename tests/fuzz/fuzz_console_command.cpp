@@ -9,7 +9,8 @@
 //   - a command is accepted only with the run's token, and only when parse_console_command
 //     accepts it; an accepted command reaches the run as exactly one action of its kind,
 //     with its arguments in range (rt-factor finite and above 0; drive: speeds within
-//     -127..127, seconds in (0, 600]); a wrong token reaches it as one "refused" record;
+//     -127..127, seconds in (0, 600]; vision: known names, once each, values in range);
+//     a wrong token reaches it as one "refused" record;
 //   - sent again (a retry after a loss), it gets the same reply and nothing more happens.
 #include <cmath>
 #include <cstdint>
@@ -110,6 +111,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       FUZZ_CHECK(a.robot_id >= 0 && std::abs(a.left) <= 127 && std::abs(a.right) <= 127);
       FUZZ_CHECK(std::isfinite(a.duration_s) && a.duration_s > 0.0 && a.duration_s <= 600.0);
       break;
+    case Kind::kVision: {
+      FUZZ_CHECK(c.command == "vision" && !a.vision.empty() && c.args.size() == 2 * a.vision.size());
+      vision::VisionSettings s;
+      for (std::size_t i = 0; i < a.vision.size(); ++i) {
+        FUZZ_CHECK(a.vision[i].first == c.args[2 * i]);
+        FUZZ_CHECK(!vision::set_vision_setting(s, a.vision[i].first, a.vision[i].second));
+        for (std::size_t j = 0; j < i; ++j) FUZZ_CHECK(a.vision[j].first != a.vision[i].first);
+      }
+      break;
+    }
     case Kind::kRefused: broken("an accepted command became a refusal");
   }
   return 0;

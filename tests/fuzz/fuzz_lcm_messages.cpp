@@ -57,11 +57,11 @@ const std::vector<std::string>& channel_names() {
   static const std::vector<std::string> names = [] {
     const links::Channels c = links::Channels::with_prefix("");
     return std::vector<std::string>{c.poses,   c.events,     c.status, c.world,         c.summary,
-                                    c.wheels,  c.sensors,    c.detections, c.frames, c.camera, c.sensor_layout, "RILBED_UNKNOWN"};
+                                    c.wheels,  c.sensors,    c.detections, c.frames, c.camera, c.sensor_layout, c.vision, "RILBED_UNKNOWN"};
   }();
   return names;
 }
-enum Pick { kPoses, kEvents, kStatus, kWorld, kSummary, kWheels, kSensors, kDetections, kFrames, kCamera, kSensorLayout, kUnknown, kPicks };
+enum Pick { kPoses, kEvents, kStatus, kWorld, kSummary, kWheels, kSensors, kDetections, kFrames, kCamera, kSensorLayout, kVision, kUnknown, kPicks };
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
@@ -78,6 +78,7 @@ bool has_nul(const rilbed::sensors_t&) { return false; }
 bool has_nul(const rilbed::detections_t&) { return false; }
 bool has_nul(const rilbed::frame_t& m) { return has_nul(m.format); }
 bool has_nul(const rilbed::camera_t& m) { return has_nul(m.source); }
+bool has_nul(const rilbed::vision_settings_t&) { return false; }
 bool has_nul(const rilbed::sensor_layout_t&) { return false; }
 bool has_nul(const rilbed::poses_t& m) {
   for (const rilbed::robot_pose_t& r : m.robots) {
@@ -306,7 +307,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     FUZZ_CHECK(problem->rfind(g_channel + ": ", 0) == 0);
   } else {
     // A camera is kept for the next world (which carries it): no call of its own.
-    FUZZ_CHECK(seen.calls.total() == (pick == kUnknown || pick == kCamera || pick == kSensorLayout ? 0 : 1));
+    FUZZ_CHECK(seen.calls.total() == (pick == kUnknown || pick == kCamera || pick == kSensorLayout || pick == kVision ? 0 : 1));
   }
   FUZZ_CHECK(decoder.summary_seen() == (seen.calls.summary == 1));
   FUZZ_CHECK(decoder.last_status().has_value() == (seen.calls.status == 1));
@@ -388,6 +389,33 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       FUZZ_CHECK(c.width_px == m.width_px && c.height_px == m.height_px && c.lens_distortion == (m.lens_distortion != 0));
       for (int i = 0; i < 9; ++i) FUZZ_CHECK(same_bits(c.image_to_field[static_cast<std::size_t>(i)], m.image_to_field[i]));
       FUZZ_CHECK(c.source == m.source);
+      break;
+    }
+    case kVision: {
+      // Accepted exactly when the bytes are a vision_settings_t that check_vision_settings
+      // takes; the next status (and only it) then carries the settings.
+      rilbed::vision_settings_t m;
+      if (problem && refused_before_decoding<rilbed::vision_settings_t>(message, length)) break;
+      const bool readable = generated_decode(message, length, m);
+      vision::VisionSettings s;
+      s.brightness = m.brightness;
+      s.contrast = m.contrast;
+      s.threshold = m.threshold;
+      s.min_diameter_px = m.min_diameter_px;
+      s.max_diameter_px = m.max_diameter_px;
+      s.min_score = m.min_score;
+      const bool usable = readable && !vision::check_vision_settings(s);
+      FUZZ_CHECK(usable == !problem);
+      if (problem) break;
+      check_round_trip(m, message, length);
+      rilbed::status_t status;
+      std::vector<std::uint8_t> bytes(static_cast<std::size_t>(status.getEncodedSize()));
+      FUZZ_CHECK(status.encode(bytes.data(), 0, static_cast<int>(bytes.size())) > 0);
+      const std::string channel = links::Channels::with_prefix("").status;
+      FUZZ_CHECK(!decoder.decode(channel, bytes.data(), bytes.size()));
+      FUZZ_CHECK(seen.calls.status == 1 && seen.last_status.vision == s);
+      FUZZ_CHECK(!decoder.decode(channel, bytes.data(), bytes.size()));
+      FUZZ_CHECK(seen.calls.status == 2 && !seen.last_status.vision);
       break;
     }
     case kSensorLayout: {

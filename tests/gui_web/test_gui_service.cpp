@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <map>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -37,6 +39,8 @@ struct RecordingSink {
       if (r.command == "pause") return ConsoleAnswer{true, "pause"};
       if (r.command == "drive" && r.args.at(0) == "99") return ConsoleAnswer{false, "this run has no robot 99"};
       if (r.command == "drive") return ConsoleAnswer{true, "drive"};
+      if (r.command == "vision" && r.args.size() >= 2 && r.args[1] == "9") return ConsoleAnswer{false, "contrast 9 is outside 0.2..5"};
+      if (r.command == "vision") return ConsoleAnswer{true, "vision"};
       return ConsoleAnswer{false, "unknown command '" + r.command + "'"};
     };
   }
@@ -267,6 +271,103 @@ TEST(GuiService, DestroyingTheServiceStopsEveryHeldRobot) {
   }
   EXPECT_EQ(run.drives(1).back(), "0 0");
   EXPECT_EQ(run.drives(2).back(), "0 0");
+}
+
+// The next text message with this op (binary data and other text skipped).
+json next_op(Client& c, const std::string& op) {
+  for (;;) {
+    const auto m = c.next();
+    if (std::holds_alternative<json>(m) && std::get<json>(m).value("op", "") == op) return std::get<json>(m);
+  }
+}
+
+// parameterValues' list as name -> value.
+std::map<std::string, json> values_of(const json& parameter_values) {
+  std::map<std::string, json> out;
+  for (const auto& p : parameter_values["parameters"]) out[p["name"].get<std::string>()] = p.contains("value") ? p["value"] : json();
+  return out;
+}
+
+agents::StatusReport status_with(std::optional<vision::VisionSettings> settings) {
+  agents::StatusReport s;
+  s.state = "running";
+  s.vision = settings;
+  return s;
+}
+
+TEST(GuiService, VisionSettingsAreParametersTheRunSetsAndReports) {
+  RecordingSink run;
+  GuiService gui(config(), run.sink());
+  Client viewer;
+  ASSERT_EQ(viewer.connect(gui.server().port(), "/ws?token=" + kToken), 101);
+  const json info = viewer.next_json();
+  for (const char* capability : {"parameters", "parametersSubscribe", "clientPublish"}) {
+    EXPECT_NE(std::find(info["capabilities"].begin(), info["capabilities"].end(), capability), info["capabilities"].end())
+        << capability << " " << info.dump();
+  }
+  // No camera yet: no parameters. (The answer also says the subscription has been read.)
+  viewer.send_text({{"op", "subscribeParameterUpdates"}, {"parameterNames", {"vision.contrast"}}});
+  viewer.send_text({{"op", "getParameters"}, {"parameterNames", json::array()}, {"id", "a"}});
+  json answer = next_op(viewer, "parameterValues");
+  EXPECT_EQ(answer["id"], "a");
+  EXPECT_TRUE(answer["parameters"].empty());
+  // A run with a camera reports its settings with its status.
+  gui.on_status(status_with(vision::VisionSettings{}));
+  json update = next_op(viewer, "parameterValues");
+  EXPECT_FALSE(update.contains("id"));
+  EXPECT_EQ(values_of(update), (std::map<std::string, json>{{"vision.contrast", 1.0}}));  // only what it subscribed to
+  viewer.send_text({{"op", "getParameters"}, {"parameterNames", json::array()}, {"id", "b"}});
+  answer = next_op(viewer, "parameterValues");
+  EXPECT_EQ(answer["id"], "b");
+  auto values = values_of(answer);
+  EXPECT_EQ(values.size(), 6u);
+  EXPECT_EQ(values["vision.threshold"], 24.0);
+  EXPECT_EQ(values["vision.min_score"], 0.75);
+
+  // Setting two at once is one console command; the answer carries the request's id.
+  viewer.send_text({{"op", "setParameters"},
+                    {"parameters", {{{"name", "vision.contrast"}, {"value", 1.5}}, {{"name", "vision.threshold"}, {"value", 30}}}},
+                    {"id", "c"}});
+  update = next_op(viewer, "parameterValues");
+  EXPECT_FALSE(update.contains("id"));  // the subscribed change first
+  EXPECT_EQ(values_of(update)["vision.contrast"], 1.5);
+  answer = next_op(viewer, "parameterValues");
+  EXPECT_EQ(answer["id"], "c");
+  EXPECT_EQ(values_of(answer), (std::map<std::string, json>{{"vision.contrast", 1.5}, {"vision.threshold", 30.0}}));
+  auto calls = run.snapshot();
+  ASSERT_EQ(calls.size(), 1u);
+  EXPECT_EQ(calls[0].request.command, "vision");
+  EXPECT_EQ(calls[0].request.args, (std::vector<std::string>{"contrast", "1.5", "threshold", "30"}));
+
+  // Refused by the run: an error status, and the values as they are.
+  viewer.send_text({{"op", "setParameters"}, {"parameters", {{{"name", "vision.contrast"}, {"value", 9}}}}, {"id", "d"}});
+  const json refusal = next_op(viewer, "status");
+  EXPECT_EQ(refusal["level"], 2);
+  EXPECT_NE(refusal["message"].get<std::string>().find("contrast 9 is outside 0.2..5"), std::string::npos) << refusal.dump();
+  answer = next_op(viewer, "parameterValues");
+  EXPECT_EQ(answer["id"], "d");
+  EXPECT_EQ(values_of(answer)["vision.contrast"], 1.5);
+
+  // Not a vision setting, or not a number: refused here, the run never hears of it.
+  viewer.send_text({{"op", "setParameters"}, {"parameters", {{{"name", "gamma"}, {"value", 2}}}}, {"id", "e"}});
+  EXPECT_NE(next_op(viewer, "status")["message"].get<std::string>().find("unknown parameter 'gamma'"), std::string::npos);
+  EXPECT_EQ(next_op(viewer, "parameterValues")["id"], "e");
+  viewer.send_text({{"op", "setParameters"}, {"parameters", {{{"name", "vision.contrast"}, {"value", "high"}}}}, {"id", "f"}});
+  EXPECT_NE(next_op(viewer, "status")["message"].get<std::string>().find("must be a number"), std::string::npos);
+  EXPECT_EQ(next_op(viewer, "parameterValues")["id"], "f");
+  EXPECT_EQ(run.snapshot().size(), 2u);
+
+  // A console elsewhere changed them: the status brings the news to subscribers.
+  vision::VisionSettings tuned;
+  tuned.contrast = 2.0;
+  gui.on_status(status_with(tuned));
+  EXPECT_EQ(values_of(next_op(viewer, "parameterValues"))["vision.contrast"], 2.0);
+  // A status without a camera (a new run without one) takes them away.
+  gui.on_status(status_with(std::nullopt));
+  update = next_op(viewer, "parameterValues");
+  EXPECT_TRUE(values_of(update)["vision.contrast"].is_null());
+  viewer.send_text({{"op", "getParameters"}, {"parameterNames", json::array()}, {"id", "g"}});
+  EXPECT_TRUE(next_op(viewer, "parameterValues")["parameters"].empty());
 }
 
 }  // namespace

@@ -62,6 +62,24 @@ TEST(LcmConsole, ParsesEveryCommandAndRefusesTheRest) {
   }
 }
 
+TEST(LcmConsole, VisionTakesNameValuePairsInRange) {
+  using Kind = agents::ControlAction::Kind;
+  const auto v = std::get<agents::ControlAction>(parse_console_command(command("vision", {"contrast", "1.5", "threshold", "30"})));
+  EXPECT_EQ(v.kind, Kind::kVision);
+  EXPECT_EQ(v.vision, (std::vector<std::pair<std::string, double>>{{"contrast", 1.5}, {"threshold", 30.0}}));
+  const auto reason = [](const rilbed::console_command_t& c) {
+    const auto parsed = parse_console_command(c);
+    return std::holds_alternative<std::string>(parsed) ? std::get<std::string>(parsed) : std::string("accepted");
+  };
+  EXPECT_EQ(reason(command("vision", {"contrast", "9"})), "contrast 9 is outside 0.2..5");
+  EXPECT_EQ(reason(command("vision", {"contrast", "1", "contrast", "2"})), "'contrast' is given twice");
+  EXPECT_EQ(reason(command("vision", {"contrast", "x"})), "'x' is not a number");
+  EXPECT_NE(reason(command("vision", {"gamma", "1"})).find("unknown vision setting 'gamma'"), std::string::npos);
+  EXPECT_NE(reason(command("vision")).find("takes NAME VALUE pairs"), std::string::npos);
+  EXPECT_NE(reason(command("vision", {"contrast"})).find("takes NAME VALUE pairs"), std::string::npos);
+  EXPECT_EQ(reason(command("vision", {"brightness", "-20"})), "accepted");
+}
+
 TEST(LcmConsole, TheTokenFileIsPrivate) {
   const auto dir = std::filesystem::temp_directory_path() / ("rilbed_token_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
