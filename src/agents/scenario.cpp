@@ -534,4 +534,25 @@ std::vector<int> real_robot_ids(const Scenario& scenario) {
   return ids;
 }
 
+Scenario wandering_scenario(int robots, double seconds, double physics_step_ms, double density_per_m2) {
+  Scenario s;
+  s.name = "wander-" + std::to_string(robots);
+  s.source = "(benchmark)";
+  const double area_m2 = robots / density_per_m2;
+  s.map.field.width_m = std::sqrt(area_m2 * 1.25);
+  s.map.field.height_m = area_m2 / s.map.field.width_m;
+  s.physics_step_us = static_cast<TimeUs>(std::llround(physics_step_ms * 1000));
+  s.control_period_us = 100'000;
+  s.duration_s = seconds;
+  for (int id = 1; id <= robots; ++id) {
+    RobotSpec r;
+    r.id = id;
+    r.controller.name = "wander";
+    r.noise.slip_sd = 0.02;
+    r.sensors.proximity = environment::ProximityConfig{};
+    s.robots.push_back(r);
+  }
+  return s;
+}
+
 }  // namespace rilbed::agents

@@ -121,6 +121,12 @@ Scenario load_scenario(const std::filesystem::path& path);
 /// Parses scenario text (`source_name` is used in messages). Throws ScenarioError.
 Scenario parse_scenario(const std::string& yaml_text, const std::string& source_name);
 
+/// The benchmarks' scenario (sim-bench, bench_gui): `robots` wandering Kheperas with their
+/// eight IR sensors and 2 % wheel slip in a field of `density_per_m2` (the lab's convoy is 8
+/// robots on 1.5 x 1.2 m), 5:4, control period 100 ms, random starts.
+Scenario wandering_scenario(int robots, double seconds, double physics_step_ms = 100.0,
+                            double density_per_m2 = 8.0 / (1.5 * 1.2));
+
 /// Poses for the robots without one: uniformly random in the field, at least
 /// `clearance_m` from walls, obstacles and every other robot, random heading; fixed poses
 /// are kept. Deterministic for a given seed. Throws ScenarioError if the field is too

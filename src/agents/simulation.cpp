@@ -15,6 +15,7 @@
 #include "agents/run_control.hpp"
 #include "agents/run_models.hpp"
 #include "core/id_list.hpp"
+#include "core/statistics.hpp"
 #include "environment/track_sensor.hpp"
 #include "sim/clock.hpp"
 #include "sim/coordinator.hpp"
@@ -310,12 +311,14 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     observer.on_sensors(t, sensor_reports_);
   }
 
-  // The most the control loop fell behind the wall clock, and the camera's frame rate,
-  // over each second between two statuses.
+  // How far the control loop fell behind the wall clock once a step and its reports are
+  // done (each step's, and the most over each second between two statuses), and the
+  // camera's frame rate.
   void measure_loop(TimeUs t) {
     if (s_.clock && !s_.clock->paused()) {
       const double behind_ms = static_cast<double>(s_.clock->now_us() - t) / 1000.0 / s_.clock->factor();
       latency_window_ms_ = std::max(latency_window_ms_, behind_ms);
+      s_.result->loop_latency_ms.push_back(static_cast<float>(behind_ms));
     }
   }
   void close_second() {
@@ -365,8 +368,8 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     if (s_.recorder) s_.recorder->add_samples(samples_);
     if (s_.options->keep_in_memory) r.trajectory.insert(r.trajectory.end(), samples_.begin(), samples_.end());
     if (o) {
-      measure_loop(t);
       if (o->wants_steps()) report_step(t, *o);
+      measure_loop(t);
       if (new_second) {
         next_report_us_ = (t / 1'000'000 + 1) * 1'000'000;
         close_second();
@@ -634,6 +637,11 @@ nlohmann::json RunResult::summary() const {
   j["wall_s"] = wall_s;
   j["run_wall_s"] = run_wall_s;
   j["ended_by"] = ended_by;
+  if (!loop_latency_ms.empty()) {
+    const std::vector<double> ms(loop_latency_ms.begin(), loop_latency_ms.end());
+    j["loop_latency_ms"] = {{"p50", percentile(ms, 0.5)}, {"p99", percentile(ms, 0.99)},
+                            {"max", *std::max_element(ms.begin(), ms.end())}, {"steps", ms.size()}};
+  }
   return j;
 }
 

@@ -506,7 +506,7 @@ int run_command(const RunArgs& args) {
     if (!args.out.empty()) std::printf("run folder: %s\n", args.out.c_str());
     // The page's viewers get the run's end (its last status and summary) before the
     // server goes; their page then says the run ended, not that the server vanished.
-    if (gui) gui->server().flush(std::chrono::seconds(2));
+    if (gui) gui->flush(std::chrono::seconds(2));
   } catch (const agents::ScenarioError& e) {
     spdlog::error("{}", e.what());
     return kExitFailure;

@@ -32,23 +32,9 @@ struct BenchArgs {
 
 // N wandering Kheperas with their eight IR sensors in a field of constant density.
 agents::Scenario bench_scenario(int robots, const BenchArgs& args) {
-  agents::Scenario s;
+  agents::Scenario s = agents::wandering_scenario(robots, args.seconds, args.physics_step_ms, args.density_per_m2);
   s.name = "sim-bench-" + std::to_string(robots);
   s.source = "(sim-bench)";
-  const double area_m2 = robots / args.density_per_m2;
-  s.map.field.width_m = std::sqrt(area_m2 * 1.25);
-  s.map.field.height_m = area_m2 / s.map.field.width_m;
-  s.physics_step_us = static_cast<TimeUs>(std::llround(args.physics_step_ms * 1000));
-  s.control_period_us = 100'000;
-  s.duration_s = args.seconds;
-  for (int id = 1; id <= robots; ++id) {
-    agents::RobotSpec r;
-    r.id = id;
-    r.controller.name = "wander";
-    r.noise.slip_sd = 0.02;
-    r.sensors.proximity = environment::ProximityConfig{};
-    s.robots.push_back(r);
-  }
   return s;
 }
 

@@ -61,6 +61,13 @@ std::string GuiService::url() const {
   return "http://" + config_.bind_address + ":" + std::to_string(server_->port()) + "/?token=" + config_.token;
 }
 
+bool GuiService::flush(std::chrono::milliseconds timeout) {
+  const auto start = Clock::now();
+  if (!channels_->flush(timeout)) return false;
+  const auto left = timeout - std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - start);
+  return server_->flush(std::max(left, std::chrono::milliseconds(0)));
+}
+
 GuiCounters GuiService::counters() const {
   std::lock_guard lock(mutex_);
   return counts_;

@@ -100,6 +100,9 @@ class GuiService final : public agents::RunObserver {
   /// The page's address with its token, for the terminal.
   std::string url() const;
   WebServer& server() { return *server_; }
+  /// Waits until everything the run reported so far has been written to every client (or
+  /// dropped for one that did not keep up), at most about `timeout`; returns whether it was.
+  bool flush(std::chrono::milliseconds timeout);
   GuiCounters counters() const;
 
   // agents::RunObserver: the run's reports, to the channels.

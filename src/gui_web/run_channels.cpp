@@ -165,6 +165,9 @@ RunChannels::RunChannels(WebServer& server) : server_(server) {
                                       {"lens_distortion", boolean()}, {"source", text()}})), /*latched=*/true);
   console_reply_ = server_.add_channel(channel("/rilbed/console_reply", "rilbed.console_reply",
       object_schema("rilbed.console_reply", {{"t_s", number()}, {"accepted", boolean()}, {"reason", text()}, {"client", text()}})));
+  server_.set_latch_source(poses_, [latest = latest_](std::uint64_t& t_ns) { return latest->build(false, t_ns); });
+  server_.set_latch_source(scene_, [latest = latest_](std::uint64_t& t_ns) { return latest->build(true, t_ns); });
+  worker_ = std::thread([this] { work(); });
 }
 
 void RunChannels::send(std::uint32_t channel, TimeUs t_us, const json& message) {
@@ -248,73 +251,179 @@ json RunChannels::scene_json(TimeUs t_us, std::span<const agents::PoseReport> po
   return {{"deletions", json::array()}, {"entities", entities}};
 }
 
-void RunChannels::on_world(TimeUs t_us, const agents::WorldReport& world) {
-  world_report_ = world;
-  if (world.camera) {
-    const agents::CameraReport& c = *world.camera;
-    const auto to_image = inverse(c.image_to_field);
-    send(camera_calibration_, t_us,
-         {{"t_s", seconds(t_us)}, {"width_px", c.width_px}, {"height_px", c.height_px}, {"image_to_field", c.image_to_field},
-          {"field_to_image", to_image ? json(*to_image) : json(nullptr)}, {"lens_distortion", c.lens_distortion},
-          {"source", c.source}});
+RunChannels::~RunChannels() {
+  {
+    std::lock_guard lock(jobs_mutex_);
+    stopping_ = true;
   }
-  send(world_, t_us, world_json(t_us, world));
+  jobs_changed_.notify_all();
+  worker_.join();  // after building what was handed over
+}
+
+void RunChannels::post(std::uint32_t channel, bool step, std::function<void()> build) {
+  {
+    std::lock_guard lock(jobs_mutex_);
+    // A step's message still waiting is stale once the next one comes: newest state wins.
+    if (step) {
+      std::erase_if(jobs_, [channel](const Job& j) { return j.step && j.channel == channel; });
+    }
+    jobs_.push_back({channel, step, std::move(build)});
+  }
+  jobs_changed_.notify_all();
+}
+
+void RunChannels::work() {
+  std::unique_lock lock(jobs_mutex_);
+  for (;;) {
+    jobs_changed_.wait(lock, [this] { return stopping_ || !jobs_.empty(); });
+    if (jobs_.empty()) return;  // stopping, and everything built
+    Job job = std::move(jobs_.front());
+    jobs_.pop_front();
+    building_ = true;
+    lock.unlock();
+    job.build();
+    lock.lock();
+    building_ = false;
+    jobs_changed_.notify_all();
+  }
+}
+
+bool RunChannels::flush(std::chrono::milliseconds timeout) {
+  std::unique_lock lock(jobs_mutex_);
+  return jobs_changed_.wait_for(lock, timeout, [this] { return jobs_.empty() && !building_; });
+}
+
+void RunChannels::on_world(TimeUs t_us, const agents::WorldReport& world) {
+  {
+    std::lock_guard lock(latest_->mutex);
+    latest_->world = world;
+  }
+  post(world_, false, [this, t_us, world] {
+    if (world.camera) {
+      const agents::CameraReport& c = *world.camera;
+      const auto to_image = inverse(c.image_to_field);
+      send(camera_calibration_, t_us,
+           {{"t_s", seconds(t_us)}, {"width_px", c.width_px}, {"height_px", c.height_px}, {"image_to_field", c.image_to_field},
+            {"field_to_image", to_image ? json(*to_image) : json(nullptr)}, {"lens_distortion", c.lens_distortion},
+            {"source", c.source}});
+    }
+    send(world_, t_us, world_json(t_us, world));
+  });
 }
 
 void RunChannels::on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) {
-  send(poses_, t_us, poses_json(t_us, poses));
-  send(scene_, t_us, scene_json(t_us, poses, world_report_));
+  // Kept (and marked unsent) before anything else: a client subscribing meanwhile gets them
+  // from the latch source, at worst twice.
+  Latest& l = *latest_;
+  {
+    std::lock_guard lock(l.mutex);
+    l.poses_t_us = t_us;
+    l.poses.assign(poses.begin(), poses.end());
+    l.poses_unsent = l.scene_unsent = true;
+  }
+  if (!server_.subscribed(poses_) && !server_.subscribed(scene_)) return;
+  post(poses_, true, [this, t_us, copy = std::vector<agents::PoseReport>(poses.begin(), poses.end())] {
+    Latest& l = *latest_;
+    if (server_.subscribed(poses_)) {
+      send(poses_, t_us, poses_json(t_us, copy));
+      std::lock_guard lock(l.mutex);
+      if (l.poses_t_us == t_us) l.poses_unsent = false;
+    }
+    if (server_.subscribed(scene_)) {
+      std::optional<agents::WorldReport> world;
+      {
+        std::lock_guard lock(l.mutex);
+        world = l.world;  // 1 Hz's copy, only while someone watches the scene
+      }
+      send(scene_, t_us, scene_json(t_us, copy, world));
+      std::lock_guard lock(l.mutex);
+      if (l.poses_t_us == t_us) l.scene_unsent = false;
+    }
+  });
+}
+
+std::shared_ptr<const std::string> RunChannels::Latest::build(bool scene, std::uint64_t& t_ns) {
+  std::lock_guard lock(mutex);
+  bool& unsent = scene ? scene_unsent : poses_unsent;
+  if (!unsent) return nullptr;
+  unsent = false;
+  t_ns = static_cast<std::uint64_t>(std::max<TimeUs>(0, poses_t_us)) * 1000;
+  const json message = scene ? scene_json(poses_t_us, poses, world) : poses_json(poses_t_us, poses);
+  return std::make_shared<const std::string>(message.dump(-1, ' ', false, json::error_handler_t::replace));
 }
 
 void RunChannels::on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wheels) {
-  json robots = json::array();
-  for (const auto& w : wheels) robots.push_back({{"id", w.id}, {"left_units", w.wheels.left}, {"right_units", w.wheels.right}});
-  send(wheels_, t_us, {{"t_s", seconds(t_us)}, {"robots", robots}});
+  if (!server_.subscribed(wheels_)) return;  // nobody would get it
+  post(wheels_, true, [this, t_us, copy = std::vector<agents::WheelReport>(wheels.begin(), wheels.end())] {
+    json robots = json::array();
+    for (const auto& w : copy) robots.push_back({{"id", w.id}, {"left_units", w.wheels.left}, {"right_units", w.wheels.right}});
+    send(wheels_, t_us, {{"t_s", seconds(t_us)}, {"robots", robots}});
+  });
 }
 
 void RunChannels::on_sensors(TimeUs t_us, std::span<const agents::SensorReport> sensors) {
-  json robots = json::array();
-  for (const auto& r : sensors) {
-    const environment::SensorReadings& s = *r.readings;
-    json ranges = json::array(), hits = json::array(), ids = json::array(), bearings = json::array();
-    for (const auto& x : s.ranges) {
-      ranges.push_back(x.distance_m);
-      hits.push_back(x.hit);
+  if (!server_.subscribed(sensors_)) return;  // nobody would get it
+  std::vector<std::pair<int, environment::SensorReadings>> copy;
+  copy.reserve(sensors.size());
+  for (const auto& r : sensors) copy.emplace_back(r.id, *r.readings);
+  post(sensors_, true, [this, t_us, copy = std::move(copy)] {
+    json robots = json::array();
+    for (const auto& [id, s] : copy) {
+      json ranges = json::array(), hits = json::array(), ids = json::array(), bearings = json::array();
+      for (const auto& x : s.ranges) {
+        ranges.push_back(x.distance_m);
+        hits.push_back(x.hit);
+      }
+      for (const auto& b : s.beacons) {
+        ids.push_back(b.id);
+        bearings.push_back(b.bearing_rad);
+      }
+      robots.push_back({{"id", id}, {"proximity", s.proximity ? json(*s.proximity) : json::array()}, {"range_m", ranges},
+                        {"range_hit", hits}, {"beacon_id", ids}, {"beacon_bearing_rad", bearings}, {"track", s.track}});
     }
-    for (const auto& b : s.beacons) {
-      ids.push_back(b.id);
-      bearings.push_back(b.bearing_rad);
-    }
-    robots.push_back({{"id", r.id}, {"proximity", s.proximity ? json(*s.proximity) : json::array()}, {"range_m", ranges},
-                      {"range_hit", hits}, {"beacon_id", ids}, {"beacon_bearing_rad", bearings}, {"track", s.track}});
-  }
-  send(sensors_, t_us, {{"t_s", seconds(t_us)}, {"robots", robots}});
+    send(sensors_, t_us, {{"t_s", seconds(t_us)}, {"robots", robots}});
+  });
 }
 
 void RunChannels::on_detections(const agents::FrameReport& f) {
-  json list = json::array();
-  for (const auto& d : f.detections) {
-    list.push_back({{"id", d.id}, {"u_px", d.u_px}, {"v_px", d.v_px}, {"heading_deg", d.heading_deg}, {"score", d.score},
-                    {"diameter_px", d.diameter_px}, {"x_m", d.pose.position_m.x}, {"y_m", d.pose.position_m.y},
-                    {"theta_rad", d.pose.heading_rad}});
-  }
-  send(detections_, f.t_us, {{"t_s", seconds(f.t_us)}, {"frame", f.frame}, {"process_ms", f.process_ms}, {"detections", list}});
+  if (!server_.subscribed(detections_)) return;  // nobody would get it
+  post(detections_, true,
+       [this, t_us = f.t_us, frame = f.frame, process_ms = f.process_ms,
+        copy = std::vector<agents::DetectionReport>(f.detections.begin(), f.detections.end())] {
+         json list = json::array();
+         for (const auto& d : copy) {
+           list.push_back({{"id", d.id}, {"u_px", d.u_px}, {"v_px", d.v_px}, {"heading_deg", d.heading_deg}, {"score", d.score},
+                           {"diameter_px", d.diameter_px}, {"x_m", d.pose.position_m.x}, {"y_m", d.pose.position_m.y},
+                           {"theta_rad", d.pose.heading_rad}});
+         }
+         send(detections_, t_us, {{"t_s", seconds(t_us)}, {"frame", frame}, {"process_ms", process_ms}, {"detections", list}});
+       });
 }
 
 void RunChannels::on_event(const agents::RunEvent& e) {
-  send(events_, e.t_us, {{"t_s", seconds(e.t_us)}, {"kind", e.kind}, {"id", e.id}, {"other", e.other}, {"detail", e.detail}});
+  post(events_, false, [this, e] {
+    send(events_, e.t_us, {{"t_s", seconds(e.t_us)}, {"kind", e.kind}, {"id", e.id}, {"other", e.other}, {"detail", e.detail}});
+  });
 }
 
-void RunChannels::on_status(const agents::StatusReport& status) { send(status_, status.t_us, status_json(status)); }
+void RunChannels::on_status(const agents::StatusReport& status) {
+  post(status_, false, [this, status] { send(status_, status.t_us, status_json(status)); });
+}
 
-void RunChannels::on_summary(TimeUs t_us, const nlohmann::json& summary) { send(summary_, t_us, summary); }
+void RunChannels::on_summary(TimeUs t_us, const nlohmann::json& summary) {
+  post(summary_, false, [this, t_us, summary] { send(summary_, t_us, summary); });
+}
 
 void RunChannels::camera_frame(TimeUs t_us, std::span<const std::uint8_t> jpeg) {
-  send(camera_, t_us, {{"timestamp", time_of(t_us)}, {"frame_id", "camera"}, {"data", base64(jpeg)}, {"format", "jpeg"}});
+  post(camera_, true, [this, t_us, copy = std::vector<std::uint8_t>(jpeg.begin(), jpeg.end())] {
+    send(camera_, t_us, {{"timestamp", time_of(t_us)}, {"frame_id", "camera"}, {"data", base64(copy)}, {"format", "jpeg"}});
+  });
 }
 
 void RunChannels::console_reply(TimeUs t_us, bool accepted, const std::string& reason, const std::string& client) {
-  send(console_reply_, t_us, {{"t_s", seconds(t_us)}, {"accepted", accepted}, {"reason", reason}, {"client", client}});
+  post(console_reply_, false, [this, t_us, accepted, reason, client] {
+    send(console_reply_, t_us, {{"t_s", seconds(t_us)}, {"accepted", accepted}, {"reason", reason}, {"client", client}});
+  });
 }
 
 }  // namespace rilbed::gui_web

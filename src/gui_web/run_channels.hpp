@@ -10,13 +10,27 @@
 //                        field_to_image homographies, row-major)
 // The world, status, poses, scene and camera calibration are latched: a viewer that joins gets the
 // last of each at once (a paused run sends nothing new).
+// A message nobody subscribes to is not built (JSON for 100 robots' scene is milliseconds of
+// the run's thread each step): the poses and the scene are built for a viewer who
+// subscribes from the last ones reported (WebServer::set_latch_source), the step
+// channels (wheels, sensors, detections) simply skipped. What is built is built on a thread
+// of its own, in the order reported, from copies: the run's thread only copies (a viewer
+// must not slow the control loop). A step's message not yet built when the next comes is
+// dropped (newest state wins).
 // Times are simulated seconds (t_s); the binary header's time is the same in nanoseconds.
 #pragma once
 
+#include <chrono>
+#include <condition_variable>
 #include <cstdint>
+#include <deque>
+#include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "agents/run_observer.hpp"
 #include "gui_web/web_server.hpp"
@@ -24,10 +38,18 @@
 namespace rilbed::gui_web {
 
 /// Publishes a run's reports on `server` (which must outlive it). Each on_ call converts
-/// and queues (WebServer::publish never blocks); call from one thread.
+/// and queues (WebServer::publish never blocks); call from one thread (the server's thread
+/// builds the latest poses and scene for a new subscriber, under a mutex).
 class RunChannels final : public agents::RunObserver {
  public:
   explicit RunChannels(WebServer& server);
+  /// Builds and publishes what was handed over, then stops its thread.
+  ~RunChannels() override;
+  RunChannels(const RunChannels&) = delete;
+  RunChannels& operator=(const RunChannels&) = delete;
+  /// Waits until everything reported so far has been published on the server (not yet
+  /// written to the clients: see WebServer::flush), at most `timeout`; returns whether it was.
+  bool flush(std::chrono::milliseconds timeout);
   void on_world(TimeUs t_us, const agents::WorldReport& world) override;
   void on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) override;
   void on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wheels) override;
@@ -52,12 +74,38 @@ class RunChannels final : public agents::RunObserver {
                                    const std::optional<agents::WorldReport>& world);
 
  private:
+  // Something to build and publish on the channels' thread.
+  struct Job {
+    std::uint32_t channel = 0;
+    bool step = false;  // a step's message: a newer one replaces it while it waits
+    std::function<void()> build;
+  };
+  void post(std::uint32_t channel, bool step, std::function<void()> build);
+  void work();
   void send(std::uint32_t channel, TimeUs t_us, const nlohmann::json& message);
+
+  // What the poses and scene channels' latch sources build from; shared with them (they
+  // run on the server's thread, which may outlive this object).
+  struct Latest {
+    std::mutex mutex;  // guards all of it
+    std::optional<agents::WorldReport> world;
+    TimeUs poses_t_us = 0;
+    std::vector<agents::PoseReport> poses;  // behaviour and health are static strings
+    bool poses_unsent = false, scene_unsent = false;  // the last poses were not published on the channel
+    // The latest poses or scene message, or null when what was published last is the latest.
+    std::shared_ptr<const std::string> build(bool scene, std::uint64_t& t_ns);
+  };
 
   WebServer& server_;
   std::uint32_t world_, status_, poses_, wheels_, sensors_, detections_, events_, scene_, console_reply_, summary_;
   std::uint32_t camera_ = 0, camera_calibration_ = 0;
-  std::optional<agents::WorldReport> world_report_;
+  std::shared_ptr<Latest> latest_ = std::make_shared<Latest>();
+  std::mutex jobs_mutex_;
+  std::condition_variable jobs_changed_;
+  std::deque<Job> jobs_;
+  bool building_ = false;
+  bool stopping_ = false;
+  std::thread worker_;  // last: started once everything else is
 };
 
 }  // namespace rilbed::gui_web

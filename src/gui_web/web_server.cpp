@@ -115,6 +115,8 @@ struct WebServer::Impl {
   WebServerCounters counts;
   std::set<std::shared_ptr<WsSession>> sessions;  // the server's thread only
   std::set<std::uint32_t> latched;                // guarded by mutex
+  std::map<std::uint32_t, int> subscribers;       // clients subscribed, by channel; guarded by mutex
+  std::map<std::uint32_t, WebServer::LatchSource> latch_sources;  // set before clients come
   // The last message of each latched channel (the server's thread only).
   std::map<std::uint32_t, std::pair<std::uint64_t, std::shared_ptr<const std::string>>> latest;
   std::atomic<std::size_t> client_count{0};
@@ -169,6 +171,10 @@ struct WebServer::Impl {
   }
   void accept();
   void remove(const std::shared_ptr<WsSession>& s);
+  void count_subscriber(std::uint32_t channel, int change) {
+    std::lock_guard lock(mutex);
+    if ((subscribers[channel] += change) <= 0) subscribers.erase(channel);
+  }
 };
 
 // One WebSocket client: its subscriptions, its channels, its send queue.
@@ -181,6 +187,12 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     name_ = ec ? std::string("client") : remote.address().to_string() + ":" + std::to_string(remote.port());
   }
   const std::string& name() const { return name_; }
+  // The channels it subscribes to, for the server's counts when it goes.
+  std::vector<std::uint32_t> subscribed_channels() const {
+    std::vector<std::uint32_t> out;
+    for (const auto& [channel, sub] : channel_to_sub_) out.push_back(channel);
+    return out;
+  }
   // Nothing queued or being written.
   bool idle() const { return queue_.empty() && !writing_; }
   // A status message for this client alone.
@@ -328,6 +340,11 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
       } else {
         sub_to_channel_[s.id] = s.channel_id;
         channel_to_sub_[s.channel_id] = s.id;
+        server_.count_subscriber(s.channel_id, +1);
+        if (const auto source = server_.latch_sources.find(s.channel_id); source != server_.latch_sources.end()) {
+          std::uint64_t t_ns = 0;
+          if (auto latest = source->second(t_ns)) server_.latest[s.channel_id] = {t_ns, std::move(latest)};
+        }
         if (const auto it = server_.latest.find(s.channel_id); it != server_.latest.end()) {
           offer(s.channel_id, it->second.first, it->second.second);
         }
@@ -342,6 +359,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
         continue;
       }
       channel_to_sub_.erase(it->second);
+      server_.count_subscriber(it->second, -1);
       sub_to_channel_.erase(it);
     }
   }
@@ -531,6 +549,7 @@ void WebServer::Impl::accept() {
 void WebServer::Impl::remove(const std::shared_ptr<WsSession>& s) {
   if (sessions.erase(s) == 0) return;
   client_count = sessions.size();
+  for (const std::uint32_t channel : s->subscribed_channels()) count_subscriber(channel, -1);
   if (handlers.on_client_gone) handlers.on_client_gone(s->name());
 }
 
@@ -582,6 +601,17 @@ std::uint32_t WebServer::add_channel(foxglove::Channel channel, bool latched) {
     for (const auto& s : m.sessions) s->advertise(channel);
   });
   return channel.id;
+}
+
+void WebServer::set_latch_source(std::uint32_t channel, LatchSource source) {
+  Impl& m = *impl_;
+  // Read on the server's thread only, after this post.
+  asio::post(m.io, [&m, channel, source = std::move(source)] { m.latch_sources[channel] = source; });
+}
+
+bool WebServer::subscribed(std::uint32_t channel) const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->subscribers.contains(channel);
 }
 
 void WebServer::publish(std::uint32_t channel, std::uint64_t t_ns, std::shared_ptr<const std::string> payload) {

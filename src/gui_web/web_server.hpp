@@ -85,6 +85,16 @@ class WebServer {
   /// `latched` channel's last message is sent to each client as it subscribes (the run's
   /// world and status, for a viewer joining a paused run); costs one message's memory.
   std::uint32_t add_channel(foxglove::Channel channel, bool latched = false);
+  /// The latest message of a latched channel, built when asked (on the server's thread):
+  /// its time in ns and payload, or null when the last one published is still the latest.
+  using LatchSource = std::function<std::shared_ptr<const std::string>(std::uint64_t& t_ns)>;
+  /// For a latched channel whose owner publishes only while someone subscribes (see
+  /// subscribed()): asked for the latest message as each client subscribes. Must be
+  /// thread-safe against the owner; set before clients come.
+  void set_latch_source(std::uint32_t channel, LatchSource source);
+  /// Whether any client subscribes to `channel` now (any thread; a mutex, tens of ns):
+  /// lets the owner skip building messages nobody gets.
+  bool subscribed(std::uint32_t channel) const;
   /// Sends `payload` on `channel` to every client subscribed to it, stamped `t_ns`. Never
   /// blocks: the message is queued on the server's thread.
   void publish(std::uint32_t channel, std::uint64_t t_ns, std::shared_ptr<const std::string> payload);

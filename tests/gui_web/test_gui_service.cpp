@@ -123,7 +123,7 @@ TEST(GuiService, ConsoleCommandsReachTheRunAndTheirAnswersComeBack) {
   const std::uint32_t replies = channel_id(watcher.next_json(), "/rilbed/console_reply");
   ASSERT_NE(replies, 0u);
   watcher.send_text({{"op", "subscribe"}, {"subscriptions", {{{"id", 3}, {"channelId", replies}}}}});
-  ASSERT_TRUE(gui.server().flush(std::chrono::seconds(5)));
+  ASSERT_TRUE(gui.flush(std::chrono::seconds(5)));
   std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the subscription is read after the flush's question
 
   PanelClient panel(gui.server().port());
@@ -368,6 +368,43 @@ TEST(GuiService, VisionSettingsAreParametersTheRunSetsAndReports) {
   EXPECT_TRUE(values_of(update)["vision.contrast"].is_null());
   viewer.send_text({{"op", "getParameters"}, {"parameterNames", json::array()}, {"id", "g"}});
   EXPECT_TRUE(next_op(viewer, "parameterValues")["parameters"].empty());
+}
+
+TEST(GuiService, AViewerJoiningLaterGetsTheLatestPosesAndSceneThoughNobodyWatchedThem) {
+  RecordingSink run;
+  GuiService gui(config(), run.sink());
+  // Reported while nobody watches: nothing is built, but the latest is kept.
+  std::vector<agents::PoseReport> poses{{3, false, true, Pose2{{0.5, 0.25}, 1.0}, "wander", "ok"}};
+  gui.on_poses(1'000'000, poses);
+  poses[0].pose.position_m = {0.75, 0.5};
+  gui.on_poses(1'100'000, poses);
+  ASSERT_TRUE(gui.flush(std::chrono::seconds(5)));
+  Client viewer;
+  ASSERT_EQ(viewer.connect(gui.server().port(), "/ws?token=" + kToken), 101);
+  viewer.next_json();
+  const json advertised = viewer.next_json();
+  viewer.send_text({{"op", "subscribe"},
+                    {"subscriptions", {{{"id", 1}, {"channelId", channel_id(advertised, "/rilbed/poses")}},
+                                       {{"id", 2}, {"channelId", channel_id(advertised, "/rilbed/scene")}}}}});
+  std::map<int, json> got;
+  while (got.size() < 2) {
+    const auto m = viewer.next();
+    if (!std::holds_alternative<std::string>(m)) continue;
+    const std::string& bytes = std::get<std::string>(m);
+    got[bytes[1]] = json::parse(bytes.substr(13));
+  }
+  EXPECT_DOUBLE_EQ(got[1]["t_s"].get<double>(), 1.1);
+  EXPECT_EQ(got[1]["robots"][0]["x_m"], 0.75);
+  EXPECT_EQ(got[2]["entities"][0]["id"], "robot 3");
+  // From now on each step comes as it is reported.
+  poses[0].pose.position_m = {1.0, 0.5};
+  gui.on_poses(1'200'000, poses);
+  for (;;) {
+    const auto m = viewer.next();
+    if (!std::holds_alternative<std::string>(m) || std::get<std::string>(m)[1] != 1) continue;
+    EXPECT_EQ(json::parse(std::get<std::string>(m).substr(13))["robots"][0]["x_m"], 1.0);
+    break;
+  }
 }
 
 }  // namespace
