@@ -167,7 +167,10 @@ RunChannels::RunChannels(WebServer& server) : server_(server) {
       object_schema("rilbed.console_reply", {{"t_s", number()}, {"accepted", boolean()}, {"reason", text()}, {"client", text()}})));
   server_.set_latch_source(poses_, [latest = latest_](std::uint64_t& t_ns) { return latest->build(false, t_ns); });
   server_.set_latch_source(scene_, [latest = latest_](std::uint64_t& t_ns) { return latest->build(true, t_ns); });
-  worker_ = std::thread([this] { work(); });
+  worker_ = std::thread([this] {
+    yield_to_control_loop();
+    work();
+  });
 }
 
 void RunChannels::send(std::uint32_t channel, TimeUs t_us, const json& message) {

@@ -1,5 +1,8 @@
 #include "gui_web/web_server.hpp"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/post.hpp>
 #include <boost/beast/core.hpp>
@@ -25,6 +28,12 @@ namespace beast = boost::beast;
 namespace http = beast::http;
 namespace websocket = beast::websocket;
 using tcp = asio::ip::tcp;
+
+void yield_to_control_loop() {
+  // setpriority on a thread's id changes that thread alone (Linux); raising one's own nice
+  // value needs no privilege. Failing leaves it as it was: nothing else depends on it.
+  ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), kViewerThreadNice);
+}
 
 bool same_secret(std::string_view a, std::string_view b) {
   unsigned char diff = a.size() == b.size() ? 0 : 1;
@@ -572,7 +581,10 @@ WebServer::WebServer(WebServerConfig config, Handlers handlers) : impl_(std::mak
   }
   m.port = m.acceptor.local_endpoint().port();
   m.accept();
-  m.thread = std::thread([&m] { m.io.run(); });
+  m.thread = std::thread([&m] {
+    yield_to_control_loop();
+    m.io.run();
+  });
 }
 
 WebServer::~WebServer() {

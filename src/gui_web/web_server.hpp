@@ -121,6 +121,14 @@ class WebServer {
   std::shared_ptr<Impl> impl_;
 };
 
+/// The nice value of the threads that serve viewers (the web server's, the channels'):
+/// on a busy machine the run's control loop gets the CPU first, and a viewer gets what is
+/// left (loop latency p99 with 50 viewers of a 100-robot run on 2 cores: see bench_gui).
+inline constexpr int kViewerThreadNice = 10;
+
+/// Lowers the calling thread to kViewerThreadNice (Linux: this thread alone).
+void yield_to_control_loop();
+
 /// Whether `a` equals `b`, in a time that depends only on their lengths.
 bool same_secret(std::string_view a, std::string_view b);
 
