@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.hpp"
+#include "app/panel_options.hpp"
 #include "gui_web/gui_service.hpp"
 #include "links/lcm_bus.hpp"
 #include "links/lcm_console.hpp"
@@ -33,11 +34,8 @@ extern "C" void on_gui_signal(int) { gui_interrupted.store(true); }
 struct GuiArgs {
   std::string url;
   std::string prefix;
-  std::string bind = "127.0.0.1";
-  int port = 8080;
   std::string run_token;  // the run's console token (default: its token file)
-  std::string web_root = RILBED_WEB_ROOT;
-  std::vector<std::string> allowed_origins;  // web clients served from elsewhere
+  PanelOptions panel;
 };
 
 // The console sink of `rilbed gui`: each command goes to the run over LCM with the run's
@@ -63,8 +61,8 @@ int gui_command(const GuiArgs& args) {
     spdlog::error("gui: {}", *problem);
     return kExitUsage;
   }
-  if (args.port < 0 || args.port > 65535) {
-    spdlog::error("gui: --gui-port {} is not a port", args.port);
+  if (const auto problem = check_panel_options(args.panel)) {
+    spdlog::error("gui: {}", *problem);
     return kExitUsage;
   }
   if (args.url.rfind("memq://", 0) == 0) {
@@ -78,30 +76,17 @@ int gui_command(const GuiArgs& args) {
     spdlog::error("gui: {}", error);
     return kExitFailure;
   }
-  gui_web::WebServerConfig config;
-  config.bind_address = args.bind;
-  config.port = static_cast<std::uint16_t>(args.port);
-  config.token = links::make_run_token();
-  config.session_id = config.token.substr(0, 8);
-  if (std::filesystem::is_directory(args.web_root)) config.web_root = args.web_root;
-  config.allowed_origins = args.allowed_origins;
-  if (args.bind != "127.0.0.1") {
-    spdlog::warn("gui: serving on {}: anyone who can reach it and has the URL's token can watch and steer the run", args.bind);
-  }
-  std::unique_ptr<gui_web::GuiService> gui;
-  try {
-    gui = std::make_unique<gui_web::GuiService>(config, lcm_console_sink(args));
-  } catch (const std::exception& e) {
-    spdlog::error("gui: {}", e.what());
-    return kExitFailure;
-  }
+  // The panel's own token: the run's stays with the run (it goes only into console commands).
+  std::unique_ptr<gui_web::GuiService> gui = start_panel(args.panel, "", lcm_console_sink(args));
+  if (!gui) return kExitFailure;
   const links::Channels run_channels = links::Channels::with_prefix(args.prefix);
   links::RunReportDecoder decoder(run_channels, *gui);
   std::vector<std::unique_ptr<links::LcmSubscription>> subscriptions;
   long bad = 0;
   for (const std::string* c : {&run_channels.world, &run_channels.poses, &run_channels.events, &run_channels.status,
                                &run_channels.summary, &run_channels.wheels, &run_channels.sensors, &run_channels.detections,
-                               &run_channels.camera, &run_channels.frames}) {
+                               &run_channels.camera, &run_channels.frames, &run_channels.sensor_layout,
+                               &run_channels.vision}) {
     subscriptions.push_back(std::make_unique<links::LcmSubscription>(*lcm, *c, [&](const std::string& ch, const void* d, std::size_t n) {
       if (const auto problem = decoder.decode(ch, d, n)) {
         if (++bad <= 5) spdlog::warn("gui: {} (skipped)", *problem);
@@ -128,14 +113,8 @@ void add_gui_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("gui", "Serve the web control panel (Foxglove WebSocket protocol) for a run on an LCM bus");
   cmd->add_option("--lcm", args->url, "LCM URL of the run's bus (e.g. udpm://239.255.76.67:7667?ttl=0)")->required();
   cmd->add_option("--channel-prefix", args->prefix, "The run's channel prefix");
-  cmd->add_option("--gui-port", args->port, "TCP port (0: any free one)")->default_val(8080);
-  cmd->add_option("--gui-bind", args->bind, "Address to serve on (anything but 127.0.0.1 opens it to the network)")
-      ->default_val("127.0.0.1");
   cmd->add_option("--token", args->run_token, "The run's console token (default: from the run's token file)");
-  cmd->add_option("--web-root", args->web_root, "The page's files")->default_val(args->web_root);
-  cmd->add_option("--gui-allow-origin", args->allowed_origins,
-                  "Also let in browsers' WebSockets from this Origin (a web client served elsewhere, "
-                  "e.g. https://app.foxglove.dev); repeatable");
+  add_panel_options(*cmd, args->panel);
   cmd->callback([args] { exit_code() = gui_command(*args); });
 }
 

@@ -23,6 +23,7 @@
 #include "app/commands.hpp"
 #include "core/id_list.hpp"
 #include "core/statistics.hpp"
+#include "app/panel_options.hpp"
 #include "gui_web/gui_service.hpp"
 #include "links/lcm_bus.hpp"
 #include "links/lcm_console.hpp"
@@ -92,10 +93,7 @@ struct RunArgs {
   bool no_place = false;      // real robots start where they stand
   double place_timeout_s = 90.0;
   bool gui = false;           // serve the web control panel from this process
-  int gui_port = 8080;
-  std::string gui_bind = "127.0.0.1";
-  std::string web_root = RILBED_WEB_ROOT;
-  std::vector<std::string> gui_allowed_origins;  // web clients served from elsewhere
+  PanelOptions panel;          // with --gui
 };
 
 // The console sink of `rilbed run --gui`: a browser's command acts on this run's own
@@ -439,26 +437,12 @@ int run_command(const RunArgs& args) {
       spdlog::error("--gui shows one run: leave out --seeds");
       return kExitUsage;
     }
-    if (args.gui_port < 0 || args.gui_port > 65535) {
-      spdlog::error("--gui-port {} is not a port", args.gui_port);
+    if (const auto problem = check_panel_options(args.panel)) {
+      spdlog::error("{}", *problem);
       return kExitUsage;
     }
-    gui_web::WebServerConfig config;
-    config.bind_address = args.gui_bind;
-    config.port = static_cast<std::uint16_t>(args.gui_port);
-    config.token = token.empty() ? links::make_run_token() : token;
-    config.session_id = config.token.substr(0, 8);
-    if (std::filesystem::is_directory(args.web_root)) config.web_root = args.web_root;
-    config.allowed_origins = args.gui_allowed_origins;
-    if (args.gui_bind != "127.0.0.1") {
-      spdlog::warn("gui: serving on {}: anyone who can reach it and has the URL's token can watch and steer the run", args.gui_bind);
-    }
-    try {
-      gui = std::make_unique<gui_web::GuiService>(config, run_control_sink(control));
-    } catch (const std::exception& e) {
-      spdlog::error("gui: {}", e.what());
-      return kExitFailure;
-    }
+    gui = start_panel(args.panel, token, run_control_sink(control));
+    if (!gui) return kExitFailure;
     std::printf("rilbed gui: %s\n", gui->url().c_str());
     std::fflush(stdout);
     options.control = &control;
@@ -557,13 +541,7 @@ void add_run_command(CLI::App& app) {
                   "Seconds the real robots get to drive to their start poses before the operator is asked")
       ->check(CLI::PositiveNumber)->default_val(90);
   cmd->add_flag("--gui", args->gui, "Serve the web control panel from this run (prints its URL with a fresh token)");
-  cmd->add_option("--gui-port", args->gui_port, "With --gui: TCP port (0: any free one)")->default_val(8080);
-  cmd->add_option("--gui-bind", args->gui_bind, "With --gui: address to serve on (anything but 127.0.0.1 opens it to the network)")
-      ->default_val("127.0.0.1");
-  cmd->add_option("--web-root", args->web_root, "With --gui: the page's files")->default_val(args->web_root);
-  cmd->add_option("--gui-allow-origin", args->gui_allowed_origins,
-                  "With --gui: also let in browsers' WebSockets from this Origin (a web client served elsewhere, "
-                  "e.g. https://app.foxglove.dev); repeatable");
+  add_panel_options(*cmd, args->panel, "With --gui: ");
   cmd->add_flag("--quiet", args->quiet, "No per-second status (realtime) or per-run lines (batch)");
   cmd->callback([args] { exit_code() = run_command(*args); });
 }

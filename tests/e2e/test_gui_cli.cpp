@@ -6,6 +6,7 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -54,6 +55,58 @@ TEST(GuiCli, ServesARunOnTheBusAndSendsItsConsoleCommands) {
   EXPECT_NE(probe.find(R"(/rilbed/console_reply {"accepted":true)"), std::string::npos) << probe;
   EXPECT_NE(probe.find(R"("reason":"pause")"), std::string::npos) << probe;
   EXPECT_NE(read_file(dir / "run" / "events.csv").find(",console,0,0,paused by "), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(GuiCli, VisionSettingsSetInTheBrowserReachARunOnTheBus) {
+  SKIP_WITHOUT_NAMESPACES();
+  const auto dir = scratch_dir("gui_cli_vision");
+  const int status = in_namespace(dir,
+      "P2='" RILBED_WS_PROBE "'\n"
+      "\"$R\" run " + shipped_scenario_arg("convoy_mixed") + " --duration 120 --lcm \"$URL\" --out run --quiet > run.txt 2> run.err &\n"
+      "P=$!\n"
+      "\"$R\" gui --lcm \"$URL\" --gui-port 0 > gui.txt 2> gui.err &\n"
+      "G=$!\n"
+      "for i in $(seq 1 200); do grep -q 'token=' gui.txt && break; sleep 0.05; done\n"
+      "HOSTPORT=$(sed -n 's|.*http://\\([^/]*\\)/?token=.*|\\1|p' gui.txt)\n"
+      "TOKEN=$(sed -n 's|.*?token=\\([0-9a-f]*\\).*|\\1|p' gui.txt)\n"
+      "set +e\n"
+      // Once the run's poses come (it is running), one setParameters; its answer ends the probe.
+      "\"$P2\" \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses --count 100000 --until parameterValues --timeout 60 "
+      "--set-parameters '[{\"name\":\"vision.threshold\",\"value\":30},{\"name\":\"vision.contrast\",\"value\":1.25}]' "
+      "> probe.txt 2>&1; echo \"probe $?\" >> codes.txt\n"
+      "\"$P2\" \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses --count 100000 --until parameterValues --timeout 60 "
+      "--set-parameters '[{\"name\":\"vision.contrast\",\"value\":9}]' > refused.txt 2>&1; echo \"refused $?\" >> codes.txt\n"
+      // A viewer joining later: the settings as the run's status says (not only those set here).
+      "for i in $(seq 1 100); do \"$P2\" \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses --count 100000 "
+      "--until parameterValues --timeout 60 --get-parameters all > get.txt 2>&1; grep -q min_score get.txt && break; sleep 0.1; done\n"
+      "\"$R\" console --lcm \"$URL\" exit > exit.txt 2>&1; echo \"exit $?\" >> codes.txt\n"
+      "wait $P; echo \"run $?\" >> codes.txt\n"
+      "kill -INT $G; wait $G; echo \"gui $?\" >> codes.txt\n");
+  ASSERT_EQ(status, 0) << read_file(dir / "ns.log");
+  const std::string codes = read_file(dir / "codes.txt");
+  const std::string probe = read_file(dir / "probe.txt");
+  for (const char* line : {"probe 0", "refused 0", "exit 0", "run 0", "gui 0"}) {
+    EXPECT_NE(codes.find(line), std::string::npos) << line << "\n" << codes << probe << read_file(dir / "gui.err");
+  }
+  // The answer carries the values the run took; the run logged who set them.
+  const std::size_t answer = probe.rfind("parameterValues {");
+  ASSERT_NE(answer, std::string::npos) << probe;
+  const auto values = nlohmann::json::parse(probe.substr(answer + 16, probe.find('\n', answer) - answer - 16));
+  EXPECT_EQ(values["id"], "probe");
+  std::map<std::string, double> by_name;
+  for (const auto& p : values["parameters"]) by_name[p["name"]] = p["value"].get<double>();
+  EXPECT_EQ(by_name["vision.threshold"], 30.0) << values.dump();
+  EXPECT_EQ(by_name["vision.contrast"], 1.25) << values.dump();
+  EXPECT_NE(read_file(dir / "run" / "events.csv").find("vision threshold 30 contrast 1.25 set by "), std::string::npos)
+      << read_file(dir / "run" / "events.csv");
+  // Refused by the run: said, and the values stay.
+  const std::string refused = read_file(dir / "refused.txt");
+  EXPECT_NE(refused.find("status 2 vision settings refused: contrast 9 is outside 0.2..5"), std::string::npos) << refused;
+  EXPECT_NE(refused.find(R"("value":1.25)"), std::string::npos) << refused;
+  const std::string got = read_file(dir / "get.txt");
+  EXPECT_NE(got.find(R"({"name":"vision.min_score","value":0.75})"), std::string::npos) << got;
+  EXPECT_NE(got.find(R"({"name":"vision.threshold","value":30.0})"), std::string::npos) << got;
   std::filesystem::remove_all(dir);
 }
 

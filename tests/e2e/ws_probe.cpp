@@ -1,10 +1,13 @@
 // A Foxglove WebSocket client for end-to-end tests (Beast, synchronous): connects to a
 // `rilbed gui` URL, subscribes to the given topics, prints each message it gets as
 // "<topic> <json>" and every status as "status <level> <message>", and, once it has had a
-// message, publishes one message on a client channel. Exits 0 after --count messages (or
-// the first on the --until topic), 1 on a timeout or error (it says which).
+// message, publishes one message on a client channel, or sets parameters (printing the
+// answer as "parameterValues <json>"). Exits 0 after --count messages (or the first on the
+// --until topic; --until parameterValues: the answer to its setParameters), 1 on a timeout
+// or error (it says which).
 //   ws_probe ws://127.0.0.1:PORT/ws?token=T --topics /rilbed/poses,/rilbed/console_reply
-//            --count 5 [--until /rilbed/console_reply] [--send '/rilbed/console={"command":"pause"}'] [--timeout 20]
+//            --count 5 [--until /rilbed/console_reply] [--send '/rilbed/console={"command":"pause"}']
+//            [--set-parameters '[{"name":"vision.threshold","value":30}]' | --get-parameters all] [--timeout 20]
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/websocket.hpp>
@@ -28,7 +31,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: ws_probe URL --topics A,B [--count N] [--send TOPIC=JSON] [--timeout S]\n");
     return 2;
   }
-  std::string url = argv[1], send, until;
+  std::string url = argv[1], send, until, set_parameters;
+  bool get_parameters = false;
   std::set<std::string> topics;
   int count = 1, timeout_s = 20;
   for (int i = 2; i + 1 < argc; i += 2) {
@@ -40,6 +44,10 @@ int main(int argc, char** argv) {
       count = std::stoi(value);
     } else if (key == "--send") {
       send = value;
+    } else if (key == "--set-parameters") {
+      set_parameters = value;
+    } else if (key == "--get-parameters") {
+      get_parameters = true;
     } else if (key == "--until") {
       until = value;
     } else if (key == "--timeout") {
@@ -84,6 +92,10 @@ int main(int argc, char** argv) {
           }
         } else if (m["op"] == "status") {
           std::printf("status %d %s\n", m["level"].get<int>(), m["message"].get<std::string>().c_str());
+        } else if (m["op"] == "parameterValues") {
+          std::printf("parameterValues %s\n", m.dump().c_str());
+          std::fflush(stdout);
+          if (until == "parameterValues" && m.value("id", "") == "probe") break;
         }
         continue;
       }
@@ -94,6 +106,16 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
       ++got;
       if (!until.empty() && sub_topic[sub] == until) break;
+      if (get_parameters && !sent) {
+        sent = true;
+        ws.text(true);
+        ws.write(boost::asio::buffer(json{{"op", "getParameters"}, {"parameterNames", json::array()}, {"id", "probe"}}.dump()));
+      }
+      if (!set_parameters.empty() && !sent) {
+        sent = true;
+        ws.text(true);
+        ws.write(boost::asio::buffer(json{{"op", "setParameters"}, {"parameters", json::parse(set_parameters)}, {"id", "probe"}}.dump()));
+      }
       if (!send.empty() && !sent) {
         sent = true;
         const std::string topic = send.substr(0, send.find('='));
