@@ -53,3 +53,8 @@ done
 # Robot in the loop: frame arrival to the D command on each real (emulated) robot's port.
 echo
 "$BUILD_DIR/rilbed" loop-bench --real 8 --virtual 100 --frames 300
+
+# The web panel: viewers of a 100-robot run (frames and bytes each gets, their effect on the
+# run's loop latency), then the page's drawing rate in headless Chromium.
+echo
+"$BUILD_DIR/bench_gui" --robots 100 --seconds 10 --repeat 3
