@@ -10,7 +10,8 @@
 // Schema); the run's poses (every robot of the scenario, inside the field); a pause, a
 // resume and an exit published on /rilbed/console, each accepted on
 // /rilbed/console_reply, the pause seen on /rilbed/status; and the run exiting with 0,
-// its folder recording who paused it. Every wait has a deadline; on any failure it says
+// its folder recording who paused it; the vision settings set and read back through the
+// client's parameters (setParameters, getParameters), and an out-of-range one refused. Every wait has a deadline; on any failure it says
 // what it was waiting for, shows the end of rilbed's output, kills rilbed and exits 1.
 // CTest runs it as web_protocol (label e2e); `./run test` installs its npm packages.
 'use strict';
@@ -234,6 +235,8 @@ async function main(state) {
     if (!state.closeExpected) abort(`the WebSocket closed (code ${e && e.code}${e && e.reason ? `, ${e.reason}` : ''})`);
   });
   client.on('serverInfo', (info) => { seen.serverInfo = info; poke(); });
+  seen.parameterValues = [];
+  client.on('parameterValues', (event) => { seen.parameterValues.push(event); poke(); });
   client.on('status', (s) => {
     seen.statusMessages.push(s);
     console.log(`# server status (level ${s.level}): ${s.message}`);
@@ -369,6 +372,31 @@ async function main(state) {
   const running = await statusSince(from, 'a message on /rilbed/status with state "running" after the resume',
     (s) => s.state === 'running');
   ok(`/rilbed/status says running again (t_s ${running.t_s})`);
+
+  // The vision settings, as Foxglove's own client sets parameters.
+  for (const capability of ['parameters', 'parametersSubscribe']) {
+    check((info.capabilities || []).includes(capability), `serverInfo's capabilities lack ${capability}`);
+  }
+  const answerTo = (id) => waitFor(`parameterValues answering ${id}`, () => seen.parameterValues.find((e) => e.id === id));
+  const valueOf = (event, name) => (event.parameters.find((p) => p.name === name) || {}).value;
+  client.setParameters([{ name: 'vision.min_score', value: 0.7 }, { name: 'vision.brightness', value: -10 }], 'set-1');
+  const set = await answerTo('set-1');
+  check(valueOf(set, 'vision.min_score') === 0.7 && valueOf(set, 'vision.brightness') === -10,
+    `setParameters' answer does not carry the new values: ${JSON.stringify(set)}`);
+  client.getParameters([], 'get-1');
+  const all = await answerTo('get-1');
+  const names = all.parameters.map((p) => p.name).sort();
+  check(JSON.stringify(names) === JSON.stringify(['vision.brightness', 'vision.contrast', 'vision.max_diameter_px',
+    'vision.min_diameter_px', 'vision.min_score', 'vision.threshold']), `getParameters gave ${JSON.stringify(names)}`);
+  check(valueOf(all, 'vision.min_score') === 0.7, `getParameters' min_score is ${valueOf(all, 'vision.min_score')}, not 0.7`);
+  ok(`parameters: setParameters accepted (${JSON.stringify(set.parameters)}), getParameters lists ${names.length}`);
+  const statusBefore = seen.statusMessages.length;
+  client.setParameters([{ name: 'vision.threshold', value: 1000 }], 'set-2');
+  const refused = await answerTo('set-2');
+  check(valueOf(refused, 'vision.threshold') === 24, `a refused threshold changed it: ${JSON.stringify(refused)}`);
+  const why = seen.statusMessages.slice(statusBefore).find((s) => s.level === 2);
+  check(why && why.message.includes('threshold 1000 is outside 1..255'), `no error status for threshold 1000: ${JSON.stringify(why)}`);
+  ok(`parameters: threshold 1000 refused ("${why.message}"), the value stays 24`);
 
   // The exit: the run ends, its server with it; its reply may or may not get out first.
   state.closeExpected = true;
