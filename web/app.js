@@ -10,6 +10,7 @@ const wsUrl = `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.hos
 
 const ROBOT_DIAMETER_M = 0.055; // a Khepera
 const IR_ANGLES_RAD = [90, 45, 10, -10, -45, -90, -170, 170].map((d) => (d * Math.PI) / 180);
+const IR_COS = IR_ANGLES_RAD.map(Math.cos), IR_SIN = IR_ANGLES_RAD.map(Math.sin);
 const IR_RANGE_M = 0.05; // what the IR ring sees; a reading of 1023 is touching
 const TRAIL_POINTS = 400;
 const HISTORY_PERIOD_S = 0.2;
@@ -616,7 +617,13 @@ function makeProjection(width, height) {
     const [a, b] = project(x, y), [c, d] = project(x + 0.01, y);
     return Math.hypot(c - a, d - b) / 0.01;
   };
-  return { project, scaleAt, base, z };
+  // Without the camera the projection is u = ax * x + bx, v = ay * y + by: the loops over
+  // thousands of points (trails) use that, allocating nothing.
+  const affine = base.camera ? null
+    : { ax: z * base.s, bx: view.panX + z * base.ox, ay: -z * base.s, by: view.panY + z * base.oy };
+  // Whether canvas point (u, v) is within `margin` pixels of the canvas (else not drawn).
+  const onCanvas = (u, v, margin) => u > -margin && v > -margin && u < width + margin && v < height + margin;
+  return { project, scaleAt, base, z, affine, onCanvas, width, height };
 }
 
 let drawPending = false;
@@ -681,46 +688,106 @@ function drawField(P) {
   });
 }
 
+// The trails' dots (2 x 2 pixels, every other trail point) are laid pixel by pixel into an
+// image of the canvas's size, put on the canvas in one call: 1,000 robots' trails are 200,000
+// dots, which fillRect (or a path of them) draws at a few frames a second without a GPU. Each
+// dot lies over what is there at its colour's alpha, as fillRect lays it, on whole CSS pixels.
+const TRAIL_COLOURS = [[210, 40, 40, 0.4], [36, 86, 199, 0.45]]; // a virtual robot's, a real one's (RGBA)
+// over[a]: the alpha (0-255) of a dot of that colour laid over alpha a.
+const TRAIL_OVER = TRAIL_COLOURS.map(([, , , alpha]) => Uint8Array.from({ length: 256 }, (_, a) => Math.round(255 * alpha + a * (1 - alpha))));
+const trailLayer = { canvas: document.createElement('canvas'), w: 0, h: 0 };
+
 function drawTrails(P) {
   const outline = $('trail-style').value === 'outline';
+  const realIds = new Set();
+  for (const r of run.poses?.robots || []) if (r.real) realIds.add(r.id);
+  const css = ([r, g, b, a]) => `rgba(${r},${g},${b},${a})`;
+  if (outline) {
+    for (const [id, trail] of run.trails) {
+      if (trail.length < 2) continue;
+      ctx.strokeStyle = css(TRAIL_COLOURS[realIds.has(id) ? 1 : 0]);
+      ctx.lineWidth = 1.5; polyline(P, trail, false); ctx.stroke();
+    }
+    return;
+  }
+  const L = trailLayer, W = Math.ceil(P.width), H = Math.ceil(P.height);
+  if (W < 1 || H < 1) return;
+  if (L.w !== W || L.h !== H) {
+    L.canvas.width = L.w = W; L.canvas.height = L.h = H;
+    L.alpha = [new Uint8Array(W * H), new Uint8Array(W * H)];
+    L.image = new ImageData(W, H);
+    L.pixels = new Uint32Array(L.image.data.buffer); // RGBA bytes: 0xAABBGGRR (little-endian)
+  }
+  L.alpha[0].fill(0); L.alpha[1].fill(0);
+  const A = P.affine;
+  let anyReal = false;
   for (const [id, trail] of run.trails) {
     if (trail.length < 2) continue;
-    const real = run.poses?.robots.find((r) => r.id === id)?.real;
-    ctx.strokeStyle = ctx.fillStyle = real ? 'rgba(36,86,199,0.45)' : 'rgba(210,40,40,0.4)';
-    if (outline) {
-      ctx.lineWidth = 1.5; polyline(P, trail, false); ctx.stroke();
-    } else {
-      for (let i = 0; i < trail.length; i += 2) {
-        const [u, v] = P.project(trail[i][0], trail[i][1]);
-        ctx.fillRect(u - 1, v - 1, 2, 2);
+    const kind = realIds.has(id) ? 1 : 0, alpha = L.alpha[kind], over = TRAIL_OVER[kind];
+    anyReal ||= kind === 1;
+    for (let i = 0; i < trail.length; i += 2) {
+      const x = trail[i][0], y = trail[i][1];
+      let u, v;
+      if (A) { u = A.ax * x + A.bx; v = A.ay * y + A.by; } else [u, v] = P.project(x, y);
+      const x0 = Math.round(u - 1), y0 = Math.round(v - 1); // the dot's top left pixel
+      if (x0 >= 0 && y0 >= 0 && x0 < W - 1 && y0 < H - 1) {
+        const k = y0 * W + x0;
+        alpha[k] = over[alpha[k]]; alpha[k + 1] = over[alpha[k + 1]];
+        alpha[k + W] = over[alpha[k + W]]; alpha[k + W + 1] = over[alpha[k + W + 1]];
+      } else if (x0 >= -1 && y0 >= -1 && x0 < W && y0 < H) { // across an edge
+        for (let py = Math.max(0, y0); py < Math.min(H, y0 + 2); ++py) {
+          for (let px = Math.max(0, x0), k = py * W + px; px < Math.min(W, x0 + 2); ++px, ++k) alpha[k] = over[alpha[k]];
+        }
       }
     }
   }
+  // Real robots' dots over virtual ones'.
+  const [v0, v1] = L.alpha, out = L.pixels;
+  const rgb = TRAIL_COLOURS.map(([r, g, b]) => (b << 16) | (g << 8) | r);
+  for (let k = 0; k < out.length; ++k) {
+    const a0 = v0[k], a1 = anyReal ? v1[k] : 0;
+    if (!a1) out[k] = a0 ? ((a0 << 24) | rgb[0]) >>> 0 : 0;
+    else if (!a0) out[k] = ((a1 << 24) | rgb[1]) >>> 0;
+    else {
+      const under = (a0 * (255 - a1)) / 255, a = a1 + under;
+      const mix = (i) => Math.round((TRAIL_COLOURS[1][i] * a1 + TRAIL_COLOURS[0][i] * under) / a);
+      out[k] = ((Math.round(a) << 24) | (mix(2) << 16) | (mix(1) << 8) | mix(0)) >>> 0;
+    }
+  }
+  L.canvas.getContext('2d').putImageData(L.image, 0, 0);
+  ctx.save(); ctx.imageSmoothingEnabled = false; ctx.drawImage(L.canvas, 0, 0, W, H); ctx.restore();
 }
 
+// The virtual robots (all alike) are one path stroked once, then every label: a thousand
+// robots are a few calls, not thousands. Robots off the canvas are not drawn.
 function drawRobots(P) {
+  const virtual = new Path2D();
+  const labels = [];
+  ctx.lineWidth = 2;
   for (const r of run.poses.robots) {
     const [u, v] = P.project(r.x_m, r.y_m);
-    const radius = Math.max(3, (ROBOT_DIAMETER_M / 2) * P.scaleAt(r.x_m, r.y_m));
+    const radius = Math.max(3, (ROBOT_DIAMETER_M / 2) * (P.affine ? P.affine.ax : P.scaleAt(r.x_m, r.y_m)));
+    if (!P.onCanvas(u + 120, v, radius + 130)) continue; // nor its label (right of it) on the canvas
     const [hu, hv] = P.project(r.x_m + Math.cos(r.theta_rad) * ROBOT_DIAMETER_M * 0.6, r.y_m + Math.sin(r.theta_rad) * ROBOT_DIAMETER_M * 0.6);
-    ctx.lineWidth = 2;
     if (r.real) {
       // A real robot is where the camera says: a square, faint when unseen.
       ctx.strokeStyle = r.seen ? '#2456c7' : 'rgba(36,86,199,0.4)';
       ctx.setLineDash(r.seen ? [] : [4, 3]);
       ctx.strokeRect(u - radius, v - radius, 2 * radius, 2 * radius);
       ctx.setLineDash([]);
+      ctx.beginPath(); ctx.moveTo(u, v); ctx.lineTo(hu, hv); ctx.stroke();
     } else {
-      ctx.strokeStyle = '#d22828';
-      ctx.beginPath(); ctx.arc(u, v, radius, 0, 2 * Math.PI); ctx.stroke();
+      virtual.moveTo(u + radius, v); virtual.arc(u, v, radius, 0, 2 * Math.PI);
+      virtual.moveTo(u, v); virtual.lineTo(hu, hv);
     }
-    ctx.beginPath(); ctx.moveTo(u, v); ctx.lineTo(hu, hv); ctx.stroke();
     if (driving.robot === r.id) { ctx.strokeStyle = '#e0a800'; ctx.beginPath(); ctx.arc(u, v, radius + 5, 0, 2 * Math.PI); ctx.stroke(); }
     if (overlays.labels) {
-      ctx.fillStyle = '#111'; ctx.font = '12px system-ui';
-      ctx.fillText(`${r.id} ${r.behaviour}${r.real && r.health && r.health !== 'ok' ? ' [' + r.health + ']' : ''}`, u + radius + 3, v - radius - 2);
+      labels.push([`${r.id} ${r.behaviour}${r.real && r.health && r.health !== 'ok' ? ' [' + r.health + ']' : ''}`, u + radius + 3, v - radius - 2]);
     }
   }
+  ctx.strokeStyle = '#d22828'; ctx.stroke(virtual);
+  ctx.fillStyle = '#111'; ctx.font = '12px system-ui';
+  for (const [text, x, y] of labels) ctx.fillText(text, x, y);
 }
 
 function drawDetections(P) {
@@ -736,23 +803,35 @@ function drawDetections(P) {
 
 function drawSensors(P) {
   const layouts = new Map((run.world?.robots || []).map((r) => [r.id, r.sensors]));
+  const idleIr = new Path2D(); // the IR rays that see nothing: one stroke for them all, last
   for (const r of run.poses.robots) {
     const s = run.sensors.get(r.id);
     if (!s) continue;
     const layout = layouts.get(r.id) || {};
+    // Not drawn when none of its sensors reaches the canvas (an ultrasonic cone may reach metres).
+    const [ru, rv] = P.project(r.x_m, r.y_m);
+    let reach = 0.3;
+    for (const g of layout.ranges || []) reach = Math.max(reach, g.max_m || 0);
+    if (!P.onCanvas(ru, rv, reach * (P.affine ? P.affine.ax : P.scaleAt(r.x_m, r.y_m)) + 30)) continue;
     const c = Math.cos(r.theta_rad), sn = Math.sin(r.theta_rad);
     const at = (fx, fy) => [r.x_m + c * fx - sn * fy, r.y_m + sn * fx + c * fy]; // robot frame to field
     if (overlays.ir && s.proximity?.length === 8) {
       const reach = layout.ir_range_m || IR_RANGE_M;
-      s.proximity.forEach((value, i) => {
-        const a = IR_ANGLES_RAD[i];
-        const r0 = ROBOT_DIAMETER_M / 2, r1 = r0 + reach;
-        const [x0, y0] = at(r0 * Math.cos(a), r0 * Math.sin(a));
-        const [x1, y1] = at(r1 * Math.cos(a), r1 * Math.sin(a));
-        ctx.strokeStyle = value > 0 ? `rgba(230,120,0,${0.3 + 0.7 * Math.min(1, value / 1023)})` : 'rgba(120,120,120,0.25)';
-        ctx.lineWidth = value > 0 ? 2 : 1;
-        polyline(P, [[x0, y0], [x1, y1]], false); ctx.stroke();
-      });
+      const r0 = ROBOT_DIAMETER_M / 2, r1 = r0 + reach, A = P.affine;
+      for (let i = 0; i < 8; ++i) {
+        const value = s.proximity[i];
+        // The ray from the rim outwards, in the field: the robot frame's (cos a, sin a) turned by theta.
+        const dx = c * IR_COS[i] - sn * IR_SIN[i], dy = sn * IR_COS[i] + c * IR_SIN[i];
+        const x0 = r.x_m + r0 * dx, y0 = r.y_m + r0 * dy, x1 = r.x_m + r1 * dx, y1 = r.y_m + r1 * dy;
+        if (value > 0) {
+          ctx.strokeStyle = `rgba(230,120,0,${0.3 + 0.7 * Math.min(1, value / 1023)})`; ctx.lineWidth = 2;
+          polyline(P, [[x0, y0], [x1, y1]], false); ctx.stroke();
+        } else if (A) {
+          idleIr.moveTo(A.ax * x0 + A.bx, A.ay * y0 + A.by); idleIr.lineTo(A.ax * x1 + A.bx, A.ay * y1 + A.by);
+        } else {
+          idleIr.moveTo(...P.project(x0, y0)); idleIr.lineTo(...P.project(x1, y1));
+        }
+      }
     }
     if (overlays.ranges && s.range_m?.length) {
       s.range_m.forEach((d, i) => {
@@ -790,6 +869,7 @@ function drawSensors(P) {
       });
     }
   }
+  ctx.strokeStyle = 'rgba(120,120,120,0.25)'; ctx.lineWidth = 1; ctx.stroke(idleIr);
   function r0x() { return run.world ? run.world.width_m / 2 : 0; }
   function r0y() { return run.world ? run.world.height_m / 2 : 0; }
 }
@@ -798,14 +878,17 @@ new ResizeObserver(requestDraw).observe(canvas);
 
 // ------------------------------------------------------------------ plots
 let plotsDirty = false;
-let lastPlot = 0;
+let lastPlot = 0, plotTimer = null;
 const COLORS = ['#d22828', '#2456c7', '#1e7d32', '#b26a00', '#7b1fa2', '#00838f', '#c2185b', '#5d4037', '#455a64', '#9e9d24'];
 
 function plotCanvas(id) { return prepareCanvas($(id)); }
 
 function drawPlots() {
   const now = performance.now();
-  if (now - lastPlot < 500) { setTimeout(requestDraw, 500); return; } // twice a second is plenty
+  if (now - lastPlot < 500) { // twice a second is plenty; one redraw waits for the next
+    plotTimer ||= setTimeout(() => { plotTimer = null; requestDraw(); }, 500 - (now - lastPlot));
+    return;
+  }
   lastPlot = now; plotsDirty = false;
   // Formation: distance to the robot ahead, followers only.
   {
@@ -817,15 +900,14 @@ function drawPlots() {
     let k = 0;
     for (const [id, s] of run.formation) {
       g.strokeStyle = COLORS[k++ % COLORS.length]; g.lineWidth = 1.2; g.beginPath();
-      let pen = false;
+      let pen = plotPen(g);
       for (const [t, d] of s) {
-        if (d === null) { pen = false; continue; }
-        const x = L + (t / tMax) * (w - L - 4), y = h - B - (d / dMax) * (h - B - 4);
-        if (pen) g.lineTo(x, y); else g.moveTo(x, y);
-        pen = true;
+        if (d === null) { pen = plotPen(g); continue; }
+        pen(L + (t / tMax) * (w - L - 4), h - B - (d / dMax) * (h - B - 4));
       }
       g.stroke();
-      g.fillStyle = g.strokeStyle; g.fillText(String(id), w - 4 - 14 * (run.formation.size - k + 1), 12);
+      const x = w - 4 - 14 * (run.formation.size - k + 1);
+      if (x > -30) { g.fillStyle = g.strokeStyle; g.fillText(String(id), x, 12); } // not the legend off the plot
     }
   }
   // Trajectories: every robot's path over the field.
@@ -837,12 +919,26 @@ function drawPlots() {
     let k = 0;
     for (const [id, pts] of run.history) {
       g.strokeStyle = COLORS[k++ % COLORS.length]; g.lineWidth = 1.2; g.beginPath();
-      pts.forEach(([, x, y], i) => { const u = ox + s * x, v = oy - s * y; if (i) g.lineTo(u, v); else g.moveTo(u, v); });
+      const pen = plotPen(g);
+      for (const [, x, y] of pts) pen(ox + s * x, oy - s * y);
       g.stroke();
       const last = pts[pts.length - 1];
       if (last) { g.fillStyle = g.strokeStyle; g.fillText(String(id), ox + s * last[1] + 3, oy - s * last[2] - 3); }
     }
   }
+}
+
+// A polyline's pen on `g` (moveTo, then lineTo) that leaves out each point within half a pixel
+// of the last one drawn: a thousand robots' minutes of samples are millions of points, most
+// under a pixel apart, which take seconds to stroke. The line stays within half a pixel of
+// every point.
+function plotPen(g) {
+  let first = true, lx = 0, ly = 0;
+  return (x, y) => {
+    if (!first && Math.abs(x - lx) < 0.5 && Math.abs(y - ly) < 0.5) return;
+    if (first) g.moveTo(x, y); else g.lineTo(x, y);
+    first = false; lx = x; ly = y;
+  };
 }
 
 function axes(g, w, h, L, B, xLabel, yLabel) {
