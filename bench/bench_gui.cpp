@@ -48,6 +48,7 @@
 #include "core/statistics.hpp"
 #include "gui_web/gui_service.hpp"
 #include "links/lcm_bus.hpp"
+#include "machine.hpp"
 
 namespace {
 
@@ -57,6 +58,9 @@ namespace websocket = beast::websocket;
 using tcp = asio::ip::tcp;
 using nlohmann::json;
 using namespace rilbed;
+using bench::cpu_model;
+using bench::env_or;
+using bench::first_line;
 
 const std::string kToken = "bench";
 // What rilbed's page subscribes to (web/app.js).
@@ -198,27 +202,6 @@ void run_once(const agents::Scenario& scenario, std::optional<int> viewers, doub
   if (gui) out.dropped += gui->server().counters().messages_dropped;
 }
 
-std::string cpu_model() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  }
-  return "unknown";
-}
-
-std::string first_line(const char* path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  return line;
-}
-
-std::string env_or(const char* name, const char* fallback) {
-  const char* v = std::getenv(name);
-  return v && *v ? v : fallback;
-}
-
 double min_of(const std::vector<double>& v) { return v.empty() ? 0.0 : *std::min_element(v.begin(), v.end()); }
 double max_of(const std::vector<double>& v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); }
 
@@ -245,7 +228,7 @@ int main(int argc, char** argv) {
 
   const agents::Scenario scenario = agents::wandering_scenario(robots, seconds);
   std::printf("# rilbed web panel benchmark\n\n");
-  std::printf("- CPU: %s; `nproc`: %u; load average at start: %s\n", cpu_model().c_str(), std::thread::hardware_concurrency(),
+  std::printf("- CPU: %s; `nproc`: %d; load average at start: %s\n", cpu_model().c_str(), bench::usable_cpus(),
               first_line("/proc/loadavg").c_str());
   std::printf("- build type: %s; sources: %s\n", env_or("RILBED_BENCH_BUILD_TYPE", "unknown (run through tools/bench.sh)").c_str(),
               env_or("RILBED_BENCH_SOURCE", "unknown (run through tools/bench.sh)").c_str());

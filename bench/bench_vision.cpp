@@ -19,6 +19,7 @@
 // tools/bench.sh runs it with the defaults (about 2 minutes on 2 cores).
 
 #include "frame_cache.hpp"
+#include "machine.hpp"
 #include "timing.hpp"
 
 #include <apriltag/apriltag.h>
@@ -55,6 +56,10 @@ namespace rv = rilbed::vision;
 namespace {
 
 using rilbed::bench::Clock;
+using rilbed::bench::cpu_model;
+using rilbed::bench::env_or;
+using rilbed::bench::first_line;
+using rilbed::bench::usable_cpus;
 using rilbed::bench::measure_timer_overhead;
 using rilbed::bench::ms_since;
 using rilbed::bench::net_ms;
@@ -573,39 +578,6 @@ void time_tracked(Row& row, const std::vector<Frame>& frames, rv::MarkerTracker&
     }
     ++row.passes;
   }
-}
-
-// ------------------------------------------------------------------ machine
-
-std::string cpu_model() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("model name", 0) == 0) {
-      const auto colon = line.find(':');
-      if (colon != std::string::npos) return line.substr(colon + 2);
-    }
-  }
-  return "unknown";
-}
-
-int usable_cpus() {  // what `nproc` prints
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  if (sched_getaffinity(0, sizeof(set), &set) != 0) return -1;
-  return CPU_COUNT(&set);
-}
-
-std::string first_line(const char* path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  return line;
-}
-
-std::string env_or(const char* name, const char* fallback) {
-  const char* v = std::getenv(name);
-  return v && *v ? v : fallback;
 }
 
 // ------------------------------------------------------------------ printing

@@ -214,6 +214,17 @@ rilbed::vision_settings_t to_lcm(TimeUs t_us, const vision::VisionSettings& s) {
   return m;
 }
 
+vision::VisionSettings from_lcm(const rilbed::vision_settings_t& m) {
+  vision::VisionSettings s;
+  s.brightness = m.brightness;
+  s.contrast = m.contrast;
+  s.threshold = m.threshold;
+  s.min_diameter_px = m.min_diameter_px;
+  s.max_diameter_px = m.max_diameter_px;
+  s.min_score = m.min_score;
+  return s;
+}
+
 rilbed::camera_t to_lcm(TimeUs t_us, const agents::CameraReport& c) {
   rilbed::camera_t m;
   m.utime = t_us;
@@ -454,13 +465,7 @@ std::optional<std::string> RunReportDecoder::decode(const std::string& channel, 
   } else if (channel == channels_.vision) {
     rilbed::vision_settings_t m;
     if (!decode_checked(data, size, m)) return bad("vision_settings_t");
-    vision::VisionSettings s;
-    s.brightness = m.brightness;
-    s.contrast = m.contrast;
-    s.threshold = m.threshold;
-    s.min_diameter_px = m.min_diameter_px;
-    s.max_diameter_px = m.max_diameter_px;
-    s.min_score = m.min_score;
+    const vision::VisionSettings s = from_lcm(m);
     if (auto why = vision::check_vision_settings(s)) return channel + ": " + *why;
     vision_ = s;
   } else if (channel == channels_.camera) {

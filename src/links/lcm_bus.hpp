@@ -98,8 +98,9 @@ rilbed::detections_t to_lcm(const agents::FrameReport& frame);
 rilbed::frame_t to_lcm(TimeUs t_us, std::int64_t frame, const cv::Mat& image, int quality);
 /// The camera's mapping onto the field.
 rilbed::camera_t to_lcm(TimeUs t_us, const agents::CameraReport& camera);
-/// The camera's vision settings.
+/// The camera's vision settings, and back (unchecked: see vision::check_vision_settings).
 rilbed::vision_settings_t to_lcm(TimeUs t_us, const vision::VisionSettings& settings);
+vision::VisionSettings from_lcm(const rilbed::vision_settings_t& message);
 /// The robots' sensor geometry (from a world's sensor_geometries and sensor_geometry_of).
 rilbed::sensor_layout_t sensor_layout(TimeUs t_us, const agents::WorldReport& world);
 

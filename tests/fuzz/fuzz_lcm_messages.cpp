@@ -397,13 +397,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       rilbed::vision_settings_t m;
       if (problem && refused_before_decoding<rilbed::vision_settings_t>(message, length)) break;
       const bool readable = generated_decode(message, length, m);
-      vision::VisionSettings s;
-      s.brightness = m.brightness;
-      s.contrast = m.contrast;
-      s.threshold = m.threshold;
-      s.min_diameter_px = m.min_diameter_px;
-      s.max_diameter_px = m.max_diameter_px;
-      s.min_score = m.min_score;
+      const vision::VisionSettings s = links::from_lcm(m);
       const bool usable = readable && !vision::check_vision_settings(s);
       FUZZ_CHECK(usable == !problem);
       if (problem) break;
