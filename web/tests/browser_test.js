@@ -30,14 +30,13 @@
 // web_browser (label e2e); `./run test` installs its npm packages and Chromium.
 'use strict';
 
-const { spawn } = require('node:child_process');
 const fs = require('node:fs');
-const os = require('node:os');
 const path = require('node:path');
+const {
+  ok, check, sleep, poll, describeExit, startRilbed, commandLine, checkBinary, checkScenario,
+  tempFolder, withRobots, requirePlaywright, launchBrowser, newContext, openPage, useArtefacts, screenshot, run,
+} = require('./support');
 
-const NAME = 'browser_test';
-const CHROMIUM = '/usr/bin/chromium';
-const DEADLINE_MS = 30000;       // every wait (the machine may be slow, or under ASan)
 const WATCHDOG_MS = 280000;      // the whole test (CTest's TIMEOUT is 300 s)
 const VIRTUAL_RGB = [0xd2, 0x28, 0x28];
 const REAL_RGB = [0x24, 0x56, 0xc7];
@@ -49,48 +48,14 @@ const STILL_M = 0.003;           // two readings 0.5 s apart closer than this: s
 const MOVED_M = 0.02;            // a clear move
 const STOP_WITHIN_S = 5;         // a stop is seen about 1 s after the key (0.5 s of it the two readings)
 
-let checks = 0;
-function ok(what) {
-  checks += 1;
-  console.log(`ok ${checks} - ${what}`);
-}
-
-class TestFailure extends Error {}
-function fail(message) {
-  throw new TestFailure(message);
-}
-function check(condition, message) {
-  if (!condition) fail(message);
-}
-const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
 const dist = (a, b) => Math.hypot(a.x - b.x, a.y - b.y);
 const mm = (m) => `${(m * 1000).toFixed(1)} mm`;
-
-// ---------------------------------------------------------------- the npm packages, Chromium
-function requirePlaywright() {
-  const modules = path.join(__dirname, 'node_modules');
-  const missing = `${modules} is missing or incomplete: run ./run test (it installs the npm packages)`;
-  if (!fs.existsSync(modules)) fail(missing);
-  let playwright;
-  try {
-    playwright = require('playwright-core');
-  } catch (e) {
-    fail(`${missing} (${e.message})`);
-  }
-  if (!fs.existsSync(CHROMIUM)) fail(`no ${CHROMIUM}: run ./run test (it installs Debian's chromium)`);
-  return playwright;
-}
 
 // ---------------------------------------------------------------- the scenarios
 // The mixed scenario's copy: its field, timing, camera and safety as shipped, its robots
 // this test's own. Robot 4 has no controller (the page drives it) and a known pose; the
 // others but the convoy stand still, so that nothing drives into robot 4 or its view.
 function mixedScenarioCopy(text) {
-  const lines = text.split('\n');
-  const start = lines.findIndex((l) => /^robots\s*:/.test(l));
-  check(start >= 0, 'the mixed scenario has no robots: section');
-  let end = start + 1;
-  while (end < lines.length && (/^\s/.test(lines[end]) || lines[end] === '' || /^#/.test(lines[end]))) end++;
   const robots = `robots:
   - ids: 1-3
     pose: random
@@ -109,96 +74,10 @@ function mixedScenarioCopy(text) {
   - ids: 6-8
     pose: random
     controller: none`;
-  return [...lines.slice(0, start), robots, ...lines.slice(end)].join('\n');
+  return withRobots(text, robots);
 }
 
-// ---------------------------------------------------------------- rilbed, the children
-let aborted = null;  // set when a child exits unexpectedly: every wait ends
-class Child {
-  constructor(label, binary, args) {
-    this.label = label;
-    this.stdoutLines = [];
-    this.stderrTail = [];
-    this.exit = null;  // {code, signal} once it exited
-    this.proc = spawn(binary, args, { stdio: ['ignore', 'pipe', 'pipe'] });
-    this.proc.on('error', (e) => {
-      this.exit = { code: null, signal: null, error: e };
-      aborted = aborted || `${label} could not be started (${e.message})`;
-    });
-    const lineReader = (onLine) => {
-      let partial = '';
-      return (chunk) => {
-        partial += chunk.toString('utf8');
-        const parts = partial.split('\n');
-        partial = parts.pop();
-        for (const l of parts) onLine(l);
-      };
-    };
-    this.proc.stdout.on('data', lineReader((l) => this.stdoutLines.push(l)));
-    this.proc.stderr.on('data', lineReader((l) => {
-      this.stderrTail.push(l);
-      if (this.stderrTail.length > 40) this.stderrTail.shift();
-    }));
-    this.proc.on('exit', (code, signal) => {
-      this.exit = { code, signal };
-      if (!this.exitExpected) aborted = aborted || `${label} exited unexpectedly (${describeExit(this.exit)})`;
-    });
-  }
-  // Ends it (SIGTERM, then SIGKILL after 5 s) unless it has exited.
-  async kill() {
-    if (this.exit || !this.proc.pid) return;
-    this.exitExpected = true;
-    const exited = new Promise((resolve) => this.proc.once('exit', resolve));
-    this.proc.kill('SIGTERM');
-    const timer = setTimeout(() => this.proc.kill('SIGKILL'), 5000);
-    await exited;
-    clearTimeout(timer);
-  }
-  tails() {
-    const out = this.stdoutLines.slice(-20).join('\n');
-    const err = this.stderrTail.join('\n');
-    return `--- ${this.label}'s stdout (last lines) ---\n${out}\n--- ${this.label}'s stderr (last lines) ---\n${err}\n---`;
-  }
-}
-function describeExit(e) {
-  if (e.error) return e.error.message;
-  return e.signal ? `killed by ${e.signal}` : `exit code ${e.code}`;
-}
-
-// ---------------------------------------------------------------- waiting
-// Tries `condition` (sync or async) every `everyMs` until it returns something other than
-// undefined, null or false, and returns that; fails after `ms`, saying what it waited for
-// and, if given, what `describe()` says it saw last.
-async function poll(what, condition, { ms = DEADLINE_MS, everyMs = 100, describe = null } = {}) {
-  const end = Date.now() + ms;
-  for (;;) {
-    if (aborted) fail(`${aborted} while waiting for ${what}`);
-    const value = await condition();
-    if (value !== undefined && value !== null && value !== false) return value;
-    if (Date.now() > end) {
-      let seen = '';
-      if (describe) {
-        try { seen = ` (last seen: ${await describe()})`; } catch (e) { seen = ` (${e.message})`; }
-      }
-      fail(`timed out after ${ms / 1000} s waiting for ${what}${seen}`);
-    }
-    await sleep(everyMs);
-  }
-}
-
-// Starts `rilbed run` with the GUI and returns {child, runDir, url, port, token}.
-async function startRun(state, label, binary, scenario, extra = []) {
-  const runDir = path.join(state.tmp, label);
-  const args = ['run', scenario, '--realtime', '--duration', '300', '--gui', '--gui-port', '0', '--out', runDir, ...extra];
-  console.log(`# starting ${binary} ${args.join(' ')}`);
-  const child = new Child(label, binary, args);
-  state.children.push(child);
-  const urlPattern = /(http:\/\/127\.0\.0\.1:(\d+)\/\?token=([^\s&#]+))/;
-  const [, url, port, token] = await poll(`the line with http://127.0.0.1:PORT/?token=TOKEN on ${label}'s stdout`,
-    () => child.stdoutLines.map((l) => urlPattern.exec(l)).find((m) => m));
-  return { child, runDir, url, port: Number(port), token };
-}
-
+// ---------------------------------------------------------------- the run's files
 // events.csv's lines (flushed by the run at every event).
 function events(runDir) {
   const file = path.join(runDir, 'events.csv');
@@ -226,35 +105,9 @@ function driveThenStop(runDir, id, from, speed) {
 }
 
 // ---------------------------------------------------------------- the page
-// A page on `url` whose console errors and uncaught exceptions are collected in
-// state.pageErrors, and whose confirm dialogs are accepted.
-async function openPage(state, context, label, url) {
-  const page = await context.newPage();
-  page.on('console', (m) => {
-    if (m.type() === 'error') {
-      const where = m.location() && m.location().url ? ` at ${m.location().url}:${m.location().lineNumber}` : '';
-      state.pageErrors.push(`${label}: console error: ${m.text()}${where}`);
-    }
-  });
-  page.on('pageerror', (e) => state.pageErrors.push(`${label}: uncaught: ${e.stack || e.message}`));
-  page.on('crash', () => state.pageErrors.push(`${label}: the page crashed`));
-  page.on('dialog', (d) => { state.dialogs.push(`${label}: ${d.type()} "${d.message()}"`); d.accept(); });
-  const response = await page.goto(url, { timeout: DEADLINE_MS });
-  check(response && response.status() === 200, `${label}: GET ${url} answered ${response && response.status()}`);
-  await poll(`${label} to connect and show the run (connection pill "connected", world, status and poses received)`,
-    () => page.evaluate(() => document.getElementById('connection').textContent === 'connected' &&
-      window.rilbed && window.rilbed.run.world && window.rilbed.run.status && window.rilbed.run.poses && true),
-    { describe: () => page.evaluate(() => `connection "${document.getElementById('connection').textContent}", ` +
-      `world ${!!window.rilbed?.run.world}, status ${!!window.rilbed?.run.status}, poses ${!!window.rilbed?.run.poses}`) });
-  return page;
-}
-
-async function screenshot(state, page, name) {
-  const file = path.join(state.artifacts, `browser-${name}.png`);
-  await page.screenshot({ path: file, fullPage: true });
-  state.screenshots.push(file);
-  console.log(`# screenshot ${file}`);
-}
+// A page on `url` (support.js's openPage) whose confirm dialogs are accepted (and kept in state.dialogs).
+const openDrivenPage = (state, context, label, url) => openPage(state, context, label, url,
+  (page) => page.on('dialog', (d) => { state.dialogs.push(`${label}: ${d.type()} "${d.message()}"`); d.accept(); }));
 
 const statusOf = (page) => page.evaluate(() => window.rilbed.run.status);
 const poseOf = (page, id) => page.evaluate((id) => {
@@ -339,36 +192,27 @@ function trajectories(runDir) {
 
 // ---------------------------------------------------------------- the test
 async function main(state) {
-  const [binary, mixedScenario, simScenario, artefactArg] = process.argv.slice(2);
-  if (!binary || !mixedScenario || !simScenario) {
-    console.error(`usage: node ${path.basename(__filename)} RILBED MIXED_SCENARIO SIM_SCENARIO [ARTEFACT_DIR]`);
-    process.exit(2);
-  }
-  const { chromium } = requirePlaywright();
-  check(fs.existsSync(binary), `no rilbed binary at ${binary} (build it first: ./run build)`);
-  check(fs.existsSync(mixedScenario), `no scenario at ${mixedScenario}`);
-  check(fs.existsSync(simScenario), `no scenario at ${simScenario}`);
+  const [binary, mixedScenario, simScenario, artefactArg] = commandLine('RILBED MIXED_SCENARIO SIM_SCENARIO [ARTEFACT_DIR]');
+  const playwright = requirePlaywright();
+  checkBinary(binary);
+  checkScenario(mixedScenario);
+  checkScenario(simScenario);
 
-  state.tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'rilbed-web-browser-'));
-  state.artifacts = process.env.RILBED_ARTIFACTS || artefactArg || fs.mkdtempSync(path.join(os.tmpdir(), 'rilbed-web-artifacts-'));
-  fs.mkdirSync(state.artifacts, { recursive: true });
-  for (const f of fs.readdirSync(state.artifacts)) {
-    if (/^browser-.*\.png$/.test(f)) fs.rmSync(path.join(state.artifacts, f));
-  }
-  console.log(`# screenshots go to ${state.artifacts}`);
+  state.dialogs = [];
+  tempFolder(state, 'browser');
+  useArtefacts(state, artefactArg, 'browser');
 
   const scenario = path.join(state.tmp, 'convoy_mixed_driven.yaml');
   fs.writeFileSync(scenario, mixedScenarioCopy(fs.readFileSync(mixedScenario, 'utf8')));
   console.log(`# ${scenario}: ${mixedScenario} with robot ${DRIVEN} real, controller none, at ` +
     `(${DRIVEN_POSE[0]} m, ${DRIVEN_POSE[1]} m, ${DRIVEN_POSE[2]} deg); 1-3 a convoy; 5 real, 6-8 virtual, standing`);
 
-  const mixed = await startRun(state, 'mixed', binary, scenario);
+  const mixed = await startRilbed(state, binary, scenario, { label: 'mixed' });
   console.log(`# the page: ${mixed.url.replace(mixed.token, 'TOKEN')}`);
 
-  state.browser = await chromium.launch({ executablePath: CHROMIUM, args: ['--no-sandbox'], timeout: DEADLINE_MS });
+  await launchBrowser(state, playwright);
   // A device pixel ratio of 2: the view's canvas must be sized and sampled in device pixels.
-  const context = await state.browser.newContext({ viewport: { width: 1280, height: 900 }, deviceScaleFactor: 2 });
-  context.setDefaultTimeout(DEADLINE_MS);
+  const context = await newContext(state, { viewport: { width: 1280, height: 900 }, deviceScaleFactor: 2 });
 
   // ------------------------------------------------ 1. the page, the token
   const base = `http://127.0.0.1:${mixed.port}`;
@@ -376,7 +220,7 @@ async function main(state) {
     const response = await fetch(url);
     check(response.status === 401, `GET ${url.replace(base, '')} without the token answered ${response.status}, not 401`);
   }
-  const page = await openPage(state, context, 'page 1', mixed.url);
+  const page = await openDrivenPage(state, context, 'page 1', mixed.url);
   const title = await page.title();
   const shown = await page.evaluate(() => ({
     scenario: document.getElementById('scenario').textContent,
@@ -460,10 +304,9 @@ async function main(state) {
     factor: window.rilbed.run.status.rt_factor, real: window.rilbed.run.status.real_robots }));
   check(mixedSlider.disabled, `the real-time factor slider is enabled in a run with ${mixedSlider.real} real robots`);
   check(mixedSlider.factor === 1, `the run with real robots runs at a factor of ${mixedSlider.factor}`);
-  const sim = await startRun(state, 'sim', binary, simScenario);
-  const simContext = await state.browser.newContext({ viewport: { width: 1280, height: 900 } });
-  simContext.setDefaultTimeout(DEADLINE_MS);
-  const simPage = await openPage(state, simContext, 'sim page', sim.url);
+  const sim = await startRilbed(state, binary, simScenario, { label: 'sim' });
+  const simContext = await newContext(state, { viewport: { width: 1280, height: 900 } });
+  const simPage = await openDrivenPage(state, simContext, 'sim page', sim.url);
   await poll('the slider to be enabled in the run without real robots', () => simPage.evaluate(() => !document.getElementById('rt-slider').disabled));
   const before = await statusOf(simPage);
   check(before.rt_factor === 1 && before.real_robots === 0, `the sim run starts at factor ${before.rt_factor} with ${before.real_robots} real robots`);
@@ -532,7 +375,7 @@ async function main(state) {
   check(releasedState.state === '' && !releasedState.take && releasedState.release,
     `after Release the driving controls are ${JSON.stringify(releasedState)}`);
   await waitForEvent(mixed, `"robot ${DRIVEN} stopped and given back" (the release)`, (l) => new RegExp(`,behaviour,${DRIVEN},0,console -> `).test(l));
-  const page2 = await openPage(state, context, 'page 2', mixed.url);
+  const page2 = await openDrivenPage(state, context, 'page 2', mixed.url);
   await page2.selectOption('#drive-robot', String(DRIVEN));
   await page2.click('#drive-take');
   const q0 = (await waitStill(page, DRIVEN, 'before page 2 drives it')).pose;
@@ -575,51 +418,4 @@ async function main(state) {
   ok(`no console error and no uncaught exception on any page (${state.dialogs.length} dialogs, all confirms accepted)`);
 }
 
-async function run() {
-  const state = { children: [], pageErrors: [], dialogs: [], screenshots: [] };
-  let failure = null;
-  const watchdog = setTimeout(() => {
-    aborted = `${NAME} ran longer than ${WATCHDOG_MS / 1000} s`;
-    console.error(`${NAME}: FAIL: ${aborted}`);
-    for (const c of state.children) if (!c.exit) c.proc.kill('SIGKILL');
-    process.exit(1);
-  }, WATCHDOG_MS);
-  const started = Date.now();
-  try {
-    await main(state);
-  } catch (e) {
-    failure = e;
-  }
-  if (failure && state.browser) {
-    // What the pages looked like when it failed.
-    for (const context of state.browser.contexts()) {
-      for (const [i, p] of context.pages().entries()) {
-        try { await screenshot(state, p, `failure-${state.browser.contexts().indexOf(context)}-${i}`); } catch (_) { /* closed */ }
-      }
-    }
-  }
-  if (state.browser) await Promise.race([state.browser.close().catch(() => {}), sleep(10000)]);
-  clearTimeout(watchdog);
-  if (failure) {
-    const message = failure instanceof TestFailure ? failure.message : (failure.stack || String(failure));
-    console.error(`${NAME}: FAIL: ${message}`);
-    if (state.pageErrors.length) console.error(`${NAME}: the pages' errors so far:\n  ${state.pageErrors.join('\n  ')}`);
-    for (const child of state.children) {
-      console.error(child.tails());
-      await child.kill();
-    }
-    if (state.tmp) console.error(`${NAME}: the runs' folders are kept in ${state.tmp}`);
-    console.log(`${checks} passed, 1 failed (${((Date.now() - started) / 1000).toFixed(1)} s)`);
-    process.exit(1);
-  }
-  for (const child of state.children) await child.kill();
-  console.log(`# screenshots: ${state.screenshots.join(' ')}`);
-  fs.rmSync(state.tmp, { recursive: true, force: true });
-  console.log(`${checks} passed, 0 failed (${((Date.now() - started) / 1000).toFixed(1)} s)`);
-  process.exit(0);
-}
-
-for (const signal of ['SIGINT', 'SIGTERM']) {
-  process.on(signal, () => { aborted = `${NAME} got ${signal}`; });
-}
-run();
+run(main, { name: 'browser_test', watchdogMs: WATCHDOG_MS });

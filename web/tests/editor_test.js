@@ -27,28 +27,19 @@
 // test` installs its npm packages (web/tests and web/: the page's js-yaml) and Chromium.
 'use strict';
 
-const { spawn, spawnSync } = require('node:child_process');
+const { spawnSync } = require('node:child_process');
 const fs = require('node:fs');
-const os = require('node:os');
 const path = require('node:path');
 const assert = require('node:assert');
+const {
+  CHROMIUM, DEADLINE_MS, ok, check, fail, startRilbed, commandLine, checkBinary, tempFolder, launchBrowser,
+  newContext, useArtefacts, run,
+} = require('./support');
 
-const NAME = 'editor_test';
-const CHROMIUM = '/usr/bin/chromium';
-const DEADLINE_MS = 30000;
 const WEB = path.resolve(__dirname, '..');
 const SCENARIOS = path.resolve(__dirname, '../../scenarios');
 const TOLERANCE_M = 0.004;     // a pixel of the canvas is about 2 mm of the field
 const TOLERANCE_DEG = 1.5;
-
-let checks = 0;
-function ok(what) {
-  checks += 1;
-  console.log(`ok ${checks} - ${what}`);
-}
-class TestFailure extends Error {}
-function fail(message) { throw new TestFailure(message); }
-function check(condition, message) { if (!condition) fail(message); }
 
 // ---------------------------------------------------------------- the npm packages
 function requirePackages() {
@@ -59,83 +50,14 @@ function requirePackages() {
   const loaded = {};
   for (const [dir, name, where] of need) {
     const missing = `${dir} is missing or incomplete (${name}): run ./run test (it installs the npm packages of ${where})`;
-    if (!fs.existsSync(dir)) {
-      console.error(`${NAME}: FAIL: ${missing}`);
-      process.exit(1);
-    }
+    if (!fs.existsSync(dir)) fail(missing);
     try {
       loaded[name] = require(require.resolve(name, { paths: [path.dirname(dir)] }));
     } catch (e) {
-      console.error(`${NAME}: FAIL: ${missing} (${e.message})`);
-      process.exit(1);
+      fail(`${missing} (${e.message})`);
     }
   }
   return { playwright: loaded['playwright-core'], yaml: loaded['js-yaml'] };
-}
-
-// ---------------------------------------------------------------- waiting on rilbed
-const waiters = new Set();
-let aborted = null;
-function poke() {
-  for (const w of [...waiters]) {
-    const value = w.condition();
-    if (value) { w.finish(); w.resolve(value); }
-  }
-}
-function abort(message) {
-  if (aborted) return;
-  aborted = message;
-  for (const w of [...waiters]) { w.finish(); w.reject(new TestFailure(`${message} while waiting for ${w.what}`)); }
-}
-function waitFor(what, condition, ms = DEADLINE_MS) {
-  return new Promise((resolve, reject) => {
-    if (aborted) { reject(new TestFailure(`${aborted} while waiting for ${what}`)); return; }
-    const w = { what, condition, resolve, reject };
-    const timer = setTimeout(() => { waiters.delete(w); reject(new TestFailure(`timed out after ${ms / 1000} s waiting for ${what}`)); }, ms);
-    w.finish = () => { clearTimeout(timer); waiters.delete(w); };
-    waiters.add(w);
-    poke();
-  });
-}
-
-class Child {
-  constructor(binary, args) {
-    this.stdoutLines = [];
-    this.stderrTail = [];
-    this.exit = null;
-    this.proc = spawn(binary, args, { stdio: ['ignore', 'pipe', 'pipe'] });
-    this.proc.on('error', (e) => { this.exit = { code: null, signal: null, error: e }; abort(`rilbed could not be started (${e.message})`); });
-    const lineReader = (onLine) => {
-      let partial = '';
-      return (chunk) => {
-        partial += chunk.toString('utf8');
-        const parts = partial.split('\n');
-        partial = parts.pop();
-        for (const l of parts) onLine(l);
-        poke();
-      };
-    };
-    this.proc.stdout.on('data', lineReader((l) => { this.stdoutLines.push(l); if (this.stdoutLines.length > 200) this.stdoutLines.shift(); }));
-    this.proc.stderr.on('data', lineReader((l) => { this.stderrTail.push(l); if (this.stderrTail.length > 40) this.stderrTail.shift(); }));
-    this.proc.on('exit', (code, signal) => {
-      this.exit = { code, signal };
-      if (!this.exitExpected) abort(`rilbed exited unexpectedly (${signal ? `killed by ${signal}` : `exit code ${code}`})`);
-      poke();
-    });
-  }
-  async kill() {
-    if (this.exit || !this.proc.pid) return;
-    this.exitExpected = true;
-    const exited = new Promise((resolve) => this.proc.once('exit', resolve));
-    this.proc.kill('SIGTERM');
-    const timer = setTimeout(() => this.proc.kill('SIGKILL'), 5000);
-    await exited;
-    clearTimeout(timer);
-  }
-  tails() {
-    return `--- rilbed's stdout (last lines) ---\n${this.stdoutLines.slice(-20).join('\n')}\n` +
-      `--- rilbed's stderr (last lines) ---\n${this.stderrTail.join('\n')}\n---`;
-  }
 }
 
 // `RILBED run FILE ARGS...`, which must exit 0 within the deadline.
@@ -147,35 +69,19 @@ function runAccepts(binary, file, args, outDir) {
 
 // ---------------------------------------------------------------- the test
 async function main(state) {
-  const [binary, artefactArg] = process.argv.slice(2);
-  if (!binary) {
-    console.error(`usage: node ${path.basename(__filename)} RILBED [ARTEFACT_DIR]`);
-    process.exit(2);
-  }
-  check(fs.existsSync(binary), `no rilbed binary at ${binary} (build it first: ./run build)`);
+  const [binary, artefactArg] = commandLine('RILBED [ARTEFACT_DIR]');
+  checkBinary(binary);
   check(fs.existsSync(CHROMIUM), `no ${CHROMIUM}: install Debian's chromium (./run test does)`);
   const { playwright, yaml } = requirePackages();
-  state.tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'rilbed-web-editor-'));
-  state.artifacts = process.env.RILBED_ARTIFACTS || artefactArg || fs.mkdtempSync(path.join(os.tmpdir(), 'rilbed-web-artifacts-'));
-  fs.mkdirSync(state.artifacts, { recursive: true });
+  tempFolder(state, 'editor');
+  useArtefacts(state, artefactArg, 'editor', { fresh: false });
 
-  const scenario = path.join(SCENARIOS, 'convoy_sim.yaml');
-  const args = ['run', scenario, '--realtime', '--duration', '300', '--gui', '--gui-port', '0', '--out', path.join(state.tmp, 'run')];
-  console.log(`# starting ${binary} ${args.join(' ')}`);
-  const child = new Child(binary, args);
-  state.child = child;
-  const urlPattern = /(http:\/\/127\.0\.0\.1:\d+\/\?token=[^\s&#]+)/;
-  const [, url] = await waitFor('the line with http://127.0.0.1:PORT/?token=TOKEN on rilbed\'s stdout',
-    () => child.stdoutLines.map((l) => urlPattern.exec(l)).find((m) => m));
+  const { url } = await startRilbed(state, binary, path.join(SCENARIOS, 'convoy_sim.yaml'), { dir: 'run' });
   ok('rilbed serves the page');
 
-  const browser = await playwright.chromium.launch({ executablePath: CHROMIUM, args: ['--no-sandbox'] });
-  state.browser = browser;
-  const context = await browser.newContext({ viewport: { width: 1400, height: 1000 }, acceptDownloads: true });
-  context.setDefaultTimeout(DEADLINE_MS);
+  await launchBrowser(state, playwright);
+  const context = await newContext(state, { viewport: { width: 1400, height: 1000 }, acceptDownloads: true });
   const page = await context.newPage();
-  state.page = page;
-  state.pageErrors = [];
   page.on('console', (m) => { if (m.type() === 'error') state.pageErrors.push(`console error: ${m.text()}`); });
   page.on('pageerror', (e) => state.pageErrors.push(`uncaught: ${e.message}`));
   const until = (what, fn, arg) => page.waitForFunction(fn, arg, { timeout: DEADLINE_MS, polling: 50 })
@@ -484,29 +390,7 @@ async function main(state) {
   ok('the page logged no console error and threw nothing');
 }
 
-async function run() {
-  const state = {};
-  let failure = null;
-  const t0 = Date.now();
-  try {
-    await main(state);
-  } catch (e) {
-    failure = e;
-  }
-  if (failure && state.page && state.artifacts) {
-    const shot = path.join(state.artifacts, 'editor-failure.png');
-    await state.page.screenshot({ path: shot, fullPage: true }).then(() => console.error(`# failure screenshot: ${shot}`)).catch(() => {});
-  }
-  if (state.browser) await state.browser.close().catch(() => {});
-  if (state.child) await state.child.kill();
-  if (failure) {
-    console.error(`${NAME}: FAIL: ${failure instanceof TestFailure ? failure.message : failure.stack}`);
-    if (state.pageErrors?.length) console.error(`page errors:\n${state.pageErrors.join('\n')}`);
-    if (state.child) console.error(state.child.tails());
-    process.exit(1);
-  }
-  if (state.tmp) fs.rmSync(state.tmp, { recursive: true, force: true });
-  console.log(`${NAME}: PASS (${checks} checks, ${((Date.now() - t0) / 1000).toFixed(1)} s)`);
-}
-
-run();
+run(main, {
+  name: 'editor_test',
+  summary: (passed, failed, seconds) => (failed ? null : `editor_test: PASS (${passed} checks, ${seconds} s)`),
+});

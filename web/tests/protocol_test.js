@@ -16,13 +16,13 @@
 // CTest runs it as web_protocol (label e2e); `./run test` installs its npm packages.
 'use strict';
 
-const { spawn } = require('node:child_process');
 const fs = require('node:fs');
-const os = require('node:os');
 const path = require('node:path');
+const {
+  ok, check, fail, poke, abort, waitFor, describeExit, startRilbed, commandLine, checkBinary, checkScenario,
+  tempFolder, requirePackage, run,
+} = require('./support');
 
-const NAME = 'protocol_test';
-const DEADLINE_MS = 30000;
 const TOPICS = [
   '/rilbed/world', '/rilbed/status', '/rilbed/poses', '/rilbed/wheels', '/rilbed/sensors',
   '/rilbed/detections', '/rilbed/events', '/rilbed/summary', '/rilbed/scene', '/rilbed/console_reply',
@@ -30,39 +30,6 @@ const TOPICS = [
 // How far a robot's centre may be outside the field's rectangle (a real robot's pose is
 // what the camera saw, which can be a little off at a wall).
 const FIELD_TOLERANCE_M = 0.02;
-
-let checks = 0;
-function ok(what) {
-  checks += 1;
-  console.log(`ok ${checks} - ${what}`);
-}
-
-class TestFailure extends Error {}
-function fail(message) {
-  throw new TestFailure(message);
-}
-function check(condition, message) {
-  if (!condition) fail(message);
-}
-
-// ---------------------------------------------------------------- the npm packages
-function requirePackages() {
-  const modules = path.join(__dirname, 'node_modules');
-  const missing = `${modules} is missing or incomplete: run ./run test (it installs the npm packages)`;
-  if (!fs.existsSync(modules)) {
-    console.error(`${NAME}: FAIL: ${missing}`);
-    process.exit(1);
-  }
-  try {
-    return {
-      FoxgloveClient: require('@foxglove/ws-protocol').FoxgloveClient,
-      WebSocket: require('ws'),
-    };
-  } catch (e) {
-    console.error(`${NAME}: FAIL: ${missing} (${e.message})`);
-    process.exit(1);
-  }
-}
 
 // ---------------------------------------------------------------- the scenario's robots
 // The robot IDs a scenario file names: `id: N` or `ids: LIST` (LIST as `1-3,5`) in its
@@ -89,135 +56,20 @@ function scenarioRobotIds(text) {
   return [...ids].sort((a, b) => a - b);
 }
 
-// ---------------------------------------------------------------- waiting on events
-// Every wait is a condition over what has arrived so far, tried again whenever something
-// arrives, with a deadline; `abort` ends every wait at once (rilbed exited, the socket
-// closed).
-const waiters = new Set();
-let aborted = null;
-function poke() {
-  for (const w of [...waiters]) {
-    let value;
-    try {
-      value = w.condition();
-    } catch (e) {
-      w.finish();
-      w.reject(e);
-      continue;
-    }
-    if (value !== undefined && value !== null && value !== false) {
-      w.finish();
-      w.resolve(value);
-    }
-  }
-}
-function abort(message) {
-  if (aborted) return;
-  aborted = message;
-  for (const w of [...waiters]) {
-    w.finish();
-    w.reject(new TestFailure(`${message} while waiting for ${w.what}`));
-  }
-}
-function waitFor(what, condition, ms = DEADLINE_MS) {
-  return new Promise((resolve, reject) => {
-    if (aborted) {
-      reject(new TestFailure(`${aborted} while waiting for ${what}`));
-      return;
-    }
-    const w = { what, condition, resolve, reject };
-    const timer = setTimeout(() => {
-      waiters.delete(w);
-      reject(new TestFailure(`timed out after ${ms / 1000} s waiting for ${what}`));
-    }, ms);
-    w.finish = () => {
-      clearTimeout(timer);
-      waiters.delete(w);
-    };
-    waiters.add(w);
-    poke();
-  });
-}
-
-// ---------------------------------------------------------------- rilbed, the child
-class Child {
-  constructor(binary, args) {
-    this.stdoutLines = [];
-    this.stderrTail = [];
-    this.exit = null;  // {code, signal} once it exited
-    this.proc = spawn(binary, args, { stdio: ['ignore', 'pipe', 'pipe'] });
-    this.proc.on('error', (e) => {
-      this.exit = { code: null, signal: null, error: e };
-      abort(`rilbed could not be started (${e.message})`);
-    });
-    const lineReader = (onLine) => {
-      let partial = '';
-      return (chunk) => {
-        partial += chunk.toString('utf8');
-        const parts = partial.split('\n');
-        partial = parts.pop();
-        for (const l of parts) onLine(l);
-        poke();
-      };
-    };
-    this.proc.stdout.on('data', lineReader((l) => this.stdoutLines.push(l)));
-    this.proc.stderr.on('data', lineReader((l) => {
-      this.stderrTail.push(l);
-      if (this.stderrTail.length > 40) this.stderrTail.shift();
-    }));
-    this.proc.on('exit', (code, signal) => {
-      this.exit = { code, signal };
-      if (!this.exitExpected) abort(`rilbed exited unexpectedly (${describeExit(this.exit)})`);
-      poke();
-    });
-  }
-  // Ends it (SIGTERM, then SIGKILL after 5 s) unless it has exited.
-  async kill() {
-    if (this.exit || !this.proc.pid) return;
-    this.exitExpected = true;
-    const exited = new Promise((resolve) => this.proc.once('exit', resolve));
-    this.proc.kill('SIGTERM');
-    const timer = setTimeout(() => this.proc.kill('SIGKILL'), 5000);
-    await exited;
-    clearTimeout(timer);
-  }
-  tails() {
-    const out = this.stdoutLines.slice(-20).join('\n');
-    const err = this.stderrTail.join('\n');
-    return `--- rilbed's stdout (last lines) ---\n${out}\n--- rilbed's stderr (last lines) ---\n${err}\n---`;
-  }
-}
-function describeExit(e) {
-  if (e.error) return e.error.message;
-  return e.signal ? `killed by ${e.signal}` : `exit code ${e.code}`;
-}
-
 // ---------------------------------------------------------------- the test
 async function main(state) {
-  const [binary, scenario] = process.argv.slice(2);
-  if (!binary || !scenario) {
-    console.error(`usage: node ${path.basename(__filename)} RILBED SCENARIO`);
-    process.exit(2);
-  }
-  check(fs.existsSync(binary), `no rilbed binary at ${binary} (build it first: ./run build)`);
-  check(fs.existsSync(scenario), `no scenario at ${scenario}`);
-  const { FoxgloveClient, WebSocket } = requirePackages();
+  const [binary, scenario] = commandLine('RILBED SCENARIO');
+  checkBinary(binary);
+  checkScenario(scenario);
+  const { FoxgloveClient } = requirePackage('@foxglove/ws-protocol');
+  const WebSocket = requirePackage('ws');
 
   const scenarioIds = scenarioRobotIds(fs.readFileSync(scenario, 'utf8'));
   console.log(`# scenario ${scenario}: robots ${scenarioIds.length ? scenarioIds.join(',') : '(none found in the file: taken from /rilbed/world)'}`);
 
-  state.tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'rilbed-web-protocol-'));
-  const runDir = path.join(state.tmp, 'run');
-  const args = ['run', scenario, '--realtime', '--duration', '60', '--gui', '--gui-port', '0', '--out', runDir];
-  console.log(`# starting ${binary} ${args.join(' ')}`);
-  const child = new Child(binary, args);
-  state.child = child;
-
+  tempFolder(state, 'protocol');
   // The page's URL on rilbed's stdout.
-  const urlPattern = /http:\/\/127\.0\.0\.1:(\d+)\/\?token=([^\s&#]+)/;
-  const match = await waitFor('the line with http://127.0.0.1:PORT/?token=TOKEN on rilbed\'s stdout',
-    () => child.stdoutLines.map((l) => urlPattern.exec(l)).find((m) => m));
-  const [, port, token] = match;
+  const { child, runDir, port, token } = await startRilbed(state, binary, scenario, { dir: 'run', duration: 60 });
   ok(`rilbed serves its page on port ${port} (token of ${token.length} characters)`);
 
   // The Foxglove client.
@@ -422,35 +274,12 @@ async function main(state) {
     .filter((l) => l.includes(',console,')).map((l) => l.split(',').slice(4).join(',')).join('; ')})`);
 }
 
-async function run() {
-  const state = {};
-  let failure = null;
-  try {
-    await main(state);
-  } catch (e) {
-    failure = e;
-  }
-  if (state.client) {
+run(main, {
+  name: 'protocol_test',
+  summary: (passed, failed) => `${passed} passed, ${failed} failed`,
+  teardown: (state) => {
+    if (!state.client) return;
     state.closeExpected = true;
     try { state.client.close(); } catch (_) { /* already closed */ }
-  }
-  if (failure) {
-    const message = failure instanceof TestFailure ? failure.message : (failure.stack || String(failure));
-    console.error(`${NAME}: FAIL: ${message}`);
-    if (state.child) {
-      console.error(state.child.tails());
-      await state.child.kill();
-    }
-    if (state.tmp) console.error(`${NAME}: the run's folder is kept in ${state.tmp}`);
-    console.log(`${checks} passed, 1 failed`);
-    process.exit(1);
-  }
-  fs.rmSync(state.tmp, { recursive: true, force: true });
-  console.log(`${checks} passed, 0 failed`);
-  process.exit(0);
-}
-
-for (const signal of ['SIGINT', 'SIGTERM']) {
-  process.on(signal, () => abort(`${NAME} got ${signal}`));
-}
-run();
+  },
+});

@@ -35,14 +35,13 @@
 // waiting for, shows the end of rilbed's output, kills rilbed and the browser and exits 1.
 'use strict';
 
-const { spawn } = require('node:child_process');
 const fs = require('node:fs');
-const os = require('node:os');
 const path = require('node:path');
+const {
+  ok, check, sleep, poll, startRilbed, commandLine, checkBinary, checkScenario, tempFolder,
+  withRobots, requirePlaywright, launchBrowser, newContext, openPage, useArtefacts, screenshot, run,
+} = require('./support');
 
-const NAME = 'vision_test';
-const CHROMIUM = '/usr/bin/chromium';
-const DEADLINE_MS = 30000;       // every wait (the machine may be slow, or under ASan)
 const WATCHDOG_MS = 280000;      // the whole test (CTest's TIMEOUT is 300 s)
 const DEFAULTS = { brightness: 0, contrast: 1, threshold: 24, min_diameter_px: 18, max_diameter_px: 480, min_score: 0.75 };
 const DEFAULT_YAML = 'vision: {brightness: 0, contrast: 1, threshold: 24, min_diameter_px: 18, max_diameter_px: 480, min_score: 0.75}';
@@ -51,40 +50,10 @@ const REAL = [4, 5];
 const REAL_POSES = { 4: [0.45, 0.6, 0], 5: [1.05, 0.6, 90] }; // x_m, y_m, theta_deg: well inside the field
 const MAX_REQUESTS_PER_S = 5;    // the page sends at most 4 a second (one each 250 ms), and one at the release
 
-let checks = 0;
-function ok(what) {
-  checks += 1;
-  console.log(`ok ${checks} - ${what}`);
-}
-class TestFailure extends Error {}
-function fail(message) { throw new TestFailure(message); }
-function check(condition, message) { if (!condition) fail(message); }
-const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
-
-// ---------------------------------------------------------------- the npm packages, Chromium
-function requirePlaywright() {
-  const modules = path.join(__dirname, 'node_modules');
-  const missing = `${modules} is missing or incomplete: run ./run test (it installs the npm packages)`;
-  if (!fs.existsSync(modules)) fail(missing);
-  let playwright;
-  try {
-    playwright = require('playwright-core');
-  } catch (e) {
-    fail(`${missing} (${e.message})`);
-  }
-  if (!fs.existsSync(CHROMIUM)) fail(`no ${CHROMIUM}: run ./run test (it installs Debian's chromium)`);
-  return playwright;
-}
-
 // ---------------------------------------------------------------- the scenario
 // The mixed scenario's copy: its field, timing, camera and safety as shipped; every robot
 // standing still, the real ones at known poses.
 function mixedScenarioCopy(text) {
-  const lines = text.split('\n');
-  const start = lines.findIndex((l) => /^robots\s*:/.test(l));
-  check(start >= 0, 'the mixed scenario has no robots: section');
-  let end = start + 1;
-  while (end < lines.length && (/^\s/.test(lines[end]) || lines[end] === '' || /^#/.test(lines[end]))) end++;
   const real = REAL.map((id) => `  - id: ${id}
     kind: real
     link: {emulate: true}
@@ -98,129 +67,20 @@ ${real}
   - ids: 6-8
     pose: random
     controller: none`;
-  return [...lines.slice(0, start), robots, ...lines.slice(end)].join('\n');
-}
-
-// ---------------------------------------------------------------- rilbed, the children
-let aborted = null;  // set when a child exits unexpectedly: every wait ends
-class Child {
-  constructor(label, binary, args) {
-    this.label = label;
-    this.stdoutLines = [];
-    this.stderrTail = [];
-    this.exit = null;
-    this.proc = spawn(binary, args, { stdio: ['ignore', 'pipe', 'pipe'] });
-    this.proc.on('error', (e) => {
-      this.exit = { code: null, signal: null, error: e };
-      aborted = aborted || `${label} could not be started (${e.message})`;
-    });
-    const lineReader = (onLine) => {
-      let partial = '';
-      return (chunk) => {
-        partial += chunk.toString('utf8');
-        const parts = partial.split('\n');
-        partial = parts.pop();
-        for (const l of parts) onLine(l);
-      };
-    };
-    this.proc.stdout.on('data', lineReader((l) => this.stdoutLines.push(l)));
-    this.proc.stderr.on('data', lineReader((l) => {
-      this.stderrTail.push(l);
-      if (this.stderrTail.length > 40) this.stderrTail.shift();
-    }));
-    this.proc.on('exit', (code, signal) => {
-      this.exit = { code, signal };
-      if (!this.exitExpected) aborted = aborted || `${label} exited unexpectedly (${describeExit(this.exit)})`;
-    });
-  }
-  async kill() {
-    if (this.exit || !this.proc.pid) return;
-    this.exitExpected = true;
-    const exited = new Promise((resolve) => this.proc.once('exit', resolve));
-    this.proc.kill('SIGTERM');
-    const timer = setTimeout(() => this.proc.kill('SIGKILL'), 5000);
-    await exited;
-    clearTimeout(timer);
-  }
-  tails() {
-    const out = this.stdoutLines.slice(-20).join('\n');
-    const err = this.stderrTail.join('\n');
-    return `--- ${this.label}'s stdout (last lines) ---\n${out}\n--- ${this.label}'s stderr (last lines) ---\n${err}\n---`;
-  }
-}
-function describeExit(e) {
-  if (e.error) return e.error.message;
-  return e.signal ? `killed by ${e.signal}` : `exit code ${e.code}`;
-}
-
-// Tries `condition` (sync or async) every `everyMs` until it returns something other than
-// undefined, null or false, and returns that; fails after `ms`, saying what it waited for
-// and, if given, what `describe()` says it saw last.
-async function poll(what, condition, { ms = DEADLINE_MS, everyMs = 100, describe = null } = {}) {
-  const end = Date.now() + ms;
-  for (;;) {
-    if (aborted) fail(`${aborted} while waiting for ${what}`);
-    const value = await condition();
-    if (value !== undefined && value !== null && value !== false) return value;
-    if (Date.now() > end) {
-      let seen = '';
-      if (describe) {
-        try { seen = ` (last seen: ${await describe()})`; } catch (e) { seen = ` (${e.message})`; }
-      }
-      fail(`timed out after ${ms / 1000} s waiting for ${what}${seen}`);
-    }
-    await sleep(everyMs);
-  }
-}
-
-// Starts `rilbed run` with the GUI and returns {child, runDir, url, port, token}.
-async function startRun(state, label, binary, scenario) {
-  const runDir = path.join(state.tmp, label);
-  const args = ['run', scenario, '--realtime', '--duration', '300', '--gui', '--gui-port', '0', '--out', runDir];
-  console.log(`# starting ${binary} ${args.join(' ')}`);
-  const child = new Child(label, binary, args);
-  state.children.push(child);
-  const urlPattern = /(http:\/\/127\.0\.0\.1:(\d+)\/\?token=([^\s&#]+))/;
-  const [, url, port, token] = await poll(`the line with http://127.0.0.1:PORT/?token=TOKEN on ${label}'s stdout`,
-    () => child.stdoutLines.map((l) => urlPattern.exec(l)).find((m) => m));
-  return { child, runDir, url, port: Number(port), token };
+  return withRobots(text, robots);
 }
 
 // ---------------------------------------------------------------- the page
-// A page on `url` whose console errors and uncaught exceptions are collected in
-// state.pageErrors, and whose setParameters requests (WebSocket frames it sends) are
-// collected in state.sent[label] as {at, parameters}.
-async function openPage(state, context, label, url) {
-  const page = await context.newPage();
-  page.on('console', (m) => {
-    if (m.type() === 'error') {
-      const where = m.location() && m.location().url ? ` at ${m.location().url}:${m.location().lineNumber}` : '';
-      state.pageErrors.push(`${label}: console error: ${m.text()}${where}`);
-    }
-  });
-  page.on('pageerror', (e) => state.pageErrors.push(`${label}: uncaught: ${e.stack || e.message}`));
-  page.on('crash', () => state.pageErrors.push(`${label}: the page crashed`));
+// A page on `url` (support.js's openPage) whose setParameters requests (WebSocket frames it
+// sends) are collected in state.sent[label] as {at, parameters}.
+const openVisionPage = (state, context, label, url) => openPage(state, context, label, url, (page) => {
   state.sent[label] = [];
   page.on('websocket', (ws) => ws.on('framesent', (f) => {
     if (typeof f.payload !== 'string' || !f.payload.includes('"setParameters"')) return;
     const m = JSON.parse(f.payload);
     if (m.op === 'setParameters') state.sent[label].push({ at: Date.now(), parameters: m.parameters });
   }));
-  const response = await page.goto(url, { timeout: DEADLINE_MS });
-  check(response && response.status() === 200, `${label}: GET ${url} answered ${response && response.status()}`);
-  await poll(`${label} to connect and show the run (connection pill "connected", world, status and poses received)`,
-    () => page.evaluate(() => document.getElementById('connection').textContent === 'connected' &&
-      window.rilbed && window.rilbed.run.world && window.rilbed.run.status && window.rilbed.run.poses && true),
-    { describe: () => page.evaluate(() => `connection "${document.getElementById('connection').textContent}"`) });
-  return page;
-}
-
-async function screenshot(state, page, name) {
-  const file = path.join(state.artifacts, `vision-${name}.png`);
-  await page.screenshot({ path: file, fullPage: true });
-  state.screenshots.push(file);
-  console.log(`# screenshot ${file}`);
-}
+});
 
 // What the page's Vision section shows.
 function visionShown(page) {
@@ -313,36 +173,27 @@ const fmtStats = (s) => `mean ${s.mean.toFixed(1)}, sd ${s.sd.toFixed(1)}`;
 
 // ---------------------------------------------------------------- the test
 async function main(state) {
-  const [binary, mixedScenario, simScenario, artefactArg] = process.argv.slice(2);
-  if (!binary || !mixedScenario || !simScenario) {
-    console.error(`usage: node ${path.basename(__filename)} RILBED MIXED_SCENARIO SIM_SCENARIO [ARTEFACT_DIR]`);
-    process.exit(2);
-  }
-  const { chromium } = requirePlaywright();
-  check(fs.existsSync(binary), `no rilbed binary at ${binary} (build it first: ./run build)`);
-  check(fs.existsSync(mixedScenario), `no scenario at ${mixedScenario}`);
-  check(fs.existsSync(simScenario), `no scenario at ${simScenario}`);
+  const [binary, mixedScenario, simScenario, artefactArg] = commandLine('RILBED MIXED_SCENARIO SIM_SCENARIO [ARTEFACT_DIR]');
+  const playwright = requirePlaywright();
+  checkBinary(binary);
+  checkScenario(mixedScenario);
+  checkScenario(simScenario);
 
-  state.tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'rilbed-web-vision-'));
-  state.artifacts = process.env.RILBED_ARTIFACTS || artefactArg || fs.mkdtempSync(path.join(os.tmpdir(), 'rilbed-web-artifacts-'));
-  fs.mkdirSync(state.artifacts, { recursive: true });
-  for (const f of fs.readdirSync(state.artifacts)) {
-    if (/^vision-.*\.png$/.test(f)) fs.rmSync(path.join(state.artifacts, f));
-  }
-  console.log(`# screenshots go to ${state.artifacts}`);
+  state.sent = {};
+  tempFolder(state, 'vision');
+  useArtefacts(state, artefactArg, 'vision');
 
   const scenario = path.join(state.tmp, 'convoy_mixed_still.yaml');
   fs.writeFileSync(scenario, mixedScenarioCopy(fs.readFileSync(mixedScenario, 'utf8')));
   console.log(`# ${scenario}: ${mixedScenario} with every robot standing, ${REAL.join(' and ')} real at ` +
     REAL.map((id) => `(${REAL_POSES[id].join(', ')})`).join(' and '));
-  const mixed = await startRun(state, 'mixed', binary, scenario);
+  const mixed = await startRilbed(state, binary, scenario, { label: 'mixed' });
 
-  state.browser = await chromium.launch({ executablePath: CHROMIUM, args: ['--no-sandbox'], timeout: DEADLINE_MS });
-  const context = await state.browser.newContext({ viewport: { width: 1280, height: 1000 } });
-  context.setDefaultTimeout(DEADLINE_MS);
+  await launchBrowser(state, playwright);
+  const context = await newContext(state, { viewport: { width: 1280, height: 1000 } });
 
   // ------------------------------------------------ 1. the Vision section, the defaults
-  const page = await openPage(state, context, 'page 1', mixed.url);
+  const page = await openVisionPage(state, context, 'page 1', mixed.url);
   const shown = await waitValues(page, DEFAULTS, 'the defaults');
   check(shown.available && !shown.greyed && shown.reason === null && !shown.defaultsDisabled,
     `the Vision section of a run with a camera: available ${shown.available}, greyed ${shown.greyed}, reason "${shown.reason}", defaults button disabled ${shown.defaultsDisabled}`);
@@ -475,7 +326,7 @@ async function main(state) {
      `min diameter 500 above the max refused: "${crossedShown.reply}"; the values stayed`);
 
   // ------------------------------------------------ 6. a second page follows
-  const page2 = await openPage(state, context, 'page 2', mixed.url);
+  const page2 = await openVisionPage(state, context, 'page 2', mixed.url);
   await waitValues(page2, DEFAULTS, 'the defaults on page 2');
   await page2.locator('#vision-threshold').fill('40');
   await waitValues(page2, { threshold: 40 }, 'threshold 40 on page 2');
@@ -488,8 +339,8 @@ async function main(state) {
   ok('page 2 set threshold 40: page 1 shows it (readout and slider), and page 2\'s "defaults" too');
 
   // ------------------------------------------------ 7. a run without a camera
-  const sim = await startRun(state, 'sim', binary, simScenario);
-  const simPage = await openPage(state, context, 'sim page', sim.url);
+  const sim = await startRilbed(state, binary, simScenario, { label: 'sim' });
+  const simPage = await openVisionPage(state, context, 'sim page', sim.url);
   const simShown = await poll('the Vision section of the run without a camera to be greyed with a reason', async () => {
     const s = await visionShown(simPage);
     state.lastSim = s;
@@ -505,50 +356,4 @@ async function main(state) {
   ok('no console error and no uncaught exception on any page');
 }
 
-async function run() {
-  const state = { children: [], pageErrors: [], screenshots: [], sent: {} };
-  let failure = null;
-  const watchdog = setTimeout(() => {
-    aborted = `${NAME} ran longer than ${WATCHDOG_MS / 1000} s`;
-    console.error(`${NAME}: FAIL: ${aborted}`);
-    for (const c of state.children) if (!c.exit) c.proc.kill('SIGKILL');
-    process.exit(1);
-  }, WATCHDOG_MS);
-  const started = Date.now();
-  try {
-    await main(state);
-  } catch (e) {
-    failure = e;
-  }
-  if (failure && state.browser) {
-    for (const context of state.browser.contexts()) {
-      for (const [i, p] of context.pages().entries()) {
-        try { await screenshot(state, p, `failure-${state.browser.contexts().indexOf(context)}-${i}`); } catch (_) { /* closed */ }
-      }
-    }
-  }
-  if (state.browser) await Promise.race([state.browser.close().catch(() => {}), sleep(10000)]);
-  clearTimeout(watchdog);
-  if (failure) {
-    const message = failure instanceof TestFailure ? failure.message : (failure.stack || String(failure));
-    console.error(`${NAME}: FAIL: ${message}`);
-    if (state.pageErrors.length) console.error(`${NAME}: the pages' errors so far:\n  ${state.pageErrors.join('\n  ')}`);
-    for (const child of state.children) {
-      console.error(child.tails());
-      await child.kill();
-    }
-    if (state.tmp) console.error(`${NAME}: the runs' folders are kept in ${state.tmp}`);
-    console.log(`${checks} passed, 1 failed (${((Date.now() - started) / 1000).toFixed(1)} s)`);
-    process.exit(1);
-  }
-  for (const child of state.children) await child.kill();
-  console.log(`# screenshots: ${state.screenshots.join(' ')}`);
-  fs.rmSync(state.tmp, { recursive: true, force: true });
-  console.log(`${checks} passed, 0 failed (${((Date.now() - started) / 1000).toFixed(1)} s)`);
-  process.exit(0);
-}
-
-for (const signal of ['SIGINT', 'SIGTERM']) {
-  process.on(signal, () => { aborted = `${NAME} got ${signal}`; });
-}
-run();
+run(main, { name: 'vision_test', watchdogMs: WATCHDOG_MS });
