@@ -14,6 +14,9 @@ const IR_COS = IR_ANGLES_RAD.map(Math.cos), IR_SIN = IR_ANGLES_RAD.map(Math.sin)
 const IR_RANGE_M = 0.05; // what the IR ring sees; a reading of 1023 is touching
 const TRAIL_POINTS = 400;
 const HISTORY_PERIOD_S = 0.2;
+const PLOT_POINTS = 1500; // at most, per robot and plot: a series that grows past it is halved
+const LEGEND_ROBOTS = 20; // beyond it the formation plot's legend is a count
+const TABLE_ROWS = 60; // the agent table shows at most this many robots
 
 const $ = (id) => document.getElementById(id);
 
@@ -124,12 +127,28 @@ function onPoses(m) {
   }
   if (m.t_s - run.lastHistoryT >= HISTORY_PERIOD_S) {
     run.lastHistoryT = m.t_s;
+    // Each robot's formation series: in a small run every robot has one (its legend), in a
+    // large one only the robots that have followed. The distance ahead (every robot against
+    // every other) is worked out for followers only, so not at all in a run without a convoy.
+    const few = m.robots.length <= LEGEND_ROBOTS;
+    // A trajectory point is kept when the robot has moved a pixel of the plot or 1 cm.
+    const step = Math.max(0.01, 1 / (trajectoryPlot.scale || Infinity));
     for (const r of m.robots) {
-      if (!run.history.has(r.id)) run.history.set(r.id, []);
-      run.history.get(r.id).push([m.t_s, r.x_m, r.y_m]);
-      const d = distanceAhead(r, m.robots);
-      if (!run.formation.has(r.id)) run.formation.set(r.id, []);
-      run.formation.get(r.id).push([m.t_s, r.behaviour === 'follow' ? d : null]);
+      let pts = run.history.get(r.id);
+      if (!pts) run.history.set(r.id, (pts = []));
+      const last = pts[pts.length - 1];
+      if (!last || Math.abs(last[1] - r.x_m) >= step || Math.abs(last[2] - r.y_m) >= step) {
+        pts.push([m.t_s, r.x_m, r.y_m]);
+        if (pts.length > PLOT_POINTS) thin(pts, () => false);
+      }
+      const follows = r.behaviour === 'follow';
+      let f = run.formation.get(r.id);
+      if (!f) {
+        if (!follows && !few) continue;
+        run.formation.set(r.id, (f = []));
+      }
+      f.push([m.t_s, follows ? distanceAhead(r, m.robots) : null]);
+      if (f.length > PLOT_POINTS) thin(f, (p) => p[1] === null);
     }
     plotsDirty = true;
   }
@@ -150,8 +169,19 @@ function distanceAhead(r, robots) {
   return best;
 }
 
+// Halves a plot's series in place, keeping its first and last points (so its whole time span)
+// and every point `keep` says must stay (the gaps in a follower's line).
+function thin(points, keep) {
+  let n = 0;
+  for (let i = 0; i < points.length; ++i) {
+    if (i % 2 === 0 || i === points.length - 1 || keep(points[i])) points[n++] = points[i];
+  }
+  points.length = n;
+}
+
 function clearHistory() {
   run.trails.clear(); run.history.clear(); run.formation.clear(); run.lastHistoryT = -Infinity;
+  trajectoryPlot.key = '';
   plotsDirty = true;
 }
 
@@ -174,26 +204,55 @@ function setStat(name, value) {
   dd.textContent = value;
 }
 
+// The agent table: one row per robot, or with many robots at most TABLE_ROWS of them (the
+// real ones first, then the one driven or chosen to drive, then by ID; those matching the ID
+// filter if one is typed) and a line saying how many more. A cell is written only when its
+// text changes, so that a message that changes nothing lays nothing out again.
+const agentRows = new Map(); // id -> { row, text: [4 strings], cls }
+let agentShown = ''; // the IDs shown, in order, as a key
 function updateAgentTable(robots) {
   const body = document.querySelector('#agents tbody');
-  const rows = new Map([...body.rows].map((row) => [Number(row.dataset.id), row]));
-  for (const r of robots) {
-    let row = rows.get(r.id);
-    if (!row) {
-      row = body.insertRow(); row.dataset.id = r.id;
-      for (let i = 0; i < 4; ++i) row.insertCell();
-      [...body.rows].sort((a, b) => a.dataset.id - b.dataset.id).forEach((x) => body.append(x));
-    }
-    rows.delete(r.id);
-    row.cells[0].textContent = r.id;
-    row.cells[1].textContent = r.real ? (r.seen ? 'real' : 'real, unseen') : 'virtual';
-    row.cells[2].textContent = r.behaviour;
-    const health = r.real ? (r.health || 'ok') : '—';
-    row.cells[3].textContent = health;
-    row.cells[3].className = !r.real ? '' : health === 'ok' ? 'health-ok' : /lost/.test(health) ? 'health-bad' : 'health-warn';
+  const filterBox = $('agent-filter'), more = $('agents-more');
+  const filter = filterBox.value.trim();
+  const noFilter = robots.length <= TABLE_ROWS && !filter;
+  if (filterBox.hidden !== noFilter) filterBox.hidden = noFilter;
+  let shown = filter ? robots.filter((r) => String(r.id).includes(filter)) : robots;
+  const matching = shown.length;
+  if (shown.length > TABLE_ROWS) {
+    const choice = $('drive-robot').value, chosen = driving.robot ?? (choice === '' ? null : Number(choice));
+    const rank = (r) => (r.real ? 0 : r.id === chosen ? 1 : 2);
+    shown = [...shown].sort((x, y) => rank(x) - rank(y) || x.id - y.id).slice(0, TABLE_ROWS);
   }
-  for (const row of rows.values()) row.remove();
+  shown = [...shown].sort((x, y) => x.id - y.id);
+  const key = shown.map((r) => r.id).join(',');
+  if (key !== agentShown) {
+    agentShown = key;
+    const keep = new Set(shown.map((r) => r.id));
+    for (const [id, a] of agentRows) if (!keep.has(id)) { a.row.remove(); agentRows.delete(id); }
+    for (const r of shown) {
+      let a = agentRows.get(r.id);
+      if (!a) {
+        const row = document.createElement('tr'); row.dataset.id = r.id;
+        for (let i = 0; i < 4; ++i) row.insertCell();
+        agentRows.set(r.id, (a = { row, text: ['', '', '', ''], cls: '' }));
+      }
+      body.append(a.row); // in order
+    }
+  }
+  for (const r of shown) {
+    const a = agentRows.get(r.id);
+    const health = r.real ? (r.health || 'ok') : '—';
+    const text = [String(r.id), r.real ? (r.seen ? 'real' : 'real, unseen') : 'virtual', r.behaviour, health];
+    for (let i = 0; i < 4; ++i) if (a.text[i] !== text[i]) a.row.cells[i].textContent = a.text[i] = text[i];
+    const cls = !r.real ? '' : health === 'ok' ? 'health-ok' : /lost/.test(health) ? 'health-bad' : 'health-warn';
+    if (a.cls !== cls) a.row.cells[3].className = a.cls = cls;
+  }
+  const hidden = matching - shown.length;
+  const line = hidden > 0 ? `… ${hidden} more robot${hidden === 1 ? '' : 's'}` : filter && !matching ? `no robot's ID contains ${filter}` : '';
+  if (more.textContent !== line) more.textContent = line;
+  if (more.hidden !== !line) more.hidden = !line;
 }
+$('agent-filter').addEventListener('input', () => { if (run.poses) updateAgentTable(run.poses.robots); });
 
 function addEvent(e) {
   const list = $('events');
@@ -897,6 +956,7 @@ function drawPlots() {
     for (const s of run.formation.values()) for (const [t, d] of s) { tMax = Math.max(tMax, t); if (d !== null) dMax = Math.max(dMax, d); }
     const L = 36, B = 20;
     axes(g, w, h, L, B, `${tMax.toFixed(0)} s`, `${dMax.toFixed(2)} m`);
+    const compact = run.formation.size > LEGEND_ROBOTS; // a label each would not fit
     let k = 0;
     for (const [id, s] of run.formation) {
       g.strokeStyle = COLORS[k++ % COLORS.length]; g.lineWidth = 1.2; g.beginPath();
@@ -907,24 +967,57 @@ function drawPlots() {
       }
       g.stroke();
       const x = w - 4 - 14 * (run.formation.size - k + 1);
-      if (x > -30) { g.fillStyle = g.strokeStyle; g.fillText(String(id), x, 12); } // not the legend off the plot
+      if (!compact && x > -30) { g.fillStyle = g.strokeStyle; g.fillText(String(id), x, 12); } // not the legend off the plot
+    }
+    if (compact) {
+      const n = `${run.formation.size} followers`;
+      g.fillStyle = '#666'; g.fillText(n, w - 8 - g.measureText(n).width, 12);
     }
   }
-  // Trajectories: every robot's path over the field.
-  {
-    const [g, w, h] = plotCanvas('trajectory-plot');
-    const fw = run.world?.width_m || 1, fh = run.world?.height_m || 1;
-    const s = Math.min((w - 8) / fw, (h - 8) / fh), ox = (w - s * fw) / 2, oy = (h + s * fh) / 2;
-    g.strokeStyle = '#1a9e2a'; g.strokeRect(ox, oy - s * fh, s * fw, s * fh);
-    let k = 0;
-    for (const [id, pts] of run.history) {
-      g.strokeStyle = COLORS[k++ % COLORS.length]; g.lineWidth = 1.2; g.beginPath();
-      const pen = plotPen(g);
-      for (const [, x, y] of pts) pen(ox + s * x, oy - s * y);
-      g.stroke();
-      const last = pts[pts.length - 1];
-      if (last) { g.fillStyle = g.strokeStyle; g.fillText(String(id), ox + s * last[1] + 3, oy - s * last[2] - 3); }
-    }
+  drawTrajectories();
+}
+
+// Trajectories: every robot's path over the field. The paths are drawn onto an offscreen
+// canvas a piece at a time (what came since the last plot), and drawn anew only when the
+// plot's size or scale changes or the history starts again; the labels go on top each time.
+const trajectoryPlot = { key: '', canvas: document.createElement('canvas'), scale: 0, last: new Map() };
+function drawTrajectories() {
+  const [g, w, h] = plotCanvas('trajectory-plot');
+  if (w <= 0 || h <= 0) return; // not shown
+  const dpr = window.devicePixelRatio || 1;
+  const fw = run.world?.width_m || 1, fh = run.world?.height_m || 1;
+  const s = Math.min((w - 8) / fw, (h - 8) / fh), ox = (w - s * fw) / 2, oy = (h + s * fh) / 2;
+  const T = trajectoryPlot, off = T.canvas;
+  const key = `${w} ${h} ${dpr} ${fw} ${fh}`;
+  const o = off.getContext('2d');
+  if (T.key !== key) {
+    T.key = key; T.scale = s; T.last.clear();
+    off.width = Math.round(w * dpr); off.height = Math.round(h * dpr);
+    o.setTransform(dpr, 0, 0, dpr, 0, 0); o.clearRect(0, 0, w, h);
+    o.strokeStyle = '#1a9e2a'; o.lineWidth = 1; o.strokeRect(ox, oy - s * fh, s * fw, s * fh);
+  }
+  let k = 0;
+  o.lineWidth = 1.2;
+  for (const [id, pts] of run.history) {
+    o.strokeStyle = COLORS[k++ % COLORS.length];
+    const last = T.last.get(id); // [t, u, v] of the last point drawn
+    let i = pts.length;
+    if (last) while (i > 0 && pts[i - 1][0] > last[0]) --i; else i = 0;
+    if (i === pts.length) continue;
+    o.beginPath();
+    const pen = plotPen(o);
+    if (last) pen(last[1], last[2]);
+    let u = 0, v = 0;
+    for (; i < pts.length; ++i) { u = ox + s * pts[i][1]; v = oy - s * pts[i][2]; pen(u, v); }
+    o.stroke();
+    T.last.set(id, [pts[pts.length - 1][0], u, v]);
+  }
+  g.drawImage(off, 0, 0, w, h);
+  k = 0;
+  for (const [id, pts] of run.history) {
+    g.fillStyle = COLORS[k++ % COLORS.length];
+    const last = pts[pts.length - 1];
+    if (last) g.fillText(String(id), ox + s * last[1] + 3, oy - s * last[2] - 3);
   }
 }
 
