@@ -205,9 +205,9 @@ rilbed::detections_t to_lcm(const agents::FrameReport& f) {
 rilbed::vision_settings_t to_lcm(TimeUs t_us, const vision::VisionSettings& s) {
   rilbed::vision_settings_t m;
   m.utime = t_us;
-  m.brightness = s.brightness;
+  m.brightness_grey = s.brightness;
   m.contrast = s.contrast;
-  m.threshold = s.threshold;
+  m.threshold_grey = s.threshold;
   m.min_diameter_px = s.min_diameter_px;
   m.max_diameter_px = s.max_diameter_px;
   m.min_score = s.min_score;
@@ -216,9 +216,9 @@ rilbed::vision_settings_t to_lcm(TimeUs t_us, const vision::VisionSettings& s) {
 
 vision::VisionSettings from_lcm(const rilbed::vision_settings_t& m) {
   vision::VisionSettings s;
-  s.brightness = m.brightness;
+  s.brightness = m.brightness_grey;
   s.contrast = m.contrast;
-  s.threshold = m.threshold;
+  s.threshold = m.threshold_grey;
   s.min_diameter_px = m.min_diameter_px;
   s.max_diameter_px = m.max_diameter_px;
   s.min_score = m.min_score;
