@@ -122,9 +122,11 @@ function onPoses(m) {
     const last = trail[trail.length - 1];
     if (!last || Math.hypot(last[0] - r.x_m, last[1] - r.y_m) > 0.003) {
       trail.push([r.x_m, r.y_m]);
+      trail.pushed = (trail.pushed || 0) + 1; // points ever pushed: which are dots (every other)
       if (trail.length > TRAIL_POINTS) trail.splice(0, trail.length - TRAIL_POINTS);
     }
   }
+  run.trailSeq = (run.trailSeq || 0) + 1; // the trails' layer lays what is new since
   if (m.t_s - run.lastHistoryT >= HISTORY_PERIOD_S) {
     run.lastHistoryT = m.t_s;
     // Each robot's formation series: in a small run every robot has one (its legend), in a
@@ -180,7 +182,7 @@ function thin(points, keep) {
 }
 
 function clearHistory() {
-  run.trails.clear(); run.history.clear(); run.formation.clear(); run.lastHistoryT = -Infinity;
+  run.trails.clear(); run.trailEpoch = (run.trailEpoch || 0) + 1; run.history.clear(); run.formation.clear(); run.lastHistoryT = -Infinity;
   trajectoryPlot.key = '';
   plotsDirty = true;
 }
@@ -754,7 +756,14 @@ function drawField(P) {
 const TRAIL_COLOURS = [[210, 40, 40, 0.4], [36, 86, 199, 0.45]]; // a virtual robot's, a real one's (RGBA)
 // over[a]: the alpha (0-255) of a dot of that colour laid over alpha a.
 const TRAIL_OVER = TRAIL_COLOURS.map(([, , , alpha]) => Uint8Array.from({ length: 256 }, (_, a) => Math.round(255 * alpha + a * (1 - alpha))));
-const trailLayer = { canvas: document.createElement('canvas'), w: 0, h: 0 };
+// The layer is kept between frames, in canvas CSS pixels: each new pose message lays only
+// its new dots (and re-makes only their pixels); it is laid anew from the trails when the
+// projection changes (zoom, pan, size, camera image), when the trails are cleared or the
+// real robots change, and every TRAIL_REBUILD pose messages, so that dots older than the
+// trails' 400 points go (they stay at most TRAIL_REBUILD messages, 4 s, too long).
+const TRAIL_REBUILD = 40;
+const trailLayer = { canvas: document.createElement('canvas'), w: 0, h: 0, key: '', laid: new Map() };
+const TRAIL_RGB = TRAIL_COLOURS.map(([r, g, b]) => (b << 16) | (g << 8) | r);
 
 function drawTrails(P) {
   const outline = $('trail-style').value === 'outline';
@@ -776,15 +785,44 @@ function drawTrails(P) {
     L.alpha = [new Uint8Array(W * H), new Uint8Array(W * H)];
     L.image = new ImageData(W, H);
     L.pixels = new Uint32Array(L.image.data.buffer); // RGBA bytes: 0xAABBGGRR (little-endian)
+    L.key = '';
   }
-  L.alpha[0].fill(0); L.alpha[1].fill(0);
-  const A = P.affine;
-  let anyReal = false;
+  const A = P.affine, B = P.base;
+  const key = [W, H, P.z, view.panX, view.panY, B.s, B.ox, B.oy, B.camera, B.camera && [run.calibration.width_px, run.calibration.height_px, ...run.calibration.field_to_image].join(','),
+    run.trailEpoch || 0, [...realIds].join(',')].join(' ');
+  const seq = run.trailSeq || 0;
+  const rebuild = key !== L.key || seq - L.builtSeq >= TRAIL_REBUILD;
+  if (rebuild) {
+    L.alpha[0].fill(0); L.alpha[1].fill(0);
+    L.laid.clear(); L.key = key; L.builtSeq = seq;
+  } else if (seq === L.seq) { // nothing new
+    ctx.save(); ctx.imageSmoothingEnabled = false; ctx.drawImage(L.canvas, 0, 0, W, H); ctx.restore();
+    return;
+  }
+  L.seq = seq;
+  const [v0, v1] = L.alpha, out = L.pixels;
+  // Pixel k's colour from its two alphas: real robots' dots over virtual ones'.
+  const compose = (k) => {
+    const a0 = v0[k], a1 = v1[k];
+    if (!a1) out[k] = a0 ? ((a0 << 24) | TRAIL_RGB[0]) >>> 0 : 0;
+    else if (!a0) out[k] = ((a1 << 24) | TRAIL_RGB[1]) >>> 0;
+    else {
+      const under = (a0 * (255 - a1)) / 255, a = a1 + under;
+      const mix = (i) => Math.round((TRAIL_COLOURS[1][i] * a1 + TRAIL_COLOURS[0][i] * under) / a);
+      out[k] = ((Math.round(a) << 24) | (mix(2) << 16) | (mix(1) << 8) | mix(0)) >>> 0;
+    }
+  };
+  let minX = W, minY = H, maxX = -1, maxY = -1; // the pixels changed
   for (const [id, trail] of run.trails) {
-    if (trail.length < 2) continue;
+    const pushed = trail.pushed || 0, laid = L.laid.get(id) || 0;
+    if (pushed === laid) continue;
+    L.laid.set(id, pushed);
     const kind = realIds.has(id) ? 1 : 0, alpha = L.alpha[kind], over = TRAIL_OVER[kind];
-    anyReal ||= kind === 1;
-    for (let i = 0; i < trail.length; i += 2) {
+    // Point i is push number first + i; the even ones are dots.
+    const first = pushed - trail.length;
+    let i = Math.max(0, laid - first);
+    if ((first + i) % 2) ++i;
+    for (; i < trail.length; i += 2) {
       const x = trail[i][0], y = trail[i][1];
       let u, v;
       if (A) { u = A.ax * x + A.bx; v = A.ay * y + A.by; } else [u, v] = P.project(x, y);
@@ -793,29 +831,35 @@ function drawTrails(P) {
         const k = y0 * W + x0;
         alpha[k] = over[alpha[k]]; alpha[k + 1] = over[alpha[k + 1]];
         alpha[k + W] = over[alpha[k + W]]; alpha[k + W + 1] = over[alpha[k + W + 1]];
+        if (!rebuild) { compose(k); compose(k + 1); compose(k + W); compose(k + W + 1); }
       } else if (x0 >= -1 && y0 >= -1 && x0 < W && y0 < H) { // across an edge
         for (let py = Math.max(0, y0); py < Math.min(H, y0 + 2); ++py) {
-          for (let px = Math.max(0, x0), k = py * W + px; px < Math.min(W, x0 + 2); ++px, ++k) alpha[k] = over[alpha[k]];
+          for (let px = Math.max(0, x0), k = py * W + px; px < Math.min(W, x0 + 2); ++px, ++k) {
+            alpha[k] = over[alpha[k]];
+            if (!rebuild) compose(k);
+          }
         }
-      }
+      } else continue;
+      if (x0 < minX) minX = x0; if (y0 < minY) minY = y0;
+      if (x0 + 1 > maxX) maxX = x0 + 1; if (y0 + 1 > maxY) maxY = y0 + 1;
     }
   }
-  // Real robots' dots over virtual ones'.
-  const [v0, v1] = L.alpha, out = L.pixels;
-  const rgb = TRAIL_COLOURS.map(([r, g, b]) => (b << 16) | (g << 8) | r);
-  for (let k = 0; k < out.length; ++k) {
-    const a0 = v0[k], a1 = anyReal ? v1[k] : 0;
-    if (!a1) out[k] = a0 ? ((a0 << 24) | rgb[0]) >>> 0 : 0;
-    else if (!a0) out[k] = ((a1 << 24) | rgb[1]) >>> 0;
-    else {
-      const under = (a0 * (255 - a1)) / 255, a = a1 + under;
-      const mix = (i) => Math.round((TRAIL_COLOURS[1][i] * a1 + TRAIL_COLOURS[0][i] * under) / a);
-      out[k] = ((Math.round(a) << 24) | (mix(2) << 16) | (mix(1) << 8) | mix(0)) >>> 0;
+  const lctx = L.canvas.getContext('2d');
+  if (rebuild) {
+    for (let k = 0; k < out.length; ++k) {
+      const a0 = v0[k], a1 = v1[k];
+      if (!a1) out[k] = a0 ? ((a0 << 24) | TRAIL_RGB[0]) >>> 0 : 0;
+      else compose(k);
     }
+    lctx.putImageData(L.image, 0, 0);
+  } else if (maxX >= 0) {
+    minX = Math.max(0, minX); minY = Math.max(0, minY);
+    lctx.putImageData(L.image, 0, 0, minX, minY, Math.min(W - 1, maxX) - minX + 1, Math.min(H - 1, maxY) - minY + 1);
   }
-  L.canvas.getContext('2d').putImageData(L.image, 0, 0);
   ctx.save(); ctx.imageSmoothingEnabled = false; ctx.drawImage(L.canvas, 0, 0, W, H); ctx.restore();
 }
+
+const MANY_LABELS = 200, LABEL_SPACING_PX = 60;
 
 // The virtual robots (all alike) are one path stroked once, then every label: a thousand
 // robots are a few calls, not thousands. Robots off the canvas are not drawn.
@@ -845,6 +889,9 @@ function drawRobots(P) {
     }
   }
   ctx.strokeStyle = '#d22828'; ctx.stroke(virtual);
+  // Many robots on the canvas: their labels only when the zoom spaces them enough to be
+  // read (a label's room, LABEL_SPACING_PX, per robot on the canvas), else none.
+  if (labels.length > MANY_LABELS && Math.sqrt((P.width * P.height) / labels.length) < LABEL_SPACING_PX) return;
   ctx.fillStyle = '#111'; ctx.font = '12px system-ui';
   for (const [text, x, y] of labels) ctx.fillText(text, x, y);
 }
