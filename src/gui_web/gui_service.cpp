@@ -54,6 +54,8 @@ GuiService::~GuiService() {
   }
   wake_.notify_all();
   thread_.join();  // sends the last stops
+  // The channels' thread publishes on the server: it ends (publishing what it holds) first.
+  channels_.reset();
   server_.reset();
 }
 
