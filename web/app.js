@@ -30,7 +30,10 @@ const run = {
   lastHistoryT: -Infinity,
 };
 // For tests and the curious: what the page holds now.
-window.rilbed = { run, stats: { frames: 0, drawMs: 0, fps: 0 } };
+// stats: frames drawn, the last draw's milliseconds, frames in the last second, and how the
+// trail layer was drawn (trailsLaid: laid anew for the view; trailsMoved: the layer laid
+// for an earlier view, moved and scaled while the view moves).
+window.rilbed = { run, stats: { frames: 0, drawMs: 0, fps: 0, trailsLaid: 0, trailsMoved: 0 } };
 
 // ------------------------------------------------------------------ the connection
 const client = new FoxgloveClient(wsUrl);
@@ -651,8 +654,9 @@ canvas.addEventListener('pointermove', (e) => {
 canvas.addEventListener('pointerup', () => { drag = null; });
 
 // Where field point (x, y) metres lands on the canvas: through the camera's homography when
-// the camera image is shown, else a fit of the field; then zoom and pan.
-function makeProjection(width, height) {
+// the camera image is shown, else a fit of the field; then zoom and pan (`vw`: the view's
+// zoom, panX, panY; the current view unless another is given, e.g. the trail layer's).
+function makeProjection(width, height, vw = view) {
   const useCamera = overlays.camera && run.image && run.calibration;
   let base;
   if (useCamera) {
@@ -668,10 +672,10 @@ function makeProjection(width, height) {
     const ox = (width - s * fw) / 2, oy = (height + s * fh) / 2;
     base = { s, ox, oy, camera: false, toPx: (x, y) => [x, -y] }; // y up on the field
   }
-  const z = view.zoom;
+  const z = vw.zoom;
   const project = (x, y) => {
     const [u, v] = base.toPx(x, y);
-    return [view.panX + z * (base.ox + base.s * u), view.panY + z * (base.oy + base.s * v)];
+    return [vw.panX + z * (base.ox + base.s * u), vw.panY + z * (base.oy + base.s * v)];
   };
   // Metres to pixels near a point (for radii): the projection's local scale.
   const scaleAt = (x, y) => {
@@ -681,7 +685,7 @@ function makeProjection(width, height) {
   // Without the camera the projection is u = ax * x + bx, v = ay * y + by: the loops over
   // thousands of points (trails) use that, allocating nothing.
   const affine = base.camera ? null
-    : { ax: z * base.s, bx: view.panX + z * base.ox, ay: -z * base.s, by: view.panY + z * base.oy };
+    : { ax: z * base.s, bx: vw.panX + z * base.ox, ay: -z * base.s, by: vw.panY + z * base.oy };
   // Whether canvas point (u, v) is within `margin` pixels of the canvas (else not drawn).
   const onCanvas = (u, v, margin) => u > -margin && v > -margin && u < width + margin && v < height + margin;
   return { project, scaleAt, base, z, affine, onCanvas, width, height };
@@ -761,7 +765,12 @@ const TRAIL_OVER = TRAIL_COLOURS.map(([, , , alpha]) => Uint8Array.from({ length
 // projection changes (zoom, pan, size, camera image), when the trails are cleared or the
 // real robots change, and every TRAIL_REBUILD pose messages, so that dots older than the
 // trails' 400 points go (they stay at most TRAIL_REBUILD messages, 4 s, too long).
+// While the view moves (zoom, pan), laying it anew each frame would cost the frame rate (a
+// few tens of milliseconds for 200,000 dots): the layer laid for the view before is drawn
+// moved and scaled to the new view (coarser for a moment), new dots go into it in its own
+// view, and it is laid anew for the view once the view has rested VIEW_REST_MS.
 const TRAIL_REBUILD = 40;
+const VIEW_REST_MS = 150;
 const trailLayer = { canvas: document.createElement('canvas'), w: 0, h: 0, key: '', laid: new Map() };
 const TRAIL_RGB = TRAIL_COLOURS.map(([r, g, b]) => (b << 16) | (g << 8) | r);
 
@@ -787,16 +796,42 @@ function drawTrails(P) {
     L.pixels = new Uint32Array(L.image.data.buffer); // RGBA bytes: 0xAABBGGRR (little-endian)
     L.key = '';
   }
-  const A = P.affine, B = P.base;
-  const key = [W, H, P.z, view.panX, view.panY, B.s, B.ox, B.oy, B.camera, B.camera && [run.calibration.width_px, run.calibration.height_px, ...run.calibration.field_to_image].join(','),
+  // The layer's own view: the current one, or while the view moves the one it was laid for.
+  const B = P.base, now = performance.now();
+  const viewNow = `${view.zoom} ${view.panX} ${view.panY}`;
+  if (viewNow !== L.seenView) { L.seenView = viewNow; L.viewMovedAt = now; }
+  const moving = now - (L.viewMovedAt ?? -Infinity) < VIEW_REST_MS;
+  const key = [W, H, B.s, B.ox, B.oy, B.camera, B.camera && [run.calibration.width_px, run.calibration.height_px, ...run.calibration.field_to_image].join(','),
     run.trailEpoch || 0, [...realIds].join(',')].join(' ');
+  const sameView = L.view && L.view.zoom === view.zoom && L.view.panX === view.panX && L.view.panY === view.panY;
+  const follow = key === L.key && !sameView && moving;
   const seq = run.trailSeq || 0;
-  const rebuild = key !== L.key || seq - L.builtSeq >= TRAIL_REBUILD;
+  const rebuild = key !== L.key || (!sameView && !follow) || (!moving && seq - L.builtSeq >= TRAIL_REBUILD);
+  if (follow) { // laid anew once the view rests
+    clearTimeout(L.restTimer);
+    L.restTimer = setTimeout(requestDraw, VIEW_REST_MS + 10);
+  }
+  const LP = follow ? makeProjection(P.width, P.height, L.view) : P;
+  const A = LP.affine;
+  // The layer onto the canvas, moved from its view to the current one: zoom and pan map
+  // canvas pixels affinely (camera or not), u' = pan' + (z' / z) (u - pan).
+  const blit = () => {
+    ctx.save(); ctx.imageSmoothingEnabled = false;
+    if (follow) {
+      const f = view.zoom / L.view.zoom;
+      ctx.translate(view.panX - f * L.view.panX, view.panY - f * L.view.panY); ctx.scale(f, f);
+    }
+    ctx.drawImage(L.canvas, 0, 0, W, H); ctx.restore();
+  };
+  const stats = window.rilbed.stats;
+  if (follow) stats.trailsMoved += 1;
   if (rebuild) {
+    stats.trailsLaid += 1;
     L.alpha[0].fill(0); L.alpha[1].fill(0);
     L.laid.clear(); L.key = key; L.builtSeq = seq;
+    L.view = { zoom: view.zoom, panX: view.panX, panY: view.panY };
   } else if (seq === L.seq) { // nothing new
-    ctx.save(); ctx.imageSmoothingEnabled = false; ctx.drawImage(L.canvas, 0, 0, W, H); ctx.restore();
+    blit();
     return;
   }
   L.seq = seq;
@@ -825,7 +860,7 @@ function drawTrails(P) {
     for (; i < trail.length; i += 2) {
       const x = trail[i][0], y = trail[i][1];
       let u, v;
-      if (A) { u = A.ax * x + A.bx; v = A.ay * y + A.by; } else [u, v] = P.project(x, y);
+      if (A) { u = A.ax * x + A.bx; v = A.ay * y + A.by; } else [u, v] = LP.project(x, y);
       const x0 = Math.round(u - 1), y0 = Math.round(v - 1); // the dot's top left pixel
       if (x0 >= 0 && y0 >= 0 && x0 < W - 1 && y0 < H - 1) {
         const k = y0 * W + x0;
@@ -856,7 +891,7 @@ function drawTrails(P) {
     minX = Math.max(0, minX); minY = Math.max(0, minY);
     lctx.putImageData(L.image, 0, 0, minX, minY, Math.min(W - 1, maxX) - minX + 1, Math.min(H - 1, maxY) - minY + 1);
   }
-  ctx.save(); ctx.imageSmoothingEnabled = false; ctx.drawImage(L.canvas, 0, 0, W, H); ctx.restore();
+  blit();
 }
 
 const MANY_LABELS = 200, LABEL_SPACING_PX = 60;

@@ -19,25 +19,34 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A namespace script: `rilbed run RUN_ARGS --lcm $URL` and `rilbed gui --lcm $URL` in the
+// background, $HOSTPORT and $TOKEN read from the URL the gui prints, $P2 the WebSocket
+// probe; then `body` (errors no longer end the script: each step writes its exit code to
+// codes.txt), then the console's exit, the run's and the gui's exit codes ("exit N", "run
+// N", "gui N").
+std::string gui_on_the_bus_script(const std::string& run_args, const std::string& body) {
+  return "P2='" RILBED_WS_PROBE "'\n"
+         "\"$R\" run " + run_args + " --lcm \"$URL\" --out run --quiet > run.txt 2> run.err &\n"
+         "P=$!\n"
+         "\"$R\" gui --lcm \"$URL\" --gui-port 0 > gui.txt 2> gui.err &\n"
+         "G=$!\n"
+         "for i in $(seq 1 200); do grep -q 'token=' gui.txt && break; sleep 0.05; done\n"
+         "HOSTPORT=$(sed -n 's|.*http://\\([^/]*\\)/?token=.*|\\1|p' gui.txt)\n"
+         "TOKEN=$(sed -n 's|.*?token=\\([0-9a-f]*\\).*|\\1|p' gui.txt)\n"
+         "set +e\n" +
+         body +
+         "\"$R\" console --lcm \"$URL\" exit > exit.txt 2>&1; echo \"exit $?\" >> codes.txt\n"
+         "wait $P; echo \"run $?\" >> codes.txt\n"
+         "kill -INT $G; wait $G; echo \"gui $?\" >> codes.txt\n";
+}
+
 TEST(GuiCli, ServesARunOnTheBusAndSendsItsConsoleCommands) {
   SKIP_WITHOUT_NAMESPACES();
   const auto dir = scratch_dir("gui_cli");
-  const int status = in_namespace(dir,
-      "P2='" RILBED_WS_PROBE "'\n"
-      "\"$R\" run " + shipped_scenario_arg("convoy_sim") + " --realtime --duration 120 --lcm \"$URL\" --out run --quiet > run.txt 2> run.err &\n"
-      "P=$!\n"
-      "\"$R\" gui --lcm \"$URL\" --gui-port 0 > gui.txt 2> gui.err &\n"
-      "G=$!\n"
-      "for i in $(seq 1 200); do grep -q 'token=' gui.txt && break; sleep 0.05; done\n"
-      "HOSTPORT=$(sed -n 's|.*http://\\([^/]*\\)/?token=.*|\\1|p' gui.txt)\n"
-      "TOKEN=$(sed -n 's|.*?token=\\([0-9a-f]*\\).*|\\1|p' gui.txt)\n"
-      "set +e\n"
+  const int status = in_namespace(dir, gui_on_the_bus_script(shipped_scenario_arg("convoy_sim") + " --realtime --duration 120",
       "\"$P2\" \"ws://$HOSTPORT/ws?token=wrong\" --topics /rilbed/poses --count 1 --timeout 5 > wrong.txt 2>&1; echo \"wrong $?\" >> codes.txt\n"
       "\"$P2\" \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses,/rilbed/console_reply --count 1000 --until /rilbed/console_reply --timeout 60 "
-      "--send '/rilbed/console={\"command\":\"pause\"}' > probe.txt 2>&1; echo \"probe $?\" >> codes.txt\n"
-      "\"$R\" console --lcm \"$URL\" exit > exit.txt 2>&1; echo \"exit $?\" >> codes.txt\n"
-      "wait $P; echo \"run $?\" >> codes.txt\n"
-      "kill -INT $G; wait $G; echo \"gui $?\" >> codes.txt\n");
+      "--send '/rilbed/console={\"command\":\"pause\"}' > probe.txt 2>&1; echo \"probe $?\" >> codes.txt\n"));
   ASSERT_EQ(status, 0) << read_file(dir / "ns.log");
   const std::string codes = read_file(dir / "codes.txt");
   const std::string probe = read_file(dir / "probe.txt");
@@ -61,16 +70,7 @@ TEST(GuiCli, ServesARunOnTheBusAndSendsItsConsoleCommands) {
 TEST(GuiCli, VisionSettingsSetInTheBrowserReachARunOnTheBus) {
   SKIP_WITHOUT_NAMESPACES();
   const auto dir = scratch_dir("gui_cli_vision");
-  const int status = in_namespace(dir,
-      "P2='" RILBED_WS_PROBE "'\n"
-      "\"$R\" run " + shipped_scenario_arg("convoy_mixed") + " --duration 120 --lcm \"$URL\" --out run --quiet > run.txt 2> run.err &\n"
-      "P=$!\n"
-      "\"$R\" gui --lcm \"$URL\" --gui-port 0 > gui.txt 2> gui.err &\n"
-      "G=$!\n"
-      "for i in $(seq 1 200); do grep -q 'token=' gui.txt && break; sleep 0.05; done\n"
-      "HOSTPORT=$(sed -n 's|.*http://\\([^/]*\\)/?token=.*|\\1|p' gui.txt)\n"
-      "TOKEN=$(sed -n 's|.*?token=\\([0-9a-f]*\\).*|\\1|p' gui.txt)\n"
-      "set +e\n"
+  const int status = in_namespace(dir, gui_on_the_bus_script(shipped_scenario_arg("convoy_mixed") + " --duration 120",
       // Once the run's poses come (it is running), one setParameters; its answer ends the probe.
       "\"$P2\" \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses --count 100000 --until parameterValues --timeout 60 "
       "--set-parameters '[{\"name\":\"vision.threshold\",\"value\":30},{\"name\":\"vision.contrast\",\"value\":1.25}]' "
@@ -79,10 +79,7 @@ TEST(GuiCli, VisionSettingsSetInTheBrowserReachARunOnTheBus) {
       "--set-parameters '[{\"name\":\"vision.contrast\",\"value\":9}]' > refused.txt 2>&1; echo \"refused $?\" >> codes.txt\n"
       // A viewer joining later: the settings as the run's status says (not only those set here).
       "for i in $(seq 1 100); do \"$P2\" \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses --count 100000 "
-      "--until parameterValues --timeout 60 --get-parameters all > get.txt 2>&1; grep -q min_score get.txt && break; sleep 0.1; done\n"
-      "\"$R\" console --lcm \"$URL\" exit > exit.txt 2>&1; echo \"exit $?\" >> codes.txt\n"
-      "wait $P; echo \"run $?\" >> codes.txt\n"
-      "kill -INT $G; wait $G; echo \"gui $?\" >> codes.txt\n");
+      "--until parameterValues --timeout 60 --get-parameters all > get.txt 2>&1; grep -q min_score get.txt && break; sleep 0.1; done\n"));
   ASSERT_EQ(status, 0) << read_file(dir / "ns.log");
   const std::string codes = read_file(dir / "codes.txt");
   const std::string probe = read_file(dir / "probe.txt");

@@ -14,7 +14,8 @@
 //   2. the live view draws every robot where /rilbed/poses (and the run's own
 //      trajectories.csv) says it is: red (#d22828) strokes around a virtual robot, blue
 //      (#2456c7) around a real one, neither far from every robot;
-//   3. Pause pauses (banner, status, events.csv "paused by gui"), Start resumes;
+//   3. Pause pauses (banner, status, events.csv "paused by gui"), Start resumes; while
+//      paused, zooming draws the trails moved with the view, lined up with the trails laid anew;
 //   4. the real-time factor slider is disabled with real robots and sets the factor of a
 //      run without them (status rt_factor 2, the clock running about twice as fast);
 //   5. manual driving: Take robot 4, hold ArrowUp: it drives forward; let go: it stops
@@ -176,6 +177,83 @@ function sampleView(page) {
   }, { VIRTUAL_RGB, REAL_RGB, COLOUR_TOLERANCE, ROBOT_RADIUS_M });
 }
 
+// While the view moves, the trails are the layer laid for the view before, moved and scaled
+// (app.js drawTrails): seen on the canvas of a paused run, without the camera image (so that
+// only the trails differ between frames). A wheel zoom (x1.57 about a point off the centre);
+// the frame drawn then (A: the layer moved, stats.trailsMoved), the frame after the view
+// rested (B: the layer laid anew for it, stats.trailsLaid) and the same view without trails
+// (C). The trails' own pixels, A - C and B - C, in 4 x 4 blocks, must line up: their
+// normalised correlation unshifted high and higher than at any shift of 2-8 blocks; a
+// layer left where it was, or moved wrongly, lines up with nothing.
+function trailsFollowTheView(page) {
+  return page.evaluate(async () => {
+    const frames = (n) => new Promise((resolve) => {
+      const step = () => (--n <= 0 ? resolve() : requestAnimationFrame(step));
+      requestAnimationFrame(step);
+    });
+    const rest = async () => { await new Promise((r) => setTimeout(r, 400)); await frames(2); };
+    const canvas = document.getElementById('view'), g = canvas.getContext('2d');
+    const grab = () => g.getImageData(0, 0, canvas.width, canvas.height).data;
+    const overlay = (name, on) => {
+      const box = document.querySelector(`input[data-overlay="${name}"]`);
+      if (box.checked !== on) box.click();
+    };
+    const stats = window.rilbed.stats;
+    overlay('camera', false); overlay('trails', true);
+    document.getElementById('fit').click();
+    await rest();
+    const r = canvas.getBoundingClientRect();
+    const before = { moved: stats.trailsMoved, laid: stats.trailsLaid };
+    const A = await new Promise((resolve) => {
+      canvas.dispatchEvent(new WheelEvent('wheel', { deltaY: -300, clientX: r.left + 0.3 * r.width, clientY: r.top + 0.6 * r.height,
+        bubbles: true, cancelable: true }));
+      requestAnimationFrame(() => resolve(grab())); // after the page's draw of this frame
+    });
+    const moved = stats.trailsMoved - before.moved;
+    await rest();
+    const laid = stats.trailsLaid - before.laid;
+    const B = grab();
+    overlay('trails', false); await frames(2);
+    const C = grab();
+    overlay('trails', true); overlay('camera', true);
+    document.getElementById('fit').click();
+    // |X - C| summed over the colour channels, in 4 x 4 blocks.
+    const K = 4, bw = Math.floor(canvas.width / K), bh = Math.floor(canvas.height / K);
+    const blocks = (X) => {
+      const out = new Float64Array(bw * bh);
+      for (let y = 0; y < bh * K; ++y) {
+        for (let x = 0; x < bw * K; ++x) {
+          const i = 4 * (y * canvas.width + x);
+          out[Math.floor(y / K) * bw + Math.floor(x / K)] += Math.abs(X[i] - C[i]) + Math.abs(X[i + 1] - C[i + 1]) + Math.abs(X[i + 2] - C[i + 2]);
+        }
+      }
+      return out;
+    };
+    const a = blocks(A), b = blocks(B);
+    const ncc = (dx, dy) => {
+      let sab = 0, saa = 0, sbb = 0;
+      for (let y = Math.max(0, -dy); y < Math.min(bh, bh - dy); ++y) {
+        for (let x = Math.max(0, -dx); x < Math.min(bw, bw - dx); ++x) {
+          const p = a[(y + dy) * bw + x + dx], q = b[y * bw + x];
+          sab += p * q; saa += p * p; sbb += q * q;
+        }
+      }
+      return saa && sbb ? sab / Math.sqrt(saa * sbb) : 0;
+    };
+    let shifted = { ncc: -1 };
+    for (let dy = -8; dy <= 8; ++dy) {
+      for (let dx = -8; dx <= 8; ++dx) {
+        if (Math.max(Math.abs(dx), Math.abs(dy)) < 2) continue;
+        const c = ncc(dx, dy);
+        if (c > shifted.ncc) shifted = { ncc: c, dx, dy };
+      }
+    }
+    let trailBlocks = 0;
+    for (const q of b) if (q > 0) ++trailBlocks;
+    return { moved, laid, aligned: ncc(0, 0), shifted, trailBlocks };
+  });
+}
+
 // trajectories.csv's rows (t_s,id,x_m,y_m,theta_deg,behaviour) by robot.
 function trajectories(runDir) {
   const file = path.join(runDir, 'trajectories.csv');
@@ -289,6 +367,14 @@ async function main(state) {
   const t2 = (await statusOf(page)).t_s;
   check(t2 === t1, `the clock ran on while paused (t ${t1} s, then ${t2} s)`);
   await screenshot(state, page, '02-paused');
+  const follow = await trailsFollowTheView(page);
+  check(follow.trailBlocks >= 20, `too few trail pixels to compare (${follow.trailBlocks} blocks): did the convoy not move?`);
+  check(follow.moved >= 1 && follow.laid >= 1, `zooming did not draw the trail layer moved, then laid anew (${JSON.stringify(follow)})`);
+  check(follow.aligned >= 0.6 && follow.aligned > follow.shifted.ncc + 0.1,
+    `the trails drawn while zooming do not line up with the trails laid for the view: ${JSON.stringify(follow)}`);
+  ok(`zooming: the trail layer moved with the view (${follow.moved} frame(s)), then laid anew; ` +
+     `the two line up (correlation ${follow.aligned.toFixed(2)} unshifted, at most ${follow.shifted.ncc.toFixed(2)} shifted, ` +
+     `${follow.trailBlocks} blocks of trails)`);
   await page.click('#start');
   await poll('status "running" and no banner after Start', async () => {
     const b = await banner();

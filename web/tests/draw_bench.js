@@ -34,6 +34,9 @@
 //   zooming    the view zoomed in and out by 0.15% every frame as well (a wheel event on it
 //              each frame), so that every frame is drawn anew, as while someone zooms or
 //              drags the view: the most the page can draw (vsync is 60 Hz, the ceiling).
+//              The trails are then the layer laid before the view moved, drawn moved
+//              and scaled (app.js lays it anew once the view rests 150 ms), as for anyone
+//              zooming or dragging.
 // Each: a warm-up, then a measured window. Frames are the page's own count,
 // window.rilbed.stats.frames (one per draw()); the frame intervals and draw()'s own
 // JavaScript time come from a wrapper around requestAnimationFrame that times the
@@ -723,7 +726,7 @@ How it was measured:
   virtual Kheperas at 0.08-0.12 m/s on smooth random paths; every overlay as the page starts (all on, trails as dots)
 - before measuring, the run is fast-forwarded ${PREFILL_STEPS} steps (${PREFILL_STEPS / 10} s) so that every trail holds its 400 points
 - each row: ${args.warmup} s warm-up, then ${args.seconds} s measured. live: the page draws when messages come (as when watched);
-  zooming: a wheel event on the view every frame as well (zoom in, out, by 0.15%), each frame drawn anew (60 Hz vsync is the ceiling).
+  zooming: a wheel event on the view every frame as well (zoom in, out, by 0.15%), each frame drawn anew, the trail layer moved with the view (60 Hz vsync is the ceiling).
   The mouse rests on the live view (Chromium hit-tests under it after layout changes, as for someone watching)
 - frames/s: window.rilbed.stats.frames (one per draw()) over the window; intervals between draws and draw()'s own
   JavaScript time from a requestAnimationFrame wrapper timing the callbacks named draw (app.js unchanged). An interval
