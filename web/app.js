@@ -1034,8 +1034,10 @@ function drawPlots() {
   // Formation: distance to the robot ahead, followers only.
   {
     const [g, w, h] = plotCanvas('formation-plot');
-    let tMax = 1, dMax = 0.3;
-    for (const s of run.formation.values()) for (const [t, d] of s) { tMax = Math.max(tMax, t); if (d !== null) dMax = Math.max(dMax, d); }
+    let tMax = 1, dMax = 0.3, followed = false;
+    for (const s of run.formation.values()) {
+      for (const [t, d] of s) { tMax = Math.max(tMax, t); if (d !== null) { dMax = Math.max(dMax, d); followed = true; } }
+    }
     const L = 36, B = 20;
     axes(g, w, h, L, B, `${tMax.toFixed(0)} s`, `${dMax.toFixed(2)} m`);
     const compact = run.formation.size > LEGEND_ROBOTS; // a label each would not fit
@@ -1054,6 +1056,10 @@ function drawPlots() {
     if (compact) {
       const n = `${run.formation.size} followers`;
       g.fillStyle = '#666'; g.fillText(n, w - 8 - g.measureText(n).width, 12);
+    }
+    if (!followed && run.poses) { // say why the plot is empty
+      const n = 'no robot has followed another yet';
+      g.fillStyle = '#888'; g.font = '12px system-ui'; g.fillText(n, (w - g.measureText(n).width) / 2, h / 2);
     }
   }
   drawTrajectories();
@@ -1095,6 +1101,11 @@ function drawTrajectories() {
     T.last.set(id, [pts[pts.length - 1][0], u, v]);
   }
   g.drawImage(off, 0, 0, w, h);
+  if (run.history.size > LEGEND_ROBOTS) { // a label at each path's end would cover the plot
+    const n = `${run.history.size} robots`;
+    g.fillStyle = '#666'; g.font = '10px system-ui'; g.fillText(n, w - 8 - g.measureText(n).width, 12);
+    return;
+  }
   k = 0;
   for (const [id, pts] of run.history) {
     g.fillStyle = COLORS[k++ % COLORS.length];

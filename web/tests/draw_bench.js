@@ -636,6 +636,7 @@ async function main() {
   const loadBefore = os.loadavg();
   const pageErrors = [];
   let screenshot = null, gpu = null, version = "?";
+  const extraShots = [];
   const cleanup = [];
   try {
     try {
@@ -691,6 +692,21 @@ async function main() {
           await page.screenshot({ path: screenshot });
         }
       }
+      if (n === Math.max(...args.robots)) { // the rest of the page at that size, to look at
+        const other = WEB_ROOT === DEFAULT_WEB_ROOT ? '' : `_${path.basename(WEB_ROOT)}`;
+        const shot = async (selector, name) => {
+          const file = path.join(ARTIFACTS, `draw_bench_${n}${other}_${name}.png`);
+          await page.locator(selector).screenshot({ path: file });
+          extraShots.push(file);
+        };
+        await shot('#status', 'status');
+        await page.fill('#agent-filter', '12');
+        await page.waitForFunction(() => [...document.querySelectorAll('#agents tbody tr')].every((tr) => tr.hidden || tr.textContent.includes('12')),
+          null, { timeout: 10000 }).catch(() => {});
+        await shot('#status', 'status_filtered');
+        await page.fill('#agent-filter', '');
+        await shot('#plots', 'plots');
+      }
       rows.filter((r) => r.n === n).forEach((r) => { r.requests = server.counts.requests; r.refused = server.counts.refused; });
       await cleanup.pop()();
       await cleanup.pop()();
@@ -734,6 +750,7 @@ How it was measured:
 - "interval p95" is the 95th-percentile frame interval; "5th-pct frames/s" is 1000 / that: the rate the slowest 5% of frames fall below
 - dropped: messages the server dropped because the page did not take them (8 MiB queue per client, as rilbed's)`);
   if (screenshot) console.log(`- screenshot of the ${Math.max(...args.robots)}-robot page, trails on: ${path.relative(REPO, screenshot)}`);
+  if (extraShots.length) console.log(`- its status (agent table, unfiltered and filtered by "12") and plots: ${extraShots.map((f) => path.relative(REPO, f)).join(', ')}`);
   if (rows.length) {
     const cpu = rows.map((r) => r.serverCpu * 100);
     console.log(`- this Node process (the stand-in server, mostly) used ${Math.min(...cpu).toFixed(0)}-${Math.max(...cpu).toFixed(0)}% of a core during the windows`);
