@@ -9,6 +9,7 @@
 
 #include "app/commands.hpp"
 #include "vision/field_mapping.hpp"
+#include "vision/stress_scene.hpp"
 #include "vision/synthetic_scene.hpp"
 
 namespace rilbed::app {
@@ -24,9 +25,70 @@ struct SynthOptions {
   int width = 1280;
   int height = 720;
   std::string format = "avi";
+  int first_scene = 0;      // stress: the first scene written
+  int frames_per_scene = 4; // stress: each scene's clip
 };
 
+// `--preset stress`: scenes of the vision stress set, each its own camera, floor, light and
+// clutter (src/vision/stress_scene.hpp), as PNG frames (each already through JPEG at its
+// scene's quality), with per-scene conditions and calibration.
+int run_stress_synth(const SynthOptions& opt, const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir / "frames", ec);
+  std::filesystem::create_directories(dir / "calibration", ec);
+  if (ec) {
+    spdlog::error("cannot create '{}': {}", (dir / "frames").string(), ec.message());
+    return kExitFailure;
+  }
+  vision::StressOptions stress;
+  stress.frames_per_scene = opt.frames_per_scene;
+  stress.image_size = {opt.width, opt.height};
+  std::ofstream truth(dir / "ground_truth.csv");
+  truth << "frame,id,u,v,heading_deg,scene,diameter_px,occluded,touching\n";
+  std::ofstream scenes(dir / "scenes.csv");
+  scenes << "scene,first_frame,frames,marker_diameter_px,blur_sigma_px,motion_blur_px,motion_blur_angle_deg,noise_sigma,"
+            "jpeg_quality,light_ratio,vignetting,tilt_deg,k1,floor,floor_source,floor_grey,clutter_items,robots\n";
+  char line[512];
+  int frame = 0;
+  for (int k = opt.first_scene; frame < opt.frames; ++k) {
+    const vision::StressScene scene = vision::make_stress_scene(opt.seed, k, stress);
+    const vision::StressConditions& c = scene.conditions;
+    std::snprintf(line, sizeof line, "%d,%d,%zu,%.2f,%.3f,%.3f,%.1f,%.2f,%d,%.3f,%.3f,%.2f,%.4f,%s,%s,%.1f,%d,%d\n", k,
+                  frame, scene.frames.size(), c.marker_diameter_px, c.blur_sigma_px, c.motion_blur_px,
+                  c.motion_blur_angle_deg, c.noise_sigma, c.jpeg_quality, c.light_ratio, c.vignetting, c.tilt_deg, c.k1,
+                  vision::floor_name(c.floor), c.floor_source.c_str(), c.floor_grey, c.clutter_items, c.robots);
+    scenes << line;
+    std::snprintf(line, sizeof line, "scene_%04d.yaml", k);
+    if (const std::string err = vision::save_field_calibration(scene.calibration, (dir / "calibration" / line).string());
+        !err.empty()) {
+      spdlog::error("{}", err);
+      return kExitFailure;
+    }
+    for (std::size_t f = 0; f < scene.frames.size() && frame < opt.frames; ++f, ++frame) {
+      std::snprintf(line, sizeof line, "frame_%04d.png", frame);
+      if (!cv::imwrite((dir / "frames" / line).string(), scene.frames[f])) {
+        spdlog::error("cannot write '{}'", (dir / "frames" / line).string());
+        return kExitFailure;
+      }
+      for (const auto& t : scene.truth[f]) {
+        std::snprintf(line, sizeof line, "%d,%d,%.3f,%.3f,%.3f,%d,%.2f,%.4f,%d\n", frame, t.id, t.u, t.v, t.heading_deg, k,
+                      t.diameter_px, t.occluded, t.touching ? 1 : 0);
+        truth << line;
+      }
+    }
+  }
+  std::ofstream about(dir / "scene.txt");
+  about << "rendered by: rilbed synth --preset stress --frames " << opt.frames << " --seed " << opt.seed << " --scene "
+        << opt.first_scene << " --frames-per-scene " << opt.frames_per_scene << " --width " << opt.width << " --height "
+        << opt.height << "\nfamily 6ucp, IDs 1..8; each scene's conditions in scenes.csv, its calibration in "
+           "calibration/scene_NNNN.yaml\n";
+  std::printf("wrote %d frames (frames/*.png), ground_truth.csv, scenes.csv, calibration/ and scene.txt to %s\n",
+              opt.frames, opt.out.c_str());
+  return 0;
+}
+
 int run_synth(const SynthOptions& opt) {
+  if (opt.preset == "stress") return run_stress_synth(opt, opt.out);
   vision::ScenePreset preset;
   try {
     preset = vision::scene_preset(opt.preset, {opt.width, opt.height});
@@ -111,19 +173,33 @@ int run_synth(const SynthOptions& opt) {
 void add_synth_command(CLI::App& app) {
   auto opt = std::make_shared<SynthOptions>();
   CLI::App* cmd = app.add_subcommand("synth", "Render footage with ground truth from the synthetic overhead camera");
-  cmd->add_option("--preset", opt->preset, "nominal or hard")->capture_default_str();
+  cmd->add_option("--preset", opt->preset,
+                  "nominal, hard, or stress (every scene's conditions drawn at random from wide ranges; PNG frames, "
+                  "per-scene conditions and calibration)")
+      ->capture_default_str();
+  cmd->add_option("--scene", opt->first_scene, "stress: the first scene written (scene K of the seed's set)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--frames-per-scene", opt->frames_per_scene, "stress: frames of each scene's clip")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 64));
   cmd->add_option("--out", opt->out, "Output directory")->capture_default_str();
   cmd->add_option("--frames", opt->frames, "Number of frames")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--fps", opt->fps, "Frames per second")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_option("--robots", opt->robots, "Robots (IDs 1..N, N <= 8)")->capture_default_str()->check(CLI::Range(1, 8));
   cmd->add_option("--seed", opt->seed, "Seed of paths and noise")->capture_default_str();
   cmd->add_option("--width", opt->width, "Image width")->capture_default_str()->check(CLI::Range(160, 4096));
-  cmd->add_option("--height", opt->height, "Image height")->capture_default_str()->check(CLI::Range(120, 4096));
+  CLI::Option* height = cmd->add_option("--height", opt->height, "Image height (stress: 960 unless given)")
+                            ->capture_default_str()
+                            ->check(CLI::Range(120, 4096));
   cmd->add_option("--format", opt->format,
                   "avi (MJPG video.avi), jpg (frames/frame_%04d.jpg at the preset's MJPG quality) or png")
       ->capture_default_str()
       ->check(CLI::IsMember({"avi", "jpg", "png"}));
-  cmd->callback([opt] { exit_code() = run_synth(*opt); });
+  cmd->callback([opt, height] {
+    if (opt->preset == "stress" && height->count() == 0) opt->height = 960;  // the stress set's frames are 1280x960
+    exit_code() = run_synth(*opt);
+  });
 }
 
 }  // namespace rilbed::app

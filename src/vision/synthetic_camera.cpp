@@ -94,6 +94,30 @@ double clutter_at(const Clutter& c, double x, double y, double black, double whi
               y <= std::max(c.y_m, c.y2_m))
                  ? c.grey
                  : -1.0;
+    case Clutter::Kind::Pattern: {
+      const double dx = x - c.x_m, dy = y - c.y_m;
+      const double lx = std::cos(c.angle_rad) * dx + std::sin(c.angle_rad) * dy;
+      const double ly = -std::sin(c.angle_rad) * dx + std::cos(c.angle_rad) * dy;
+      const double gx = (lx / c.size_m + 0.5) * c.pattern.cols, gy = (0.5 - ly / c.size_m) * c.pattern.rows;
+      if (c.pattern.empty() || gx < 0 || gy < 0 || gx >= c.pattern.cols || gy >= c.pattern.rows) return -1.0;
+      const double cell = c.pattern.at<std::uint8_t>(static_cast<int>(gy), static_cast<int>(gx)) / 255.0;
+      return black + cell * (white - black);
+    }
+    case Clutter::Kind::Cable: {
+      const Vec2 p{x, y};
+      for (std::size_t i = 0; i + 1 < c.path_m.size(); ++i) {
+        const Vec2 a{c.path_m[i].x, c.path_m[i].y}, b{c.path_m[i + 1].x, c.path_m[i + 1].y};
+        const Vec2 ab = b - a;
+        const double t = std::clamp((p - a).dot(ab) / std::max(1e-12, ab.dot(ab)), 0.0, 1.0);
+        const double d = (p - (a + ab * t)).norm();
+        if (d <= c.size_m / 2) {
+          // A round cable: lit along its middle, darker towards its sides.
+          const double across = d / (c.size_m / 2);
+          return c.grey * (1.0 - 0.35 * across * across);
+        }
+      }
+      return -1.0;
+    }
     case Clutter::Kind::Text:
       return -1.0;  // drawn with putText
   }
@@ -141,6 +165,7 @@ SyntheticCamera::SyntheticCamera(CameraModel camera, MarkerFamily family, Imagin
   floor_rng.fill(blotches, cv::RNG::NORMAL, 0.0, 4.0);
   cv::resize(blotches, floor_, size, 0, 0, cv::INTER_CUBIC);
   floor_ += conditions_.floor_grey;
+  if (!conditions_.floor_texture.empty()) add_floor_texture();
   for (const Clutter& c : clutter) draw_clutter(floor_, c);
 
   // Lighting varies across the field's extent as seen by this camera.
@@ -158,6 +183,60 @@ SyntheticCamera::SyntheticCamera(CameraModel camera, MarkerFamily family, Imagin
       light_.at<float>(v, u) = static_cast<float>(lighting_gain(std::max(1.0, conditions_.light_ratio),
                                                                 conditions_.light_direction_rad,
                                                                 field_x_.at<double>(v, u), field_y_.at<double>(v, u), lo, hi));
+    }
+  }
+  if (conditions_.vignetting > 0.0) {
+    const double cu = (size.width - 1) / 2.0, cv_ = (size.height - 1) / 2.0, corner2 = cu * cu + cv_ * cv_;
+    for (int v = 0; v < size.height; ++v) {
+      float* row = light_.ptr<float>(v);
+      for (int u = 0; u < size.width; ++u) {
+        const double r2 = ((u - cu) * (u - cu) + (v - cv_) * (v - cv_)) / corner2;
+        row[u] = static_cast<float>(row[u] * (1.0 - conditions_.vignetting * r2));
+      }
+    }
+  }
+}
+
+void SyntheticCamera::add_floor_texture() {
+  // Average the texture down to about one texel per pixel where the floor is nearest the
+  // camera (the most pixels per metre), as the lens would: finer texels would alias.
+  const cv::Size size = camera_.image_size;
+  double px_per_m = 0.0;
+  for (int v = 0; v + 1 < size.height; v += std::max(1, size.height / 16)) {
+    for (int u = 0; u + 1 < size.width; u += std::max(1, size.width / 16)) {
+      const double du = std::hypot(field_x_.at<double>(v, u + 1) - field_x_.at<double>(v, u),
+                                   field_y_.at<double>(v, u + 1) - field_y_.at<double>(v, u));
+      if (du > 1e-12) px_per_m = std::max(px_per_m, 1.0 / du);
+    }
+  }
+  const double tile_m = std::max(1e-3, conditions_.floor_texture_tile_m);
+  cv::Mat texture = conditions_.floor_texture;
+  const double texels_per_px = texture.cols / std::max(1.0, tile_m * px_per_m);
+  if (texels_per_px > 1.0) {
+    cv::resize(texture, texture,
+               cv::Size(std::max(2, static_cast<int>(texture.cols / texels_per_px)),
+                        std::max(2, static_cast<int>(texture.rows / texels_per_px))),
+               0, 0, cv::INTER_AREA);
+  }
+  texture = texture - cv::mean(texture)[0];
+  const double texel_m = tile_m / texture.cols;
+  for (int v = 0; v < size.height; ++v) {
+    float* row = floor_.ptr<float>(v);
+    for (int u = 0; u < size.width; ++u) {
+      // Bilinear, the texture repeating mirrored in both directions (a photograph's edges
+      // do not meet: mirrored, its copies join without a seam).
+      const double tx = field_x_.at<double>(v, u) / texel_m - 0.5, ty = -field_y_.at<double>(v, u) / texel_m - 0.5;
+      const double fx = std::floor(tx), fy = std::floor(ty);
+      const double ax = tx - fx, ay = ty - fy;
+      const auto mirror = [](double i, int n) {
+        const int k = static_cast<int>(i - 2.0 * n * std::floor(i / (2.0 * n)));  // [0, 2n)
+        return k < n ? k : 2 * n - 1 - k;
+      };
+      const int x0 = mirror(fx, texture.cols), x1 = mirror(fx + 1, texture.cols);
+      const int y0 = mirror(fy, texture.rows), y1 = mirror(fy + 1, texture.rows);
+      const float* r0 = texture.ptr<float>(y0);
+      const float* r1 = texture.ptr<float>(y1);
+      row[u] += static_cast<float>((r0[x0] * (1 - ax) + r0[x1] * ax) * (1 - ay) + (r1[x0] * (1 - ax) + r1[x1] * ax) * ay);
     }
   }
 }
@@ -232,7 +311,19 @@ void SyntheticCamera::draw_clutter(cv::Mat& reflectance, const Clutter& c) const
     return;
   }
   double cx = c.x_m, cy = c.y_m, half = c.size_m;
-  if (c.kind == Clutter::Kind::Tape || c.kind == Clutter::Kind::Mat) {
+  if (c.kind == Clutter::Kind::Cable) {
+    if (c.path_m.empty()) return;
+    double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+    for (const auto& p : c.path_m) {
+      x0 = std::min(x0, p.x); y0 = std::min(y0, p.y);
+      x1 = std::max(x1, p.x); y1 = std::max(y1, p.y);
+    }
+    cx = (x0 + x1) / 2;
+    cy = (y0 + y1) / 2;
+    half = std::max(x1 - x0, y1 - y0) / 2 + c.size_m;
+  } else if (c.kind == Clutter::Kind::Pattern) {
+    half = c.size_m * 0.75;
+  } else if (c.kind == Clutter::Kind::Tape || c.kind == Clutter::Kind::Mat) {
     cx = (c.x_m + c.x2_m) / 2;
     cy = (c.y_m + c.y2_m) / 2;
     half = std::hypot(c.x2_m - c.x_m, c.y2_m - c.y_m) / 2 + c.size_m;
@@ -257,12 +348,41 @@ void SyntheticCamera::draw_clutter(cv::Mat& reflectance, const Clutter& c) const
   }
 }
 
-cv::Mat SyntheticCamera::render(const std::vector<SceneMarker>& markers, cv::RNG& rng) const {
+namespace {
+
+// A motion-blur kernel: a smear of `length_px` pixels in direction `angle_rad` (counter-
+// clockwise from +u on screen), its weight spread evenly along it, bilinear between pixels.
+cv::Mat motion_blur_kernel(double length_px, double angle_rad) {
+  const int half = static_cast<int>(std::ceil(length_px / 2)) + 1;
+  cv::Mat k = cv::Mat::zeros(2 * half + 1, 2 * half + 1, CV_32F);
+  const int steps = std::max(2, static_cast<int>(std::ceil(length_px * 8)));
+  for (int i = 0; i <= steps; ++i) {
+    const double t = length_px * (static_cast<double>(i) / steps - 0.5);
+    const double x = half + t * std::cos(angle_rad), y = half - t * std::sin(angle_rad);
+    const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+    const double ax = x - x0, ay = y - y0;
+    k.at<float>(y0, x0) += static_cast<float>((1 - ax) * (1 - ay));
+    k.at<float>(y0, x0 + 1) += static_cast<float>(ax * (1 - ay));
+    k.at<float>(y0 + 1, x0) += static_cast<float>((1 - ax) * ay);
+    k.at<float>(y0 + 1, x0 + 1) += static_cast<float>(ax * ay);
+  }
+  return k / cv::sum(k)[0];
+}
+
+}  // namespace
+
+cv::Mat SyntheticCamera::render(const std::vector<SceneMarker>& markers, cv::RNG& rng,
+                                const std::vector<Clutter>& over) const {
   cv::Mat reflectance = floor_.clone();
   for (const SceneMarker& m : markers) draw_marker(reflectance, m);
+  for (const Clutter& c : over) draw_clutter(reflectance, c);
   cv::Mat radiance = reflectance.mul(light_);
   if (conditions_.blur_sigma_px > 0.0) {
     cv::GaussianBlur(radiance, radiance, cv::Size(), conditions_.blur_sigma_px);
+  }
+  if (conditions_.motion_blur_px > 0.0) {
+    cv::filter2D(radiance, radiance, -1, motion_blur_kernel(conditions_.motion_blur_px, conditions_.motion_blur_angle_rad),
+                 cv::Point(-1, -1), 0.0, cv::BORDER_REFLECT);
   }
   if (conditions_.noise_sigma > 0.0) {
     cv::Mat noise(radiance.size(), CV_32F);

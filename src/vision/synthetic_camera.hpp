@@ -48,17 +48,27 @@ struct SceneMarker {
   double diameter_m = 0.05;
 };
 
-/// Things on the floor that are not markers and must never get an ID.
+/// Things on the floor that are not markers and must never get an ID (and, drawn after
+/// the markers, things that cover part of a marker: see SyntheticCamera::render).
 struct Clutter {
-  enum class Kind { DarkDisc, Ring, Tape, Chessboard, Text, Mat };
+  /// Pattern: a printed square of cells (another tag family: AprilTag, ArUco), `pattern`'s
+  /// pixels as cells. Cable: a round cable of width size_m along `path_m`, grey `grey`.
+  enum class Kind { DarkDisc, Ring, Tape, Chessboard, Text, Mat, Pattern, Cable };
   Kind kind = Kind::DarkDisc;
   double x_m = 0.0, y_m = 0.0;   ///< centre (tape: start point; text: lower-left; mat: a corner)
-  double size_m = 0.05;          ///< disc/ring outer diameter, tape width, chessboard square, text height
+  /// disc/ring outer diameter, tape and cable width, chessboard square, text height, the
+  /// pattern's side
+  double size_m = 0.05;
   double x2_m = 0.0, y2_m = 0.0; ///< tape end point; mat: the opposite corner
-  double grey = 60.0;            ///< mat reflectance, 0..255 (a dark floor region)
+  double grey = 60.0;            ///< mat and cable reflectance, 0..255
   int cols = 5, rows = 4;        ///< chessboard squares
-  double angle_rad = 0.0;        ///< chessboard rotation
+  double angle_rad = 0.0;        ///< chessboard and pattern rotation
   std::string text;              ///< for Text
+  /// For Pattern: CV_8U cells, 0 printed black, 255 printed white (nearest cell, no
+  /// interpolation: printed cells have sharp edges), row 0 at the pattern's top (+y).
+  cv::Mat pattern;
+  /// For Cable: the centre line, field metres (a polyline).
+  std::vector<cv::Point2d> path_m;
 };
 
 /// Imaging conditions.
@@ -72,6 +82,19 @@ struct ImagingConditions {
   double noise_sigma = 0.0;         ///< Gaussian sensor noise, grey levels
   int jpeg_quality = 0;             ///< 1..100 to pass frames through JPEG (MJPG), 0 for none
   int supersample = 4;              ///< subpixels per pixel side for anti-aliasing
+  /// A texture on the floor (a photograph of wood, carpet, concrete, paper...): CV_32F
+  /// grey levels, added to floor_grey about their own mean; empty for none. It repeats,
+  /// mirrored, every floor_texture_tile_m metres along field x (its rows scaled alike), and is
+  /// averaged down to about a pixel per texel first, as a lens integrates it.
+  cv::Mat floor_texture;
+  double floor_texture_tile_m = 0.5;  ///< the texture's width on the floor, metres
+  /// The light falls by this fraction at the image's corners (0 for none), with the
+  /// square of the distance from the image centre (lens vignetting).
+  double vignetting = 0.0;
+  /// Motion blur: the length of the smear in pixels (0 for none) and its direction in the
+  /// image, radians counter-clockwise from +u. Applied after blur_sigma_px.
+  double motion_blur_px = 0.0;
+  double motion_blur_angle_rad = 0.0;
 };
 
 /// Ground truth of one marker in one frame.
@@ -91,8 +114,11 @@ class SyntheticCamera {
   SyntheticCamera(CameraModel camera, MarkerFamily family, ImagingConditions conditions,
                   std::vector<Clutter> clutter = {});
 
-  /// Renders the markers into an 8-bit BGR frame; `rng` drives the noise.
-  cv::Mat render(const std::vector<SceneMarker>& markers, cv::RNG& rng) const;
+  /// Renders the markers into an 8-bit BGR frame; `rng` drives the noise. `over` is drawn
+  /// after the markers (a cable lying across a robot).
+  cv::Mat render(const std::vector<SceneMarker>& markers, cv::RNG& rng, const std::vector<Clutter>& over = {}) const;
+  /// The floor point (z = 0) that pixel (u, v) sees, field metres (distorted pixels).
+  cv::Point2d field_point(cv::Point2d pixel) const { return field_at(pixel.x, pixel.y); }
   /// Ground truth of the markers as this camera sees them.
   std::vector<MarkerTruth> truth(const std::vector<SceneMarker>& markers) const;
 
@@ -103,6 +129,7 @@ class SyntheticCamera {
   cv::Point2d field_at(double u, double v) const;  // bilinear in the per-pixel maps
   void draw_marker(cv::Mat& reflectance, const SceneMarker& m) const;
   void draw_clutter(cv::Mat& reflectance, const Clutter& c) const;
+  void add_floor_texture();  // conditions_.floor_texture onto floor_
 
   CameraModel camera_;
   MarkerFamily family_;
