@@ -202,8 +202,10 @@ int main(int argc, char** argv) {
       rv::MarkerTracker clip(family, all_ids());
       for (int f = 0; f < static_cast<int>(scene->frames.size()); ++f) {
         const cv::Mat& frame = scene->frames[static_cast<std::size_t>(f)];
-        full.add(*scene, f, single.detect_full_frame(frame));
-        tracked.add(*scene, f, clip.process(frame));
+        const auto found_full = single.detect_full_frame(frame);
+        full.add(*scene, f, found_full, single.last_stats().declined);
+        const auto found_tracked = clip.process(frame);
+        tracked.add(*scene, f, found_tracked, clip.last_stats().declined);
       }
       const bool textured = scene->conditions.floor != rv::StressFloor::Plain;
       int& kept = textured ? textured_kept : plain_kept;

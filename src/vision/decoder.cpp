@@ -128,10 +128,15 @@ double wrap_samples(double t, double n) {
 }  // namespace
 
 Decoder::Decoder(const MarkerFamily& family, const std::vector<int>& ids, DecoderConfig config)
-    : config_(config), ids_(ids) {
+    : config_(config), family_(family), ids_(ids) {
   config_.samples = std::max(24, config_.samples);
   config_.circles = std::clamp(config_.circles, 1, 3);
   track_reach_samples_ = static_cast<int>(std::ceil(kTrackReachDeg * config_.samples / 360.0));
+  {
+    const auto widths = family.slice_widths_deg();
+    const double narrowest = *std::min_element(widths.begin(), widths.end());
+    rival_guard_samples_ = static_cast<int>(std::ceil(0.75 * narrowest * config_.samples / 360.0));
+  }
   // One circle: the middle of the annulus; two: its inner and outer; three: all.
   constexpr auto& radii = MarkerFamily::sample_radii;
   if (config_.circles == 1) circle_radii_ = {radii[1]};
@@ -574,30 +579,91 @@ void Decoder::match_all(const SampledSignal& signal, const Blob& blob, std::vect
     match_by_key(p, blob, out);
     return;
   }
-  // Every ID shares the key and its guards, so every ID's peak lies where the key's
-  // does: find that lag once (every lag, the key's few edges), then score each ID at the
-  // whole-sample lags next to it.
+  // Each ID at every lag (a few edges per lag: cheap for a handful of IDs): its peak, and
+  // its best away from that peak's main lobe, so that a marker two key-slice positions
+  // explain almost equally well shows as such (CodeMatch::rival_score). Sharing one lag
+  // found from the key and guards alone would hide that: under heavy blur the key's own
+  // peak may sit where a different ID's code fits better than the true one's.
   thread_local std::vector<double> scratch;
-  thread_local std::vector<std::pair<int, double>> peaks;
+  thread_local std::vector<std::array<double, 3>> peaks;  // lag, value, rival value
   peaks.clear();
-  const auto [key_lag, key_value] = coarse_peak(p, key_, scratch);
-  const double lag = refine_peak(p, key_, key_lag, key_value).first;
   const int n = config_.samples;
-  const int centre = (static_cast<int>(lag + 0.5) % n + n) % n;
   double family_best = -1e300;
   for (const Ideal& ideal : ideals_) {
-    peaks.push_back(local_peak(p, ideal, centre, 1));
-    family_best = std::max(family_best, peaks.back().second);
+    correlate_all_lags(p, ideal, scratch);
+    const int best = static_cast<int>(std::max_element(scratch.begin(), scratch.end()) - scratch.begin());
+    double rival = -1e300;
+    for (int lag = 0; lag < n; ++lag) {
+      const int apart = std::abs(lag - best);
+      if (std::min(apart, n - apart) > rival_guard_samples_) rival = std::max(rival, scratch[static_cast<std::size_t>(lag)]);
+    }
+    peaks.push_back({static_cast<double>(best), scratch[static_cast<std::size_t>(best)], rival});
+    family_best = std::max(family_best, scratch[static_cast<std::size_t>(best)]);
   }
   // Fine pass only for IDs that could win.
   constexpr double kRefineMargin = 0.1;
   for (std::size_t i = 0; i < ideals_.size(); ++i) {
-    auto [lag, value] = std::pair<double, double>(peaks[i].first, peaks[i].second);
+    double lag = peaks[i][0], value = peaks[i][1];
     if ((family_best - value) / p.norm < kRefineMargin) {
-      std::tie(lag, value) = refine_peak(p, ideals_[i], peaks[i].first, value);
+      std::tie(lag, value) = refine_peak(p, ideals_[i], static_cast<int>(peaks[i][0]), value);
     }
     out.push_back({ideals_[i].id, std::clamp(value / p.norm, -1.0, 1.0), heading_on_screen(blob, lag),
-                   2.0 * kPi * lag / n});
+                   2.0 * kPi * lag / n, std::clamp(peaks[i][2] / p.norm, -1.0, 1.0)});
+  }
+}
+
+bool Decoder::levels_agree(const cv::Mat& grey, const Blob& blob, const SampledSignal& signal,
+                           const CodeMatch& match) const {
+  const int n = static_cast<int>(signal.values.size());
+  const double contrast = signal.white_level - signal.black_level;
+  if (n == 0 || contrast <= 0.0) return false;
+  // The code's colour at each sample (the middle of the annulus; sample k lies at angle
+  // 2 pi k / n in the shape's unit-circle frame, the key's bisector at key_angle_rad),
+  // and whether it lies clear of the slice's edges (blur mixes the colours there).
+  constexpr double kMiddle = MarkerFamily::sample_radii[1];
+  const double key_deg = match.key_angle_rad * 180.0 / kPi;
+  const int clear = std::max(1, n / 24);  // 15 degrees
+  thread_local std::vector<double> colour;
+  colour.resize(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) colour[static_cast<std::size_t>(k)] = family_.colour_at(match.id, kMiddle, 360.0 * k / n - key_deg);
+  double key_sum = 0.0, black_sum = 0.0;
+  int key_count = 0, black_count = 0;
+  for (int k = 0; k < n; ++k) {
+    const double off_key = std::abs(std::remainder(360.0 * k / n - key_deg, 360.0));
+    if (off_key < 25.0) {  // well inside the key (the narrowest key, 6UCP's, is 85 degrees)
+      key_sum += signal.values[static_cast<std::size_t>(k)];
+      ++key_count;
+    }
+    if (colour[static_cast<std::size_t>(k)] != 0.0) continue;
+    bool away = true;
+    for (int d = -clear; d <= clear && away; ++d) away = colour[static_cast<std::size_t>(((k + d) % n + n) % n)] == 0.0;
+    if (away) {
+      black_sum += signal.values[static_cast<std::size_t>(k)];
+      ++black_count;
+    }
+  }
+  if (key_count == 0 || black_count == 0) return false;
+  if (signal.white_level - key_sum / key_count > config_.max_key_shortfall * contrast) return false;
+  if (black_sum / black_count - signal.black_level > config_.max_black_excess * contrast) return false;
+  // The hole: a small circle half way out to its edge (within the image: the whole marker is).
+  const double reach = 1.0 / MarkerFamily::black_ring_outer_radius;
+  thread_local std::vector<float> hole;
+  hole.resize(ring_directions_.cos.size());
+  sample_ellipse(grey, blob.u, blob.v, blob.shape, reach * 0.5 * MarkerFamily::hole_radius, ring_directions_, hole.data());
+  double hole_sum = 0.0;
+  for (int k = 0; k < kRingSamples; ++k) hole_sum += hole[static_cast<std::size_t>(k)];
+  return hole_sum / kRingSamples - signal.black_level <= config_.max_hole_excess * contrast;
+}
+
+void Decoder::correlate_all_lags(const Prepared& p, const Ideal& ideal, std::vector<double>& out) const {
+  const int n = config_.samples;
+  out.assign(static_cast<std::size_t>(n), 0.0);
+  // Edge by edge over all lags: contiguous loops the compiler vectorises.
+  for (std::size_t e = 0; e < ideal.edge.size(); ++e) {
+    const double* c = &p.doubled_cumulative[ideal.edge_index[e]];  // + lag < 2n: no modulo
+    const double* x = &p.doubled_signal[ideal.edge_index[e]];
+    const double step = ideal.step[e], frac = ideal.edge_frac[e];
+    for (int lag = 0; lag < n; ++lag) out[static_cast<std::size_t>(lag)] += step * (c[lag] + frac * x[lag]);
   }
 }
 

@@ -34,6 +34,15 @@ struct DecoderConfig {
   /// Least spread of the coded signal (10th to 90th percentile) as a fraction of the
   /// ring contrast. Rejects uniform discs and rings that carry no code.
   double min_code_contrast = 0.45;
+  /// The levels a printed marker must show where its code says (levels_agree), each as a
+  /// fraction of the ring contrast: the key slice at most this far below the white ring,
+  /// (blur of a small marker darkens it a little; a dark blob on a textured floor that
+  /// merely correlates with a code reads far darker)...
+  double max_key_shortfall = 0.6;
+  /// ...its black slices at most this far above the black ring...
+  double max_black_excess = 0.35;
+  /// ...and its hole (the centre) at most this far above the black ring.
+  double max_hole_excess = 0.7;
 };
 
 /// The angular signal sampled from one blob.
@@ -57,6 +66,11 @@ struct CodeMatch {
   /// (radians, counter-clockwise on screen as the decoder's samples: the direction is
   /// shape · (cos a, -sin a)); what a tracker predicts the next frame's key from.
   double key_angle_rad = 0.0;
+  /// The same ID's best score at a heading away from this one's peak (beyond its main
+  /// lobe: more than three quarters of the family's narrowest slice): high when two
+  /// key-slice positions explain the marker almost equally well. Set by match_all for
+  /// families of up to 16 IDs; -1 otherwise.
+  double rival_score = -1.0;
 };
 
 /// What a spot check of a tracked marker found (Decoder::spot_check).
@@ -97,6 +111,14 @@ class Decoder {
   std::vector<CodeMatch> match_all(const SampledSignal& signal, const Blob& blob) const;
   /// The same into `out` (replacing its contents, reusing its storage).
   void match_all(const SampledSignal& signal, const Blob& blob, std::vector<CodeMatch>& out) const;
+
+  /// Whether the marker's grey levels are where `match` (its ID at its heading) says a
+  /// printed marker has them, against the rings' levels in `signal` (sampled by sample()
+  /// or sample_code()): the key slice white, the black slices and the hole black (see
+  /// DecoderConfig::max_key_shortfall). Correlation alone is blind to levels: a dark blob
+  /// on a textured floor can correlate with a code at 0.9 with its "white" key darker
+  /// than the black ring. Reads one small circle (the hole) besides the signal.
+  bool levels_agree(const cv::Mat& grey, const Blob& blob, const SampledSignal& signal, const CodeMatch& match) const;
 
   /// Similarity of the signal to one ID (which must be one of ids()): what a tracked
   /// marker needs to confirm its ID at a fraction of match_all's cost.
@@ -164,6 +186,8 @@ class Decoder {
   // The lag refined below one sample, with its correlation.
   std::pair<double, double> refine_peak(const Prepared& p, const Ideal& ideal, int lag, double value) const;
   double correlate(const Prepared& p, const Ideal& ideal, double lag) const;
+  // The correlation at every whole-sample lag into `out` (n entries), unnormalised.
+  void correlate_all_lags(const Prepared& p, const Ideal& ideal, std::vector<double>& out) const;
   // The running integral at fractional sample t (any t; it is periodic).
   double integral_at(const Prepared& p, double t) const;
   double heading_on_screen(const Blob& blob, double lag) const;
@@ -193,6 +217,7 @@ class Decoder {
   std::vector<SpotSlices> spot_slices_;
   double key_half_cos_ = 1.0, key_half_sin_ = 0.0;  // half the key slice's width, as a unit vector
   int track_reach_samples_ = 0;  // kTrackReachDeg in samples, rounded up
+  int rival_guard_samples_ = 0;  // CodeMatch::rival_score's main lobe: lags this close to a peak are its own
   // Entries of the running integral past 2n + 2 that local_peak reads for the windows the
   // decoder uses (at most one lag either side, scored as two pairs of lags); a wider
   // window falls back to correlate() per lag.
@@ -205,6 +230,7 @@ class Decoder {
   std::vector<std::pair<double, double>> slice_bounds_;  // slices at lag 0, in samples; empty: exhaustive
   std::vector<int> index_of_id_;                         // ID -> index in ideals_, -1 if absent
   DecoderConfig config_;
+  MarkerFamily family_;  // the slices' colours, for levels_agree
   CircleDirections sample_directions_, ring_directions_;
   std::vector<double> circle_radii_;  // as fractions of the marker's outer radius
   std::vector<int> ids_;

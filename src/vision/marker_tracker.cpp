@@ -135,12 +135,24 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
     thresholds_.push_back(0.5 * (signal_.black_level + signal_.white_level));
     std::vector<CodeMatch>& matches = matches_[b];
     decoder_.match_all(signal_, blob, matches);
-    double family_best = -1.0;
-    for (const CodeMatch& m : matches) family_best = std::max(family_best, m.score);
+    // Its own reading: the family's best match, and how far it stands above the next
+    // explanation (another ID, or the same ID at another heading).
+    std::size_t own = 0;
+    for (std::size_t m = 1; m < matches.size(); ++m)
+      if (matches[m].score > matches[own].score) own = m;
+    double runner_up = matches[own].rival_score;
+    for (std::size_t m = 0; m < matches.size(); ++m)
+      if (m != own) runner_up = std::max(runner_up, matches[m].score);
+    if (matches[own].score < config_.min_assign_score) continue;
+    if (matches[own].score - runner_up < config_.ambiguity_margin) {
+      ++stats_.declined;
+      continue;
+    }
+    if (!decoder_.levels_agree(grey, blob, signal_, matches[own])) continue;  // not a printed marker's levels
     double* row = &similarity_[b * columns];
     for (std::size_t c = 0; c < columns; ++c) {
-      const double score = matches[decoder_index_[c]].score;
-      if (score < config_.min_assign_score || score < family_best - config_.family_margin) continue;
+      if (static_cast<std::size_t>(decoder_index_[c]) != own) continue;  // only the ID its code reads
+      const double score = matches[own].score;
       if (std::find(taken_ids.begin(), taken_ids.end(), ids_[c]) != taken_ids.end()) continue;
       row[c] = score;
       if (!use_tracks) continue;
@@ -178,6 +190,7 @@ std::optional<MarkerDetection> MarkerTracker::confirm(const cv::Mat& grey, const
   ++stats_.decoded;
   const CodeMatch m = decoder_.match_one(signal_, blob, track.id, track.predicted_heading_deg());
   if (m.score < config_.min_assign_score || m.score < track.score - config_.confirm_drop) return std::nullopt;
+  if (!decoder_.levels_agree(grey, blob, signal_, m)) return std::nullopt;
   return make_detection(blob, m, true, 0.5 * (signal_.black_level + signal_.white_level));
 }
 

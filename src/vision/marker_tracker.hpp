@@ -95,12 +95,13 @@ struct TrackerConfig {
   /// Smallest similarity at which an object may take an ID. Lower finds markers in
   /// worse images but lets clutter through more often.
   double min_assign_score = 0.75;
-  /// An object takes an ID only if no other ID of the whole family matches it better by
-  /// more than this. Keeps a marker whose ID is not in the list (a robot left out of the
-  /// scenario, a spare marker on a desk) from taking a listed ID that looks alike
-  /// (6ucp codes cross-correlate up to about 0.76, 9ucp up to 0.82). Families of more
-  /// than 64 IDs compare with the listed IDs only (cost grows with the family size).
-  double family_margin = 0.03;
+  /// A blob is named only when its best match (an ID at one heading) beats every other
+  /// explanation by this much: any other ID of the whole family at any heading, and the
+  /// same ID at a heading beyond the peak's main lobe (CodeMatch::rival_score).
+  /// Otherwise it is declined (FrameStats::declined): a miss beats a wrong ID. A blob
+  /// only ever takes the ID its own code reads best; when that ID is not listed, none.
+  /// Higher declines more markers in poor images; lower lets ambiguous codes through.
+  double ambiguity_margin = 0.05;
   /// Local-search window half-size as a multiple of the marker's diameter, plus the
   /// distance it moved in the last frame. Larger tolerates faster robots, costs more.
   double search_window_diameters = 0.75;
@@ -126,6 +127,7 @@ struct FrameStats {
   int decoded = 0;           ///< blobs whose signal was decodable
   int fills = 0;             ///< dark regions filled (the detector's main work)
   int edge_fits = 0;         ///< tracked markers confirmed from their outline, without a fill
+  int declined = 0;          ///< decoded blobs left unnamed: two explanations too close (TrackerConfig::ambiguity_margin)
 };
 
 /// Runs the pipeline over a stream of frames of one size. Not thread-safe; one per
