@@ -350,6 +350,18 @@ double clutter_reach(const Clutter& c) {
   }
 }
 
+// The widest vertical field of view (degrees, at most `cap`) a lens of radial distortion
+// k1 < 0 can have on this image and still be one to one: barrel distortion r (1 + k1 r^2)
+// peaks at r = 1 / sqrt(-3 k1), and beyond it no real point maps to the image (a lab's
+// calibration of such a lens carries k2, k3 terms that keep it monotonic). The image's
+// corner is kept within 90 % of that peak.
+double widest_vfov_deg(cv::Size image, double k1, double cap) {
+  if (k1 >= -1e-6) return cap;
+  const double peak = (2.0 / 3.0) / std::sqrt(-3.0 * k1);  // the largest distorted radius
+  const double f_min = 0.5 * std::hypot(image.width, image.height) / (0.9 * peak);
+  return std::min(cap, 2.0 * rad_to_deg(std::atan(0.5 * image.height / f_min)));
+}
+
 // The projected outer disc's equivalent diameter, pixels.
 double projected_diameter_px(const CameraModel& camera, const Pose& pose, double r_m) {
   std::vector<cv::Point3d> rim;
@@ -390,7 +402,9 @@ StressScene make_stress_scene(std::uint64_t seed, int index, const StressOptions
 
   // The camera: over the middle of a 4 x 3 m floor, 2.5 m up, tilted and distorting.
   const cv::Point2d target(2.0, 1.5);
-  const CameraModel camera = CameraModel::overhead(c.image_size, rnd.uniform(45, 65), target, 2.5, c.tilt_deg, c.k1);
+  const double vfov_max = widest_vfov_deg(c.image_size, c.k1, 65.0);
+  const CameraModel camera =
+      CameraModel::overhead(c.image_size, rnd.uniform(std::min(45.0, 0.85 * vfov_max), vfov_max), target, 2.5, c.tilt_deg, c.k1);
   scene.calibration = camera.field_calibration(4.0, 3.0);
   // Metres per pixel at the image centre set the markers' size.
   const auto probe = camera.project({cv::Point3d(target.x - 0.01, target.y, 0), cv::Point3d(target.x + 0.01, target.y, 0)});
@@ -409,6 +423,7 @@ StressScene make_stress_scene(std::uint64_t seed, int index, const StressOptions
   imaging.vignetting = c.vignetting;
   imaging.motion_blur_px = c.motion_blur_px;
   imaging.motion_blur_angle_rad = deg_to_rad(c.motion_blur_angle_deg);
+  imaging.clutter_supersample = 2;
   if (c.floor != StressFloor::Plain) {
     cv::Mat texture = c.floor == StressFloor::Photo
                           ? photo_floor((std::filesystem::path(options.photo_dir) / c.floor_source).string())
