@@ -34,6 +34,12 @@ fi
 
 "$BUILD_DIR/bench_vision" "$@"
 
+# The vision stress set (issue 14): 500 random scenes (2,000 frames) from a fresh seed,
+# full-frame and tracked, and the search's cost on plain and textured floors beside
+# AprilTag and ArUco. Its seed is printed; pass it back to see the same frames.
+echo
+"$BUILD_DIR/bench_stress" --scenes 500
+
 # The simulation: sim-bench's table, then the convoy batch in both modes
 # (wall time of the whole command, as a user sees it).
 echo
