@@ -145,6 +145,7 @@ Decoder::Decoder(const MarkerFamily& family, const std::vector<int>& ids, Decode
   // Directions of the sampling angles, computed once: the sampler runs per blob per frame.
   sample_directions_ = CircleDirections::make(config_.samples);
   ring_directions_ = CircleDirections::make(kRingSamples, 0.5);
+  dense_ring_directions_ = CircleDirections::make(64, 0.25);
   const double n = config_.samples;
   const double deg_per_sample = 360.0 / n;
   for (int id : ids) {
@@ -645,8 +646,43 @@ bool Decoder::levels_agree(const cv::Mat& grey, const Blob& blob, const SampledS
   if (key_count == 0 || black_count == 0) return false;
   if (signal.white_level - key_sum / key_count > config_.max_key_shortfall * contrast) return false;
   if (black_sum / black_count - signal.black_level > config_.max_black_excess * contrast) return false;
-  // The hole: a small circle half way out to its edge (within the image: the whole marker is).
+  // The same code on the annulus's inner and outer circles, each read on its own.
   const double reach = 1.0 / MarkerFamily::black_ring_outer_radius;
+  thread_local std::vector<float> circle;
+  thread_local std::vector<double> ideal;
+  circle.resize(sample_directions_.cos.size());
+  ideal.resize(static_cast<std::size_t>(n));
+  double ideal_mean = 0.0;
+  for (int k = 0; k < n; ++k) {
+    ideal[static_cast<std::size_t>(k)] = family_.colour_at(match.id, MarkerFamily::sample_radii[1], 360.0 * k / n - key_deg);
+    ideal_mean += ideal[static_cast<std::size_t>(k)];
+  }
+  ideal_mean /= n;
+  for (const double r : {MarkerFamily::sample_radii[0], MarkerFamily::sample_radii[2]}) {
+    if (static_cast<int>(sample_directions_.count) != n) break;  // a signal of another length: not ours to check
+    sample_ellipse(grey, blob.u, blob.v, blob.shape, reach * r, sample_directions_, circle.data());
+    double mean = 0.0;
+    for (int k = 0; k < n; ++k) mean += circle[static_cast<std::size_t>(k)];
+    mean /= n;
+    double sxy = 0.0, sxx = 0.0, syy = 0.0;
+    for (int k = 0; k < n; ++k) {
+      const double x = circle[static_cast<std::size_t>(k)] - mean, y = ideal[static_cast<std::size_t>(k)] - ideal_mean;
+      sxy += x * y;
+      sxx += x * x;
+      syy += y * y;
+    }
+    if (sxx <= 0.0 || syy <= 0.0 || sxy / std::sqrt(sxx * syy) < config_.min_radial_agreement) return false;
+  }
+  // The white ring unbroken: nothing lies across the marker.
+  thread_local std::vector<float> ring;
+  ring.resize(dense_ring_directions_.cos.size());
+  sample_ellipse(grey, blob.u, blob.v, blob.shape, reach * 0.5 * (MarkerFamily::black_ring_outer_radius + 1.0),
+                 dense_ring_directions_, ring.data());
+  const double mid = 0.5 * (signal.black_level + signal.white_level);
+  int dark_reads = 0;
+  for (int k = 0; k < dense_ring_directions_.count; ++k) dark_reads += ring[static_cast<std::size_t>(k)] <= mid;
+  if (dark_reads > config_.max_dark_white_ring_reads) return false;
+  // The hole: a small circle half way out to its edge (within the image: the whole marker is).
   thread_local std::vector<float> hole;
   hole.resize(ring_directions_.cos.size());
   sample_ellipse(grey, blob.u, blob.v, blob.shape, reach * 0.5 * MarkerFamily::hole_radius, ring_directions_, hole.data());

@@ -43,6 +43,17 @@ struct DecoderConfig {
   double max_black_excess = 0.35;
   /// ...and its hole (the centre) at most this far above the black ring.
   double max_hole_excess = 0.7;
+  /// How many of 64 reads around the white ring may fall below the midpoint between the
+  /// rings (levels_agree). Anything lying across a marker (a cable, a hand) breaks the
+  /// ring where it crosses, and what it covers of the code can read as another code; 0
+  /// declines such a marker (a miss beats a wrong ID). A clean marker reads 0 even blurred.
+  int max_dark_white_ring_reads = 0;
+  /// Least correlation of the code read on the annulus's inner and on its outer circle
+  /// (each on its own) with the code found (levels_agree). A printed marker's slices run
+  /// radially, so both circles read the same code; a digit, a texture's blob or the like
+  /// that happens to correlate on one circle reads something else on the other. Clean
+  /// markers give 0.7 and more, blurred to the limit of reading.
+  double min_radial_agreement = 0.6;
 };
 
 /// The angular signal sampled from one blob.
@@ -232,6 +243,7 @@ class Decoder {
   DecoderConfig config_;
   MarkerFamily family_;  // the slices' colours, for levels_agree
   CircleDirections sample_directions_, ring_directions_;
+  CircleDirections dense_ring_directions_;  // levels_agree's 64 reads of the white ring
   std::vector<double> circle_radii_;  // as fractions of the marker's outer radius
   std::vector<int> ids_;
   std::vector<Ideal> ideals_;
