@@ -13,6 +13,7 @@
 
 namespace fs = std::filesystem;
 using namespace rilbed;
+using rilbed::e2e::read_file;
 using rilbed::e2e::run_rilbed;
 using rilbed::e2e::scratch_dir;
 
@@ -128,6 +129,44 @@ TEST(DetectCli, VideoAndTruncatedVideo) {
   EXPECT_LT(part.rows.size(), 96u);
   EXPECT_EQ(vision::score_detections(truth.rows, part.rows).wrong_id, 0);
   fs::remove_all(out);
+}
+
+// `synth --preset stress` writes a scene's clip as the contract says (PNG frames, the truth
+// with its extra columns, each scene's conditions and calibration), the same pair of seed
+// and scene gives the same frames, and `detect` on those frames with that calibration
+// names no marker wrongly.
+TEST(DetectCli, StressScenesAsTheContractSays) {
+  const auto out = scratch_dir("detect_stress");
+  auto r = run_rilbed("synth --preset stress --seed 11 --scene 3 --frames 4 --out '" + out.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string truth_text = read_file(out / "ground_truth.csv");
+  EXPECT_EQ(truth_text.substr(0, truth_text.find('\n')), "frame,id,u,v,heading_deg,scene,diameter_px,occluded,touching");
+  const std::string scenes = read_file(out / "scenes.csv");
+  EXPECT_EQ(scenes.rfind("scene,first_frame,frames,marker_diameter_px,", 0), 0u) << scenes;
+  EXPECT_NE(scenes.find("\n3,0,4,"), std::string::npos) << scenes;
+  ASSERT_TRUE(fs::exists(out / "calibration" / "scene_0003.yaml"));
+  for (int f = 0; f < 4; ++f) EXPECT_TRUE(fs::exists(out / "frames" / ("frame_000" + std::to_string(f) + ".png")));
+  const cv::Mat first = cv::imread((out / "frames" / "frame_0000.png").string());
+  EXPECT_EQ(first.cols, 1280);
+  EXPECT_EQ(first.rows, 960);
+  // Again: the same frames, byte for byte.
+  const auto again = scratch_dir("detect_stress_again");
+  r = run_rilbed("synth --preset stress --seed 11 --scene 3 --frames 1 --out '" + again.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(read_file(again / "frames" / "frame_0000.png"), read_file(out / "frames" / "frame_0000.png"));
+  r = run_rilbed("detect '" + (out / "frames").string() + "' --calib '" + (out / "calibration" / "scene_0003.yaml").string() +
+                 "' --csv '" + (out / "found.csv").string() + "' -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto truth = vision::read_marker_csv((out / "ground_truth.csv").string());
+  const auto found = vision::read_marker_csv((out / "found.csv").string());
+  ASSERT_TRUE(truth.ok()) << truth.error;
+  ASSERT_TRUE(found.ok()) << found.error;
+  const auto s = vision::score_detections(truth.rows, found.rows);
+  EXPECT_GT(s.truth_markers, 0);
+  EXPECT_EQ(s.wrong_id, 0);
+  EXPECT_EQ(s.duplicates, 0);
+  fs::remove_all(out);
+  fs::remove_all(again);
 }
 
 // Bad frames in a directory are named and skipped; the good ones keep their frame numbers.
