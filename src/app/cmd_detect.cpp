@@ -133,7 +133,7 @@ int run_detect(const DetectOptions& opt) {
   cv::VideoWriter annotated;
   const bool show_progress = !opt.quiet && ::isatty(STDERR_FILENO);
   std::map<int, long> per_id;
-  long frames = 0, bad_frames = 0, rows = 0;
+  long frames = 0, bad_frames = 0, rows = 0, declined = 0;
   double pipeline_s = 0.0;
   const auto start = std::chrono::steady_clock::now();
   g_interrupted = false;
@@ -153,6 +153,7 @@ int run_detect(const DetectOptions& opt) {
     const auto t0 = std::chrono::steady_clock::now();
     const auto found = opt.no_track ? tracker.detect_full_frame(r.image) : tracker.process(r.image);
     pipeline_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    declined += tracker.last_stats().declined;
 
     char line[256];
     for (const auto& d : found) {
@@ -196,6 +197,8 @@ int run_detect(const DetectOptions& opt) {
     const long n = per_id.count(id) ? per_id[id] : 0;
     std::fprintf(stderr, "  id %3d: %6ld frames (%5.1f%%)\n", id, n, frames ? 100.0 * n / frames : 0.0);
   }
+  // A marker two readings explain almost equally well is reported as nothing: counted here.
+  std::fprintf(stderr, "  declined: %ld markers left unnamed (two IDs or headings read almost alike)\n", declined);
   std::fprintf(stderr, "  speed: %.1f frames/s overall, %.1f frames/s in the pipeline (%.3f ms/frame)\n",
                frames / std::max(wall, 1e-9), frames / std::max(pipeline_s, 1e-9),
                frames ? 1000.0 * pipeline_s / frames : 0.0);
