@@ -16,7 +16,23 @@ namespace rilbed::vision {
 namespace {
 
 constexpr std::uint64_t kSeed = 31102611;  // drawn after the last threshold changed, never tuned on
-constexpr int kScenes = 60;
+
+// Under AddressSanitizer (`./run asan`, a Debug build) the detector runs some thirty times
+// slower: there the test renders 12 scenes and holds them to the mistakes only (a wrong ID,
+// a false detection, a heading far off need no statistics; recall and RMS over 12 scenes
+// would be noise). The scenes are the same, the results bit for bit those of Release.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+#else
+constexpr bool kSanitized = false;
+#endif
+constexpr int kScenes = kSanitized ? 12 : 60;
 
 struct Tallies {
   StressTally full, tracked;
@@ -74,6 +90,7 @@ TEST(StressSet, HoldsIssue14sTargetsFullFrameAndTracked) {
     EXPECT_LE(t.count(StressMistake::Kind::FalseDetection), 4) << describe(t);
     EXPECT_EQ(t.count(StressMistake::Kind::WrongHeading), 0) << describe(t);
     EXPECT_EQ(t.count(StressMistake::Kind::Duplicate), 0) << describe(t);
+    if (kSanitized) continue;
 
     const auto large = summarise(t.outcomes(), [](const StressOutcome& o) { return o.occluded == 0 && o.diameter_px >= 32; });
     ASSERT_GT(large.markers, 300);
