@@ -33,8 +33,11 @@ struct PoseReport {
   bool real = false;  ///< a real robot: its pose is the camera's
   bool seen = true;   ///< false: a real robot the camera has not seen recently (pose is its last)
   Pose2 pose;         ///< field frame
-  std::string_view behaviour;  ///< a static string
-  std::string_view health;     ///< a static string: "ok", "unseen", ...
+  /// Valid during the call that hands the report over: the run's own are static, but a
+  /// bus decoder's (links::RunReportDecoder) view the message being decoded. An observer
+  /// that keeps a report keeps a copy of its strings.
+  std::string_view behaviour;
+  std::string_view health;     ///< "ok", "unseen", ...; valid as `behaviour` is
 };
 
 /// One robot's wheel command at one control step.

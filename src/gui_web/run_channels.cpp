@@ -314,6 +314,16 @@ void RunChannels::on_world(TimeUs t_us, const agents::WorldReport& world) {
   });
 }
 
+void RunChannels::OwnedPoses::assign(std::span<const agents::PoseReport> from) {
+  poses.assign(from.begin(), from.end());
+  strings.clear();
+  strings.reserve(2 * poses.size());
+  for (agents::PoseReport& p : poses) {
+    p.behaviour = strings.emplace_back(p.behaviour);
+    p.health = strings.emplace_back(p.health);
+  }
+}
+
 void RunChannels::on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) {
   // Kept (and marked unsent) before anything else: a client subscribing meanwhile gets them
   // from the latch source, at worst twice.
@@ -321,11 +331,14 @@ void RunChannels::on_poses(TimeUs t_us, std::span<const agents::PoseReport> pose
   {
     std::lock_guard lock(l.mutex);
     l.poses_t_us = t_us;
-    l.poses.assign(poses.begin(), poses.end());
+    l.poses.assign(poses);
     l.poses_unsent = l.scene_unsent = true;
   }
   if (!server_.subscribed(poses_) && !server_.subscribed(scene_)) return;
-  post(poses_, true, [this, t_us, copy = std::vector<agents::PoseReport>(poses.begin(), poses.end())] {
+  auto owned = std::make_shared<OwnedPoses>();
+  owned->assign(poses);
+  post(poses_, true, [this, t_us, owned] {
+    const std::vector<agents::PoseReport>& copy = owned->poses;
     Latest& l = *latest_;
     if (server_.subscribed(poses_)) {
       send(poses_, t_us, poses_json(t_us, copy));
@@ -351,7 +364,7 @@ std::shared_ptr<const std::string> RunChannels::Latest::build(bool scene, std::u
   if (!unsent) return nullptr;
   unsent = false;
   t_ns = static_cast<std::uint64_t>(std::max<TimeUs>(0, poses_t_us)) * 1000;
-  const json message = scene ? scene_json(poses_t_us, poses, world) : poses_json(poses_t_us, poses);
+  const json message = scene ? scene_json(poses_t_us, poses.poses, world) : poses_json(poses_t_us, poses.poses);
   return std::make_shared<const std::string>(message.dump(-1, ' ', false, json::error_handler_t::replace));
 }
 

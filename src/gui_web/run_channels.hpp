@@ -84,13 +84,25 @@ class RunChannels final : public agents::RunObserver {
   void work();
   void send(std::uint32_t channel, TimeUs t_us, const nlohmann::json& message);
 
+  // Pose reports whose strings it owns: the run's own behaviour names are static, but
+  // those a bus decoder hands over live only during the call (`rilbed gui --lcm`), and
+  // these are kept for later. Not copyable: the reports view its own strings.
+  struct OwnedPoses {
+    std::vector<agents::PoseReport> poses;
+    std::vector<std::string> strings;  // reserved up front, so that the views stay put
+    OwnedPoses() = default;
+    OwnedPoses(const OwnedPoses&) = delete;
+    OwnedPoses& operator=(const OwnedPoses&) = delete;
+    void assign(std::span<const agents::PoseReport> from);
+  };
+
   // What the poses and scene channels' latch sources build from; shared with them (they
   // run on the server's thread, which may outlive this object).
   struct Latest {
     std::mutex mutex;  // guards all of it
     std::optional<agents::WorldReport> world;
     TimeUs poses_t_us = 0;
-    std::vector<agents::PoseReport> poses;  // behaviour and health are static strings
+    OwnedPoses poses;
     bool poses_unsent = false, scene_unsent = false;  // the last poses were not published on the channel
     // The latest poses or scene message, or null when what was published last is the latest.
     std::shared_ptr<const std::string> build(bool scene, std::uint64_t& t_ns);
