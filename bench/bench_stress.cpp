@@ -29,6 +29,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <deque>
 #include <functional>
 #include <map>
@@ -321,8 +322,11 @@ int main(int argc, char** argv) {
               "before each call (as a frame from a camera arrives); the detectors take turns frame by frame; the "
               "timer's own cost (%.4f ms CPU) subtracted. AprilTag 3: tag36h11, quad_decimate 2, nthreads 1; "
               "OpenCV ArUco: DICT_4X4_50, default parameters. The peers search the same frames (6UCP markers and "
-              "clutter, among it their own kind of tags): their cost on them, not their recall.\n\n",
-              plain_kept, textured_kept, timer.cpu_ms);
+              "clutter, among it their own kind of tags): their cost on them, not their recall. GLIBC_TUNABLES: %s "
+              "(tools/bench.sh fixes glibc's malloc thresholds, so that no detector pays page faults for buffers "
+              "mapped afresh each frame).\n\n",
+              plain_kept, textured_kept, timer.cpu_ms,
+              std::getenv("GLIBC_TUNABLES") ? std::getenv("GLIBC_TUNABLES") : "unset");
   apriltag_family_t* tag_family = tag36h11_create();
   apriltag_detector_t* td = apriltag_detector_create();
   apriltag_detector_add_family(td, tag_family);

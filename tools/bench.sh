@@ -32,6 +32,10 @@ if SOURCE="$(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null)"; then
   export RILBED_BENCH_SOURCE="$SOURCE"
 fi
 
+# The vision comparisons time every detector with glibc's malloc thresholds fixed: glibc
+# moves its mmap threshold as a program runs and may map a frame's large buffers afresh every
+# frame, and page faults cost a peer several times its time on identical frames.
+export GLIBC_TUNABLES=glibc.malloc.mmap_threshold=67108864:glibc.malloc.trim_threshold=268435456
 "$BUILD_DIR/bench_vision" "$@"
 
 # The vision stress set (issue 14): 500 random scenes (2,000 frames) from a fresh seed,
@@ -39,6 +43,7 @@ fi
 # AprilTag and ArUco. Its seed is printed; pass it back to see the same frames.
 echo
 "$BUILD_DIR/bench_stress" --scenes 500
+unset GLIBC_TUNABLES
 
 # The simulation: sim-bench's table, then the convoy batch in both modes
 # (wall time of the whole command, as a user sees it).
