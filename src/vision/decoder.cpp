@@ -439,14 +439,7 @@ std::pair<int, double> Decoder::coarse_peak(const Prepared& p, const Ideal& idea
     return {static_cast<int>(take_odd ? odd_lag : even_lag), take_odd ? odd : even};
   }
 #endif
-  scratch.assign(n, 0.0);
-  // Edge by edge over all lags: contiguous loops the compiler vectorises.
-  for (std::size_t e = 0; e < edges; ++e) {
-    const double* c = &p.doubled_cumulative[ideal.edge_index[e]];  // + lag < 2n: no modulo
-    const double* x = &p.doubled_signal[ideal.edge_index[e]];
-    const double step = ideal.step[e], frac = ideal.edge_frac[e];
-    for (int lag = 0; lag < n; ++lag) scratch[lag] += step * (c[lag] + frac * x[lag]);
-  }
+  correlate_all_lags(p, ideal, scratch);
   const auto best = std::max_element(scratch.begin(), scratch.end());
   return {static_cast<int>(best - scratch.begin()), *best};
 }
