@@ -844,8 +844,12 @@ bool BlobDetector::measure(const cv::Mat& grey, const Fill& fill, Blob& blob) co
 
   const double inv = 1.0 / (4.0 * det);
   const double qxx = syy * inv, qyy = sxx * inv, qxy = -sxy * inv;
-  if (chord_error(row_chords, qxx, qxy, qyy, cx, cy) > config_.max_chord_error) return false;
-  if (chord_error(col_chords, qyy, qxy, qxx, cy, cx) > config_.max_chord_error) return false;
+  const double chord_limit = std::max(config_.max_chord_error, config_.max_doubtful_chord_error);
+  const double row_err = chord_error(row_chords, qxx, qxy, qyy, cx, cy);
+  if (row_err > chord_limit) return false;
+  const double col_err = chord_error(col_chords, qyy, qxy, qxx, cy, cx);
+  if (col_err > chord_limit) return false;
+  blob.doubtful = std::max(row_err, col_err) > config_.max_chord_error;
 
   // Symmetric square root of 4S maps the unit circle onto the outline.
   const double s = std::sqrt(det);
@@ -886,16 +890,21 @@ bool BlobDetector::try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blo
   // on a dark mat or a circular floor track around robots, may enclose dark shapes
   // that are not connected to it, and only the true fill tells them apart.
   if (sweep_fill(roi, x, y, fill)) {
+    // A swept region holds every dark region it touches, whole: when all of it is too
+    // small for a disc, so is everything in it, and the exact fill is not needed. Most
+    // of a textured floor's dark specks end here, at the cost of one sweep.
+    if (fill.extent_area < min_disc_area()) {
+      clear_swept_region(fill);
+      reset_region(fill);
+      return false;
+    }
     // A marker's centre is its black hole; a dark ring around some other shape has its
     // hole there. (A centre lighter than the threshold only sends a marker to the fill.)
+    // (A doubtful outline is left to the exact fill too: the sweep may have taken in
+    // what lies around the disc.)
     const bool ok = fill.area >= kMinDarkFraction * fill.extent_area && measure_region(grey, fill, blob) &&
-                    centre_is_dark(blob);
-    if (ok) {
-      for (int r = fill.y0; r <= fill.y1; ++r) {
-        std::uint8_t* mask = dark_.ptr<std::uint8_t>(r);
-        std::fill(mask + row_min_x_[r], mask + row_max_x_[r] + 1, 0);
-      }
-    }
+                    !blob.doubtful && centre_is_dark(blob);
+    if (ok) clear_swept_region(fill);
     reset_region(fill);
     if (ok) return true;
   }
@@ -905,15 +914,40 @@ bool BlobDetector::try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blo
   return ok;
 }
 
+void BlobDetector::clear_swept_region(const Fill& fill) {
+  for (int r = fill.y0; r <= fill.y1; ++r) {
+    std::uint8_t* mask = dark_.ptr<std::uint8_t>(r);
+    std::fill(mask + row_min_x_[r], mask + row_max_x_[r] + 1, 0);
+  }
+}
+
+double BlobDetector::min_disc_area() const {
+  const double min_disc_d = config_.min_diameter_px * kDiscFraction;
+  return kPi * min_disc_d * min_disc_d / 4.0 / config_.max_axis_ratio * 0.8;
+}
+
+bool BlobDetector::could_be_ellipse(const Fill& fill) const {
+  long extent_area = 0;
+  for (int r = fill.y0; r <= fill.y1; ++r) {
+    if (row_max_x_[r] >= row_min_x_[r]) extent_area += row_max_x_[r] - row_min_x_[r] + 1;
+  }
+  const int w = fill.x1 - fill.x0 + 1, h = fill.y1 - fill.y0 + 1;
+  // An ellipse of axis ratio r fills at least pi r / (2 (1 + r^2)) of its bounding box
+  // (turned 45 degrees; pi/4 upright), and its box is at most r times as long as wide.
+  // measure() allows the area max_area_error and the outline some chord error: the
+  // margins below keep every region it would accept.
+  const double r = config_.max_axis_ratio;
+  const double least_fill = 0.75 * (1.0 - config_.max_area_error) * kPi * r / (2.0 * (1.0 + r * r));
+  return extent_area >= least_fill * w * h && std::max(w, h) <= 1.3 * r * std::min(w, h) + 2;
+}
+
 bool BlobDetector::centre_is_dark(const Blob& blob) const {
   const int x = static_cast<int>(std::lround(blob.u)), y = static_cast<int>(std::lround(blob.v));
   return x >= 0 && y >= 0 && x < size_.width && y < size_.height && dark_.at<std::uint8_t>(y, x) != 0;
 }
 
 bool BlobDetector::measure_region(const cv::Mat& grey, const Fill& fill, Blob& blob) {
-  const double min_disc_d = config_.min_diameter_px * kDiscFraction;
-  const double min_area = kPi * min_disc_d * min_disc_d / 4.0 / config_.max_axis_ratio * 0.8;
-  if (fill.area < min_area) return false;
+  if (fill.area < min_disc_area() || !could_be_ellipse(fill)) return false;
   // Column extents of the region, from its row extents: only candidates pay for them
   // (a long strip of tape is filled, but never measured). A column's bottom is the last
   // row (going down) that covers it and its top the last going up: two plain fills per

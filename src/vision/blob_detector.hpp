@@ -56,6 +56,15 @@ struct BlobDetectorConfig {
   /// Largest mean relative deviation of the blob's chord lengths from those of an
   /// ellipse. A disc scores about 0.02, a square 0.2.
   double max_chord_error = 0.09;
+  /// A region that passes every other test but whose chord error lies between
+  /// max_chord_error and this is still reported, flagged Blob::doubtful, for the caller
+  /// to confirm from the disc's outline (MarkerTracker re-fits it with fit_disc_edges and
+  /// drops it when that fails). Heavy blur bleeds a marker's white key slice into its thin
+  /// black ring, so the dark region of a small blurred marker has a notch where the fit
+  /// of its outline, at the marker's own threshold, finds the whole ellipse. Costs an edge
+  /// fit per such region; at most max_chord_error turns it off. Higher finds more
+  /// blurred markers and hands more lookalikes to the decoder's and the template's tests.
+  double max_doubtful_chord_error = 0.3;
   /// Largest ratio of the ellipse's axes (a marker viewed at 60 degrees gives 2).
   double max_axis_ratio = 1.8;
   /// Least fraction of the outline's outside neighbours that must be bright (above a
@@ -79,6 +88,10 @@ struct Blob {
   double filled_area_px = 0.0;
   /// Diameter of a circle of the same area as the disc, pixels.
   double disc_diameter_px() const;
+  /// Its outline strays from an ellipse more than a clean disc's would (see
+  /// BlobDetectorConfig::max_doubtful_chord_error): the centre and shape are only a
+  /// first guess, to be confirmed from the outline before use.
+  bool doubtful = false;
 };
 
 /// Detects marker blobs in 8-bit grey frames of one size. Keeps its scratch buffers
@@ -135,6 +148,13 @@ class BlobDetector {
   // Column extents from the row extents, then measure(); false for a region too small.
   bool measure_region(const cv::Mat& grey, const Fill& fill, Blob& blob);
   bool centre_is_dark(const Blob& blob) const;  // the mask at the blob's centre pixel
+  void clear_swept_region(const Fill& fill);     // the mask within a sweep's row extents
+  // Least area of a region that may be a marker's disc (config's smallest diameter,
+  // foreshortened by max_axis_ratio, with a margin), pixels.
+  double min_disc_area() const;
+  // A cheap look at the region's bounding box and row extents before measure(): false
+  // for a region far from any ellipse measure() would accept (long, thin or ragged).
+  bool could_be_ellipse(const Fill& fill) const;
   void reset_region(const Fill& fill);      // row and column extents back to empty
   void clear_row_extents(int y0, int y1);
   std::uint8_t threshold_at(int x, int y) const { return tile_threshold_[tile_row_[y] * tiles_x_ + tile_col_[x]]; }

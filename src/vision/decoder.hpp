@@ -37,8 +37,14 @@ struct DecoderConfig {
   /// The levels a printed marker must show where its code says (levels_agree), each as a
   /// fraction of the ring contrast: the key slice at most this far below the white ring,
   /// (blur of a small marker darkens it a little; a dark blob on a textured floor that
-  /// merely correlates with a code reads far darker)...
-  double max_key_shortfall = 0.6;
+  /// merely correlates with a code reads far darker)... The key is the widest white
+  /// slice (6UCP: 85 degrees against the data slices' 55): blur that takes 0.3 of the
+  /// contrast from the key's middle leaves a lone white data slice's middle below the
+  /// midpoint (Gaussian blur across the circle: the key's middle keeps erf(85/55 x) where
+  /// a data slice's keeps erf(x) = 0.5), so the data bits are no longer read reliably and
+  /// the marker is declined. 0.35 allows for the levels' own noise; 0.6 let a blurred
+  /// 19 px ID 8 read as ID 1, and letters and digits printed on the floor pass as ID 7 or 8.
+  double max_key_shortfall = 0.35;
   /// ...its black slices at most this far above the black ring...
   double max_black_excess = 0.35;
   /// ...and its hole (the centre) at most this far above the black ring.

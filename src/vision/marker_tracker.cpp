@@ -79,7 +79,8 @@ MarkerTracker::MarkerTracker(MarkerFamily family, std::vector<int> ids, TrackerC
       config_(config),
       detector_(config.blobs),
       decoder_(family_, decoder_ids(family_, ids_), config.decoder),
-      confirm_decoder_(family_, ids_, confirm_config(config)) {
+      confirm_decoder_(family_, ids_, confirm_config(config)),
+      templates_(family_, ids_, config.templates) {
   index_decoder();
 }
 
@@ -96,6 +97,7 @@ void MarkerTracker::set_config(const TrackerConfig& config) {
   detector_.set_config(config.blobs);
   decoder_ = Decoder(family_, decoder_ids(family_, ids_), config.decoder);
   confirm_decoder_ = Decoder(family_, ids_, confirm_config(config));
+  templates_ = MarkerTemplates(family_, ids_, config.templates);
   index_decoder();
   reset();
 }
@@ -149,6 +151,7 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
       continue;
     }
     if (!decoder_.levels_agree(grey, blob, signal_, matches[own])) continue;  // not a printed marker's levels
+    if (!templates_.matches(grey, blob, matches[own].id, matches[own].key_angle_rad)) continue;  // not all of one
     double* row = &similarity_[b * columns];
     for (std::size_t c = 0; c < columns; ++c) {
       if (static_cast<std::size_t>(decoder_index_[c]) != own) continue;  // only the ID its code reads
@@ -175,11 +178,32 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
   return out;
 }
 
+std::vector<Blob> MarkerTracker::find_blobs(const cv::Mat& grey) {
+  std::vector<Blob> blobs = detector_.detect(grey);
+  settle_doubtful(grey, blobs);
+  return blobs;
+}
+
+void MarkerTracker::settle_doubtful(const cv::Mat& grey, std::vector<Blob>& blobs) {
+  // A doubtful blob's outline is re-found at its own threshold; what does not fit a
+  // clean ellipse with a white ring around it is no marker anyone can read.
+  std::erase_if(blobs, [&](Blob& blob) {
+    if (!blob.doubtful) return false;
+    ++stats_.refits;
+    const auto fit = fit_disc_edges(grey, blob, blob.threshold, config_.edge_fit);
+    if (!fit || fit->white_fraction < decoder_.config().min_white_ring_fraction) return true;
+    ++stats_.refits_kept;
+    blob = fit->blob;
+    blob.doubtful = false;
+    return false;
+  });
+}
+
 std::vector<MarkerDetection> MarkerTracker::detect_full_frame(const cv::Mat& frame) {
   const cv::Mat grey = to_grey(frame);
   stats_ = FrameStats{};
   stats_.full_search = true;
-  auto found = assign(grey, detector_.detect(grey), false);
+  auto found = assign(grey, find_blobs(grey), false);
   stats_.fills = detector_.take_fill_count();
   return found;
 }
@@ -191,6 +215,7 @@ std::optional<MarkerDetection> MarkerTracker::confirm(const cv::Mat& grey, const
   const CodeMatch m = decoder_.match_one(signal_, blob, track.id, track.predicted_heading_deg());
   if (m.score < config_.min_assign_score || m.score < track.score - config_.confirm_drop) return std::nullopt;
   if (!decoder_.levels_agree(grey, blob, signal_, m)) return std::nullopt;
+  if (!templates_.matches(grey, blob, m.id, m.key_angle_rad)) return std::nullopt;
   return make_detection(blob, m, true, 0.5 * (signal_.black_level + signal_.white_level));
 }
 
@@ -308,7 +333,8 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     const double half = (config_.search_window_diameters + 0.5) * t.diameter_px + t.predicted_travel();
     const cv::Rect roi(static_cast<int>(std::floor(p.x - half)), static_cast<int>(std::floor(p.y - half)),
                        static_cast<int>(std::ceil(2 * half)) + 1, static_cast<int>(std::ceil(2 * half)) + 1);
-    const std::vector<Blob> near = detector_.detect_near(grey, roi, p, t.threshold_grey);
+    std::vector<Blob> near = detector_.detect_near(grey, roi, p, t.threshold_grey);
+    settle_doubtful(grey, near);
     if (near.size() == 1 && t.missed == 0) {
       ++stats_.blobs;
       if (auto d = confirm(grey, t, near[0])) {
@@ -332,7 +358,7 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
   ++frames_since_full_;
   if (tracks_.empty() || (!all_found && frames_since_full_ >= config_.full_search_interval_frames)) {
     frames_since_full_ = 0;
-    std::vector<Blob> more = detector_.detect(grey);
+    std::vector<Blob> more = find_blobs(grey);
     found.resize(confirmed);  // the blobs are assigned again, with the new ones
     drop_confirmed(more, found);
     append_unique(blobs, more);

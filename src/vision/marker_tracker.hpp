@@ -11,6 +11,7 @@
 
 #include "core/geometry.hpp"
 #include "vision/blob_detector.hpp"
+#include "vision/marker_template.hpp"
 #include "vision/decoder.hpp"
 #include "vision/disc_edge_fit.hpp"
 #include "vision/marker_family.hpp"
@@ -53,6 +54,10 @@ struct MarkerDetection {
 struct TrackerConfig {
   BlobDetectorConfig blobs;
   DecoderConfig decoder;
+  /// The whole-marker check a blob passes before it takes an ID or a track confirms
+  /// one from a fill (MarkerTemplates): after the decoder's tests, the last guard
+  /// against letters and digits printed on the floor.
+  MarkerTemplateConfig templates;
   /// How a tracked marker is re-found from its outline before any fill. In the frames
   /// that only spot-check its code (see full_confirm_interval_frames) `quick_edge_fit`
   /// comes first: the centre and size only (2 rows and 2 columns, the shape kept from the
@@ -127,6 +132,8 @@ struct FrameStats {
   int decoded = 0;           ///< blobs whose signal was decodable
   int fills = 0;             ///< dark regions filled (the detector's main work)
   int edge_fits = 0;         ///< tracked markers confirmed from their outline, without a fill
+  int refits = 0;            ///< doubtful blobs (Blob::doubtful) whose outline was fitted again
+  int refits_kept = 0;       ///< ...and that fitted a clean ellipse, so went on to decoding
   int declined = 0;          ///< decoded blobs left unnamed: two explanations too close (TrackerConfig::ambiguity_margin)
 };
 
@@ -195,6 +202,10 @@ class MarkerTracker {
   std::optional<MarkerDetection> confirm(const cv::Mat& grey, const Track& track, const Blob& blob);
   // The tracked marker re-found by the edge fit around its prediction, confirmed.
   std::optional<MarkerDetection> confirm_by_edges(const cv::Mat& grey, const Track& track);
+  // The blob detector's full search, with its doubtful blobs settled (settle_doubtful).
+  std::vector<Blob> find_blobs(const cv::Mat& grey);
+  // Replaces each doubtful blob by the ellipse fitted to its outline, or drops it.
+  void settle_doubtful(const cv::Mat& grey, std::vector<Blob>& blobs);
   cv::Mat to_grey(const cv::Mat& frame);
   // decoder_index_ for decoder_.
   void index_decoder();
@@ -212,6 +223,7 @@ class MarkerTracker {
   BlobDetector detector_;
   Decoder decoder_;
   Decoder confirm_decoder_;  // the listed IDs only, at confirm_samples: the edge-fit confirmation
+  MarkerTemplates templates_;  // the listed IDs
   std::vector<Track> tracks_;
   std::vector<int> track_of_id_;  // per ID, its index in tracks_ or -1 (rebuilt per frame)
   std::vector<int> confirmed_ids_;  // process()'s, kept between frames (no allocation per frame)

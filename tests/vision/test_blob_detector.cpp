@@ -39,8 +39,28 @@ TEST(BlobDetector, RejectsSquaresAndLines) {
   cv::rectangle(img, {20, 20, 30, 30}, cv::Scalar(28), cv::FILLED);       // square
   cv::line(img, {100, 20}, {180, 60}, cv::Scalar(28), 4);                // tape
   cv::rectangle(img, {20, 120, 60, 20}, cv::Scalar(28), cv::FILLED);      // bar
+  // The square's outline strays from an ellipse by a chord error of about 0.2: doubtful
+  // at most, for the tracker's edge fit to turn down (MarkerTracker test below).
   BlobDetector detector;
-  EXPECT_TRUE(detector.detect(img).empty());
+  for (const Blob& b : detector.detect(img)) EXPECT_TRUE(b.doubtful) << b.u << ", " << b.v;
+  BlobDetectorConfig strict;
+  strict.max_doubtful_chord_error = 0.0;
+  EXPECT_TRUE(BlobDetector(strict).detect(img).empty());
+}
+
+// A disc with a notch in its outline (as heavy blur bleeds a marker's white key slice
+// into its black ring) is reported, flagged doubtful, near its true centre.
+TEST(BlobDetector, NotchedDiscIsDoubtful) {
+  cv::Mat img(100, 100, CV_8UC1, cv::Scalar(185));
+  cv::circle(img, {50, 50}, 15, cv::Scalar(28), cv::FILLED, cv::LINE_AA);
+  const std::vector<cv::Point> notch = {{50, 50}, {62, 33}, {70, 42}};
+  cv::fillPoly(img, std::vector<std::vector<cv::Point>>{notch}, cv::Scalar(185), cv::LINE_AA);
+  cv::circle(img, {50, 50}, 4, cv::Scalar(28), cv::FILLED);  // the hole stays dark
+  const auto blobs = BlobDetector().detect(img);
+  ASSERT_EQ(blobs.size(), 1u);
+  EXPECT_TRUE(blobs[0].doubtful);
+  EXPECT_NEAR(blobs[0].u, 49.5, 3.0);
+  EXPECT_NEAR(blobs[0].v, 49.5, 3.0);
 }
 
 TEST(BlobDetector, FindsTiltedEllipses) {

@@ -242,6 +242,19 @@ TEST(MarkerTracker, NoisyFloorDoesNotFloodTheSearch) {
   EXPECT_LT(tracker.last_stats().fills, 400);
 }
 
+// Doubtful blobs are fitted again from their outline: a square fits no ellipse and
+// never reaches the decoder.
+TEST(MarkerTracker, DoubtfulSquaresAreRefittedAndDropped) {
+  cv::Mat img(200, 200, CV_8UC1, cv::Scalar(185));
+  cv::rectangle(img, {20, 20, 30, 30}, cv::Scalar(28), cv::FILLED);
+  cv::rectangle(img, {120, 120, 24, 24}, cv::Scalar(28), cv::FILLED);
+  MarkerTracker tracker(MarkerFamily::six_ucp(), {1, 2, 3, 4, 5, 6, 7, 8});
+  EXPECT_TRUE(tracker.detect_full_frame(img).empty());
+  EXPECT_GE(tracker.last_stats().refits, 1);
+  EXPECT_EQ(tracker.last_stats().refits_kept, 0);
+  EXPECT_EQ(tracker.last_stats().blobs, 0);
+}
+
 // A marker right at the frame's edge: the edge tiles get thresholds too.
 TEST(MarkerTracker, MarkerAtTheFrameEdge) {
   const auto f = MarkerFamily::six_ucp();

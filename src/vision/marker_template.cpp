@@ -1,0 +1,143 @@
+#include "vision/marker_template.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "vision/circle_sampler.hpp"
+
+namespace rilbed::vision {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// The polar grid, radii as fractions of the outer radius R: the hole, the coded annulus,
+// the black ring and the white ring, each a few times (and clear of the floor beyond R).
+constexpr std::array<double, 13> kRadii = {0.05, 0.1, 0.2, 0.27, 0.35, 0.43, 0.5, 0.6, 0.665, 0.72, 0.83, 0.9, 0.96};
+constexpr int kAngles = 64;
+// Blur strengths, Gaussian sigma as a fraction of R: from a sharp 64 px marker to a
+// 20 px one under 2 px of blur and some smear.
+constexpr std::array<double, 7> kBlurOfRadius = {0.02, 0.05, 0.08, 0.11, 0.15, 0.2, 0.26};
+// The rendered model: R in pixels, and the image's side.
+constexpr double kModelRadiusPx = 50.0;
+constexpr int kModelSide = 2 * 64 + 1;
+
+// At least the circles up to the white ring's inner half (0.83 R) must lie in the image.
+constexpr std::size_t kLeastCircles = 11;
+
+// Pearson correlation of `levels` (centred, unit norm) with the first levels.size()
+// values of `model`.
+double correlate(const std::vector<float>& levels, const std::vector<float>& model) {
+  const std::size_t n = levels.size();
+  double sum = 0.0, sum_sq = 0.0, dot = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    sum += model[i];
+    sum_sq += static_cast<double>(model[i]) * model[i];
+    dot += static_cast<double>(levels[i]) * model[i];
+  }
+  const double var = sum_sq - sum * sum / static_cast<double>(n);
+  return var > 1e-12 ? dot / std::sqrt(var) : -1.0;  // levels sum to 0: the model's mean drops out of dot
+}
+
+// Centres `values` and scales them to unit norm; false when they are all alike.
+bool normalise(std::vector<float>& values) {
+  double mean = 0.0;
+  for (float v : values) mean += v;
+  mean /= static_cast<double>(values.size());
+  double norm = 0.0;
+  for (float& v : values) {
+    v = static_cast<float>(v - mean);
+    norm += static_cast<double>(v) * v;
+  }
+  if (norm <= 1e-12) return false;
+  const double scale = 1.0 / std::sqrt(norm);
+  for (float& v : values) v = static_cast<float>(v * scale);
+  return true;
+}
+
+// The marker drawn large and sharp, the key's bisector pointing right (+u); white 1.
+cv::Mat render(const MarkerFamily& family, int id) {
+  cv::Mat image(kModelSide, kModelSide, CV_32F);
+  const double c = (kModelSide - 1) / 2.0;
+  for (int y = 0; y < kModelSide; ++y) {
+    for (int x = 0; x < kModelSide; ++x) {
+      const double dx = x - c, dy = y - c;
+      const double r = std::hypot(dx, dy) / kModelRadiusPx;
+      const double angle_deg = std::atan2(-dy, dx) * 180.0 / kPi;  // counter-clockwise on screen
+      const double colour = family.colour_at(id, r, angle_deg);
+      image.at<float>(y, x) = static_cast<float>(colour < 0.0 ? 1.0 : colour);  // beyond R: the white ring's
+    }
+  }
+  return image;
+}
+
+// The model's levels on the polar grid (bilinear), radius-major.
+std::vector<float> sample_polar(const cv::Mat& model) {
+  std::vector<float> out;
+  out.reserve(kRadii.size() * kAngles);
+  const double c = (kModelSide - 1) / 2.0;
+  for (double r : kRadii) {
+    for (int k = 0; k < kAngles; ++k) {
+      const double a = 2.0 * kPi * k / kAngles;
+      const float x = static_cast<float>(c + r * kModelRadiusPx * std::cos(a));
+      const float y = static_cast<float>(c - r * kModelRadiusPx * std::sin(a));
+      cv::Mat px;
+      cv::getRectSubPix(model, cv::Size(1, 1), cv::Point2f(x, y), px);
+      out.push_back(px.at<float>(0, 0));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+MarkerTemplates::MarkerTemplates(const MarkerFamily& family, const std::vector<int>& ids, MarkerTemplateConfig config)
+    : family_(family), config_(config), ids_(ids), models_(ids.size()) {}
+
+const MarkerTemplates::Models& MarkerTemplates::models_of(std::size_t index) const {
+  Models& blurred = models_[index];
+  if (!blurred.empty()) return blurred;
+  const cv::Mat sharp = render(family_, ids_[index]);
+  for (double blur : kBlurOfRadius) {
+    cv::Mat model;
+    cv::GaussianBlur(sharp, model, cv::Size(), blur * kModelRadiusPx, 0.0, cv::BORDER_REPLICATE);
+    blurred.push_back(sample_polar(model));
+  }
+  return blurred;
+}
+
+double MarkerTemplates::correlation(const cv::Mat& grey, const Blob& blob, int id, double key_angle_rad) const {
+  const auto which = std::find(ids_.begin(), ids_.end(), id);
+  if (which == ids_.end()) return -1.0;
+  // The shape turned so that direction 0 of the circle reads the key's bisector:
+  // (cos(key + b), -sin(key + b)) = [[c, s], [-s, c]] (cos b, -sin b).
+  const double c = std::cos(key_angle_rad), s = std::sin(key_angle_rad);
+  const cv::Matx22d shape = blob.shape * cv::Matx22d(c, s, -s, c);
+  const double to_disc = 1.0 / MarkerFamily::black_ring_outer_radius;  // the shape maps the unit circle to the disc
+  // The circles that lie inside the image: a marker at the frame's edge may lose the
+  // outer part of its white ring, but not the rings within.
+  std::size_t circles = 0;
+  // (Checked on the blob's own shape: the same ellipse, and turning the shape would only
+  // loosen ellipse_inside's box.)
+  while (circles < kRadii.size() && ellipse_inside(grey, blob.u, blob.v, blob.shape, kRadii[circles] * to_disc)) {
+    ++circles;
+  }
+  if (circles < kLeastCircles) return -1.0;
+  static const CircleDirections directions = CircleDirections::make(kAngles);
+  thread_local std::vector<float> circle, levels;
+  circle.resize(directions.cos.size());
+  levels.clear();
+  for (std::size_t i = 0; i < circles; ++i) {
+    sample_ellipse(grey, blob.u, blob.v, shape, kRadii[i] * to_disc, directions, circle.data());
+    levels.insert(levels.end(), circle.begin(), circle.begin() + kAngles);
+  }
+  if (!normalise(levels)) return -1.0;
+  double best = -1.0;
+  for (const std::vector<float>& model : models_of(static_cast<std::size_t>(which - ids_.begin()))) {
+    best = std::max(best, correlate(levels, model));
+  }
+  return best;
+}
+
+}  // namespace rilbed::vision
