@@ -2,11 +2,12 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstring>
+#include <span>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include <opencv2/core/hal/intrin.hpp>
 
 #include "core/geometry.hpp"
 #include "vision/marker_family.hpp"
@@ -45,12 +46,41 @@ std::uint8_t deep_threshold(std::uint8_t threshold, std::uint8_t range, bool loc
 }
 }  // namespace
 
-#if defined(__SSE2__)
+// The kernels below are written once with OpenCV's universal intrinsics (SSE2 on x86,
+// NEON on ARM, OpenCV's C++ emulation elsewhere), sixteen bytes per vector.
 namespace {
+using cv::v_uint8x16;
+using cv::v_uint16x8;
+using cv::v_float64x2;
+
 // Sixteen bytes from any address.
-__m128i load16(const std::uint8_t* p) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); }
+v_uint8x16 load16(const std::uint8_t* p) { return cv::v_load(p); }
+
+// Bit i set where byte i of `v` is nonzero.
+unsigned nonzero_bits(const v_uint8x16& v) {
+  return static_cast<unsigned>(cv::v_signmask(v == cv::v_setzero_u8())) ^ 0xFFFFu;
+}
+unsigned nonzero_bits(const std::uint8_t* p) { return nonzero_bits(load16(p)); }
+
+// Each eight-byte half of `v` folded by `op` (min or max) onto its first byte: three
+// shifts of the two 64-bit lanes, which move bytes towards the first on a little-endian CPU.
+static_assert(std::endian::native == std::endian::little, "fold_halves and store_half_results read bytes as lane bits");
+template <class Op>
+v_uint8x16 fold_halves(v_uint8x16 v, Op op) {
+  v = op(v, cv::v_reinterpret_as_u8(cv::v_shr<32>(cv::v_reinterpret_as_u64(v))));
+  v = op(v, cv::v_reinterpret_as_u8(cv::v_shr<16>(cv::v_reinterpret_as_u64(v))));
+  return op(v, cv::v_reinterpret_as_u8(cv::v_shr<8>(cv::v_reinterpret_as_u64(v))));
+}
+
+// The first byte of each eight-byte half into out[0] and out[1], as the low bytes of
+// 16-bit lanes 0 and 4: one instruction each on SSE2 and NEON (a byte extract needs
+// SSE4.1 or a shift first).
+void store_half_results(const v_uint8x16& v, std::uint8_t* out) {
+  const v_uint16x8 lanes = cv::v_reinterpret_as_u16(v);
+  out[0] = static_cast<std::uint8_t>(cv::v_extract_n<0>(lanes));
+  out[1] = static_cast<std::uint8_t>(cv::v_extract_n<4>(lanes));
+}
 }  // namespace
-#endif
 
 double Blob::disc_diameter_px() const { return 2.0 * std::sqrt(filled_area_px / kPi); }
 
@@ -110,29 +140,24 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
     const int y_end = std::min(size_.height, (ty + 1) * t);
     prefetch_sampled_rows(grey, ty + kPrefetchTileRows, tx0, tx1);
     int tx = tx0;
-#if defined(__SSE2__)
     // The default 8-pixel tiles two at a time: one 16-byte load per sampled row, then
     // a reduction within each 8-byte half. Every pixel of a sampled row is seen.
     if (t == 8) {
+      auto min_op = [](const v_uint8x16& a, const v_uint8x16& b) { return cv::v_min(a, b); };
+      auto max_op = [](const v_uint8x16& a, const v_uint8x16& b) { return cv::v_max(a, b); };
       for (; tx + 1 <= tx1 && (tx + 2) * 8 <= size_.width; tx += 2) {
-        __m128i mn = _mm_set1_epi8(static_cast<char>(0xFF)), mx = _mm_setzero_si128();
+        v_uint8x16 mn = cv::v_setall_u8(0xFF), mx = cv::v_setzero_u8();
         for (int y = ty * t; y < y_end; y += kStatStep) {
-          const __m128i v = load16(grey.ptr<std::uint8_t>(y) + tx * 8);
-          mn = _mm_min_epu8(mn, v);
-          mx = _mm_max_epu8(mx, v);
-        }
-        for (int shift : {32, 16, 8}) {
-          mn = _mm_min_epu8(mn, _mm_srli_epi64(mn, shift));
-          mx = _mm_max_epu8(mx, _mm_srli_epi64(mx, shift));
+          const v_uint8x16 v = load16(grey.ptr<std::uint8_t>(y) + tx * 8);
+          mn = cv::v_min(mn, v);
+          mx = cv::v_max(mx, v);
         }
         const std::size_t i = static_cast<std::size_t>(ty) * tiles_x_ + tx;
-        tile_min_[i] = static_cast<std::uint8_t>(_mm_cvtsi128_si32(mn) & 0xFF);
-        tile_min_[i + 1] = static_cast<std::uint8_t>(_mm_extract_epi16(mn, 4) & 0xFF);
-        tile_max_[i] = static_cast<std::uint8_t>(_mm_cvtsi128_si32(mx) & 0xFF);
-        tile_max_[i + 1] = static_cast<std::uint8_t>(_mm_extract_epi16(mx, 4) & 0xFF);
+        store_half_results(fold_halves(mn, min_op), &tile_min_[i]);
+        store_half_results(fold_halves(mx, max_op), &tile_max_[i]);
       }
     }
-#endif
+    // The tiles left (all of them for other tile sizes), pixel by pixel.
     for (; tx <= tx1; ++tx) {
       const int x_end = std::min(size_.width, (tx + 1) * t);
       std::uint8_t mn = 255, mx = 0;
@@ -163,15 +188,11 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
     std::uint8_t* __restrict__ out_min = &row_min_scratch_[row];
     std::uint8_t* __restrict__ out_max = &row_max_scratch_[row];
     int tx = ix0;
-#if defined(__SSE2__)
     for (; tx + 16 <= ix1 + 1; tx += 16) {  // sixteen tiles per step
-      const __m128i lo = _mm_min_epu8(_mm_min_epu8(load16(mins + tx - 1), load16(mins + tx)), load16(mins + tx + 1));
-      const __m128i hi = _mm_max_epu8(_mm_max_epu8(load16(maxs + tx - 1), load16(maxs + tx)), load16(maxs + tx + 1));
-      _mm_storeu_si128(reinterpret_cast<__m128i*>(out_min + tx), lo);
-      _mm_storeu_si128(reinterpret_cast<__m128i*>(out_max + tx), hi);
+      cv::v_store(out_min + tx, cv::v_min(cv::v_min(load16(mins + tx - 1), load16(mins + tx)), load16(mins + tx + 1)));
+      cv::v_store(out_max + tx, cv::v_max(cv::v_max(load16(maxs + tx - 1), load16(maxs + tx)), load16(maxs + tx + 1)));
     }
-#endif
-    for (; tx <= ix1; ++tx) {
+    for (; tx <= ix1; ++tx) {  // the rest one by one
       out_min[tx] = std::min(std::min(mins[tx - 1], mins[tx]), mins[tx + 1]);
       out_max[tx] = std::max(std::max(maxs[tx - 1], maxs[tx]), maxs[tx + 1]);
     }
@@ -199,23 +220,31 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
     std::uint8_t* __restrict__ range = &tile_range_[row];
     std::uint8_t* __restrict__ threshold = &tile_threshold_[row];
     int tx = ax;
-#if defined(__SSE2__)
-    const __m128i ratio = _mm_set1_epi16(static_cast<short>(black_ratio_256));
-    const __m128i zero = _mm_setzero_si128();
-    for (; tx + 16 <= bx + 1; tx += 16) {  // sixteen tiles per step; avg_epu8 is (a + b + 1) / 2
-      const __m128i mn = _mm_min_epu8(_mm_min_epu8(load16(min_up + tx), load16(min_row + tx)), load16(min_down + tx));
-      const __m128i mx = _mm_max_epu8(_mm_max_epu8(load16(max_up + tx), load16(max_row + tx)), load16(max_down + tx));
-      _mm_storeu_si128(reinterpret_cast<__m128i*>(range + tx), _mm_sub_epi8(mx, mn));
-      // No black here: mn > mx * ratio / 256, in 16-bit lanes.
-      const __m128i light_lo = _mm_cmpgt_epi16(_mm_unpacklo_epi8(mn, zero),
-                                               _mm_srli_epi16(_mm_mullo_epi16(_mm_unpacklo_epi8(mx, zero), ratio), 8));
-      const __m128i light_hi = _mm_cmpgt_epi16(_mm_unpackhi_epi8(mn, zero),
-                                               _mm_srli_epi16(_mm_mullo_epi16(_mm_unpackhi_epi8(mx, zero), ratio), 8));
-      const __m128i no_black = _mm_packs_epi16(light_lo, light_hi);
-      _mm_storeu_si128(reinterpret_cast<__m128i*>(threshold + tx), _mm_andnot_si128(no_black, _mm_avg_epu8(mn, mx)));
+    const v_uint16x8 ratio = cv::v_setall_u16(static_cast<std::uint16_t>(black_ratio_256));
+    for (; tx + 16 <= bx + 1; tx += 16) {  // sixteen tiles per step
+      const v_uint8x16 mn = cv::v_min(cv::v_min(load16(min_up + tx), load16(min_row + tx)), load16(min_down + tx));
+      const v_uint8x16 mx = cv::v_max(cv::v_max(load16(max_up + tx), load16(max_row + tx)), load16(max_down + tx));
+      const v_uint8x16 spread = cv::v_sub_wrap(mx, mn);
+      cv::v_store(range + tx, spread);
+      // The rounded-up average (mn + mx + 1) / 2 is mx - (mx - mn) / 2 (rounded down); the
+      // bytes are halved in 16-bit lanes (no byte shifts), dropping the bit each takes
+      // from its neighbour.
+      const v_uint8x16 half_spread =
+          cv::v_reinterpret_as_u8(cv::v_shr<1>(cv::v_reinterpret_as_u16(spread))) & cv::v_setall_u8(0x7F);
+      const v_uint8x16 mid = cv::v_sub_wrap(mx, half_spread);
+      // No black here where mn > mx * ratio / 256, in 16-bit lanes (grey levels: the
+      // signed compare serves).
+      v_uint16x8 mn_lo, mn_hi, mx_lo, mx_hi;
+      cv::v_expand(mn, mn_lo, mn_hi);
+      cv::v_expand(mx, mx_lo, mx_hi);
+      auto light = [&](const v_uint16x8& mn16, const v_uint16x8& mx16) {
+        return cv::v_reinterpret_as_s16(mn16) > cv::v_reinterpret_as_s16(cv::v_shr<8>(cv::v_mul_wrap(mx16, ratio)));
+      };
+      // Packing saturates: an all-ones 16-bit lane (-1) stays all ones.
+      const v_uint8x16 no_black = cv::v_reinterpret_as_u8(cv::v_pack(light(mn_lo, mx_lo), light(mn_hi, mx_hi)));
+      cv::v_store(threshold + tx, mid & ~no_black);
     }
-#endif
-    for (; tx <= bx; ++tx) {
+    for (; tx <= bx; ++tx) {  // the rest one by one
       const std::uint8_t mn = std::min(std::min(min_up[tx], min_row[tx]), min_down[tx]);
       const std::uint8_t mx = std::max(std::max(max_up[tx], max_row[tx]), max_down[tx]);
       range[tx] = static_cast<std::uint8_t>(mx - mn);
@@ -256,30 +285,24 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
     const std::uint8_t* __restrict__ range = &tile_range_[row];
     std::uint8_t* __restrict__ threshold = &tile_threshold_[row];
     int tx = ax;
-#if defined(__SSE2__)
-    const __m128i cut = _mm_set1_epi8(static_cast<char>(floor_cut));
+    const v_uint8x16 cut = cv::v_setall_u8(floor_cut);
     for (; tx + 16 <= bx + 1; tx += 16) {  // keep where range >= cut, i.e. max(range, cut) == range
-      const __m128i r = load16(range + tx);
-      const __m128i keep = _mm_cmpeq_epi8(_mm_max_epu8(r, cut), r);
-      const __m128i t = load16(threshold + tx);
-      _mm_storeu_si128(reinterpret_cast<__m128i*>(threshold + tx), _mm_and_si128(keep, t));
+      const v_uint8x16 r = load16(range + tx);
+      cv::v_store(threshold + tx, (cv::v_max(r, cut) == r) & load16(threshold + tx));
     }
-#endif
     for (; tx <= bx; ++tx) threshold[tx] = range[tx] < floor_cut ? 0 : threshold[tx];
     // The tiles with contrast, listed per tile row: the seed scan visits only these.
     std::int16_t* list = &contrast_tiles_[row];
     int n = 0;
     int tx_list = ax;
-#if defined(__SSE2__)
     // Sixteen tiles per step; a plain floor has no contrast tile in most steps.
     for (; tx_list + 16 <= bx + 1; tx_list += 16) {
-      unsigned mask = static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(load16(threshold + tx_list), _mm_setzero_si128()))) ^ 0xFFFFu;
+      unsigned mask = nonzero_bits(threshold + tx_list);
       while (mask != 0) {
         list[n++] = static_cast<std::int16_t>(tx_list + __builtin_ctz(mask));
         mask &= mask - 1;
       }
     }
-#endif
     for (; tx_list <= bx; ++tx_list) {
       list[n] = static_cast<std::int16_t>(tx_list);
       n += threshold[tx_list] != 0;
@@ -345,28 +368,26 @@ void BlobDetector::build_dark_mask(const cv::Mat& grey, cv::Rect roi, bool local
       }
     };
     int tx = tx0;
-#if defined(__SSE2__)
     for (; tx + 16 <= tx1 + 1; tx += 16) {
-      const __m128i either = _mm_or_si128(load16(&tile_threshold_[row + tx]), load16(&dark_written_[row + tx]));
-      unsigned bits = ~static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(either, _mm_setzero_si128()))) & 0xFFFFu;
+      unsigned bits = nonzero_bits(load16(&tile_threshold_[row + tx]) | load16(&dark_written_[row + tx]));
       while (bits != 0) {  // in increasing order: the list stays sorted
         visit(tx + __builtin_ctz(bits));
         bits &= bits - 1;
       }
     }
-#endif
     for (; tx <= tx1; ++tx) visit(tx);
     // Row by row across the tile row (not tile by tile down it), so that the frame is
     // read as a stream: a new frame is not in the caches yet.
     const std::size_t listed = contrast.size();
     // The next tile row's list is this search's only with its own statistics.
     if (local_thresholds && ty + 1 <= ty1) prefetch_contrast_tiles(grey, ty + 1);
-#if defined(__SSE2__)
     if (t_px == 8) {
       // The default tiles, eight pixels per tile; two neighbouring tiles in one
       // sixteen-byte step. The steps' limits are set once per tile row, not per pixel row.
       // x < t is max(x, t - 1) == t - 1.
-      mask_steps_.clear();
+      // Sized once for the widest tile row, so that a step costs no growth check.
+      if (mask_steps_.size() < static_cast<std::size_t>(tiles_x_)) mask_steps_.resize(tiles_x_);
+      std::size_t steps = 0;
       int narrow_tile = -1;  // a last tile narrower than eight pixels, done byte by byte
       for (std::size_t i = 0; i < listed; ++i) {
         const int tx = contrast[i];
@@ -377,35 +398,43 @@ void BlobDetector::build_dark_mask(const cv::Mat& grey, cv::Rect roi, bool local
         }
         const bool pair = i + 1 < listed && contrast[i + 1] == tx + 1 && x0 + 16 <= size_.width;
         const int tx2 = pair ? tx + 1 : tx;
-        auto limit_of = [&](int x) { return static_cast<char>(tile_threshold_[row + x] - 1); };
+        auto limit_of = [&](int x) { return static_cast<std::uint8_t>(tile_threshold_[row + x] - 1); };
         auto deep_of = [&](int x) {
-          return static_cast<char>(deep_threshold(tile_threshold_[row + x], tile_range_[row + x], local_thresholds) - 1);
+          const std::uint8_t deep = deep_threshold(tile_threshold_[row + x], tile_range_[row + x], local_thresholds);
+          return static_cast<std::uint8_t>(deep - 1);
         };
-        mask_steps_.push_back({_mm_unpacklo_epi64(_mm_set1_epi8(limit_of(tx)), _mm_set1_epi8(limit_of(tx2))),
-                               _mm_unpacklo_epi64(_mm_set1_epi8(deep_of(tx)), _mm_set1_epi8(deep_of(tx2))), x0, pair});
+        auto halves = [](std::uint8_t first, std::uint8_t second) {
+          return cv::v_combine_low(cv::v_setall_u8(first), cv::v_setall_u8(second));
+        };
+        MaskStep& step = mask_steps_[steps++];
+        cv::v_store_aligned(step.limit.data(), halves(limit_of(tx), limit_of(tx2)));
+        cv::v_store_aligned(step.deep_limit.data(), halves(deep_of(tx), deep_of(tx2)));
+        step.x0 = x0;
+        step.pair = pair;
         i += pair;
       }
-      const __m128i dark_bit = _mm_set1_epi8(kDarkBit), deep_bit = _mm_set1_epi8(kDeepBit);
+      const v_uint8x16 dark_bit = cv::v_setall_u8(kDarkBit), deep_bit = cv::v_setall_u8(kDeepBit);
       for (int y = y0; y < y1; ++y) {
         const std::uint8_t* in = grey.ptr<std::uint8_t>(y);
         std::uint8_t* out = dark_.ptr<std::uint8_t>(y);
-        for (const MaskStep& step : mask_steps_) {
-          const __m128i v = step.pair ? load16(in + step.x0)
-                                      : _mm_loadl_epi64(reinterpret_cast<const __m128i*>(in + step.x0));
-          const __m128i is_dark = _mm_cmpeq_epi8(_mm_max_epu8(v, step.limit), step.limit);
-          const __m128i is_deep = _mm_cmpeq_epi8(_mm_max_epu8(v, step.deep_limit), step.deep_limit);
-          const __m128i bits = _mm_or_si128(_mm_and_si128(is_dark, dark_bit), _mm_and_si128(is_deep, deep_bit));
+        for (const MaskStep& step : std::span(mask_steps_.data(), steps)) {
+          // A single tile reads and writes its eight bytes only (the next may be unlisted).
+          const v_uint8x16 v = step.pair ? load16(in + step.x0) : cv::v_load_low(in + step.x0);
+          const v_uint8x16 limit = cv::v_load_aligned(step.limit.data());
+          const v_uint8x16 deep_limit = cv::v_load_aligned(step.deep_limit.data());
+          const v_uint8x16 bits = ((cv::v_max(v, limit) == limit) & dark_bit) |
+                                  ((cv::v_max(v, deep_limit) == deep_limit) & deep_bit);
           if (step.pair) {
-            _mm_storeu_si128(reinterpret_cast<__m128i*>(out + step.x0), bits);
+            cv::v_store(out + step.x0, bits);
           } else {
-            _mm_storel_epi64(reinterpret_cast<__m128i*>(out + step.x0), bits);
+            cv::v_store_low(out + step.x0, bits);
           }
         }
         if (narrow_tile >= 0) mask_tile_row_bytes(in, out, row, narrow_tile, local_thresholds);
       }
       continue;
     }
-#endif
+    // Other tile sizes, byte by byte.
     for (int y = y0; y < y1; ++y) {
       const std::uint8_t* in = grey.ptr<std::uint8_t>(y);
       std::uint8_t* out = dark_.ptr<std::uint8_t>(y);
@@ -427,42 +456,28 @@ namespace {
 // The first and last pixel of the run of nonzero mask bytes through `x` (mask[x] != 0),
 // in a row with zero padding on both sides (so every run ends inside the buffer).
 int run_start(const std::uint8_t* mask, int x) {
-#if defined(__SSE2__)
   for (;;) {  // sixteen bytes ending at x, looking for the last zero
-    const unsigned zeros =
-        static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(load16(mask + x - 15), _mm_setzero_si128())));
+    const unsigned zeros = nonzero_bits(mask + x - 15) ^ 0xFFFFu;
     if (zeros != 0) return x - 15 + (31 - __builtin_clz(zeros)) + 1;
     x -= 16;
   }
-#else
-  while (mask[x - 1]) --x;
-  return x;
-#endif
 }
 
 int run_end(const std::uint8_t* mask, int x) {
-#if defined(__SSE2__)
   for (;;) {  // sixteen bytes starting at x, looking for the first zero
-    const unsigned zeros =
-        static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(load16(mask + x), _mm_setzero_si128())));
+    const unsigned zeros = nonzero_bits(mask + x) ^ 0xFFFFu;
     if (zeros != 0) return x + __builtin_ctz(zeros) - 1;
     x += 16;
   }
-#else
-  while (mask[x + 1]) ++x;
-  return x;
-#endif
 }
 
 // Calls `seed(x)` once per run of nonzero mask bytes within [a, b], at the run's first
 // pixel in that range.
 template <class SeedFn>
 void for_each_run(const std::uint8_t* mask, int a, int b, SeedFn&& seed) {
-#if defined(__SSE2__)
   unsigned carry = 0;  // the pixel before the chunk was dark (and in range)
   for (int x = a; x <= b; x += 16) {
-    unsigned bits =
-        ~static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(load16(mask + x), _mm_setzero_si128()))) & 0xFFFFu;
+    unsigned bits = nonzero_bits(mask + x);
     if (b - x < 15) bits &= (1u << (b - x + 1)) - 1;
     unsigned starts = bits & ~((bits << 1) | carry);
     while (starts != 0) {
@@ -471,71 +486,52 @@ void for_each_run(const std::uint8_t* mask, int a, int b, SeedFn&& seed) {
     }
     carry = (bits >> 15) & 1u;
   }
-#else
-  for (int x = a; x <= b; ++x) {
-    if (!mask[x]) continue;
-    seed(x);
-    while (x < b && mask[x + 1]) ++x;
-  }
-#endif
 }
 
 // The first and the last nonzero mask byte in [a, b], or -1 when there is none.
 int first_dark(const std::uint8_t* mask, int a, int b) {
-#if defined(__SSE2__)
   for (int x = a; x <= b; x += 16) {
-    unsigned bits =
-        ~static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(load16(mask + x), _mm_setzero_si128()))) & 0xFFFFu;
+    unsigned bits = nonzero_bits(mask + x);
     if (b - x < 15) bits &= (1u << (b - x + 1)) - 1;
     if (bits != 0) return x + __builtin_ctz(bits);
   }
   return -1;
-#else
-  for (int x = a; x <= b; ++x) {
-    if (mask[x]) return x;
-  }
-  return -1;
-#endif
 }
 
 int last_dark(const std::uint8_t* mask, int a, int b) {
-#if defined(__SSE2__)
   for (int x = b; x >= a; x -= 16) {  // sixteen bytes ending at x
-    unsigned bits =
-        ~static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(load16(mask + x - 15), _mm_setzero_si128()))) & 0xFFFFu;
+    unsigned bits = nonzero_bits(mask + x - 15);
     if (x - a < 15) bits &= ~((1u << (15 - (x - a))) - 1);
     if (bits != 0) return x - 15 + (31 - __builtin_clz(bits));
   }
   return -1;
-#else
-  for (int x = b; x >= a; --x) {
-    if (mask[x]) return x;
-  }
-  return -1;
-#endif
 }
 
-// How many mask bytes in [a, b] are nonzero.
-int count_nonzero(const std::uint8_t* mask, int a, int b) {
-  int count = 0;
+// How many mask bytes in [a, b] are nonzero, for a span of at most 255 * 16 bytes:
+// min(byte, 1) summed per byte lane (255 at most) and the lanes summed once at the end (no
+// population count: not in baseline x86-64).
+constexpr int kMaxCountedSpan = 255 * 16;
+int count_nonzero_span(const std::uint8_t* mask, int a, int b) {
+  const v_uint8x16 one = cv::v_setall_u8(1);
+  v_uint8x16 ones = cv::v_setzero_u8();
   int x = a;
-#if defined(__SSE2__)
-  // min(byte, 1) summed by psadbw: no population count (not in baseline x86-64).
-  __m128i sums = _mm_setzero_si128();
-  const __m128i one = _mm_set1_epi8(1);
-  for (; x + 15 <= b; x += 16) sums = _mm_add_epi64(sums, _mm_sad_epu8(_mm_min_epu8(load16(mask + x), one), _mm_setzero_si128()));
+  for (; x + 15 <= b; x += 16) ones += cv::v_min(load16(mask + x), one);
   if (x <= b) {
     // The last few bytes in one step: the row's zero padding keeps the load inside the
     // buffer, and the bytes beyond b are masked off.
     alignas(16) static constexpr std::uint8_t kOnes[32] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
-    const __m128i keep = _mm_loadu_si128(reinterpret_cast<const __m128i*>(kOnes + 16 - (b - x + 1)));
-    sums = _mm_add_epi64(sums, _mm_sad_epu8(_mm_min_epu8(load16(mask + x), keep), _mm_setzero_si128()));
-    x = b + 1;
+    ones += cv::v_min(load16(mask + x), load16(kOnes + 16 - (b - x + 1)));
   }
-  count = _mm_cvtsi128_si32(sums) + _mm_cvtsi128_si32(_mm_srli_si128(sums, 8));
-#endif
-  for (; x <= b; ++x) count += mask[x] != 0;
-  return count;
+  return static_cast<int>(cv::v_reduce_sum(ones));
+}
+
+// How many mask bytes in [a, b] are nonzero (a marker's row is one span).
+int count_nonzero(const std::uint8_t* mask, int a, int b) {
+  int count = 0;
+  for (; b - a + 1 > kMaxCountedSpan; a += kMaxCountedSpan) {
+    count += count_nonzero_span(mask, a, a + kMaxCountedSpan - 1);
+  }
+  return count + count_nonzero_span(mask, a, b);
 }
 
 }  // namespace
@@ -728,8 +724,8 @@ struct ChordMoments {
 // Mean deviation of the chords {a, b, position across} from those of the ellipse whose
 // quadratic form is q_along*s^2 + 2*q_mixed*s*d + q_across*d^2 = 1 around
 // (centre_along, centre_across): the difference in length plus the offset of the
-// midpoint, over the number of chords and the longest chord. Two chords per step with
-// SSE2 (two square roots in one instruction): this ran once per chord per candidate.
+// midpoint, over the number of chords and the longest chord. Two chords per step in
+// vector lanes (two square roots in one instruction): this ran once per chord per candidate.
 double chord_error(const std::vector<std::array<double, 3>>& chords, double q_along, double q_mixed,
                    double q_across, double centre_along, double centre_across) {
   const double inv_q_along = 1.0 / q_along;
@@ -739,27 +735,24 @@ double chord_error(const std::vector<std::array<double, 3>>& chords, double q_al
   const double mid_slope = q_mixed * inv_q_along;
   double err = 0.0, longest = 0.0;
   std::size_t i = 0;
-#if defined(__SSE2__)
-  const __m128d v_k0 = _mm_set1_pd(q_along), v_k2 = _mm_set1_pd(k2), v_two_inv = _mm_set1_pd(2.0 * inv_q_along);
-  const __m128d v_centre_across = _mm_set1_pd(centre_across), v_centre_along = _mm_set1_pd(centre_along);
-  const __m128d v_slope = _mm_set1_pd(mid_slope), v_half = _mm_set1_pd(0.5), v_zero = _mm_setzero_pd();
-  const __m128d abs_mask = _mm_castsi128_pd(_mm_set1_epi64x(0x7FFFFFFFFFFFFFFFLL));
-  __m128d v_err = _mm_setzero_pd(), v_longest = _mm_setzero_pd();
+  const v_float64x2 v_k0 = cv::v_setall_f64(q_along), v_k2 = cv::v_setall_f64(k2);
+  const v_float64x2 v_two_inv = cv::v_setall_f64(2.0 * inv_q_along);
+  const v_float64x2 v_centre_across = cv::v_setall_f64(centre_across), v_centre_along = cv::v_setall_f64(centre_along);
+  const v_float64x2 v_slope = cv::v_setall_f64(mid_slope), v_half = cv::v_setall_f64(0.5), v_zero = cv::v_setzero_f64();
+  v_float64x2 v_err = cv::v_setzero_f64(), v_longest = cv::v_setzero_f64();
   for (; i + 2 <= chords.size(); i += 2) {
-    const __m128d a = _mm_set_pd(chords[i + 1][0], chords[i][0]);
-    const __m128d b = _mm_set_pd(chords[i + 1][1], chords[i][1]);
-    const __m128d d = _mm_sub_pd(_mm_set_pd(chords[i + 1][2], chords[i][2]), v_centre_across);
-    const __m128d disc = _mm_add_pd(v_k0, _mm_mul_pd(v_k2, _mm_mul_pd(d, d)));
-    const __m128d model = _mm_mul_pd(_mm_sqrt_pd(_mm_max_pd(disc, v_zero)), v_two_inv);
-    v_longest = _mm_max_pd(v_longest, model);
-    const __m128d mid_model = _mm_sub_pd(v_centre_along, _mm_mul_pd(v_slope, d));
-    const __m128d len_err = _mm_and_pd(_mm_sub_pd(_mm_sub_pd(b, a), model), abs_mask);
-    const __m128d mid_err = _mm_and_pd(_mm_sub_pd(_mm_mul_pd(v_half, _mm_add_pd(a, b)), mid_model), abs_mask);
-    v_err = _mm_add_pd(v_err, _mm_add_pd(len_err, mid_err));
+    const v_float64x2 a(chords[i][0], chords[i + 1][0]);
+    const v_float64x2 b(chords[i][1], chords[i + 1][1]);
+    const v_float64x2 d = v_float64x2(chords[i][2], chords[i + 1][2]) - v_centre_across;
+    const v_float64x2 disc = v_k0 + v_k2 * (d * d);
+    const v_float64x2 model = cv::v_sqrt(cv::v_max(disc, v_zero)) * v_two_inv;
+    v_longest = cv::v_max(v_longest, model);
+    const v_float64x2 mid_model = v_centre_along - v_slope * d;
+    v_err += cv::v_abs((b - a) - model) + cv::v_abs(v_half * (a + b) - mid_model);
   }
-  err = _mm_cvtsd_f64(v_err) + _mm_cvtsd_f64(_mm_unpackhi_pd(v_err, v_err));
-  longest = std::max(_mm_cvtsd_f64(v_longest), _mm_cvtsd_f64(_mm_unpackhi_pd(v_longest, v_longest)));
-#endif
+  err = cv::v_reduce_sum(v_err);  // lane 0 + lane 1
+  longest = std::max(cv::v_extract_n<0>(v_longest), cv::v_extract_n<1>(v_longest));
+  // An odd chord left over.
   for (; i < chords.size(); ++i) {
     const auto& c = chords[i];
     const double d = c[2] - centre_across;
@@ -986,14 +979,14 @@ std::vector<Blob> BlobDetector::scan(const cv::Mat& grey, cv::Rect roi) {
     for (int i = 0; i < listed; ++i) {
       const int tx = list[i];
       const int xa = std::max(roi.x, tx * config_.tile_px), xb = std::min(x_end, (tx + 1) * config_.tile_px);
-#if defined(__SSE2__)
       // Most contrast tiles hold no pixel dark enough to seed a fill on a given seed row
       // (the bright side of an edge): one load of eight mask bytes skips them.
       if (xb - xa == 8) {
-        constexpr long long kDeepBytes = 0x0202020202020202LL;
-        if ((_mm_cvtsi128_si64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(dark + xa))) & kDeepBytes) == 0) continue;
+        constexpr std::uint64_t kDeepBytes = 0x0202020202020202ULL;
+        std::uint64_t eight;
+        std::memcpy(&eight, dark + xa, sizeof eight);
+        if ((eight & kDeepBytes) == 0) continue;
       }
-#endif
       for (int x = xa; x < xb; ++x) {
         if (!(dark[x] & kDeepBit)) continue;
         Blob blob;

@@ -7,10 +7,6 @@
 
 #include <opencv2/core.hpp>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -199,16 +195,16 @@ class BlobDetector {
   };
   std::vector<FillSeed> fill_stack_;
   std::vector<int> mask_tiles_;  // build_dark_mask()'s scratch: tiles with contrast in a tile row
-#if defined(__SSE2__)
   // build_dark_mask()'s scratch: per tile (or pair of neighbouring tiles) with contrast
-  // in a tile row, where it starts and the grey limits (threshold - 1) of each half.
+  // in a tile row, where it starts and the grey limits (threshold - 1) of each half, as
+  // sixteen bytes for one vector load (plain bytes: no SIMD type in this header, which
+  // code built for another instruction set includes too).
   struct MaskStep {
-    __m128i limit, deep_limit;
+    alignas(16) std::array<std::uint8_t, 16> limit, deep_limit;
     int x0;
     bool pair;
   };
   std::vector<MaskStep> mask_steps_;
-#endif
 };
 
 }  // namespace rilbed::vision

@@ -2,11 +2,8 @@
 
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include <opencv2/core/hal/intrin.hpp>
 
 #include "core/geometry.hpp"
 
@@ -40,75 +37,66 @@ void sample_ellipse(const cv::Mat& grey, double centre_u, double centre_v, const
   const auto a = static_cast<float>(shape(0, 0) * radius), b = static_cast<float>(shape(0, 1) * radius);
   const auto c = static_cast<float>(shape(1, 0) * radius), d = static_cast<float>(shape(1, 1) * radius);
   const auto cu = static_cast<float>(centre_u), cv = static_cast<float>(centre_v);
-  const int n = count;
-  auto pixel_quad = [&](int x, int y, float fx, float fy) {
-    const std::uint8_t* p = data + static_cast<std::ptrdiff_t>(y) * stride + x;
-    const float top = p[0] + (p[1] - p[0]) * fx;
-    const float bottom = p[stride] + (p[stride + 1] - p[stride]) * fx;
-    return top + (bottom - top) * fy;
-  };
-#if defined(__SSE2__)
-  // Four points per step: their coordinates, whole and fractional parts in SSE; the
-  // pixel reads are scalar (SSE2 has no gather), two neighbours per 16-bit read, and the
-  // interpolation is SSE again.
-  const __m128 va = _mm_set1_ps(a), vb = _mm_set1_ps(b), vc = _mm_set1_ps(c), vd = _mm_set1_ps(d);
-  const __m128 vcu = _mm_set1_ps(cu), vcv = _mm_set1_ps(cv);
-  const __m128i low_byte = _mm_set1_epi32(0xFF);
+  // Four points per step, written once with OpenCV's universal intrinsics (SSE2 on x86,
+  // NEON on ARM, OpenCV's C++ emulation elsewhere): their coordinates, whole and
+  // fractional parts in vector lanes; the pixel reads are scalar (SSE2 has no gather),
+  // two neighbours per 16-bit read, and the interpolation is in vector lanes again.
+  using cv::v_float32x4;
+  using cv::v_int32x4;
+  using cv::v_uint16x8;
+  using cv::v_uint32x4;
+  const v_float32x4 va = cv::v_setall_f32(a), vb = cv::v_setall_f32(b), vc = cv::v_setall_f32(c),
+                    vd = cv::v_setall_f32(d);
+  const v_float32x4 vcu = cv::v_setall_f32(cu), vcv = cv::v_setall_f32(cv);
   // Byte offsets of the points' top-left pixels, y * stride + x, formed in float (exact
   // below 2^24 bytes, checked below) and converted once: SSE2 has no 32-bit multiply.
   const bool offsets_in_float = static_cast<double>(grey.rows) * static_cast<double>(stride) < 16777216.0;
-  const __m128 vstride = _mm_set1_ps(static_cast<float>(stride));
+  const v_float32x4 vstride = cv::v_setall_f32(static_cast<float>(stride));
   alignas(16) int offsets[4], xs[4], ys[4];
-  // p[0] | p[1] << 8 of four pixels into the low halves of four 32-bit lanes, each pair
-  // inserted straight from memory (pinsrw), with no round trip through an integer register.
-  auto pairs_at = [](const std::uint8_t* p0, const std::uint8_t* p1, const std::uint8_t* p2, const std::uint8_t* p3) {
-    auto word = [](const std::uint8_t* p) {
-      std::uint16_t w;
-      std::memcpy(&w, p, sizeof w);
-      return static_cast<int>(w);
-    };
-    __m128i v = _mm_setzero_si128();
-    v = _mm_insert_epi16(v, word(p0), 0);
-    v = _mm_insert_epi16(v, word(p1), 2);
-    v = _mm_insert_epi16(v, word(p2), 4);
-    return _mm_insert_epi16(v, word(p3), 6);
-  };
-  for (int k = 0; k < n; k += 4) {
-    const __m128 dx = _mm_loadu_ps(direction_x + k), dy = _mm_loadu_ps(direction_y + k);
-    const __m128 u = _mm_add_ps(vcu, _mm_add_ps(_mm_mul_ps(va, dx), _mm_mul_ps(vb, dy)));
-    const __m128 v = _mm_add_ps(vcv, _mm_add_ps(_mm_mul_ps(vc, dx), _mm_mul_ps(vd, dy)));
-    const __m128i ui = _mm_cvttps_epi32(u), vi = _mm_cvttps_epi32(v);  // floor: coordinates are positive
-    const __m128 uf = _mm_cvtepi32_ps(ui), vf = _mm_cvtepi32_ps(vi);
-    const __m128 fx = _mm_sub_ps(u, uf), fy = _mm_sub_ps(v, vf);
-    const std::uint8_t *p0, *p1, *p2, *p3;
-    if (offsets_in_float) {
-      _mm_store_si128(reinterpret_cast<__m128i*>(offsets), _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(vf, vstride), uf)));
-      p0 = data + offsets[0], p1 = data + offsets[1], p2 = data + offsets[2], p3 = data + offsets[3];
-    } else {
-      _mm_store_si128(reinterpret_cast<__m128i*>(xs), ui);
-      _mm_store_si128(reinterpret_cast<__m128i*>(ys), vi);
-      p0 = data + static_cast<std::ptrdiff_t>(ys[0]) * stride + xs[0];
-      p1 = data + static_cast<std::ptrdiff_t>(ys[1]) * stride + xs[1];
-      p2 = data + static_cast<std::ptrdiff_t>(ys[2]) * stride + xs[2];
-      p3 = data + static_cast<std::ptrdiff_t>(ys[3]) * stride + xs[3];
+  // p[0] | p[1] << 8 of a pixel and its right neighbour (one 16-bit read).
+  auto pair = [](const std::uint8_t* p) { return static_cast<std::uint16_t>(p[0] | p[1] << 8); };
+  const v_uint16x8 low_byte = cv::v_setall_u16(0xFF);
+  // The choice of offsets is a template parameter: no test per step.
+  auto sample_all = [&]<bool kOffsetsInFloat>() {
+    for (int k = 0; k < count; k += 4) {
+      const v_float32x4 dx = cv::v_load(direction_x + k), dy = cv::v_load(direction_y + k);
+      const v_float32x4 u = vcu + (va * dx + vb * dy);
+      const v_float32x4 v = vcv + (vc * dx + vd * dy);
+      const v_int32x4 ui = cv::v_trunc(u), vi = cv::v_trunc(v);  // floor: coordinates are positive
+      const v_float32x4 uf = cv::v_cvt_f32(ui), vf = cv::v_cvt_f32(vi);
+      const v_float32x4 fx = u - uf, fy = v - vf;
+      const std::uint8_t *p0, *p1, *p2, *p3;
+      if constexpr (kOffsetsInFloat) {
+        cv::v_store_aligned(offsets, cv::v_trunc(vf * vstride + uf));
+        p0 = data + offsets[0], p1 = data + offsets[1], p2 = data + offsets[2], p3 = data + offsets[3];
+      } else {
+        cv::v_store_aligned(xs, ui);
+        cv::v_store_aligned(ys, vi);
+        p0 = data + static_cast<std::ptrdiff_t>(ys[0]) * stride + xs[0];
+        p1 = data + static_cast<std::ptrdiff_t>(ys[1]) * stride + xs[1];
+        p2 = data + static_cast<std::ptrdiff_t>(ys[2]) * stride + xs[2];
+        p3 = data + static_cast<std::ptrdiff_t>(ys[3]) * stride + xs[3];
+      }
+      // The four points' pairs on their upper row, then on the row below, in 16-bit lanes;
+      // split into left and right pixels there and widened to 32 bits for the conversion.
+      const v_uint16x8 pairs(pair(p0), pair(p1), pair(p2), pair(p3), pair(p0 + stride), pair(p1 + stride),
+                             pair(p2 + stride), pair(p3 + stride));
+      v_uint32x4 left_upper, left_lower, right_upper, right_lower;
+      cv::v_expand(pairs & low_byte, left_upper, left_lower);
+      cv::v_expand(pairs >> 8, right_upper, right_lower);
+      auto to_float = [](const v_uint32x4& x) { return cv::v_cvt_f32(cv::v_reinterpret_as_s32(x)); };
+      const v_float32x4 a00 = to_float(left_upper), a01 = to_float(right_upper);
+      const v_float32x4 a10 = to_float(left_lower), a11 = to_float(right_lower);
+      const v_float32x4 top = a00 + (a01 - a00) * fx;
+      const v_float32x4 bottom = a10 + (a11 - a10) * fx;
+      cv::v_store(out + k, top + (bottom - top) * fy);
     }
-    const __m128i upper = pairs_at(p0, p1, p2, p3);
-    const __m128i lower = pairs_at(p0 + stride, p1 + stride, p2 + stride, p3 + stride);
-    const __m128 a00 = _mm_cvtepi32_ps(_mm_and_si128(upper, low_byte)), a01 = _mm_cvtepi32_ps(_mm_srli_epi32(upper, 8));
-    const __m128 a10 = _mm_cvtepi32_ps(_mm_and_si128(lower, low_byte)), a11 = _mm_cvtepi32_ps(_mm_srli_epi32(lower, 8));
-    const __m128 top = _mm_add_ps(a00, _mm_mul_ps(_mm_sub_ps(a01, a00), fx));
-    const __m128 bottom = _mm_add_ps(a10, _mm_mul_ps(_mm_sub_ps(a11, a10), fx));
-    _mm_storeu_ps(out + k, _mm_add_ps(top, _mm_mul_ps(_mm_sub_ps(bottom, top), fy)));
+  };
+  if (offsets_in_float) {
+    sample_all.template operator()<true>();
+  } else {
+    sample_all.template operator()<false>();
   }
-#else
-  for (int k = 0; k < n; ++k) {
-    const float u = cu + a * direction_x[k] + b * direction_y[k];
-    const float v = cv + c * direction_x[k] + d * direction_y[k];
-    const int x = static_cast<int>(u), y = static_cast<int>(v);
-    out[k] = pixel_quad(x, y, u - x, v - y);
-  }
-#endif
-  (void)pixel_quad;
 }
 
 }  // namespace rilbed::vision

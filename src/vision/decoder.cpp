@@ -9,9 +9,7 @@
 #include <stdexcept>
 #include <tuple>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include <opencv2/core/hal/intrin.hpp>
 
 #include "core/fast_trig.hpp"
 #include "core/geometry.hpp"
@@ -21,32 +19,44 @@ namespace rilbed::vision {
 
 namespace {
 
+// The kernels below are written once with OpenCV's universal intrinsics (SSE2 on x86,
+// NEON on ARM, OpenCV's C++ emulation elsewhere): sixteen bytes or two doubles per vector.
+using cv::v_float64x2;
+using cv::v_uint8x16;
+
+// How many of the `span` (a multiple of sixteen, at most 255 * 16) levels are at most
+// `level`: per byte lane, a true compare (all ones: -1) is added, counting down from
+// zero (255 steps at most), and the lanes are negated and summed once.
+constexpr int kMaxCountedSpan = 255 * 16;
+int count_span_at_or_below(const std::uint8_t* levels, int span, const v_uint8x16& level) {
+  v_uint8x16 minus_counts = cv::v_setzero_u8();
+  for (int i = 0; i < span; i += 16) {
+    const v_uint8x16 v = cv::v_load(levels + i);
+    minus_counts = cv::v_add_wrap(minus_counts, cv::v_min(v, level) == v);  // v <= level
+  }
+  return static_cast<int>(cv::v_reduce_sum(cv::v_sub_wrap(cv::v_setzero_u8(), minus_counts)));
+}
+
+// The same for any multiple of sixteen levels (no decoder samples more than one span).
+int count_at_or_below(const std::uint8_t* levels, int padded, int level) {
+  const v_uint8x16 l = cv::v_setall_u8(static_cast<std::uint8_t>(level));
+  int count = 0;
+  for (; padded > kMaxCountedSpan; levels += kMaxCountedSpan, padded -= kMaxCountedSpan) {
+    count += count_span_at_or_below(levels, kMaxCountedSpan, l);
+  }
+  return count + count_span_at_or_below(levels, padded, l);
+}
+
 // The smallest grey level L with more than `rank` of the levels at or below it, by
 // bisection over L with a count per step (sixteen levels per compare): no histogram to
 // clear and scan, and few branches. `levels` holds `count` levels rounded down, padded
 // with 255 to a multiple of sixteen (padding never counts: L stays below 255).
 int level_of_rank(const std::uint8_t* levels, int count, int rank) {
   const int padded = (count + 15) & ~15;
-  auto at_or_below = [&](int level) {
-    int n = 0;
-#if defined(__SSE2__)
-    const __m128i l = _mm_set1_epi8(static_cast<char>(level)), one = _mm_set1_epi8(1);
-    __m128i sums = _mm_setzero_si128();
-    for (int i = 0; i < padded; i += 16) {
-      const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(levels + i));
-      const __m128i below = _mm_and_si128(_mm_cmpeq_epi8(_mm_min_epu8(v, l), v), one);
-      sums = _mm_add_epi64(sums, _mm_sad_epu8(below, _mm_setzero_si128()));
-    }
-    n = _mm_cvtsi128_si32(sums) + _mm_cvtsi128_si32(_mm_srli_si128(sums, 8));
-#else
-    for (int i = 0; i < padded; ++i) n += levels[i] <= level;
-#endif
-    return n;
-  };
-  int lo = 0, hi = 255;  // at_or_below(255) is everything: more than any rank
+  int lo = 0, hi = 255;  // every level is at or below 255: more than any rank
   while (lo < hi) {
     const int mid = (lo + hi) / 2;
-    if (at_or_below(mid) > rank) {
+    if (count_at_or_below(levels, padded, mid) > rank) {
       hi = mid;
     } else {
       lo = mid + 1;
@@ -346,42 +356,29 @@ void Decoder::prepare(const SampledSignal& signal, Prepared& p) const {
   double* c = p.doubled_cumulative.data();
   double mean = 0.0, norm2 = 0.0;
   int k = 0;
-#if defined(__SSE2__)
   // Two samples per step. The running integral of a pair [a, b] starting from r is
-  // [r, r + a], and r moves on by a + b: one shuffle and two adds per pair.
-  __m128d sums = _mm_setzero_pd();
-  for (; k + 1 < n; k += 2) sums = _mm_add_pd(sums, _mm_loadu_pd(x + k));
-  double sum = _mm_cvtsd_f64(sums) + _mm_cvtsd_f64(_mm_unpackhi_pd(sums, sums));
+  // [r, r + a], and r moves on by a + b: one shift, one swap and three adds per pair.
+  v_float64x2 sums = cv::v_setzero_f64();
+  for (; k + 1 < n; k += 2) sums += cv::v_load(x + k);
+  double sum = cv::v_reduce_sum(sums);  // lane 0 + lane 1
   if (k < n) sum += x[k];
   mean = sum / n;
-  const __m128d means = _mm_set1_pd(mean);
-  __m128d squares = _mm_setzero_pd(), running = _mm_setzero_pd();  // running: r in both lanes
+  const v_float64x2 means = cv::v_setall_f64(mean);
+  v_float64x2 squares = cv::v_setzero_f64(), running = cv::v_setzero_f64();  // running: r in both lanes
   for (k = 0; k + 1 < n; k += 2) {
-    const __m128d centred = _mm_sub_pd(_mm_loadu_pd(x + k), means);
-    squares = _mm_add_pd(squares, _mm_mul_pd(centred, centred));
-    const __m128d before = _mm_add_pd(running, _mm_unpacklo_pd(_mm_setzero_pd(), centred));  // [r, r + a]
-    _mm_storeu_pd(c + k, before);
-    _mm_storeu_pd(c + k + n, before);
-    running = _mm_add_pd(running, _mm_add_pd(centred, _mm_shuffle_pd(centred, centred, 1)));
+    const v_float64x2 centred = cv::v_load(x + k) - means;
+    squares += centred * centred;
+    const v_float64x2 before = running + cv::v_rotate_left<1>(centred);  // [r, r + a]
+    cv::v_store(c + k, before);
+    cv::v_store(c + k + n, before);
+    running += centred + cv::v_reverse(centred);  // a + b in both lanes
   }
-  norm2 = _mm_cvtsd_f64(squares) + _mm_cvtsd_f64(_mm_unpackhi_pd(squares, squares));
-  if (k < n) {
+  norm2 = cv::v_reduce_sum(squares);
+  if (k < n) {  // an odd sample left over
     const double centred = x[k] - mean;
-    c[k] = c[k + n] = _mm_cvtsd_f64(running);
+    c[k] = c[k + n] = cv::v_extract_n<0>(running);
     norm2 += centred * centred;
   }
-#else
-  double sum = 0.0;
-  for (k = 0; k < n; ++k) sum += x[k];
-  mean = sum / n;
-  double running = 0.0;
-  for (k = 0; k < n; ++k) {
-    c[k] = c[k + n] = running;
-    const double centred = x[k] - mean;
-    norm2 += centred * centred;
-    running += centred;
-  }
-#endif
   for (k = 0; k < tail; ++k) c[2 * n + k] = c[k];
   p.norm = std::sqrt(norm2);
   p.mean = mean;
@@ -403,42 +400,40 @@ double Decoder::lag_of_heading(const Blob& blob, double heading_deg) const {
 std::pair<int, double> Decoder::coarse_peak(const Prepared& p, const Ideal& ideal, std::vector<double>& scratch) const {
   const int n = config_.samples;
   const std::size_t edges = ideal.edge.size();
-#if defined(__SSE2__)
   constexpr std::size_t kMaxEdges = 16;
   if (edges <= kMaxEdges && n % 2 == 0) {
     // Two lags per step, every edge summed in registers and the best kept per lane: one
     // pass, no array of all lags to write, read back and search. The sum per lag is
-    // formed in the same order as below, and ties go to the lowest lag, as
-    // std::max_element's do.
+    // formed in the same order as correlate_all_lags's, and ties go to the lowest lag,
+    // as std::max_element's do.
     const double* cs[kMaxEdges];
     const double* xs[kMaxEdges];
-    __m128d steps[kMaxEdges], fracs[kMaxEdges];
+    v_float64x2 steps[kMaxEdges], fracs[kMaxEdges];
     for (std::size_t e = 0; e < edges; ++e) {
       cs[e] = &p.doubled_cumulative[ideal.edge_index[e]];  // + lag < 2n: no modulo
       xs[e] = &p.doubled_signal[ideal.edge_index[e]];
-      steps[e] = _mm_set1_pd(ideal.step[e]);
-      fracs[e] = _mm_set1_pd(ideal.edge_frac[e]);
+      steps[e] = cv::v_setall_f64(ideal.step[e]);
+      fracs[e] = cv::v_setall_f64(ideal.edge_frac[e]);
     }
-    __m128d best = _mm_set1_pd(-std::numeric_limits<double>::infinity());
-    __m128d best_lag = _mm_setzero_pd(), lag_pair = _mm_set_pd(1.0, 0.0);
-    const __m128d two = _mm_set1_pd(2.0);
+    v_float64x2 best = cv::v_setall_f64(-std::numeric_limits<double>::infinity());
+    v_float64x2 best_lag = cv::v_setzero_f64(), lag_pair(0.0, 1.0);
+    const v_float64x2 two = cv::v_setall_f64(2.0);
     for (int lag = 0; lag < n; lag += 2) {
-      __m128d v = _mm_setzero_pd();
+      v_float64x2 v = cv::v_setzero_f64();
       for (std::size_t e = 0; e < edges; ++e) {
-        const __m128d c = _mm_loadu_pd(cs[e] + lag), x = _mm_loadu_pd(xs[e] + lag);
-        v = _mm_add_pd(v, _mm_mul_pd(steps[e], _mm_add_pd(c, _mm_mul_pd(fracs[e], x))));
+        v += steps[e] * (cv::v_load(cs[e] + lag) + fracs[e] * cv::v_load(xs[e] + lag));
       }
-      const __m128d better = _mm_cmpgt_pd(v, best);
-      best = _mm_or_pd(_mm_and_pd(better, v), _mm_andnot_pd(better, best));
-      best_lag = _mm_or_pd(_mm_and_pd(better, lag_pair), _mm_andnot_pd(better, best_lag));
-      lag_pair = _mm_add_pd(lag_pair, two);
+      const v_float64x2 better = v > best;
+      best = cv::v_select(better, v, best);
+      best_lag = cv::v_select(better, lag_pair, best_lag);
+      lag_pair += two;
     }
-    const double even = _mm_cvtsd_f64(best), odd = _mm_cvtsd_f64(_mm_unpackhi_pd(best, best));
-    const double even_lag = _mm_cvtsd_f64(best_lag), odd_lag = _mm_cvtsd_f64(_mm_unpackhi_pd(best_lag, best_lag));
+    const double even = cv::v_extract_n<0>(best), odd = cv::v_extract_n<1>(best);
+    const double even_lag = cv::v_extract_n<0>(best_lag), odd_lag = cv::v_extract_n<1>(best_lag);
     const bool take_odd = odd > even || (odd == even && odd_lag < even_lag);
     return {static_cast<int>(take_odd ? odd_lag : even_lag), take_odd ? odd : even};
   }
-#endif
+  // Many edges (no family has more than 16) or an odd count: every lag into an array.
   correlate_all_lags(p, ideal, scratch);
   const auto best = std::max_element(scratch.begin(), scratch.end());
   return {static_cast<int>(best - scratch.begin()), *best};
@@ -465,27 +460,16 @@ std::pair<int, double> Decoder::local_peak(const Prepared& p, const Ideal& ideal
   }
   alignas(16) double values[kMaxLags];
   const double* c = p.doubled_cumulative.data();
-#if defined(__SSE2__)
-  for (int j = 0; j < padded; j += 2) {
-    __m128d v = _mm_setzero_pd();
+  for (int j = 0; j < padded; j += 2) {  // two lags per step
+    v_float64x2 v = cv::v_setzero_f64();
     for (std::size_t e = 0; e < ideal.edge.size(); ++e) {
       const double* at = c + ideal.edge_index[e] + first + j;
-      const __m128d lo = _mm_loadu_pd(at), hi = _mm_loadu_pd(at + 1);
-      const __m128d in_bin = _mm_add_pd(lo, _mm_mul_pd(_mm_set1_pd(ideal.edge_frac[e]), _mm_sub_pd(hi, lo)));
-      v = _mm_add_pd(v, _mm_mul_pd(_mm_set1_pd(ideal.step[e]), in_bin));
+      const v_float64x2 lo = cv::v_load(at), hi = cv::v_load(at + 1);
+      const v_float64x2 in_bin = lo + cv::v_setall_f64(ideal.edge_frac[e]) * (hi - lo);
+      v += cv::v_setall_f64(ideal.step[e]) * in_bin;
     }
-    _mm_store_pd(values + j, v);
+    cv::v_store_aligned(values + j, v);
   }
-#else
-  for (int j = 0; j < padded; ++j) {
-    double v = 0.0;
-    for (std::size_t e = 0; e < ideal.edge.size(); ++e) {
-      const double* at = c + ideal.edge_index[e] + first + j;
-      v += ideal.step[e] * (at[0] + ideal.edge_frac[e] * (at[1] - at[0]));
-    }
-    values[j] = v;
-  }
-#endif
   // The first of equal values wins, as in a scan from the window's low end.
   int best = 0;
   for (int d = 1; d < count; ++d) {

@@ -4,9 +4,7 @@
 #include <cmath>
 #include <cstdint>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include <opencv2/core/hal/intrin.hpp>
 
 #include "core/geometry.hpp"
 #include "vision/circle_sampler.hpp"
@@ -189,29 +187,31 @@ void prefetch_disc_area(const cv::Mat& grey, const Blob& predicted, const DiscEd
 
 namespace {
 
+// The sums over crossings below take two per step in the lanes of OpenCV's universal
+// intrinsics (SSE2 on x86, NEON on ARM, OpenCV's C++ emulation elsewhere), written once;
+// the lanes are added at the end, and an odd crossing left over is added alone.
+using cv::v_float64x2;
+
 // Mean square of each crossing's radial distance from the ellipse (p - c)^T m (p - c) = 1,
 // as a fraction of its radius there (the same in every linearly related frame).
 double residual_rms2(const double* px, const double* py, int found, double x0, double y0, double m00, double m01,
                      double m11) {
   double residual2 = 0.0;
   int first_unpaired = 0;
-#if defined(__SSE2__)
   {
     // Two crossings per step (a square root each: one instruction for both).
-    const __m128d vx0 = _mm_set1_pd(x0), vy0 = _mm_set1_pd(y0), vm00 = _mm_set1_pd(m00),
-                  vm01 = _mm_set1_pd(2.0 * m01), vm11 = _mm_set1_pd(m11), one = _mm_set1_pd(1.0);
-    __m128d sum = _mm_setzero_pd();
+    const v_float64x2 vx0 = cv::v_setall_f64(x0), vy0 = cv::v_setall_f64(y0), vm00 = cv::v_setall_f64(m00),
+                      vm01 = cv::v_setall_f64(2.0 * m01), vm11 = cv::v_setall_f64(m11), one = cv::v_setall_f64(1.0);
+    v_float64x2 sum = cv::v_setzero_f64();
     for (; first_unpaired + 1 < found; first_unpaired += 2) {
-      const __m128d dx = _mm_sub_pd(_mm_load_pd(px + first_unpaired), vx0);
-      const __m128d dy = _mm_sub_pd(_mm_load_pd(py + first_unpaired), vy0);
-      const __m128d form = _mm_add_pd(_mm_mul_pd(_mm_mul_pd(vm00, dx), dx),
-                                      _mm_add_pd(_mm_mul_pd(_mm_mul_pd(vm01, dx), dy), _mm_mul_pd(_mm_mul_pd(vm11, dy), dy)));
-      const __m128d rho = _mm_sub_pd(_mm_sqrt_pd(_mm_max_pd(form, _mm_setzero_pd())), one);
-      sum = _mm_add_pd(sum, _mm_mul_pd(rho, rho));
+      const v_float64x2 dx = cv::v_load(px + first_unpaired) - vx0;
+      const v_float64x2 dy = cv::v_load(py + first_unpaired) - vy0;
+      const v_float64x2 form = vm00 * dx * dx + (vm01 * dx * dy + vm11 * dy * dy);
+      const v_float64x2 rho = cv::v_sqrt(cv::v_max(form, cv::v_setzero_f64())) - one;
+      sum += rho * rho;
     }
-    residual2 = _mm_cvtsd_f64(sum) + _mm_cvtsd_f64(_mm_unpackhi_pd(sum, sum));
+    residual2 = cv::v_reduce_sum(sum);
   }
-#endif
   for (int i = first_unpaired; i < found; ++i) {
     const double dx = px[i] - x0, dy = py[i] - y0;
     const double rho = std::sqrt(std::max(0.0, m00 * dx * dx + 2.0 * m01 * dx * dy + m11 * dy * dy)) - 1.0;
@@ -240,29 +240,27 @@ std::optional<DiscEdgeFit> fit_centre_and_size(const Blob& predicted, double thr
                                                const double* black, const double* white, int levels) {
   double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, sz = 0, sxz = 0, syz = 0;
   int first_single = 0;
-#if defined(__SSE2__)
   {
     // Two crossings per step, one in each lane; the lanes are added at the end.
-    const __m128d vq00 = _mm_set1_pd(q00), vq01 = _mm_set1_pd(2.0 * q01), vq11 = _mm_set1_pd(q11);
-    __m128d mx = _mm_setzero_pd(), my = mx, mxx = mx, mxy = mx, myy = mx, mz = mx, mxz = mx, myz = mx;
+    const v_float64x2 vq00 = cv::v_setall_f64(q00), vq01 = cv::v_setall_f64(2.0 * q01), vq11 = cv::v_setall_f64(q11);
+    v_float64x2 mx = cv::v_setzero_f64(), my = mx, mxx = mx, mxy = mx, myy = mx, mz = mx, mxz = mx, myz = mx;
     for (; first_single + 1 < found; first_single += 2) {
-      const __m128d x = _mm_load_pd(px + first_single), y = _mm_load_pd(py + first_single);
-      const __m128d xx = _mm_mul_pd(x, x), xy = _mm_mul_pd(x, y), yy = _mm_mul_pd(y, y);
-      const __m128d z = _mm_add_pd(_mm_mul_pd(vq00, xx), _mm_add_pd(_mm_mul_pd(vq01, xy), _mm_mul_pd(vq11, yy)));
-      mx = _mm_add_pd(mx, x);
-      my = _mm_add_pd(my, y);
-      mxx = _mm_add_pd(mxx, xx);
-      mxy = _mm_add_pd(mxy, xy);
-      myy = _mm_add_pd(myy, yy);
-      mz = _mm_add_pd(mz, z);
-      mxz = _mm_add_pd(mxz, _mm_mul_pd(x, z));
-      myz = _mm_add_pd(myz, _mm_mul_pd(y, z));
+      const v_float64x2 x = cv::v_load(px + first_single), y = cv::v_load(py + first_single);
+      const v_float64x2 xx = x * x, xy = x * y, yy = y * y;
+      const v_float64x2 z = vq00 * xx + (vq01 * xy + vq11 * yy);
+      mx += x;
+      my += y;
+      mxx += xx;
+      mxy += xy;
+      myy += yy;
+      mz += z;
+      mxz += x * z;
+      myz += y * z;
     }
-    auto lanes = [](__m128d v) { return _mm_cvtsd_f64(v) + _mm_cvtsd_f64(_mm_unpackhi_pd(v, v)); };
+    auto lanes = [](const v_float64x2& v) { return cv::v_reduce_sum(v); };
     sx = lanes(mx), sy = lanes(my), sxx = lanes(mxx), sxy = lanes(mxy), syy = lanes(myy);
     sz = lanes(mz), sxz = lanes(mxz), syz = lanes(myz);
   }
-#endif
   for (int i = first_single; i < found; ++i) {
     const double x = px[i], y = py[i];
     const double z = q00 * x * x + 2.0 * q01 * x * y + q11 * y * y;
@@ -295,7 +293,9 @@ std::optional<DiscEdgeFit> fit_centre_and_size(const Blob& predicted, double thr
   const double inv_k = 1.0 / k;
   // The residual test as fit_from's, with the form Q / k of the fitted outline.
   const double residual2 = residual_rms2(px, py, found, x0, y0, q00 * inv_k, q01 * inv_k, q11 * inv_k);
-  if (residual2 > config.max_residual * config.max_residual) return std::nullopt;
+  // [[unlikely]]: a tracked disc's outline mostly fits, and without the hint GCC takes the
+  // success path for cold and calls set_levels instead of inlining it.
+  if (residual2 > config.max_residual * config.max_residual) [[unlikely]] return std::nullopt;
   // The area scales as k (the outline's radius as sqrt(k)).
   if (std::abs(k - 1.0) > config.max_area_change) return std::nullopt;
   DiscEdgeFit fit;
@@ -439,35 +439,33 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
   double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, sxxx = 0, sxxy = 0, sxyy = 0, syyy = 0;
   double sxxxx = 0, sxxxy = 0, sxxyy = 0, sxyyy = 0, syyyy = 0;
   int first_single = 0;
-#if defined(__SSE2__)
   {
     // Two points per step, one in each lane; the lanes are added at the end.
-    __m128d mx = _mm_setzero_pd(), my = mx, mxx = mx, mxy = mx, myy = mx, mxxx = mx, mxxy = mx, mxyy = mx,
-            myyy = mx, mxxxx = mx, mxxxy = mx, mxxyy = mx, mxyyy = mx, myyyy = mx;
+    v_float64x2 mx = cv::v_setzero_f64(), my = mx, mxx = mx, mxy = mx, myy = mx, mxxx = mx, mxxy = mx, mxyy = mx,
+                myyy = mx, mxxxx = mx, mxxxy = mx, mxxyy = mx, mxyyy = mx, myyyy = mx;
     for (; first_single + 1 < found; first_single += 2) {
-      const __m128d x = _mm_load_pd(px + first_single), y = _mm_load_pd(py + first_single);
-      const __m128d xx = _mm_mul_pd(x, x), xy = _mm_mul_pd(x, y), yy = _mm_mul_pd(y, y);
-      mx = _mm_add_pd(mx, x);
-      my = _mm_add_pd(my, y);
-      mxx = _mm_add_pd(mxx, xx);
-      mxy = _mm_add_pd(mxy, xy);
-      myy = _mm_add_pd(myy, yy);
-      mxxx = _mm_add_pd(mxxx, _mm_mul_pd(xx, x));
-      mxxy = _mm_add_pd(mxxy, _mm_mul_pd(xx, y));
-      mxyy = _mm_add_pd(mxyy, _mm_mul_pd(x, yy));
-      myyy = _mm_add_pd(myyy, _mm_mul_pd(yy, y));
-      mxxxx = _mm_add_pd(mxxxx, _mm_mul_pd(xx, xx));
-      mxxxy = _mm_add_pd(mxxxy, _mm_mul_pd(xx, xy));
-      mxxyy = _mm_add_pd(mxxyy, _mm_mul_pd(xx, yy));
-      mxyyy = _mm_add_pd(mxyyy, _mm_mul_pd(xy, yy));
-      myyyy = _mm_add_pd(myyyy, _mm_mul_pd(yy, yy));
+      const v_float64x2 x = cv::v_load(px + first_single), y = cv::v_load(py + first_single);
+      const v_float64x2 xx = x * x, xy = x * y, yy = y * y;
+      mx += x;
+      my += y;
+      mxx += xx;
+      mxy += xy;
+      myy += yy;
+      mxxx += xx * x;
+      mxxy += xx * y;
+      mxyy += x * yy;
+      myyy += yy * y;
+      mxxxx += xx * xx;
+      mxxxy += xx * xy;
+      mxxyy += xx * yy;
+      mxyyy += xy * yy;
+      myyyy += yy * yy;
     }
-    auto lanes = [](__m128d v) { return _mm_cvtsd_f64(v) + _mm_cvtsd_f64(_mm_unpackhi_pd(v, v)); };
+    auto lanes = [](const v_float64x2& v) { return cv::v_reduce_sum(v); };
     sx = lanes(mx), sy = lanes(my), sxx = lanes(mxx), sxy = lanes(mxy), syy = lanes(myy);
     sxxx = lanes(mxxx), sxxy = lanes(mxxy), sxyy = lanes(mxyy), syyy = lanes(myyy);
     sxxxx = lanes(mxxxx), sxxxy = lanes(mxxxy), sxxyy = lanes(mxxyy), sxyyy = lanes(mxyyy), syyyy = lanes(myyyy);
   }
-#endif
   for (int i = first_single; i < found; ++i) {
     const double x = px[i], y = py[i];
     const double xx = x * x, xy = x * y, yy = y * y;
@@ -512,7 +510,7 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
   // RMS of each crossing's distance from the ellipse, radially, as a fraction of the
   // ellipse's radius there (the same in every linearly related frame).
   const double residual2 = residual_rms2(px, py, found, x0, y0, m00, m01, m11);
-  if (residual2 > config.max_residual * config.max_residual) return std::nullopt;
+  if (residual2 > config.max_residual * config.max_residual) [[unlikely]] return std::nullopt;  // as above
 
   // Back to pixels: the outline is centre + radius (x0 + m^-1/2 u), so the shape's
   // square is radius² m^-1.
