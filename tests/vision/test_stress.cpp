@@ -2,8 +2,7 @@
 // condition is drawn at random from wide ranges (src/vision/stress_scene.hpp), scored
 // full-frame and tracked. The seed is not one any threshold was tuned on; draw a new one
 // whenever a threshold changes (bench/bench_stress --seed S runs thousands of frames from
-// any seed and prints the whole table). Two of the issue's targets are not met yet (see
-// below): their bounds are what is reached, not what is asked.
+// any seed and prints the whole table). Every bound below is the issue's own target.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -15,7 +14,7 @@
 namespace rilbed::vision {
 namespace {
 
-constexpr std::uint64_t kSeed = 31102611;  // drawn after the last threshold changed, never tuned on
+constexpr std::uint64_t kSeed = 1963091292;  // drawn after the last threshold changed, never tuned on
 
 // Under AddressSanitizer (`./run asan`, a Debug build) the detector runs some thirty times
 // slower: there the test renders 12 scenes and holds them to the mistakes only (a wrong ID,
@@ -85,9 +84,7 @@ TEST(StressSet, HoldsIssue14sTargetsFullFrameAndTracked) {
     // A miss beats a wrong ID; clutter (other tag families among it) never gets one; no
     // heading is far off.
     EXPECT_EQ(t.count(StressMistake::Kind::WrongId), 0) << describe(t);
-    // Issue 14 asks 0; this seed has one object (scene 59) taken for ID 8 in 2 frames
-    // full-frame, 4 tracked: held here at what is reached, so that it cannot grow unseen.
-    EXPECT_LE(t.count(StressMistake::Kind::FalseDetection), 4) << describe(t);
+    EXPECT_EQ(t.count(StressMistake::Kind::FalseDetection), 0) << describe(t);
     EXPECT_EQ(t.count(StressMistake::Kind::WrongHeading), 0) << describe(t);
     EXPECT_EQ(t.count(StressMistake::Kind::Duplicate), 0) << describe(t);
     if (kSanitized) continue;
@@ -96,13 +93,11 @@ TEST(StressSet, HoldsIssue14sTargetsFullFrameAndTracked) {
     ASSERT_GT(large.markers, 300);
     EXPECT_GE(large.recall(), 0.99) << large.found << " of " << large.markers;
 
-    // Issue 14 asks 0.95 for markers 24-32 px across; this seed gives 0.908 full-frame and
-    // 0.920 tracked (blob detection loses the most blurred of them: see the issue's note).
-    // Held here at what is reached, so that it cannot fall back unseen.
+    // Markers 24-32 px across, the most blurred of which are at the edge of reading.
     const auto mid = summarise(
         t.outcomes(), [](const StressOutcome& o) { return o.occluded == 0 && o.diameter_px >= 24 && o.diameter_px < 32; });
     ASSERT_GT(mid.markers, 150);
-    EXPECT_GE(mid.recall(), 0.90) << mid.found << " of " << mid.markers;
+    EXPECT_GE(mid.recall(), 0.95) << mid.found << " of " << mid.markers;
 
     // Markers 24 px and larger, partly covered ones included: centre and heading accurate,
     // and no ID's heading biased (a bias by code is what a lab cannot calibrate away).
