@@ -9,6 +9,7 @@
 
 #include "run_command.hpp"
 #include "vision/detection_score.hpp"
+#include "vision/stress_scene.hpp"
 #include "vision/synthetic_scene.hpp"
 
 namespace fs = std::filesystem;
@@ -168,6 +169,21 @@ TEST(DetectCli, StressScenesAsTheContractSays) {
   EXPECT_EQ(s.duplicates, 0);
   fs::remove_all(out);
   fs::remove_all(again);
+}
+
+// bench_stress draws 64-bit seeds and names them for `synth` to show its mistakes: synth
+// takes them whole and renders the very frame the bench scored.
+TEST(DetectCli, StressSynthTakesTheBenchsSixtyFourBitSeeds) {
+  const auto out = scratch_dir("detect_stress_seed64");
+  const std::uint64_t seed = 2822153290125956176ULL;
+  auto r = run_rilbed("synth --preset stress --seed " + std::to_string(seed) + " --scene 5 --frames 1 --out '" +
+                      out.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const cv::Mat written = cv::imread((out / "frames" / "frame_0000.png").string());
+  const vision::StressScene scene = vision::make_stress_scene(seed, 5);
+  ASSERT_EQ(written.size(), scene.frames[0].size());
+  EXPECT_EQ(cv::norm(written, scene.frames[0], cv::NORM_INF), 0.0);
+  fs::remove_all(out);
 }
 
 // Bad frames in a directory are named and skipped; the good ones keep their frame numbers.
