@@ -192,6 +192,43 @@ namespace {
 // the lanes are added at the end, and an odd crossing left over is added alone.
 using cv::v_float64x2;
 
+// The moments of points up to the fourth order, for one point (T = double) or one per
+// lane (T = v_float64x2): one body for both, so that the vector and the tail loop add
+// the same terms in the same order.
+template <class T>
+struct PointMoments {
+  T x, y, xx, xy, yy, xxx, xxy, xyy, yyy, xxxx, xxxy, xxyy, xyyy, yyyy;
+  explicit PointMoments(T zero)
+      : x(zero), y(zero), xx(zero), xy(zero), yy(zero), xxx(zero), xxy(zero), xyy(zero), yyy(zero), xxxx(zero),
+        xxxy(zero), xxyy(zero), xyyy(zero), yyyy(zero) {}
+  void add(const T& px, const T& py) {
+    const T pxx = px * px, pxy = px * py, pyy = py * py;
+    x += px;
+    y += py;
+    xx += pxx;
+    xy += pxy;
+    yy += pyy;
+    xxx += pxx * px;
+    xxy += pxx * py;
+    xyy += px * pyy;
+    yyy += pyy * py;
+    xxxx += pxx * pxx;
+    xxxy += pxx * pxy;
+    xxyy += pxx * pyy;
+    xyyy += pxy * pyy;
+    yyyy += pyy * pyy;
+  }
+  // Each moment through `f` (the lanes' sum).
+  template <class F>
+  PointMoments<double> map(F f) const {
+    PointMoments<double> out(0.0);
+    out.x = f(x), out.y = f(y), out.xx = f(xx), out.xy = f(xy), out.yy = f(yy);
+    out.xxx = f(xxx), out.xxy = f(xxy), out.xyy = f(xyy), out.yyy = f(yyy);
+    out.xxxx = f(xxxx), out.xxxy = f(xxxy), out.xxyy = f(xxyy), out.xyyy = f(xyyy), out.yyyy = f(yyyy);
+    return out;
+  }
+};
+
 // Mean square of each crossing's radial distance from the ellipse (p - c)^T m (p - c) = 1,
 // as a fraction of its radius there (the same in every linearly related frame).
 double residual_rms2(const double* px, const double* py, int found, double x0, double y0, double m00, double m01,
@@ -435,55 +472,15 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
 
   // The normal equations need only the moments of the points up to the fourth order;
   // summed in named accumulators (a loop over a small phi array made the compiler store
-  // and reload it through memory, which stalled on every point).
-  double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, sxxx = 0, sxxy = 0, sxyy = 0, syyy = 0;
-  double sxxxx = 0, sxxxy = 0, sxxyy = 0, sxyyy = 0, syyyy = 0;
+  // and reload it through memory, which stalled on every point). Two points per step,
+  // one in each lane, then the odd one out: the same sums for both (PointMoments).
+  PointMoments<v_float64x2> pairs(cv::v_setzero_f64());
   int first_single = 0;
-  {
-    // Two points per step, one in each lane; the lanes are added at the end.
-    v_float64x2 mx = cv::v_setzero_f64(), my = mx, mxx = mx, mxy = mx, myy = mx, mxxx = mx, mxxy = mx, mxyy = mx,
-                myyy = mx, mxxxx = mx, mxxxy = mx, mxxyy = mx, mxyyy = mx, myyyy = mx;
-    for (; first_single + 1 < found; first_single += 2) {
-      const v_float64x2 x = cv::v_load(px + first_single), y = cv::v_load(py + first_single);
-      const v_float64x2 xx = x * x, xy = x * y, yy = y * y;
-      mx += x;
-      my += y;
-      mxx += xx;
-      mxy += xy;
-      myy += yy;
-      mxxx += xx * x;
-      mxxy += xx * y;
-      mxyy += x * yy;
-      myyy += yy * y;
-      mxxxx += xx * xx;
-      mxxxy += xx * xy;
-      mxxyy += xx * yy;
-      mxyyy += xy * yy;
-      myyyy += yy * yy;
-    }
-    auto lanes = [](const v_float64x2& v) { return cv::v_reduce_sum(v); };
-    sx = lanes(mx), sy = lanes(my), sxx = lanes(mxx), sxy = lanes(mxy), syy = lanes(myy);
-    sxxx = lanes(mxxx), sxxy = lanes(mxxy), sxyy = lanes(mxyy), syyy = lanes(myyy);
-    sxxxx = lanes(mxxxx), sxxxy = lanes(mxxxy), sxxyy = lanes(mxxyy), sxyyy = lanes(mxyyy), syyyy = lanes(myyyy);
-  }
-  for (int i = first_single; i < found; ++i) {
-    const double x = px[i], y = py[i];
-    const double xx = x * x, xy = x * y, yy = y * y;
-    sx += x;
-    sy += y;
-    sxx += xx;
-    sxy += xy;
-    syy += yy;
-    sxxx += xx * x;
-    sxxy += xx * y;
-    sxyy += x * yy;
-    syyy += yy * y;
-    sxxxx += xx * xx;
-    sxxxy += xx * xy;
-    sxxyy += xx * yy;
-    sxyyy += xy * yy;
-    syyyy += yy * yy;
-  }
+  for (; first_single + 1 < found; first_single += 2) pairs.add(cv::v_load(px + first_single), cv::v_load(py + first_single));
+  PointMoments<double> m = pairs.map([](const v_float64x2& v) { return cv::v_reduce_sum(v); });
+  for (int i = first_single; i < found; ++i) m.add(px[i], py[i]);
+  const double sx = m.x, sy = m.y, sxx = m.xx, sxy = m.xy, syy = m.yy, sxxx = m.xxx, sxxy = m.xxy, sxyy = m.xyy,
+               syyy = m.yyy, sxxxx = m.xxxx, sxxxy = m.xxxy, sxxyy = m.xxyy, sxyyy = m.xyyy, syyyy = m.yyyy;
   // Rows and columns in the order x², xy, y², x, y.
   const double normal_values[25] = {sxxxx, sxxxy, sxxyy, sxxx, sxxy,  //
                                     sxxxy, sxxyy, sxyyy, sxxy, sxyy,  //
