@@ -1,5 +1,6 @@
 #include "vision/circle_sampler.hpp"
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 
@@ -55,7 +56,7 @@ void sample_ellipse(const cv::Mat& grey, double centre_u, double centre_v, const
   alignas(16) int offsets[4], xs[4], ys[4];
   // p[0] | p[1] << 8 of a pixel and its right neighbour (one 16-bit read).
   auto pair = [](const std::uint8_t* p) { return static_cast<std::uint16_t>(p[0] | p[1] << 8); };
-  const v_uint16x8 low_byte = cv::v_setall_u16(0xFF);
+  const v_uint32x4 low_byte = cv::v_setall_u32(0xFF);
   // The choice of offsets is a template parameter: no test per step.
   auto sample_all = [&]<bool kOffsetsInFloat>() {
     for (int k = 0; k < count; k += 4) {
@@ -77,16 +78,16 @@ void sample_ellipse(const cv::Mat& grey, double centre_u, double centre_v, const
         p2 = data + static_cast<std::ptrdiff_t>(ys[2]) * stride + xs[2];
         p3 = data + static_cast<std::ptrdiff_t>(ys[3]) * stride + xs[3];
       }
-      // The four points' pairs on their upper row, then on the row below, in 16-bit lanes;
-      // split into left and right pixels there and widened to 32 bits for the conversion.
-      const v_uint16x8 pairs(pair(p0), pair(p1), pair(p2), pair(p3), pair(p0 + stride), pair(p1 + stride),
-                             pair(p2 + stride), pair(p3 + stride));
-      v_uint32x4 left_upper, left_lower, right_upper, right_lower;
-      cv::v_expand(pairs & low_byte, left_upper, left_lower);
-      cv::v_expand(pairs >> 8, right_upper, right_lower);
+      // Each point's pair on its row and the pair below in one 32-bit lane (16-bit lanes
+      // filled from memory), then the four pixels apart: bytes 0 to 3 of the lane, low
+      // to high on a little-endian CPU.
+      static_assert(std::endian::native == std::endian::little, "two 16-bit lanes read as one 32-bit lane");
+      const v_uint32x4 quads = cv::v_reinterpret_as_u32(v_uint16x8(pair(p0), pair(p0 + stride), pair(p1),
+                                                                   pair(p1 + stride), pair(p2), pair(p2 + stride),
+                                                                   pair(p3), pair(p3 + stride)));
       auto to_float = [](const v_uint32x4& x) { return cv::v_cvt_f32(cv::v_reinterpret_as_s32(x)); };
-      const v_float32x4 a00 = to_float(left_upper), a01 = to_float(right_upper);
-      const v_float32x4 a10 = to_float(left_lower), a11 = to_float(right_lower);
+      const v_float32x4 a00 = to_float(quads & low_byte), a01 = to_float((quads >> 8) & low_byte);
+      const v_float32x4 a10 = to_float((quads >> 16) & low_byte), a11 = to_float(quads >> 24);
       const v_float32x4 top = a00 + (a01 - a00) * fx;
       const v_float32x4 bottom = a10 + (a11 - a10) * fx;
       cv::v_store(out + k, top + (bottom - top) * fy);
