@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include "vision/circle_sampler.hpp"
 
@@ -25,10 +26,20 @@ constexpr int kModelSide = 2 * 64 + 1;
 
 // At least the circles up to the white ring's inner half (0.83 R) must lie in the image.
 constexpr std::size_t kLeastCircles = 11;
+// The black ring's circles (0.6, 0.665 and 0.72 R) and the sector its misfit is summed
+// over: 4 of the 64 angles, 22.5 degrees, about a cable's width on a 24 px marker.
+constexpr std::size_t kFirstBlackCircle = 7, kBlackCircles = 3;
+constexpr int kSectorAngles = 4;
+static_assert(kRadii[kFirstBlackCircle] > MarkerFamily::code_outer_radius &&
+              kRadii[kFirstBlackCircle + kBlackCircles - 1] < MarkerFamily::black_ring_outer_radius);
 
-// Pearson correlation of `levels` (centred, unit norm) with the first levels.size()
-// values of `model`.
-double correlate(const std::vector<float>& levels, const std::vector<float>& model) {
+// The least-squares fit of `levels` (centred, unit norm) by the first levels.size()
+// values of `model`: levels ~ gain * (model - mean).
+struct LinearFit {
+  double correlation = -1.0;
+  double gain = 0.0, mean = 0.0;
+};
+LinearFit fit_levels(const std::vector<float>& levels, const std::vector<float>& model) {
   const std::size_t n = levels.size();
   double sum = 0.0, sum_sq = 0.0, dot = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -37,7 +48,33 @@ double correlate(const std::vector<float>& levels, const std::vector<float>& mod
     dot += static_cast<double>(levels[i]) * model[i];
   }
   const double var = sum_sq - sum * sum / static_cast<double>(n);
-  return var > 1e-12 ? dot / std::sqrt(var) : -1.0;  // levels sum to 0: the model's mean drops out of dot
+  if (var <= 1e-12) return {};
+  // levels sum to 0: the model's mean drops out of dot.
+  return {dot / std::sqrt(var), dot / var, sum / static_cast<double>(n)};
+}
+
+// The worst sector's mean residual energy per sample on the black ring's circles, over
+// the fitted model's mean energy per sample across the whole grid (the correlation
+// squared over the samples: the levels have unit norm). Measured against the whole
+// marker's contrast, not the ring's own, which a heavily blurred model leaves near zero.
+double black_ring_misfit(const std::vector<float>& levels, const std::vector<float>& model, const LinearFit& fit) {
+  std::array<double, kAngles> residual{};
+  for (std::size_t c = kFirstBlackCircle; c < kFirstBlackCircle + kBlackCircles; ++c) {
+    for (int k = 0; k < kAngles; ++k) {
+      const std::size_t i = c * kAngles + static_cast<std::size_t>(k);
+      const double r = levels[i] - fit.gain * (model[i] - fit.mean);
+      residual[static_cast<std::size_t>(k)] += r * r;
+    }
+  }
+  const double signal_per_sample = fit.correlation * fit.correlation / static_cast<double>(levels.size());
+  if (signal_per_sample <= 1e-12) return std::numeric_limits<double>::infinity();
+  double worst = 0.0;
+  for (int k = 0; k < kAngles; ++k) {
+    double r = 0.0;
+    for (int j = 0; j < kSectorAngles; ++j) r += residual[static_cast<std::size_t>((k + j) % kAngles)];
+    worst = std::max(worst, r / (kSectorAngles * kBlackCircles) / signal_per_sample);
+  }
+  return worst;
 }
 
 // Centres `values` and scales them to unit norm; false when they are all alike.
@@ -107,9 +144,9 @@ const MarkerTemplates::Models& MarkerTemplates::models_of(std::size_t index) con
   return blurred;
 }
 
-double MarkerTemplates::correlation(const cv::Mat& grey, const Blob& blob, int id, double key_angle_rad) const {
+TemplateFit MarkerTemplates::fit(const cv::Mat& grey, const Blob& blob, int id, double key_angle_rad) const {
   const auto which = std::find(ids_.begin(), ids_.end(), id);
-  if (which == ids_.end()) return -1.0;
+  if (which == ids_.end()) return {};
   // The shape turned so that direction 0 of the circle reads the key's bisector:
   // (cos(key + b), -sin(key + b)) = [[c, s], [-s, c]] (cos b, -sin b).
   const double c = std::cos(key_angle_rad), s = std::sin(key_angle_rad);
@@ -123,7 +160,7 @@ double MarkerTemplates::correlation(const cv::Mat& grey, const Blob& blob, int i
   while (circles < kRadii.size() && ellipse_inside(grey, blob.u, blob.v, blob.shape, kRadii[circles] * to_disc)) {
     ++circles;
   }
-  if (circles < kLeastCircles) return -1.0;
+  if (circles < kLeastCircles) return {};
   static const CircleDirections directions = CircleDirections::make(kAngles);
   thread_local std::vector<float> circle, levels;
   circle.resize(directions.cos.size());
@@ -132,12 +169,18 @@ double MarkerTemplates::correlation(const cv::Mat& grey, const Blob& blob, int i
     sample_ellipse(grey, blob.u, blob.v, shape, kRadii[i] * to_disc, directions, circle.data());
     levels.insert(levels.end(), circle.begin(), circle.begin() + kAngles);
   }
-  if (!normalise(levels)) return -1.0;
-  double best = -1.0;
+  if (!normalise(levels)) return {};
+  LinearFit best;
+  const std::vector<float>* best_model = nullptr;
   for (const std::vector<float>& model : models_of(static_cast<std::size_t>(which - ids_.begin()))) {
-    best = std::max(best, correlate(levels, model));
+    const LinearFit f = fit_levels(levels, model);
+    if (f.correlation > best.correlation) {
+      best = f;
+      best_model = &model;
+    }
   }
-  return best;
+  if (best_model == nullptr) return {};
+  return {best.correlation, black_ring_misfit(levels, *best_model, best)};
 }
 
 }  // namespace rilbed::vision

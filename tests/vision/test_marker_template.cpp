@@ -112,3 +112,30 @@ TEST(MarkerTemplates, AMarkerCutByTheFrameEdgeIsComparedOnWhatIsInside) {
   disc.u = 8.5;
   EXPECT_EQ(templates.correlation(img, disc, 3, key), -1.0);
 }
+
+// A gap in the black ring (a printed "e"'s opening, a light cable across a marker) is a
+// local flaw the whole marker's correlation averages away; the ring's sector check is
+// what sees it.
+TEST(MarkerTemplates, AGapInTheBlackRingFailsTheRingCheck) {
+  MarkerTemplates templates(MarkerFamily::six_ucp(), kIds);
+  for (int id : {2, 6, 8}) {
+    const double heading_deg = 40.0 * id;
+    cv::Mat img = one_marker(id, 40, heading_deg, 0.7);
+    const auto found = detect_markers(img, MarkerFamily::six_ucp(), kIds);
+    ASSERT_EQ(found.size(), 1u) << "ID " << id;
+    const Blob disc = disc_of(found[0]);
+    const TemplateFit whole = templates.fit(img, disc, id, found[0].key_angle_rad);
+    EXPECT_LT(whole.black_ring_misfit, 0.5) << "ID " << id;
+    EXPECT_TRUE(templates.matches(img, disc, id, found[0].key_angle_rad)) << "ID " << id;
+    // Floor grey over 30 degrees of the ring (radius 0.55-0.78 R of the 20 px radius),
+    // opposite the key slice; OpenCV's arcs turn clockwise on screen.
+    const cv::Point centre(37 + 20, 41 + 20);
+    const double away_deg = -(heading_deg + 180.0);
+    cv::ellipse(img, centre, cv::Size(13, 13), 0.0, away_deg - 15.0, away_deg + 15.0, cv::Scalar(185), 5);
+    const TemplateFit gapped = templates.fit(img, disc, id, found[0].key_angle_rad);
+    // The whole marker still correlates well enough: the correlation alone would pass it.
+    EXPECT_GE(gapped.correlation, templates.config().min_correlation) << "ID " << id;
+    EXPECT_GT(gapped.black_ring_misfit, templates.config().max_black_ring_misfit) << "ID " << id;
+    EXPECT_FALSE(templates.matches(img, disc, id, found[0].key_angle_rad)) << "ID " << id;
+  }
+}
