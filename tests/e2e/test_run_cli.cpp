@@ -71,13 +71,16 @@ TEST(RunCli, ABadScenarioNamesFileLineAndKey) {
 
 TEST(RunCli, RealTimeRunPrintsBehavioursAndStopsOnSigint) {
   const fs::path dir = scratch_dir("run_sigint");
-  // The binary in the background; SIGINT after 1.5 s of wall time. --duration bounds the
-  // run should the signal be missed.
+  // The binary in the background; SIGINT once it has printed its second status line
+  // (polled: a fixed sleep was too short when a loaded machine, or a sanitizer, slowed the
+  // start). --duration bounds the run should the signal be missed.
   const std::string out = (dir / "out.txt").string();
   const fs::path script = dir / "interrupt.sh";
   std::ofstream(script) << "'" << RILBED_BINARY << "' run " << shipped_scenario_arg("convoy_sim") << " --realtime --duration 20 --out '"
                         << (dir / "run").string() << "' >'" << out << "' 2>&1 &\n"
-                        << "pid=$!\nsleep 1.5\nkill -INT $pid\nwait $pid\n";
+                        << "pid=$!\n"
+                        << "i=0; while [ $i -lt 1200 ] && ! grep -q 't=1.0s' '" << out << "' 2>/dev/null; do sleep 0.05; i=$((i+1)); done\n"
+                        << "kill -INT $pid\nwait $pid\n";
   const int status = std::system(("/bin/sh '" + script.string() + "'").c_str());
   EXPECT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 0);
