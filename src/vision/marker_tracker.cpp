@@ -190,7 +190,8 @@ void MarkerTracker::settle_doubtful(const cv::Mat& grey, std::vector<Blob>& blob
   std::erase_if(blobs, [&](Blob& blob) {
     if (!blob.doubtful) return false;
     ++stats_.refits;
-    const auto fit = fit_disc_edges(grey, blob, blob.threshold, config_.edge_fit);
+    auto fit = fit_disc_edges(grey, blob, blob.threshold, config_.edge_fit);
+    if (!fit) fit = fit_disc_edges(grey, blob, blob.threshold, config_.doubtful_edge_fit);
     if (!fit || fit->white_fraction < decoder_.config().min_white_ring_fraction) return true;
     ++stats_.refits_kept;
     blob = fit->blob;
