@@ -178,13 +178,13 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
   return out;
 }
 
-std::vector<Blob> MarkerTracker::find_blobs(const cv::Mat& grey) {
+std::vector<Blob> MarkerTracker::find_blobs(const cv::Mat& grey, std::vector<Blob>* fragments) {
   std::vector<Blob> blobs = detector_.detect(grey);
-  settle_doubtful(grey, blobs);
+  settle_doubtful(grey, blobs, fragments);
   return blobs;
 }
 
-void MarkerTracker::settle_doubtful(const cv::Mat& grey, std::vector<Blob>& blobs) {
+void MarkerTracker::settle_doubtful(const cv::Mat& grey, std::vector<Blob>& blobs, std::vector<Blob>* fragments) {
   // A doubtful blob's outline is re-found at its own threshold; what does not fit a
   // clean ellipse with a white ring around it is no marker anyone can read.
   std::erase_if(blobs, [&](Blob& blob) {
@@ -192,7 +192,18 @@ void MarkerTracker::settle_doubtful(const cv::Mat& grey, std::vector<Blob>& blob
     ++stats_.refits;
     auto fit = fit_disc_edges(grey, blob, blob.threshold, config_.edge_fit);
     if (!fit) fit = fit_disc_edges(grey, blob, blob.threshold, config_.doubtful_edge_fit);
-    if (!fit || fit->white_fraction < decoder_.config().min_white_ring_fraction) return true;
+    if (!fit) {
+      if (!config_.use_ring_search) return true;
+      if (fragments != nullptr) {
+        fragments->push_back(blob);
+        return true;
+      }
+      const auto disc = rescue_fragment(grey, blob);
+      if (!disc) return true;
+      blob = *disc;
+      return false;
+    }
+    if (fit->white_fraction < decoder_.config().min_white_ring_fraction) return true;
     ++stats_.refits_kept;
     blob = fit->blob;
     blob.doubtful = false;
@@ -200,11 +211,42 @@ void MarkerTracker::settle_doubtful(const cv::Mat& grey, std::vector<Blob>& blob
   });
 }
 
+std::optional<Blob> MarkerTracker::rescue_fragment(const cv::Mat& grey, const Blob& fragment) {
+  if (fragment.disc_diameter_px() > config_.ring_search.max_fragment_diameter_px) return std::nullopt;
+  ++stats_.ring_searches;
+  const auto guess = search_ring(grey, fragment, config_.ring_search);
+  if (!guess) return std::nullopt;
+  const auto fit = fit_disc_edges(grey, *guess, fragment.threshold, config_.edge_fit);
+  if (!fit || fit->white_fraction < decoder_.config().min_white_ring_fraction) return std::nullopt;
+  ++stats_.refits_kept;
+  Blob disc = fit->blob;
+  disc.doubtful = false;
+  return disc;
+}
+
+void MarkerTracker::assign_rescued(const cv::Mat& grey, const std::vector<Blob>& fragments, bool use_tracks,
+                                   std::vector<MarkerDetection>& found) {
+  if (fragments.empty() || found.size() >= ids_.size()) return;
+  std::vector<Blob> discs;
+  for (const Blob& fragment : fragments) {
+    if (auto disc = rescue_fragment(grey, fragment)) append_unique(discs, {*disc});
+  }
+  drop_confirmed(discs, found);
+  if (discs.empty()) return;
+  std::vector<int> taken;
+  for (const MarkerDetection& d : found) taken.push_back(d.id);
+  for (MarkerDetection& d : assign(grey, discs, use_tracks, taken)) found.push_back(std::move(d));
+  std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
+}
+
 std::vector<MarkerDetection> MarkerTracker::detect_full_frame(const cv::Mat& frame) {
   const cv::Mat grey = to_grey(frame);
   stats_ = FrameStats{};
   stats_.full_search = true;
-  auto found = assign(grey, find_blobs(grey), false);
+  std::vector<Blob>& fragments = fragments_;
+  fragments.clear();
+  auto found = assign(grey, find_blobs(grey, &fragments), false);
+  assign_rescued(grey, fragments, false, found);
   stats_.fills = detector_.take_fill_count();
   return found;
 }
@@ -359,11 +401,13 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
   ++frames_since_full_;
   if (tracks_.empty() || (!all_found && frames_since_full_ >= config_.full_search_interval_frames)) {
     frames_since_full_ = 0;
-    std::vector<Blob> more = find_blobs(grey);
+    fragments_.clear();
+    std::vector<Blob> more = find_blobs(grey, &fragments_);
     found.resize(confirmed);  // the blobs are assigned again, with the new ones
     drop_confirmed(more, found);
     append_unique(blobs, more);
     for (MarkerDetection& d : assign(grey, blobs, true, confirmed_ids)) found.push_back(std::move(d));
+    assign_rescued(grey, fragments_, true, found);
     stats_.full_search = true;
   }
   auto by_id = [](const auto& a, const auto& b) { return a.id < b.id; };
