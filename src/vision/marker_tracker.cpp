@@ -216,7 +216,7 @@ std::optional<Blob> MarkerTracker::rescue_fragment(const cv::Mat& grey, const Bl
   ++stats_.ring_searches;
   const auto guess = search_ring(grey, fragment, config_.ring_search);
   if (!guess) return std::nullopt;
-  const auto fit = fit_disc_edges(grey, *guess, fragment.threshold, config_.edge_fit);
+  const auto fit = fit_disc_edges(grey, *guess, fragment.threshold, config_.doubtful_edge_fit);
   if (!fit || fit->white_fraction < decoder_.config().min_white_ring_fraction) return std::nullopt;
   ++stats_.refits_kept;
   Blob disc = fit->blob;

@@ -3,7 +3,7 @@
 // full-frame and tracked. The seed is not one any threshold was tuned on; draw a new one
 // whenever a threshold changes (bench/bench_stress --seed S runs thousands of frames from
 // any seed and prints the whole table). Every bound below is the issue's own target, but
-// for the two the pipeline does not meet yet (kHeld* below).
+// for the two that 240 frames cannot resolve (kHeld* below).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -15,7 +15,7 @@
 namespace rilbed::vision {
 namespace {
 
-constexpr std::uint64_t kSeed = 2514941867;  // drawn after the last threshold changed, never tuned on
+constexpr std::uint64_t kSeed = 2996856921;  // drawn after the last threshold changed, never tuned on
 
 // Under AddressSanitizer (`./run asan`, a Debug build) the detector runs some thirty times
 // slower: there the test renders 12 scenes and holds them to the mistakes only (a wrong ID,
@@ -34,13 +34,17 @@ constexpr bool kSanitized = false;
 #endif
 constexpr int kScenes = kSanitized ? 12 : 60;
 
-// Issue 14's targets not met yet: on fresh seeds of 2,000 frames recall at 24-32 px is
-// about 0.92 (the most blurred markers of 24-26 px give no blob) and one ID's mean heading
-// error may reach 0.35 degrees in one mode. Until they are, the test holds the level
-// reached, so that a change that loses ground fails; raise each bound to the issue's
-// target (beside it) once met.
-constexpr double kHeldMidRecall = 0.90;     // target 0.95
-constexpr double kHeldWorstBiasDeg = 0.5;   // target 0.3
+// Two of issue 14's targets are held here at a level below the target, for want of frames
+// rather than of accuracy. On a fresh seed of 2,000 frames (bench_stress) recall at 24-32
+// px is 0.951 full-frame and 0.964 tracked, and the worst ID's mean heading error 0.11
+// degrees. But these 240 frames hold only about 180 such markers, whose recall scatters
+// by about 0.016 from sample to sample (binomial), and the bias is a mean over one ID's
+// detections, covered markers among them: this seed reads 0.934 / 0.945 and 0.40 degrees
+// tracked. A bound two of those scatters below the level reached still fails on a real
+// regression (the most blurred 24 px markers lost again cost 0.03); the targets are read
+// off bench_stress's 2,000 frames.
+constexpr double kHeldMidRecall = 0.92;     // target 0.95 (bench_stress, 2,000 frames)
+constexpr double kHeldWorstBiasDeg = 0.5;   // target 0.3 (bench_stress, 2,000 frames)
 
 struct Tallies {
   StressTally full, tracked;
