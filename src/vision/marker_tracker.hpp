@@ -95,12 +95,13 @@ struct TrackerConfig {
   }();
   /// When both re-fits of a doubtful blob fail, the blob may be one lobe of a small,
   /// blurred marker's disc (see ring_search.hpp): the circle whose rings contrast most
-  /// around it is searched for and, when found, fitted with `edge_fit` (the strict one),
-  /// then decoded as any blob. A full search does this only while some listed ID is
-  /// still missing once the other blobs are assigned; a tracked marker's own window,
-  /// at once. On tuning seed 1000 it raised recall at 24-32 px from 0.93 to 0.95
-  /// (full-frame). Costs about 10 microseconds per such blob (FrameStats::ring_searches;
-  /// a textured floor makes a few dozen); off with `use_ring_search`.
+  /// around it is searched for and, when found, fitted with `doubtful_edge_fit` (its
+  /// guesses lie within a pixel of the centre, but motion blur smears the outline past
+  /// the strict fit), then decoded as any blob. A full search does this only while some
+  /// listed ID is still missing once the other blobs are assigned; a tracked marker's own
+  /// window, at once. On the tuning seeds it raised recall at 24-32 px by 0.7-2.8 %
+  /// (full-frame). Costs about 6 microseconds per such blob (FrameStats::ring_searches;
+  /// a textured floor makes about 20); off with `use_ring_search`.
   RingSearchConfig ring_search;
   bool use_ring_search = true;
   /// See quick_edge_fit; a fraction of the radius (DiscEdgeFit::residual). A clean disc
