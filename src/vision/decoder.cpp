@@ -651,14 +651,7 @@ bool Decoder::levels_agree(const cv::Mat& grey, const Blob& blob, const SampledS
     if (sxx <= 0.0 || syy <= 0.0 || sxy / std::sqrt(sxx * syy) < config_.min_radial_agreement) return false;
   }
   // The white ring unbroken: nothing lies across the marker.
-  thread_local std::vector<float> ring;
-  ring.resize(dense_ring_directions_.cos.size());
-  sample_ellipse(grey, blob.u, blob.v, blob.shape, reach * 0.5 * (MarkerFamily::black_ring_outer_radius + 1.0),
-                 dense_ring_directions_, ring.data());
-  const double mid = 0.5 * (signal.black_level + signal.white_level);
-  int dark_reads = 0;
-  for (int k = 0; k < dense_ring_directions_.count; ++k) dark_reads += ring[static_cast<std::size_t>(k)] <= mid;
-  if (dark_reads > config_.max_dark_white_ring_reads) return false;
+  if (!white_ring_unbroken(grey, blob, signal.black_level, signal.white_level)) return false;
   // The hole: a small circle half way out to its edge (within the image: the whole marker is).
   thread_local std::vector<float> hole;
   hole.resize(ring_directions_.cos.size());
@@ -666,6 +659,18 @@ bool Decoder::levels_agree(const cv::Mat& grey, const Blob& blob, const SampledS
   double hole_sum = 0.0;
   for (int k = 0; k < kRingSamples; ++k) hole_sum += hole[static_cast<std::size_t>(k)];
   return hole_sum / kRingSamples - signal.black_level <= config_.max_hole_excess * contrast;
+}
+
+bool Decoder::white_ring_unbroken(const cv::Mat& grey, const Blob& blob, double black_level, double white_level) const {
+  const double reach = 1.0 / MarkerFamily::black_ring_outer_radius;
+  thread_local std::vector<float> ring;
+  ring.resize(dense_ring_directions_.cos.size());
+  sample_ellipse(grey, blob.u, blob.v, blob.shape, reach * 0.5 * (MarkerFamily::black_ring_outer_radius + 1.0),
+                 dense_ring_directions_, ring.data());
+  const double mid = 0.5 * (black_level + white_level);
+  int dark_reads = 0;
+  for (int k = 0; k < dense_ring_directions_.count; ++k) dark_reads += ring[static_cast<std::size_t>(k)] <= mid;
+  return dark_reads <= config_.max_dark_white_ring_reads;
 }
 
 void Decoder::correlate_all_lags(const Prepared& p, const Ideal& ideal, std::vector<double>& out) const {

@@ -137,6 +137,14 @@ class Decoder {
   /// than the black ring. Reads one small circle (the hole) besides the signal.
   bool levels_agree(const cv::Mat& grey, const Blob& blob, const SampledSignal& signal, const CodeMatch& match) const;
 
+  /// Whether the white ring around `blob` (the dark disc; centre and shape) is unbroken:
+  /// at most DecoderConfig::max_dark_white_ring_reads of 64 reads around its middle lie
+  /// at or below the midpoint of `black_level` and `white_level` (grey levels). Anything
+  /// lying across the ring (a cable's end, a hand) breaks it, and a disc's outline fitted
+  /// through it is pulled towards what lies there. Part of levels_agree; a tracked marker
+  /// re-found by its outline is held to it too. 64 reads.
+  bool white_ring_unbroken(const cv::Mat& grey, const Blob& blob, double black_level, double white_level) const;
+
   /// Similarity of the signal to one ID (which must be one of ids()): what a tracked
   /// marker needs to confirm its ID at a fraction of match_all's cost.
   /// With `expected_heading_deg` (the heading last seen, on screen) only lags within a
