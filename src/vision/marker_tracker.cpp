@@ -243,10 +243,9 @@ std::vector<MarkerDetection> MarkerTracker::detect_full_frame(const cv::Mat& fra
   const cv::Mat grey = to_grey(frame);
   stats_ = FrameStats{};
   stats_.full_search = true;
-  std::vector<Blob>& fragments = fragments_;
-  fragments.clear();
-  auto found = assign(grey, find_blobs(grey, &fragments), false);
-  assign_rescued(grey, fragments, false, found);
+  fragments_.clear();
+  auto found = assign(grey, find_blobs(grey, &fragments_), false);
+  assign_rescued(grey, fragments_, false, found);
   stats_.fills = detector_.take_fill_count();
   return found;
 }
