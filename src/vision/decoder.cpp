@@ -604,18 +604,28 @@ bool Decoder::levels_agree(const cv::Mat& grey, const Blob& blob, const SampledS
   thread_local std::vector<double> colour;
   colour.resize(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) colour[static_cast<std::size_t>(k)] = family_.colour_at(match.id, kMiddle, 360.0 * k / n - key_deg);
+  // white_before[i]: white samples among the first i of the colours read twice round, so
+  // that a window's count is a difference (a modulo per read cost more than the rest).
+  thread_local std::vector<int> white_before;
+  white_before.assign(static_cast<std::size_t>(3 * n + 1), 0);
+  for (int i = 0; i < 3 * n; ++i) {
+    white_before[static_cast<std::size_t>(i + 1)] =
+        white_before[static_cast<std::size_t>(i)] + (colour[static_cast<std::size_t>(i % n)] != 0.0 ? 1 : 0);
+  }
   double key_sum = 0.0, black_sum = 0.0;
   int key_count = 0, black_count = 0;
   for (int k = 0; k < n; ++k) {
-    const double off_key = std::abs(std::remainder(360.0 * k / n - key_deg, 360.0));
+    // (x - 360 round(x / 360) is std::remainder's value here, at a fraction of its cost.)
+    const double x = 360.0 * k / n - key_deg;
+    const double off_key = std::abs(x - 360.0 * std::nearbyint(x / 360.0));
     if (off_key < 25.0) {  // well inside the key (the narrowest key, 6UCP's, is 85 degrees)
       key_sum += signal.values[static_cast<std::size_t>(k)];
       ++key_count;
     }
     if (colour[static_cast<std::size_t>(k)] != 0.0) continue;
-    bool away = true;
-    for (int d = -clear; d <= clear && away; ++d) away = colour[static_cast<std::size_t>(((k + d) % n + n) % n)] == 0.0;
-    if (away) {
+    // Black from k - clear to k + clear: no white sample in that window (around the circle).
+    const int first = k - clear + n;  // index into the doubled counts, >= 0
+    if (white_before[static_cast<std::size_t>(first + 2 * clear + 1)] == white_before[static_cast<std::size_t>(first)]) {
       black_sum += signal.values[static_cast<std::size_t>(k)];
       ++black_count;
     }
@@ -626,14 +636,10 @@ bool Decoder::levels_agree(const cv::Mat& grey, const Blob& blob, const SampledS
   // The same code on the annulus's inner and outer circles, each read on its own.
   const double reach = 1.0 / MarkerFamily::black_ring_outer_radius;
   thread_local std::vector<float> circle;
-  thread_local std::vector<double> ideal;
   circle.resize(sample_directions_.cos.size());
-  ideal.resize(static_cast<std::size_t>(n));
+  const std::vector<double>& ideal = colour;  // the code at the annulus's middle, as above
   double ideal_mean = 0.0;
-  for (int k = 0; k < n; ++k) {
-    ideal[static_cast<std::size_t>(k)] = family_.colour_at(match.id, MarkerFamily::sample_radii[1], 360.0 * k / n - key_deg);
-    ideal_mean += ideal[static_cast<std::size_t>(k)];
-  }
+  for (int k = 0; k < n; ++k) ideal_mean += ideal[static_cast<std::size_t>(k)];
   ideal_mean /= n;
   for (const double r : {MarkerFamily::sample_radii[0], MarkerFamily::sample_radii[2]}) {
     if (static_cast<int>(sample_directions_.count) != n) break;  // a signal of another length: not ours to check

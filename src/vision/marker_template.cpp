@@ -1,5 +1,6 @@
 #include "vision/marker_template.hpp"
 
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -17,6 +18,7 @@ constexpr double kPi = 3.14159265358979323846;
 // the black ring and the white ring, each a few times (and clear of the floor beyond R).
 constexpr std::array<double, 13> kRadii = {0.05, 0.1, 0.2, 0.27, 0.35, 0.43, 0.5, 0.6, 0.665, 0.72, 0.83, 0.9, 0.96};
 constexpr int kAngles = 64;
+static_assert(std::tuple_size_v<decltype(MarkerTemplates::Model::prefix_sum)> == kRadii.size() + 1);
 // Blur strengths, Gaussian sigma as a fraction of R: from a sharp 64 px marker to a
 // 20 px one under 2 px of blur and some smear.
 constexpr std::array<double, 7> kBlurOfRadius = {0.02, 0.05, 0.08, 0.11, 0.15, 0.2, 0.26};
@@ -39,13 +41,24 @@ struct LinearFit {
   double correlation = -1.0;
   double gain = 0.0, mean = 0.0;
 };
-LinearFit fit_levels(const std::vector<float>& levels, const std::vector<float>& model) {
+LinearFit fit_levels(const std::vector<float>& levels, const MarkerTemplates::Model& model) {
   const std::size_t n = levels.size();
-  double sum = 0.0, sum_sq = 0.0, dot = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    sum += model[i];
-    sum_sq += static_cast<double>(model[i]) * model[i];
-    dot += static_cast<double>(levels[i]) * model[i];
+  const std::size_t circles = n / kAngles;
+  // The model's sums over those circles were taken when it was rendered; only the dot
+  // product is left, a circle (64 floats) at a time in vector lanes, the circles summed
+  // in double. This ran for every blob that reached the template, 7 models each.
+  static_assert(kAngles % 16 == 0);
+  const double sum = model.prefix_sum[circles], sum_sq = model.prefix_sum_sq[circles];
+  double dot = 0.0;
+  for (std::size_t c = 0; c < circles; ++c) {
+    const float* l = levels.data() + c * kAngles;
+    const float* m = model.levels.data() + c * kAngles;
+    cv::v_float32x4 acc0 = cv::v_setzero_f32(), acc1 = cv::v_setzero_f32();
+    for (int k = 0; k < kAngles; k += 8) {
+      acc0 = cv::v_fma(cv::v_load(l + k), cv::v_load(m + k), acc0);
+      acc1 = cv::v_fma(cv::v_load(l + k + 4), cv::v_load(m + k + 4), acc1);
+    }
+    dot += cv::v_reduce_sum(acc0 + acc1);
   }
   const double var = sum_sq - sum * sum / static_cast<double>(n);
   if (var <= 1e-12) return {};
@@ -77,19 +90,31 @@ double black_ring_misfit(const std::vector<float>& levels, const std::vector<flo
   return worst;
 }
 
-// Centres `values` and scales them to unit norm; false when they are all alike.
+// Centres `values` and scales them to unit norm; false when they are all alike. (Four
+// running sums each: one chain of dependent additions left the CPU waiting on every add.)
 bool normalise(std::vector<float>& values) {
-  double mean = 0.0;
-  for (float v : values) mean += v;
-  mean /= static_cast<double>(values.size());
-  double norm = 0.0;
-  for (float& v : values) {
-    v = static_cast<float>(v - mean);
-    norm += static_cast<double>(v) * v;
+  const std::size_t n = values.size(), n4 = n & ~std::size_t{3};
+  std::array<double, 4> sums{};
+  for (std::size_t i = 0; i < n4; i += 4) {
+    for (std::size_t j = 0; j < 4; ++j) sums[j] += values[i + j];
   }
+  for (std::size_t i = n4; i < n; ++i) sums[0] += values[i];
+  const double mean = (sums[0] + sums[1] + sums[2] + sums[3]) / static_cast<double>(n);
+  std::array<double, 4> norms{};
+  for (std::size_t i = 0; i < n4; i += 4) {
+    for (std::size_t j = 0; j < 4; ++j) {
+      values[i + j] = static_cast<float>(values[i + j] - mean);
+      norms[j] += static_cast<double>(values[i + j]) * values[i + j];
+    }
+  }
+  for (std::size_t i = n4; i < n; ++i) {
+    values[i] = static_cast<float>(values[i] - mean);
+    norms[0] += static_cast<double>(values[i]) * values[i];
+  }
+  const double norm = norms[0] + norms[1] + norms[2] + norms[3];
   if (norm <= 1e-12) return false;
-  const double scale = 1.0 / std::sqrt(norm);
-  for (float& v : values) v = static_cast<float>(v * scale);
+  const auto scale = static_cast<float>(1.0 / std::sqrt(norm));
+  for (float& v : values) v *= scale;
   return true;
 }
 
@@ -137,9 +162,22 @@ const MarkerTemplates::Models& MarkerTemplates::models_of(std::size_t index) con
   if (!blurred.empty()) return blurred;
   const cv::Mat sharp = render(family_, ids_[index]);
   for (double blur : kBlurOfRadius) {
-    cv::Mat model;
-    cv::GaussianBlur(sharp, model, cv::Size(), blur * kModelRadiusPx, 0.0, cv::BORDER_REPLICATE);
-    blurred.push_back(sample_polar(model));
+    cv::Mat image;
+    cv::GaussianBlur(sharp, image, cv::Size(), blur * kModelRadiusPx, 0.0, cv::BORDER_REPLICATE);
+    Model model;
+    model.levels = sample_polar(image);
+    // Running sums over whole circles, in the order a plain loop over the levels takes.
+    double sum = 0.0, sum_sq = 0.0;
+    for (std::size_t c = 0; c < kRadii.size(); ++c) {
+      for (int k = 0; k < kAngles; ++k) {
+        const float v = model.levels[c * kAngles + static_cast<std::size_t>(k)];
+        sum += v;
+        sum_sq += static_cast<double>(v) * v;
+      }
+      model.prefix_sum[c + 1] = sum;
+      model.prefix_sum_sq[c + 1] = sum_sq;
+    }
+    blurred.push_back(std::move(model));
   }
   return blurred;
 }
@@ -172,11 +210,11 @@ TemplateFit MarkerTemplates::fit(const cv::Mat& grey, const Blob& blob, int id, 
   if (!normalise(levels)) return {};
   LinearFit best;
   const std::vector<float>* best_model = nullptr;
-  for (const std::vector<float>& model : models_of(static_cast<std::size_t>(which - ids_.begin()))) {
+  for (const Model& model : models_of(static_cast<std::size_t>(which - ids_.begin()))) {
     const LinearFit f = fit_levels(levels, model);
     if (f.correlation > best.correlation) {
       best = f;
-      best_model = &model;
+      best_model = &model.levels;
     }
   }
   if (best_model == nullptr) return {};

@@ -7,6 +7,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <array>
 #include <vector>
 
 #include "vision/blob_detector.hpp"
@@ -78,9 +79,18 @@ class MarkerTemplates {
 
   const MarkerTemplateConfig& config() const { return config_; }
 
+  /// One ideal marker at one blur strength: its grey levels on the polar grid
+  /// (radius-major, 64 angles per circle), and the sums of the levels and of their squares
+  /// over the first c circles (prefix_sum[c]), which fit() would otherwise add up again
+  /// for every blob. (Public only for the file's own helpers.)
+  struct Model {
+    std::vector<float> levels;
+    std::array<double, 14> prefix_sum{}, prefix_sum_sq{};
+  };
+
  private:
-  // Per blur strength: the model's grey levels on the polar grid, radius-major.
-  using Models = std::vector<std::vector<float>>;
+  // Per blur strength.
+  using Models = std::vector<Model>;
   const Models& models_of(std::size_t index) const;
 
   MarkerFamily family_;
