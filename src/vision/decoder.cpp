@@ -608,9 +608,11 @@ bool Decoder::levels_agree(const cv::Mat& grey, const Blob& blob, const SampledS
   // that a window's count is a difference (a modulo per read cost more than the rest).
   thread_local std::vector<int> white_before;
   white_before.assign(static_cast<std::size_t>(3 * n + 1), 0);
-  for (int i = 0; i < 3 * n; ++i) {
-    white_before[static_cast<std::size_t>(i + 1)] =
-        white_before[static_cast<std::size_t>(i)] + (colour[static_cast<std::size_t>(i % n)] != 0.0 ? 1 : 0);
+  for (int round = 0, i = 0; round < 3; ++round) {
+    for (int k = 0; k < n; ++k, ++i) {
+      white_before[static_cast<std::size_t>(i + 1)] =
+          white_before[static_cast<std::size_t>(i)] + (colour[static_cast<std::size_t>(k)] != 0.0 ? 1 : 0);
+    }
   }
   double key_sum = 0.0, black_sum = 0.0;
   int key_count = 0, black_count = 0;
