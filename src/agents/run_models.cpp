@@ -6,11 +6,12 @@
 namespace rilbed::agents {
 
 AgentModel::AgentModel(Body& body, std::unique_ptr<Controller> controller, TimeUs period_us, TimeUs first_step_us,
-                       bool commanded)
+                       bool commanded, AgentExchange* remote)
     : sim::AtomicModel<AgentState>("agent" + std::to_string(body.id()), AgentState{}),
       body_(body),
       controller_(std::move(controller)),
       period_us_(period_us),
+      remote_(remote && remote->serves(body.id()) ? remote : nullptr),
       team_in_(add_input<TeamBroadcast>("team")),
       command_in_(add_input<AgentCommand>("command")),
       console_in_(add_input<ConsoleOrder>("console")) {
@@ -53,9 +54,21 @@ void AgentModel::step() {
   input.sensors = body_.sense(state_.t_us);
   input.pose = body_.pose();
   if (state_.team) input.team = *state_.team;
-  state_.last = controller_->step(input);
-  body_.drive(state_.last.wheels);
+  if (remote_) {
+    // Its answer comes back through complete(), later in this instant.
+    remote_->submit(input);
+  } else {
+    state_.last = controller_->step(input);
+    body_.drive(state_.last.wheels);
+  }
   state_.sensors = std::move(input.sensors);  // kept for the run's observer
+}
+
+void AgentModel::complete(const RemoteOutput& answer) {
+  if (!remote_ || state_.commanded || state_.manual) return;
+  state_.last = answer.output;
+  remote_done_ = answer.done;
+  body_.drive(state_.last.wheels);
 }
 
 void AgentModel::external_transition(TimeUs elapsed_us) {
@@ -98,9 +111,33 @@ void AgentModel::apply(const ConsoleOrder& order) {
 }
 
 void AgentModel::finish() {
-  if (controller_) controller_->finish();
+  // A remote controller finishes in its own process (AgentExchange::end).
+  if (controller_ && !remote_) controller_->finish();
   body_.stop();
   state_.last.wheels = {};
+}
+
+QuantumModel::QuantumModel(AgentExchange& exchange, std::vector<AgentModel*> agents, TimeUs period_us, TimeUs first_us)
+    : sim::AtomicModel<TimeUs>("quantum", first_us),
+      exchange_(exchange),
+      agents_(std::move(agents)),
+      period_us_(period_us),
+      t_us_(first_us) {
+  if (period_us <= 0) throw std::invalid_argument("quantum: period must be > 0");
+}
+
+void QuantumModel::internal_transition() {
+  const TimeUs t = t_us_;
+  for (const RemoteOutput& answer : exchange_.exchange(t)) {
+    for (AgentModel* a : agents_) {
+      if (a->body().id() == answer.robot_id) a->complete(answer);
+    }
+  }
+  if (record_) {
+    for (const ExchangeNotice& n : exchange_.take_notices()) record_(t, n);
+  }
+  t_us_ += period_us_;
+  state_ = period_us_;
 }
 
 TeamBroadcaster::TeamBroadcaster(std::vector<const AgentModel*> agents, TimeUs period_us, TimeUs first_us)

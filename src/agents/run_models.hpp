@@ -8,11 +8,13 @@
 // agent senses at t.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "agents/agent_exchange.hpp"
 #include "agents/body.hpp"
 #include "agents/controller.hpp"
 #include "agents/convoy.hpp"
@@ -70,8 +72,13 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   /// The first control step is at `first_step_us`, then every `period_us` (> 0).
   /// `commanded`: it starts obeying its "command" input (central mode) rather than its
   /// controller.
+  /// `remote` (may be null; must outlive the model): when it serves this robot, the
+  /// controller runs there. At each step the model then submits the input to it and
+  /// drives nothing itself; the QuantumModel of the same instant applies the answer
+  /// (complete()). `controller` is still given: it says whether the robot reads the team
+  /// broadcast, and is never stepped here.
   AgentModel(Body& body, std::unique_ptr<Controller> controller, TimeUs period_us, TimeUs first_step_us = 0,
-             bool commanded = false);
+             bool commanded = false, AgentExchange* remote = nullptr);
 
   TimeUs time_advance() const override;
   void internal_transition() override;
@@ -83,7 +90,12 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   bool wants_team() const { return controller_ && controller_->wants_team(); }
   /// Whether it has no goal left: no controller (it stands still or is commanded), or
   /// its controller is done.
-  bool done() const { return !controller_ || state_.commanded || controller_->done(); }
+  bool done() const { return !controller_ || state_.commanded || (remote_ ? remote_done_ : controller_->done()); }
+  /// Whether its controller runs elsewhere (see the constructor).
+  bool is_remote() const { return remote_ != nullptr; }
+  /// A remote controller's answer: drives the body with it, as step() would have (ignored
+  /// while the robot is commanded or driven by hand).
+  void complete(const RemoteOutput& answer);
   /// The active behaviour (a static string), "idle" before the first step.
   std::string_view behaviour() const { return state_.last.behaviour; }
   const WheelCommand& wheels() const { return state_.last.wheels; }
@@ -97,6 +109,8 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   Body& body_;
   std::unique_ptr<Controller> controller_;
   TimeUs period_us_;
+  AgentExchange* remote_ = nullptr;  // serves this robot, or null
+  bool remote_done_ = false;         // the remote controller's done() at its last answer
   void apply(const ConsoleOrder& order);
   // Its own step: sense, decide (controller or hand), drive.
   void step();
@@ -122,6 +136,31 @@ class TeamBroadcaster final : public sim::AtomicModel<TimeUs> {  // state: time 
   TimeUs period_us_;
   TimeUs t_us_ = 0;  // simulated time, advanced with each broadcast
   sim::Port<TeamBroadcast>& team_out_;
+};
+
+/// Sends each control instant's quantum to the remote controllers and applies their
+/// answers (issue 18). Added after every AgentModel, with the same period and first step,
+/// so that at each control instant every agent has submitted its input before the
+/// exchange, and the answers drive the bodies before anything later in the instant (the
+/// central coordinator, the monitor) reads them. State: time to the next quantum.
+class QuantumModel final : public sim::AtomicModel<TimeUs> {
+ public:
+  /// `exchange` and the agents must outlive the model; `agents` are every AgentModel of
+  /// the run (those the exchange serves are answered).
+  QuantumModel(AgentExchange& exchange, std::vector<AgentModel*> agents, TimeUs period_us, TimeUs first_us = 0);
+  TimeUs time_advance() const override { return state_; }
+  void internal_transition() override;
+  void external_transition(TimeUs elapsed_us) override { state_ -= elapsed_us; }
+  void output() override {}
+  /// Where the exchange's notices go (the run's events), from then on.
+  void on_notice(std::function<void(TimeUs, const ExchangeNotice&)> record) { record_ = std::move(record); }
+
+ private:
+  AgentExchange& exchange_;
+  std::vector<AgentModel*> agents_;
+  TimeUs period_us_;
+  TimeUs t_us_ = 0;  // the instant of the next quantum
+  std::function<void(TimeUs, const ExchangeNotice&)> record_;
 };
 
 /// State of the central coordinator: when it next decides, and the commands it is about

@@ -320,7 +320,7 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source) {
   Scenario s;
   const Reader top(root, source, "");
   top.allow({"name", "description", "mode", "field", "timing", "duration_s", "convoy", "obstacles", "tracks", "beacons",
-             "moving_obstacles", "robots", "camera", "safety"});
+             "moving_obstacles", "robots", "camera", "safety", "agents"});
   s.name = top.text("name", std::filesystem::path(source).stem().string());
   const std::string mode = top.text("mode", "distributed");
   if (mode == "distributed") {
@@ -438,6 +438,39 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source) {
     s.lost_timeout_ms = f.integer("lost_timeout_ms", s.lost_timeout_ms);
     if (s.lost_timeout_ms <= 0) f.fail_key("lost_timeout_ms", "must be greater than 0");
     s.geofence_margin_m = f.non_negative("geofence_margin_m", s.geofence_margin_m);
+  }
+  if (top.has("agents")) {
+    const Reader a = top.child("agents");
+    a.allow({"processes", "ids", "announce_timeout_s", "resend_ms", "dead_after_ms", "deadline_ms"});
+    AgentsSpec spec;
+    spec.processes = a.integer("processes", 0);
+    if (spec.processes < 0 || spec.processes > 64) a.fail_key("processes", "must be 0 to 64");
+    if (a.has("ids")) {
+      const auto parsed = parse_id_list(a.text("ids", ""), 1, 100000);
+      if (!parsed.ok()) a.fail_key("ids", parsed.error);
+      for (const int id : parsed.ids) {
+        const auto robot = std::find_if(s.robots.begin(), s.robots.end(), [&](const RobotSpec& r) { return r.id == id; });
+        if (robot == s.robots.end()) a.fail_key("ids", "there is no robot " + std::to_string(id));
+        if (robot->controller.name == "none") a.fail_key("ids", "robot " + std::to_string(id) + " has no controller");
+      }
+      spec.ids = parsed.ids;
+    } else {
+      for (const RobotSpec& r : s.robots) {
+        if (r.controller.name != "none") spec.ids.push_back(r.id);
+      }
+    }
+    if (spec.ids.empty()) a.fail_key("ids", "no robot has a controller to run elsewhere");
+    if (spec.processes > static_cast<int>(spec.ids.size())) {
+      a.fail_key("processes", "more processes than robots to run (" + std::to_string(spec.ids.size()) + ")");
+    }
+    spec.announce_timeout_s = a.positive("announce_timeout_s", spec.announce_timeout_s);
+    spec.resend_ms = a.integer("resend_ms", spec.resend_ms);
+    if (spec.resend_ms < 1) a.fail_key("resend_ms", "must be at least 1");
+    spec.dead_after_ms = a.integer("dead_after_ms", spec.dead_after_ms);
+    if (spec.dead_after_ms <= spec.resend_ms) a.fail_key("dead_after_ms", "must be longer than resend_ms");
+    spec.deadline_ms = a.integer("deadline_ms", spec.deadline_ms);
+    if (spec.deadline_ms < 1) a.fail_key("deadline_ms", "must be at least 1");
+    s.agents = spec;
   }
   const bool any_real = std::any_of(s.robots.begin(), s.robots.end(),
                                     [](const RobotSpec& r) { return r.kind == environment::RobotKind::Real; });

@@ -94,6 +94,25 @@ struct RobotSpec {
 };
 
 /// A whole scenario.
+/// Where the robots' controllers run (the `agents:` block; issue 18). Without it, every
+/// controller runs in the run's own process.
+struct AgentsSpec {
+  /// `rilbed agent` processes that `rilbed run` starts on this machine, the remote robots
+  /// split among them in ID order. 0: they are started by hand (`rilbed agent --ids ...`,
+  /// on any machine of the LAN), and the run waits for them.
+  int processes = 0;
+  /// The robots whose controllers run elsewhere; empty: every robot with a controller.
+  std::vector<int> ids;
+  /// How long the run waits for every remote robot's process to announce itself.
+  double announce_timeout_s = 10.0;
+  /// A quantum not answered within this is sent again (milliseconds).
+  int resend_ms = 20;
+  /// A process that answers nothing for this long is lost: its robots stop (milliseconds).
+  int dead_after_ms = 1000;
+  /// Real-time runs: how long a control step waits for its answers (milliseconds).
+  int deadline_ms = 20;
+};
+
 struct Scenario {
   std::string name;                 ///< the file's `name`, else its stem
   std::filesystem::path source;     ///< the file it came from
@@ -111,6 +130,7 @@ struct Scenario {
   /// Safety: stop a real robot whose centre comes nearer than this to the field's edge, metres.
   double geofence_margin_m = 0.0;
   std::vector<RobotSpec> robots;    ///< sorted by ID
+  std::optional<AgentsSpec> agents; ///< controllers in other processes (the `agents:` block)
 };
 
 /// The IDs of the scenario's real robots, in ID order.

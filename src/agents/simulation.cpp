@@ -773,7 +773,14 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   for (std::size_t i = 0; i < scenario.robots.size(); ++i) {
     auto controller = make_controller(scenario, scenario.robots[i]);
     const bool commanded = central && i < convoy_ids.size();
-    agents.push_back(&root->emplace<AgentModel>(*bodies[i], std::move(controller), scenario.control_period_us, 0, commanded));
+    agents.push_back(&root->emplace<AgentModel>(*bodies[i], std::move(controller), scenario.control_period_us, 0, commanded,
+                                                options.remote_agents));
+  }
+  // The remote controllers' quantum, right after every agent of the instant has stepped.
+  QuantumModel* quantum = nullptr;
+  if (options.remote_agents &&
+      std::any_of(agents.begin(), agents.end(), [](const AgentModel* a) { return a->is_remote(); })) {
+    quantum = &root->emplace<QuantumModel>(*options.remote_agents, agents, scenario.control_period_us, 0);
   }
   // Both ways of running a convoy are built; the mode says which one drives (the console
   // may switch it while the run runs).
@@ -824,6 +831,11 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   if (options.realtime) setup.clock = &real_clock;
   setup.camera = camera.get();
   auto& monitor = root->emplace<MonitorModel>(setup);
+  if (quantum) {
+    quantum->on_notice([&monitor](TimeUs t, const ExchangeNotice& n) {
+      monitor.record_event(RunEvent{t, n.kind, n.robot_id, 0, n.detail});
+    });
+  }
   if (camera) {
     camera->report_to(options.observer);
     root->add(camera);
@@ -916,6 +928,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   result.run_cpu_s = thread_cpu_seconds() - cpu_start;
   // Every body is stopped whatever happened (a real robot must not drive on).
   for (AgentModel* a : agents) a->finish();
+  if (quantum) options.remote_agents->end();
   if (result.ended_by.empty()) result.ended_by = "duration";
   result.simulated_s = us_to_seconds(std::min(coordinator.now_us(), end_us));
   result.formed = monitor.formed();

@@ -1,11 +1,16 @@
 // `rilbed run SCENARIO.yaml`: one run, or a batch of runs over seeds, of a scenario.
+#include <signal.h>
+#include <spawn.h>
 #include <spdlog/spdlog.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <limits>
@@ -27,6 +32,7 @@
 #include "gui_web/gui_service.hpp"
 #include "links/lcm_bus.hpp"
 #include "links/lcm_console.hpp"
+#include "links/remote_agents.hpp"
 #include "links/placement.hpp"
 #include "links/real_robots.hpp"
 
@@ -154,6 +160,62 @@ void print_result(const agents::RunResult& r) {
 }
 
 // Runs one seed of a batch (its options already hold the seed and out_dir).
+// The `rilbed agent` processes a scenario's `agents: {processes: N}` asks for, started on
+// this machine with the run's bus and stopped (SIGTERM, then waited for) when it goes.
+class AgentProcesses {
+ public:
+  AgentProcesses() = default;
+  AgentProcesses(const AgentProcesses&) = delete;
+  AgentProcesses& operator=(const AgentProcesses&) = delete;
+  ~AgentProcesses() {
+    for (const pid_t pid : pids_) kill(pid, SIGTERM);
+    for (const pid_t pid : pids_) waitpid(pid, nullptr, 0);
+  }
+  /// Starts one process per group of robots; false (and the reason) when one cannot start.
+  bool start(const std::string& scenario_file, const std::vector<std::vector<int>>& groups, const std::string& url,
+             const std::string& prefix, std::string& error) {
+    char self[4096] = {};
+    const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (n <= 0) {
+      error = "cannot find rilbed's own binary to start the agents";
+      return false;
+    }
+    for (const std::vector<int>& group : groups) {
+      std::vector<std::string> args = {self, "agent", "--scenario", scenario_file, "--ids", id_list_arg(group),
+                                       "--lcm", url, "--quiet"};
+      if (!prefix.empty()) {
+        args.push_back("--channel-prefix");
+        args.push_back(prefix);
+      }
+      std::vector<char*> argv;
+      for (std::string& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      pid_t pid = 0;
+      if (const int rc = posix_spawn(&pid, self, nullptr, nullptr, argv.data(), environ); rc != 0) {
+        error = std::string("cannot start an agent process: ") + std::strerror(rc);
+        return false;
+      }
+      pids_.push_back(pid);
+    }
+    return true;
+  }
+
+ private:
+  static std::string id_list_arg(const std::vector<int>& ids) {
+    std::string s;
+    for (const int id : ids) s += (s.empty() ? "" : ",") + std::to_string(id);
+    return s;
+  }
+  std::vector<pid_t> pids_;
+};
+
+// The scenario's remote robots in `processes` groups of consecutive IDs, as even as can be.
+std::vector<std::vector<int>> split_ids(const std::vector<int>& ids, int processes) {
+  std::vector<std::vector<int>> groups(static_cast<std::size_t>(processes));
+  for (std::size_t i = 0; i < ids.size(); ++i) groups[i * groups.size() / ids.size()].push_back(ids[i]);
+  return groups;
+}
+
 using SeedRunner = std::function<agents::RunResult(const agents::RunOptions&)>;
 
 int run_batch(const agents::Scenario& scenario, const RunArgs& args, agents::RunOptions base, const SeedRunner& run_seed,
@@ -465,6 +527,60 @@ int run_command(const RunArgs& args) {
       if (!args.no_place) place_or_throw(*real, scenario, o.seed, args);
       return agents::run_scenario(scenario, o, real_bodies);
     });
+  }
+  // Controllers in other processes (issue 18): each run waits for every remote robot's
+  // process to announce itself, then steps them one quantum per control instant.
+  std::unique_ptr<lcm::LCM> agents_lcm;
+  AgentProcesses agent_processes;
+  if (scenario.agents) {
+    const agents::AgentsSpec& spec = *scenario.agents;
+    if (!network_bus) {
+      spdlog::error("{}: its agents run in other processes, which need a bus they reach: give --lcm URL "
+                    "(e.g. udpm://239.255.76.67:7667?ttl=0)",
+                    args.scenario);
+      return kExitUsage;
+    }
+    std::string error;
+    agents_lcm = links::open_lcm(args.lcm_url, error);
+    if (!agents_lcm) {
+      spdlog::error("{}", error);
+      return kExitFailure;
+    }
+    if (spec.processes > 0 && !agent_processes.start(args.scenario, split_ids(spec.ids, spec.processes), args.lcm_url,
+                                                     args.channel_prefix, error)) {
+      spdlog::error("{}", error);
+      return kExitFailure;
+    }
+    links::RemoteAgentsConfig config;
+    config.channels = channels;
+    config.scenario_name = scenario.name;
+    config.robot_ids = spec.ids;
+    for (const int id : spec.ids) {
+      const auto robot = std::find_if(scenario.robots.begin(), scenario.robots.end(), [&](const auto& r) { return r.id == id; });
+      if (const auto c = agents::make_controller(scenario, *robot); c && c->wants_team()) config.team_readers.insert(id);
+    }
+    config.realtime = options.realtime;
+    config.resend_ms = spec.resend_ms;
+    config.dead_after_ms = spec.dead_after_ms;
+    config.deadline_ms = spec.deadline_ms;
+    const auto timeout = std::chrono::milliseconds(static_cast<std::int64_t>(spec.announce_timeout_s * 1000.0));
+    run_seed = [&, config, timeout, inner = run_seed](const agents::RunOptions& given) {
+      agents::RunOptions o = given;
+      links::RemoteAgents remote(*agents_lcm, config);
+      if (const auto missing = remote.wait_for_agents(timeout)) throw agents::ScenarioError(args.scenario + ": " + *missing);
+      o.remote_agents = &remote;
+      agents::RunResult r = inner(o);
+      const links::RemoteAgentsCounters& c = remote.counters();
+      if (!args.quiet) {
+        std::printf("agents: %lld quanta sent, %lld sent again, %lld duplicate answers, %lld late, %lld processes lost, "
+                    "%lld robots rejoined\n",
+                    static_cast<long long>(c.quanta_sent), static_cast<long long>(c.repeats),
+                    static_cast<long long>(c.duplicates), static_cast<long long>(c.late),
+                    static_cast<long long>(c.lost_processes), static_cast<long long>(c.rejoins));
+        std::fflush(stdout);
+      }
+      return r;
+    };
   }
   // The console's reset ends a run to start it over (its folder too), as it began: real
   // robots are placed again.

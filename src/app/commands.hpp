@@ -30,6 +30,9 @@ void add_khepera_command(CLI::App& app);
 /// `rilbed khepera-emu`: an emulated Khepera on a pseudo-terminal.
 void add_khepera_emu_command(CLI::App& app);
 
+/// `rilbed agent --scenario FILE --ids 3,4 --lcm URL`: runs those robots' controllers for a run on the bus.
+void add_agent_command(CLI::App& app);
+
 /// `rilbed watch --lcm URL`: a terminal display of a run on an LCM bus.
 void add_watch_command(CLI::App& app);
 

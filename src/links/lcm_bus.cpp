@@ -39,6 +39,9 @@ Channels Channels::with_prefix(const std::string& prefix) {
   c.summary = prefix + c.summary;
   c.console = prefix + c.console;
   c.console_reply = prefix + c.console_reply;
+  c.agent_hello = prefix + c.agent_hello;
+  c.quantum = prefix + c.quantum;
+  c.quantum_reply = prefix + c.quantum_reply;
   c.wheels = prefix + c.wheels;
   c.sensors = prefix + c.sensors;
   c.detections = prefix + c.detections;
@@ -141,43 +144,43 @@ void fill(rilbed::wheels_t& m, TimeUs t_us, std::span<const agents::WheelReport>
   }
 }
 
+void fill(rilbed::robot_sensors_t& r, int id, const environment::SensorReadings& s) {
+  r.id = id;
+  r.proximity.clear();
+  if (s.proximity) {
+    for (const int v : *s.proximity) r.proximity.push_back(static_cast<std::int16_t>(v));
+  }
+  r.num_proximity = static_cast<std::int8_t>(r.proximity.size());
+  // Counts are int8/int16 on the wire: a robot carries a handful of each sensor.
+  const std::size_t ranges = std::min<std::size_t>(s.ranges.size(), 127);
+  r.range_m.resize(ranges);
+  r.range_hit.resize(ranges);
+  for (std::size_t k = 0; k < ranges; ++k) {
+    r.range_m[k] = s.ranges[k].distance_m;
+    r.range_hit[k] = s.ranges[k].hit;
+  }
+  r.num_ranges = static_cast<std::int8_t>(ranges);
+  const std::size_t beacons = std::min<std::size_t>(s.beacons.size(), 127);
+  r.beacon_id.resize(beacons);
+  r.beacon_bearing_rad.resize(beacons);
+  for (std::size_t k = 0; k < beacons; ++k) {
+    r.beacon_id[k] = s.beacons[k].id;
+    r.beacon_bearing_rad[k] = s.beacons[k].bearing_rad;
+  }
+  r.num_beacons = static_cast<std::int8_t>(beacons);
+  const std::size_t track = std::min<std::size_t>(s.track.size(), 32767);
+  r.track.assign(s.track.begin(), s.track.begin() + static_cast<std::ptrdiff_t>(track));
+  r.num_track = static_cast<std::int16_t>(track);
+  r.has_odometry = s.odometry.has_value();
+  r.left_pulses = s.odometry ? s.odometry->left_pulses : 0;
+  r.right_pulses = s.odometry ? s.odometry->right_pulses : 0;
+}
+
 void fill(rilbed::sensors_t& m, TimeUs t_us, std::span<const agents::SensorReport> sensors) {
   m.utime = t_us;
   m.num_robots = static_cast<std::int32_t>(sensors.size());
   m.robots.resize(sensors.size());
-  for (std::size_t i = 0; i < sensors.size(); ++i) {
-    rilbed::robot_sensors_t& r = m.robots[i];
-    const environment::SensorReadings& s = *sensors[i].readings;
-    r.id = sensors[i].id;
-    r.proximity.clear();
-    if (s.proximity) {
-      for (const int v : *s.proximity) r.proximity.push_back(static_cast<std::int16_t>(v));
-    }
-    r.num_proximity = static_cast<std::int8_t>(r.proximity.size());
-    // Counts are int8/int16 on the wire: a robot carries a handful of each sensor.
-    const std::size_t ranges = std::min<std::size_t>(s.ranges.size(), 127);
-    r.range_m.resize(ranges);
-    r.range_hit.resize(ranges);
-    for (std::size_t k = 0; k < ranges; ++k) {
-      r.range_m[k] = s.ranges[k].distance_m;
-      r.range_hit[k] = s.ranges[k].hit;
-    }
-    r.num_ranges = static_cast<std::int8_t>(ranges);
-    const std::size_t beacons = std::min<std::size_t>(s.beacons.size(), 127);
-    r.beacon_id.resize(beacons);
-    r.beacon_bearing_rad.resize(beacons);
-    for (std::size_t k = 0; k < beacons; ++k) {
-      r.beacon_id[k] = s.beacons[k].id;
-      r.beacon_bearing_rad[k] = s.beacons[k].bearing_rad;
-    }
-    r.num_beacons = static_cast<std::int8_t>(beacons);
-    const std::size_t track = std::min<std::size_t>(s.track.size(), 32767);
-    r.track.assign(s.track.begin(), s.track.begin() + static_cast<std::ptrdiff_t>(track));
-    r.num_track = static_cast<std::int16_t>(track);
-    r.has_odometry = s.odometry.has_value();
-    r.left_pulses = s.odometry ? s.odometry->left_pulses : 0;
-    r.right_pulses = s.odometry ? s.odometry->right_pulses : 0;
-  }
+  for (std::size_t i = 0; i < sensors.size(); ++i) fill(m.robots[i], sensors[i].id, *sensors[i].readings);
 }
 
 rilbed::detections_t to_lcm(const agents::FrameReport& f) {
@@ -375,6 +378,8 @@ agents::StatusReport from_lcm(const rilbed::status_t& m) {
   return s;
 }
 
+}  // namespace
+
 environment::SensorReadings from_lcm(const rilbed::robot_sensors_t& m, TimeUs t_us) {
   environment::SensorReadings s;
   s.t_us = t_us;
@@ -392,7 +397,6 @@ environment::SensorReadings from_lcm(const rilbed::robot_sensors_t& m, TimeUs t_
   return s;
 }
 
-}  // namespace
 
 RunReportDecoder::RunReportDecoder(Channels channels, agents::RunObserver& observer)
     : channels_(std::move(channels)), observer_(observer) {}

@@ -71,6 +71,9 @@ struct Channels {
   std::string vision = "RILBED_VISION";    ///< rilbed::vision_settings_t, before each status_t of a run with a camera
   std::string console = "RILBED_CONSOLE";  ///< rilbed::console_command_t, from consoles
   std::string console_reply = "RILBED_CONSOLE_REPLY";  ///< rilbed::console_reply_t, the run's answers
+  std::string agent_hello = "RILBED_AGENT_HELLO";  ///< rilbed::agent_hello_t, from agent processes (issue 18)
+  std::string quantum = "RILBED_QUANTUM";          ///< rilbed::quantum_t, the run's quanta to agent processes
+  std::string quantum_reply = "RILBED_QUANTUM_REPLY";  ///< rilbed::quantum_reply_t, their answers
   /// The same names behind `prefix`.
   static Channels with_prefix(const std::string& prefix);
 };
@@ -93,6 +96,11 @@ rilbed::world_t to_lcm(TimeUs t_us, const agents::WorldReport& world);
 rilbed::summary_t to_lcm(TimeUs t_us, const nlohmann::json& summary);
 void fill(rilbed::wheels_t& message, TimeUs t_us, std::span<const agents::WheelReport> wheels);
 void fill(rilbed::sensors_t& message, TimeUs t_us, std::span<const agents::SensorReport> sensors);
+/// One robot's readings (counts beyond the wire's int8/int16 are cut; a robot carries a
+/// handful of each sensor).
+void fill(rilbed::robot_sensors_t& message, int id, const environment::SensorReadings& readings);
+/// The readings back, taken at `t_us` (a proximity array of another length than 8 is left out).
+environment::SensorReadings from_lcm(const rilbed::robot_sensors_t& message, TimeUs t_us);
 rilbed::detections_t to_lcm(const agents::FrameReport& frame);
 /// A camera frame as JPEG of `quality` (1..100); an empty image gives size 0.
 rilbed::frame_t to_lcm(TimeUs t_us, std::int64_t frame, const cv::Mat& image, int quality);

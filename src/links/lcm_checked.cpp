@@ -227,6 +227,57 @@ void fields(Walk& w, const rilbed::sensor_layout_t*) {
   w.skip(static_cast<std::size_t>(robots) * 2 * 4);
 }
 
+// The agent exchange (issue 18).
+void fields(Walk& w, const rilbed::agent_hello_t*) {
+  w.string();
+  w.string();
+  const std::int32_t n = w.count(w.i32(), 4);
+  w.skip(static_cast<std::size_t>(n) * 4);
+  w.string();
+  w.i32();
+}
+void agent_input(Walk& w) {
+  w.i32();
+  w.boolean();
+  w.f64();
+  w.f64();
+  w.f64();
+  robot_sensors(w);
+}
+void team_member(Walk& w) {
+  w.i32();
+  w.f64();
+  w.f64();
+  w.f64();
+  w.string();
+  w.i64();
+}
+void fields(Walk& w, const rilbed::quantum_t*) {
+  w.string();
+  w.string();
+  w.i64();
+  w.i64();
+  w.boolean();
+  std::int32_t n = w.count(w.i32(), 4 + 1 + 24 + 4 + 1 + 1 + 1 + 2 + 1 + 16);
+  for (std::int32_t i = 0; i < n && w.ok(); ++i) agent_input(w);
+  w.boolean();
+  n = w.count(w.i32(), 4 + 24 + 5 + 8);
+  for (std::int32_t i = 0; i < n && w.ok(); ++i) team_member(w);
+}
+void fields(Walk& w, const rilbed::quantum_reply_t*) {
+  w.string();
+  w.string();
+  w.i64();
+  const std::int32_t n = w.count(w.i32(), 4 + 2 + 2 + 5 + 1);
+  for (std::int32_t i = 0; i < n && w.ok(); ++i) {
+    w.i32();
+    w.i16();
+    w.i16();
+    w.string();
+    w.boolean();
+  }
+}
+
 }  // namespace
 
 template <typename Message>
@@ -251,5 +302,8 @@ template bool well_formed<rilbed::frame_t>(const void*, std::size_t);
 template bool well_formed<rilbed::camera_t>(const void*, std::size_t);
 template bool well_formed<rilbed::sensor_layout_t>(const void*, std::size_t);
 template bool well_formed<rilbed::vision_settings_t>(const void*, std::size_t);
+template bool well_formed<rilbed::agent_hello_t>(const void*, std::size_t);
+template bool well_formed<rilbed::quantum_t>(const void*, std::size_t);
+template bool well_formed<rilbed::quantum_reply_t>(const void*, std::size_t);
 
 }  // namespace rilbed::links

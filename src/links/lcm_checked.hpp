@@ -15,6 +15,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "rilbed/agent_hello_t.hpp"
 #include "rilbed/console_command_t.hpp"
 #include "rilbed/console_reply_t.hpp"
 #include "rilbed/detections_t.hpp"
@@ -23,6 +24,8 @@
 #include "rilbed/sensor_layout_t.hpp"
 #include "rilbed/frame_t.hpp"
 #include "rilbed/poses_t.hpp"
+#include "rilbed/quantum_reply_t.hpp"
+#include "rilbed/quantum_t.hpp"
 #include "rilbed/sensors_t.hpp"
 #include "rilbed/status_t.hpp"
 #include "rilbed/vision_settings_t.hpp"

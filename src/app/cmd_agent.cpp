@@ -1,0 +1,123 @@
+// `rilbed agent --scenario FILE --ids 3,4 --lcm URL`: runs those robots' controllers in this
+// process, for whichever run of that scenario on the bus lists them as remote (issue 18).
+// The controllers are built from the scenario exactly as `rilbed run` builds them, afresh
+// for each run; the run sends their inputs each control step and applies their answers.
+#include <signal.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "agents/scenario.hpp"
+#include "agents/simulation.hpp"
+#include "app/commands.hpp"
+#include "core/id_list.hpp"
+#include "links/agent_server.hpp"
+#include "links/lcm_bus.hpp"
+
+namespace rilbed::app {
+
+namespace {
+
+std::atomic<bool> agent_interrupted{false};
+extern "C" void on_agent_signal(int) { agent_interrupted.store(true); }
+
+struct AgentArgs {
+  std::string scenario;
+  std::string ids;
+  std::string url;
+  std::string prefix;
+  bool once = false;
+  bool quiet = false;
+};
+
+int agent_command(const AgentArgs& args) {
+  if (const auto problem = links::check_channel_prefix(args.prefix)) {
+    spdlog::error("agent: {}", *problem);
+    return kExitUsage;
+  }
+  agents::Scenario scenario;
+  try {
+    scenario = agents::load_scenario(args.scenario);
+  } catch (const std::exception& e) {
+    spdlog::error("agent: {}", e.what());
+    return kExitFailure;
+  }
+  const IdListResult parsed = parse_id_list(args.ids, 1, 1 << 20);
+  if (!parsed.error.empty()) {
+    spdlog::error("agent: --ids {}: {}", args.ids, parsed.error);
+    return kExitUsage;
+  }
+  const std::vector<int>& ids = parsed.ids;
+  // Every ID must be a robot of the scenario with a controller; each is built once here,
+  // so that a bad parameter shows now rather than when a run starts.
+  for (const int id : ids) {
+    const auto spec = std::find_if(scenario.robots.begin(), scenario.robots.end(), [&](const auto& r) { return r.id == id; });
+    if (spec == scenario.robots.end()) {
+      spdlog::error("agent: {} has no robot {}", args.scenario, id);
+      return kExitUsage;
+    }
+    try {
+      if (!agents::make_controller(scenario, *spec)) {
+        spdlog::error("agent: robot {} of {} has no controller (controller: none)", id, args.scenario);
+        return kExitUsage;
+      }
+    } catch (const std::exception& e) {
+      spdlog::error("agent: {}", e.what());
+      return kExitFailure;
+    }
+  }
+  std::string error;
+  std::unique_ptr<lcm::LCM> lcm = links::open_lcm(args.url, error);
+  if (!lcm) {
+    spdlog::error("agent: {}", error);
+    return kExitFailure;
+  }
+  links::AgentServerConfig config;
+  config.channels = links::Channels::with_prefix(args.prefix);
+  config.scenario_name = scenario.name;
+  config.robot_ids = ids;
+  config.once = args.once;
+  links::AgentServer server(*lcm, config, [&scenario](int id) {
+    const auto spec = std::find_if(scenario.robots.begin(), scenario.robots.end(), [&](const auto& r) { return r.id == id; });
+    return agents::make_controller(scenario, *spec);
+  });
+  std::signal(SIGINT, on_agent_signal);
+  std::signal(SIGTERM, on_agent_signal);
+  if (!args.quiet) {
+    std::printf("agent %s: robots %s of %s, on %s\n", server.session().c_str(), args.ids.c_str(), scenario.name.c_str(),
+                args.url.empty() ? "LCM's default bus" : args.url.c_str());
+    std::fflush(stdout);
+  }
+  server.serve(agent_interrupted);
+  if (!args.quiet) {
+    const auto& c = server.counters();
+    std::printf("agent %s: %lld run(s), %lld steps, %lld repeated answers, %lld quanta skipped\n", server.session().c_str(),
+                static_cast<long long>(c.runs), static_cast<long long>(c.steps), static_cast<long long>(c.repeats),
+                static_cast<long long>(c.skipped));
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_agent_command(CLI::App& app) {
+  auto args = std::make_shared<AgentArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "agent", "Run some robots' controllers in this process, for a run on an LCM bus that lists them as remote");
+  cmd->add_option("--scenario", args->scenario, "The run's scenario file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--ids", args->ids, "The robots whose controllers run here (e.g. 3,4 or 1-8)")->required();
+  cmd->add_option("--lcm", args->url, "LCM URL of the run's bus (e.g. udpm://239.255.76.67:7667?ttl=0)")->required();
+  cmd->add_option("--channel-prefix", args->prefix, "The run's channel prefix (rilbed run --channel-prefix)");
+  cmd->add_flag("--once", args->once, "Exit when the first run it serves ends (default: serve runs until Ctrl-C)");
+  cmd->add_flag("--quiet", args->quiet, "Print nothing but errors");
+  cmd->callback([args] { exit_code() = agent_command(*args); });
+}
+
+}  // namespace rilbed::app

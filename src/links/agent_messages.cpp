@@ -1,0 +1,79 @@
+#include "links/agent_messages.hpp"
+
+#include <algorithm>
+#include <mutex>
+#include <set>
+#include <string>
+
+#include "links/lcm_bus.hpp"
+
+namespace rilbed::links {
+
+rilbed::agent_input_t to_lcm(const agents::ControlInput& input) {
+  rilbed::agent_input_t m;
+  m.id = input.robot_id;
+  m.has_pose = input.pose.has_value();
+  m.x_m = input.pose ? input.pose->position_m.x : 0.0;
+  m.y_m = input.pose ? input.pose->position_m.y : 0.0;
+  m.theta_rad = input.pose ? input.pose->heading_rad : 0.0;
+  fill(m.sensors, input.robot_id, input.sensors);
+  return m;
+}
+
+agents::ControlInput from_lcm(const rilbed::agent_input_t& m, TimeUs t_us) {
+  agents::ControlInput input;
+  input.t_us = t_us;
+  input.robot_id = m.id;
+  if (m.has_pose) input.pose = Pose2{{m.x_m, m.y_m}, m.theta_rad};
+  input.sensors = from_lcm(m.sensors, t_us);
+  return input;
+}
+
+rilbed::team_member_t to_lcm(const agents::TeamMessage& member) {
+  rilbed::team_member_t m;
+  m.id = member.id;
+  m.x_m = member.pose.position_m.x;
+  m.y_m = member.pose.position_m.y;
+  m.theta_rad = member.pose.heading_rad;
+  m.behaviour = std::string(member.behaviour);
+  m.utime = member.t_us;
+  return m;
+}
+
+agents::TeamMessage from_lcm(const rilbed::team_member_t& m) {
+  return {m.id, Pose2{{m.x_m, m.y_m}, m.theta_rad}, intern_behaviour(m.behaviour), m.utime};
+}
+
+rilbed::agent_output_t to_lcm(const agents::RemoteOutput& output) {
+  rilbed::agent_output_t m;
+  m.id = output.robot_id;
+  m.left = static_cast<std::int16_t>(std::clamp(output.output.wheels.left, -agents::kMaxWheelUnits, agents::kMaxWheelUnits));
+  m.right = static_cast<std::int16_t>(std::clamp(output.output.wheels.right, -agents::kMaxWheelUnits, agents::kMaxWheelUnits));
+  m.behaviour = std::string(output.output.behaviour);
+  m.done = output.done;
+  return m;
+}
+
+agents::RemoteOutput from_lcm(const rilbed::agent_output_t& m) {
+  agents::RemoteOutput out;
+  out.robot_id = m.id;
+  out.output.wheels = {std::clamp<int>(m.left, -agents::kMaxWheelUnits, agents::kMaxWheelUnits),
+                       std::clamp<int>(m.right, -agents::kMaxWheelUnits, agents::kMaxWheelUnits)};
+  out.output.behaviour = intern_behaviour(m.behaviour);
+  out.done = m.done;
+  return out;
+}
+
+std::string_view intern_behaviour(std::string_view name) {
+  constexpr std::size_t kMaxLength = 64, kMaxNames = 256;
+  // Nodes of a std::set never move: a view of one stays valid for the program's life.
+  static std::mutex mutex;
+  static std::set<std::string, std::less<>> names;
+  if (name.size() > kMaxLength) return "other";
+  std::lock_guard lock(mutex);
+  if (const auto it = names.find(name); it != names.end()) return *it;
+  if (names.size() >= kMaxNames) return "other";
+  return *names.emplace(name).first;
+}
+
+}  // namespace rilbed::links

@@ -1,0 +1,120 @@
+// The run's side of the agent exchange over LCM (issue 18): the robots whose controllers
+// run in `rilbed agent` processes, on this machine or others of the LAN.
+//
+// Each agent process announces itself (agent_hello_t, with its robots). At each control
+// instant the run sends every process one quantum_t holding only its own robots' inputs
+// (and the team broadcast when one of them reads it), and waits for the answers:
+// - lock-step (fast runs): until every process has answered; a quantum not answered
+//   within `resend_ms` is sent again, unchanged (UDP multicast loses messages; the
+//   process answers a repeat without stepping again);
+// - real time: until `deadline_ms` of wall time; an answer that comes later is counted
+//   late and applied at the next instant.
+// A process that answers nothing for `dead_after_ms` is lost: its robots are stopped
+// (a real robot through its body, as any stop) and the run goes on without them; a
+// process that announces itself for them later takes them over (a rejoin). Both become
+// events. Everything runs on the calling (run's) thread, through `lcm`.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "agents/agent_exchange.hpp"
+#include "links/lcm_bus.hpp"
+
+namespace rilbed::links {
+
+/// Knobs of the exchange.
+struct RemoteAgentsConfig {
+  Channels channels;               ///< RILBED_AGENT_HELLO, RILBED_QUANTUM, RILBED_QUANTUM_REPLY (with the run's prefix)
+  std::string scenario_name;       ///< agents announcing another scenario are refused
+  std::vector<int> robot_ids;      ///< the robots whose controllers run elsewhere
+  std::set<int> team_readers;      ///< among them, those whose controllers read the team broadcast
+  bool realtime = false;           ///< real-time mode (see the file comment), else lock-step
+  /// A quantum not answered within this is sent again. Lower recovers from a lost datagram
+  /// sooner and sends more repeats to a process that is merely slow.
+  int resend_ms = 20;
+  /// A process that has answered nothing for this long is lost. Lower notices a dead
+  /// process sooner, and gives up sooner on one paused by its machine.
+  int dead_after_ms = 1000;
+  /// Real time: how long an instant waits for its answers (wall time).
+  int deadline_ms = 20;
+};
+
+/// What the exchange has counted since it was made.
+struct RemoteAgentsCounters {
+  std::int64_t quanta_sent = 0;    ///< quantum messages sent, repeats not included
+  std::int64_t repeats = 0;        ///< quantum messages sent again (no answer in time)
+  std::int64_t answers = 0;        ///< answers taken
+  std::int64_t duplicates = 0;     ///< answers to a quantum already answered, or stale ones
+  std::int64_t late = 0;           ///< real time: answers that missed their instant
+  std::int64_t refused = 0;        ///< messages that were not well formed, or not for this run
+  std::int64_t lost_processes = 0; ///< processes found dead
+  std::int64_t rejoins = 0;        ///< robots taken over by a new process after their process was lost
+};
+
+class RemoteAgents final : public agents::AgentExchange {
+ public:
+  /// `lcm` must outlive the exchange and be handled by no other thread.
+  RemoteAgents(lcm::LCM& lcm, RemoteAgentsConfig config);
+  ~RemoteAgents() override;
+
+  /// Waits until every listed robot's process has announced itself (handling the bus).
+  /// Returns nothing when all have, else the error naming the robots still missing after
+  /// `timeout`.
+  std::optional<std::string> wait_for_agents(std::chrono::milliseconds timeout);
+
+  bool serves(int robot_id) const override;
+  void submit(const agents::ControlInput& input) override;
+  std::vector<agents::RemoteOutput> exchange(TimeUs t_us) override;
+  std::vector<agents::ExchangeNotice> take_notices() override;
+  void end() override;
+
+  const RemoteAgentsCounters& counters() const { return counters_; }
+  /// The run's nonce, in every quantum (new for each RemoteAgents).
+  const std::string& run_nonce() const { return run_; }
+
+ private:
+  struct Session {
+    std::string name;          // agent_hello_t.session
+    std::string host;
+    int pid = 0;
+    std::vector<int> robot_ids;
+    bool lost = false;
+    std::int64_t next_quantum = 0;
+    std::chrono::steady_clock::time_point last_heard;
+    // The quantum in flight: its bytes (sent again unchanged) and when it last went out.
+    std::optional<std::int64_t> awaiting;
+    std::vector<std::uint8_t> bytes;
+    std::chrono::steady_clock::time_point sent_at;
+    std::chrono::steady_clock::time_point first_sent_at;
+  };
+  void on_hello(const void* data, std::size_t size);
+  void on_reply(const void* data, std::size_t size);
+  Session* session_of_robot(int robot_id);
+  void send(Session& s, TimeUs t_us, bool end);
+  void lose(Session& s, const char* why);
+  void handle_for(std::chrono::milliseconds wait);
+
+  lcm::LCM& lcm_;
+  RemoteAgentsConfig config_;
+  std::string run_;
+  std::map<std::string, Session> sessions_;     // by session name
+  std::map<int, std::string> owner_;            // robot -> session name
+  std::map<int, agents::ControlInput> pending_; // submitted for the coming quantum, by robot
+  std::vector<agents::TeamMessage> team_;       // the team broadcast of the pending inputs
+  std::vector<agents::RemoteOutput> answered_;  // answers taken for the quantum in flight
+  std::vector<agents::RemoteOutput> late_;      // real time: answers that missed their instant
+  std::vector<agents::ExchangeNotice> notices_;
+  RemoteAgentsCounters counters_;
+  std::unique_ptr<LcmSubscription> hello_sub_, reply_sub_;
+};
+
+}  // namespace rilbed::links
