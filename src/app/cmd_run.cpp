@@ -203,7 +203,10 @@ class AgentProcesses {
  private:
   static std::string id_list_arg(const std::vector<int>& ids) {
     std::string s;
-    for (const int id : ids) s += (s.empty() ? "" : ",") + std::to_string(id);
+    for (const int id : ids) {
+    if (!s.empty()) s += ',';
+    s += std::to_string(id);
+  }
     return s;
   }
   std::vector<pid_t> pids_;

@@ -1,6 +1,7 @@
 #include "links/remote_agents.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <sstream>
 
@@ -24,7 +25,10 @@ std::string make_nonce() {
 
 std::string join(const std::vector<int>& ids) {
   std::string s;
-  for (const int id : ids) s += (s.empty() ? "" : ",") + std::to_string(id);
+  for (const int id : ids) {
+    if (!s.empty()) s += ',';
+    s += std::to_string(id);
+  }
   return s;
 }
 
@@ -103,6 +107,10 @@ void RemoteAgents::on_reply(const void* data, std::size_t size) {
   if (s.awaiting && reply.quantum == *s.awaiting) {
     into = &answered_;
     s.awaiting.reset();
+    if (!s.repeated) {
+      const double ms = std::chrono::duration<double, std::milli>(s.last_heard - s.first_sent_at).count();
+      s.round_trip_ms = s.round_trip_ms < 0.0 ? ms : 0.9 * s.round_trip_ms + 0.1 * ms;
+    }
   } else if (config_.realtime && reply.quantum < s.next_quantum && reply.quantum > s.next_quantum - 3) {
     // Real time: the answer to an instant already gone, applied at the next one (once).
     into = &late_;
@@ -179,7 +187,13 @@ void RemoteAgents::send(Session& s, TimeUs t_us, bool end) {
   lcm_.publish(config_.channels.quantum, s.bytes.data(), static_cast<unsigned>(s.bytes.size()));
   ++counters_.quanta_sent;
   s.awaiting = q.quantum;
+  s.repeated = false;
   s.sent_at = s.first_sent_at = Clock::now();
+}
+
+int RemoteAgents::resend_after_ms(const Session& s) const {
+  if (s.round_trip_ms < 0.0) return config_.resend_ms;
+  return std::clamp(static_cast<int>(std::ceil(3.0 * s.round_trip_ms)), 1, config_.resend_ms);
 }
 
 void RemoteAgents::lose(Session& s, const char* why) {
@@ -228,17 +242,19 @@ std::vector<agents::RemoteOutput> RemoteAgents::exchange(TimeUs t_us) {
       }
       if (config_.realtime && now >= deadline) continue;  // late: its answer goes to the next instant
       waiting = true;
-      if (ms_between(s.sent_at, now) >= config_.resend_ms) {
+      const auto resend_after = std::chrono::milliseconds(resend_after_ms(s));
+      if (now - s.sent_at >= resend_after) {
         lcm_.publish(config_.channels.quantum, s.bytes.data(), static_cast<unsigned>(s.bytes.size()));
         ++counters_.repeats;
+        s.repeated = true;
         s.sent_at = now;
       }
-      next_event = std::min(next_event, s.sent_at + std::chrono::milliseconds(config_.resend_ms));
+      next_event = std::min(next_event, s.sent_at + resend_after);
     }
     if (!waiting) break;
     if (config_.realtime) next_event = std::min(next_event, deadline);
-    handle_for(std::chrono::duration_cast<std::chrono::milliseconds>(next_event - Clock::now()) +
-               std::chrono::milliseconds(1));
+    // Rounded up to whole milliseconds (LCM waits in those).
+    handle_for(std::chrono::ceil<std::chrono::milliseconds>(next_event - Clock::now()));
   }
   out.insert(out.end(), answered_.begin(), answered_.end());
   answered_.clear();

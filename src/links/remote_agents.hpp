@@ -38,8 +38,10 @@ struct RemoteAgentsConfig {
   std::vector<int> robot_ids;      ///< the robots whose controllers run elsewhere
   std::set<int> team_readers;      ///< among them, those whose controllers read the team broadcast
   bool realtime = false;           ///< real-time mode (see the file comment), else lock-step
-  /// A quantum not answered within this is sent again. Lower recovers from a lost datagram
-  /// sooner and sends more repeats to a process that is merely slow.
+  /// A quantum not answered within this is sent again, at most: once a process has
+  /// answered, the wait is three times its usual round trip (at least 1 ms), so that a
+  /// lost datagram on a fast network costs a millisecond or two, not this. Lower recovers
+  /// sooner from a loss before the first answer, and repeats more to a slow process.
   int resend_ms = 20;
   /// A process that has answered nothing for this long is lost. Lower notices a dead
   /// process sooner, and gives up sooner on one paused by its machine.
@@ -95,7 +97,10 @@ class RemoteAgents final : public agents::AgentExchange {
     std::vector<std::uint8_t> bytes;
     std::chrono::steady_clock::time_point sent_at;
     std::chrono::steady_clock::time_point first_sent_at;
+    bool repeated = false;       // the quantum in flight went out more than once
+    double round_trip_ms = -1.0; // smoothed, from answers to quanta sent once; < 0: none yet
   };
+  int resend_after_ms(const Session& s) const;
   void on_hello(const void* data, std::size_t size);
   void on_reply(const void* data, std::size_t size);
   Session* session_of_robot(int robot_id);
