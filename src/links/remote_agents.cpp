@@ -103,6 +103,7 @@ void RemoteAgents::on_reply(const void* data, std::size_t size) {
   Session& s = it->second;
   s.last_heard = Clock::now();
   if (s.lost) return;
+  s.unanswered_since.reset();
   std::vector<agents::RemoteOutput>* into = nullptr;
   if (s.awaiting && reply.quantum == *s.awaiting) {
     into = &answered_;
@@ -189,6 +190,8 @@ void RemoteAgents::send(Session& s, TimeUs t_us, bool end) {
   s.awaiting = q.quantum;
   s.repeated = false;
   s.sent_at = s.first_sent_at = Clock::now();
+  s.repeat_wait_ms = resend_after_ms(s);
+  if (!s.unanswered_since) s.unanswered_since = s.sent_at;
 }
 
 int RemoteAgents::resend_after_ms(const Session& s) const {
@@ -236,20 +239,22 @@ std::vector<agents::RemoteOutput> RemoteAgents::exchange(TimeUs t_us) {
     auto next_event = now + std::chrono::milliseconds(config_.resend_ms);
     for (auto& [name, s] : sessions_) {
       if (s.lost || !s.awaiting) continue;
-      if (ms_between(s.last_heard, now) >= config_.dead_after_ms && ms_between(s.first_sent_at, now) >= config_.dead_after_ms) {
+      if (s.unanswered_since && ms_between(*s.unanswered_since, now) >= config_.dead_after_ms &&
+          ms_between(s.last_heard, now) >= config_.dead_after_ms) {
         lose(s, "stopped answering");
         continue;
       }
       if (config_.realtime && now >= deadline) continue;  // late: its answer goes to the next instant
       waiting = true;
-      const auto resend_after = std::chrono::milliseconds(resend_after_ms(s));
-      if (now - s.sent_at >= resend_after) {
+      if (now - s.sent_at >= std::chrono::milliseconds(s.repeat_wait_ms)) {
         lcm_.publish(config_.channels.quantum, s.bytes.data(), static_cast<unsigned>(s.bytes.size()));
         ++counters_.repeats;
         s.repeated = true;
         s.sent_at = now;
+        // Backing off: a process that is gone, or slow, is not flooded.
+        s.repeat_wait_ms = std::min(config_.resend_ms, 2 * s.repeat_wait_ms);
       }
-      next_event = std::min(next_event, s.sent_at + resend_after);
+      next_event = std::min(next_event, s.sent_at + std::chrono::milliseconds(s.repeat_wait_ms));
     }
     if (!waiting) break;
     if (config_.realtime) next_event = std::min(next_event, deadline);

@@ -98,6 +98,10 @@ class RemoteAgents final : public agents::AgentExchange {
     std::chrono::steady_clock::time_point sent_at;
     std::chrono::steady_clock::time_point first_sent_at;
     bool repeated = false;       // the quantum in flight went out more than once
+    int repeat_wait_ms = 0;      // the wait before the next repeat (doubles with each)
+    // Since when a quantum to it has gone unanswered (real time sends the next one
+    // without waiting); cleared by any answer.
+    std::optional<std::chrono::steady_clock::time_point> unanswered_since;
     double round_trip_ms = -1.0; // smoothed, from answers to quanta sent once; < 0: none yet
   };
   int resend_after_ms(const Session& s) const;
