@@ -65,10 +65,15 @@ agents::RemoteOutput from_lcm(const rilbed::agent_output_t& m) {
 }
 
 std::string_view intern_behaviour(std::string_view name) {
-  constexpr std::size_t kMaxLength = 64, kMaxNames = 256;
-  // Nodes of a std::set never move: a view of one stays valid for the program's life.
+  constexpr std::size_t kMaxLength = 64, kMaxNames = 1024;
+  // Nodes of a std::set never move: a view of one stays valid for the program's life. The
+  // names rilbed's own controllers use are there from the start, so that a peer sending
+  // junk names cannot make them "other".
   static std::mutex mutex;
-  static std::set<std::string, std::less<>> names;
+  static std::set<std::string, std::less<>> names = {
+      "idle",  "console", "lost",   "search", "follow", "wait", "avoid", "unknown", "cruise", "arrived", "home",
+      "placed", "yield",  "place",  "align",  "c0",     "c1",   "c2",    "c3",      "c4",     "c5",      "c6",
+      "c7",    "c?"};
   if (name.size() > kMaxLength) return "other";
   std::lock_guard lock(mutex);
   if (const auto it = names.find(name); it != names.end()) return *it;

@@ -30,7 +30,8 @@ agents::RemoteOutput from_lcm(const rilbed::agent_output_t& message);
 
 /// A behaviour name from the network as a string that lives as long as the program (as
 /// ControlOutput::behaviour must): the same view for the same name. Names are kept up to
-/// 64 bytes and at most 256 distinct ones; beyond that (a peer sending junk) "other".
+/// 64 bytes and at most 1,024 distinct ones, the names of rilbed's own controllers among
+/// them from the start; beyond that (a peer sending junk) "other".
 std::string_view intern_behaviour(std::string_view name);
 
 }  // namespace rilbed::links

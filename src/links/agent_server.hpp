@@ -54,6 +54,13 @@ class AgentServer {
   /// ends, and before returning.
   void serve(const std::atomic<bool>& stop);
 
+  /// Announces this process once (serve() does so every hello_ms while idle); for callers
+  /// that handle the bus themselves.
+  void announce() { hello(); }
+  /// Handles one quantum's bytes as if they came off the bus (serve() does this for
+  /// every message on the quantum channel).
+  void handle_quantum(const void* data, std::size_t size) { on_quantum(data, size); }
+
   /// This process's session name (in its announcements).
   const std::string& session() const { return session_; }
   const AgentServerCounters& counters() const { return counters_; }

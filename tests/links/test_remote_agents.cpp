@@ -1,0 +1,214 @@
+// The agent exchange over LCM (issue 18), in one process on the in-process bus: the
+// run's side (RemoteAgents) and an agent process's side (AgentServer) share one memq
+// instance, so the run's waits hand the quanta to the server on the same thread. A convoy
+// stepped through the exchange follows the in-process convoy exactly; a process that stops
+// answering is lost and its robots stopped; bytes that are not a message are refused.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <map>
+#include <memory>
+#include <random>
+
+#include "agents/scenario.hpp"
+#include "agents/simulation.hpp"
+#include "links/agent_messages.hpp"
+#include "links/agent_server.hpp"
+#include "links/remote_agents.hpp"
+#include "rilbed/quantum_t.hpp"
+
+namespace rilbed::links {
+namespace {
+
+agents::Scenario convoy() {
+  return agents::load_scenario(std::filesystem::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml");
+}
+
+std::unique_ptr<lcm::LCM> memq() {
+  std::string error;
+  auto lcm = open_lcm("memq://", error);
+  EXPECT_TRUE(lcm) << error;
+  return lcm;
+}
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+TEST(AgentMessages, AnInputAndAnOutputCrossTheWireExactly) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> any(-10.0, 10.0);
+  agents::ControlInput in;
+  in.t_us = 1'234'500;
+  in.robot_id = 7;
+  in.pose = Pose2{{any(rng), any(rng)}, any(rng)};
+  environment::ProximityValues prox{};
+  for (int& v : prox) v = static_cast<int>(rng() % 1024);
+  in.sensors.t_us = in.t_us;
+  in.sensors.proximity = prox;
+  in.sensors.ranges = {{true, any(rng)}, {false, 0.8}};
+  in.sensors.beacons = {{3, any(rng)}};
+  in.sensors.track = {0, 17, 255};
+  in.sensors.odometry = environment::OdometryReading{-123456789012LL, 42};
+  const agents::ControlInput back = from_lcm(to_lcm(in), in.t_us);
+  EXPECT_EQ(back.robot_id, 7);
+  EXPECT_EQ(back.t_us, in.t_us);
+  ASSERT_TRUE(back.pose);
+  EXPECT_TRUE(same_bits(back.pose->position_m.x, in.pose->position_m.x));
+  EXPECT_TRUE(same_bits(back.pose->position_m.y, in.pose->position_m.y));
+  EXPECT_TRUE(same_bits(back.pose->heading_rad, in.pose->heading_rad));
+  EXPECT_EQ(back.sensors.t_us, in.t_us);
+  EXPECT_EQ(back.sensors.proximity, in.sensors.proximity);
+  ASSERT_EQ(back.sensors.ranges.size(), 2u);
+  EXPECT_TRUE(same_bits(back.sensors.ranges[0].distance_m, in.sensors.ranges[0].distance_m));
+  EXPECT_FALSE(back.sensors.ranges[1].hit);
+  ASSERT_EQ(back.sensors.beacons.size(), 1u);
+  EXPECT_TRUE(same_bits(back.sensors.beacons[0].bearing_rad, in.sensors.beacons[0].bearing_rad));
+  EXPECT_EQ(back.sensors.track, in.sensors.track);
+  ASSERT_TRUE(back.sensors.odometry);
+  EXPECT_EQ(back.sensors.odometry->left_pulses, -123456789012LL);
+
+  agents::ControlInput unseen;
+  unseen.robot_id = 2;
+  EXPECT_FALSE(from_lcm(to_lcm(unseen), 0).pose);
+
+  const agents::RemoteOutput out{4, agents::ControlOutput{{-127, 300}, "follow"}, true};
+  const agents::RemoteOutput got = from_lcm(to_lcm(out));
+  EXPECT_EQ(got.robot_id, 4);
+  EXPECT_EQ(got.output.wheels, (agents::WheelCommand{-127, 127}));  // clamped to what the robot takes
+  EXPECT_EQ(got.output.behaviour, "follow");
+  EXPECT_TRUE(got.done);
+}
+
+TEST(AgentMessages, BehaviourNamesAreInternedAndBounded) {
+  const std::string_view a = intern_behaviour(std::string("search"));
+  const std::string_view b = intern_behaviour(std::string("search"));
+  EXPECT_EQ(a.data(), b.data());  // one string for the program's life
+  EXPECT_EQ(intern_behaviour(std::string(200, 'x')), "other");
+  for (int i = 0; i < 1100; ++i) intern_behaviour("junk" + std::to_string(i));  // a peer sending junk
+  EXPECT_EQ(intern_behaviour("never-seen-before"), "other");
+  // rilbed's own names still come back as themselves.
+  EXPECT_EQ(intern_behaviour("search").data(), a.data());
+  EXPECT_EQ(intern_behaviour("wait"), "wait");
+  EXPECT_EQ(intern_behaviour("follow"), "follow");
+}
+
+// A convoy run whose controllers all run in an AgentServer on the same memq bus.
+agents::RunResult run_through_exchange(const agents::Scenario& scenario, std::uint64_t seed, int dead_after_ms = 1000,
+                                       bool kill_server_midway = false) {
+  auto lcm = memq();
+  AgentServerConfig sc;
+  sc.scenario_name = scenario.name;
+  for (const auto& r : scenario.robots) sc.robot_ids.push_back(r.id);
+  auto server = std::make_unique<AgentServer>(*lcm, sc, [&scenario](int id) {
+    return agents::make_controller(scenario, scenario.robots[static_cast<std::size_t>(id - 1)]);
+  });
+  RemoteAgentsConfig rc;
+  rc.scenario_name = scenario.name;
+  rc.robot_ids = sc.robot_ids;
+  for (const int id : rc.robot_ids) rc.team_readers.insert(id);  // convoy controllers read the team
+  rc.dead_after_ms = dead_after_ms;
+  rc.resend_ms = 5;
+  RemoteAgents remote(*lcm, rc);
+  server->announce();
+  EXPECT_FALSE(remote.wait_for_agents(std::chrono::seconds(2)));
+  // The server "dies" after some steps: a controller wrapper would be needed to time it
+  // from inside the run, so the server is destroyed from the exchange's notice instead:
+  // here it is simply gone from the start of a second run.
+  if (kill_server_midway) server.reset();
+  agents::RunOptions o;
+  o.seed = seed;
+  o.duration_s = 20.0;
+  o.keep_in_memory = true;
+  o.remote_agents = &remote;
+  agents::RunResult r = agents::run_scenario(scenario, o);
+  EXPECT_EQ(remote.counters().refused, 0);
+  // Every step (0, 0.1, ..., 20 s) went through the exchange, and was answered; a process
+  // that is gone gets one quantum, then is lost and gets none.
+  EXPECT_EQ(remote.counters().answers, kill_server_midway ? 0 : 201);
+  EXPECT_EQ(remote.counters().quanta_sent, kill_server_midway ? 1 : 201 + 3 /* the end, three times */);
+  return r;
+}
+
+TEST(RemoteAgents, AConvoyThroughTheExchangeFollowsTheInProcessConvoyExactly) {
+  const agents::Scenario scenario = convoy();
+  agents::RunOptions o;
+  o.seed = 11;
+  o.duration_s = 20.0;
+  o.keep_in_memory = true;
+  const agents::RunResult local = agents::run_scenario(scenario, o);
+  const agents::RunResult remote = run_through_exchange(scenario, 11);
+  ASSERT_EQ(local.trajectory.size(), remote.trajectory.size());
+  ASSERT_FALSE(local.trajectory.empty());
+  for (std::size_t i = 0; i < local.trajectory.size(); ++i) {
+    const auto& a = local.trajectory[i];
+    const auto& b = remote.trajectory[i];
+    ASSERT_EQ(a.t_us, b.t_us);
+    ASSERT_EQ(a.id, b.id);
+    ASSERT_TRUE(same_bits(a.pose.position_m.x, b.pose.position_m.x)) << "t " << a.t_us << " robot " << a.id;
+    ASSERT_TRUE(same_bits(a.pose.position_m.y, b.pose.position_m.y));
+    ASSERT_TRUE(same_bits(a.pose.heading_rad, b.pose.heading_rad));
+    ASSERT_EQ(a.behaviour, b.behaviour);
+  }
+  EXPECT_EQ(local.formed, remote.formed);
+  EXPECT_EQ(local.formation_time_s, remote.formation_time_s);
+  EXPECT_EQ(local.collisions, remote.collisions);
+}
+
+TEST(RemoteAgents, AProcessThatStopsAnsweringIsLostAndItsRobotsStop) {
+  const agents::Scenario scenario = convoy();
+  const agents::RunResult r = run_through_exchange(scenario, 11, 60, /*kill_server_midway=*/true);
+  // Every robot stands still from the first step on, marked lost.
+  ASSERT_FALSE(r.trajectory.empty());
+  std::map<int, Pose2> first;
+  for (const auto& s : r.trajectory) {
+    if (!first.contains(s.id)) first[s.id] = s.pose;
+    EXPECT_EQ(s.behaviour, "lost") << "robot " << s.id << " at " << s.t_us;
+  }
+  for (const auto& s : r.trajectory) {
+    EXPECT_NEAR(s.pose.position_m.x, first[s.id].position_m.x, 1e-9);
+    EXPECT_NEAR(s.pose.position_m.y, first[s.id].position_m.y, 1e-9);
+  }
+}
+
+TEST(RemoteAgents, BytesThatAreNoMessageAreRefusedAndMissingRobotsNamed) {
+  auto lcm = memq();
+  RemoteAgentsConfig rc;
+  rc.scenario_name = "convoy_sim";
+  rc.robot_ids = {3, 4};
+  RemoteAgents remote(*lcm, rc);
+  const std::uint8_t junk[] = {1, 2, 3, 4, 5, 6, 7, 8, 0xFF, 0xFF, 0xFF, 0xFF};
+  lcm->publish(rc.channels.agent_hello, junk, sizeof junk);
+  lcm->publish(rc.channels.quantum_reply, junk, sizeof junk);
+  // An agent of another scenario does not count.
+  AgentServerConfig other;
+  other.scenario_name = "wander";
+  other.robot_ids = {3, 4};
+  AgentServer stranger(*lcm, other, [](int) { return std::unique_ptr<agents::Controller>(); });
+  stranger.announce();
+  const auto missing = remote.wait_for_agents(std::chrono::milliseconds(300));
+  ASSERT_TRUE(missing);
+  EXPECT_NE(missing->find("robots 3,4"), std::string::npos) << *missing;
+  EXPECT_EQ(remote.counters().refused, 3);
+
+  // The agent's side refuses junk quanta too, and ignores quanta for other processes.
+  AgentServerConfig sc;
+  sc.scenario_name = "convoy_sim";
+  sc.robot_ids = {3};
+  int made = 0;
+  AgentServer server(*lcm, sc, [&made](int) {
+    ++made;
+    return std::unique_ptr<agents::Controller>();
+  });
+  server.handle_quantum(junk, sizeof junk);
+  EXPECT_EQ(server.counters().refused, 1);
+  rilbed::quantum_t q{};  // (lcm-gen leaves the numbers of a plain declaration unset)
+  q.run = "r1";
+  q.session = "someone-else";
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(q.getEncodedSize()));
+  q.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  server.handle_quantum(bytes.data(), bytes.size());
+  EXPECT_EQ(made, 0);
+  EXPECT_EQ(server.counters().steps, 0);
+}
+
+}  // namespace
+}  // namespace rilbed::links
