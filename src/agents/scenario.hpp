@@ -108,7 +108,7 @@ struct AgentsSpec {
   /// A quantum not answered within this is sent again (milliseconds).
   int resend_ms = 20;
   /// A process that answers nothing for this long is lost: its robots stop (milliseconds).
-  int dead_after_ms = 1000;
+  int dead_after_ms = 750;
   /// Real-time runs: how long a control step waits for its answers (milliseconds).
   int deadline_ms = 20;
 };

@@ -45,7 +45,7 @@ struct RemoteAgentsConfig {
   int resend_ms = 20;
   /// A process that has answered nothing for this long is lost. Lower notices a dead
   /// process sooner, and gives up sooner on one paused by its machine.
-  int dead_after_ms = 1000;
+  int dead_after_ms = 750;
   /// Real time: how long an instant waits for its answers (wall time).
   int deadline_ms = 20;
 };
