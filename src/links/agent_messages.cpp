@@ -1,6 +1,7 @@
 #include "links/agent_messages.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <mutex>
 #include <set>
 #include <string>
@@ -62,6 +63,25 @@ agents::RemoteOutput from_lcm(const rilbed::agent_output_t& m) {
   out.output.behaviour = intern_behaviour(m.behaviour);
   out.done = m.done;
   return out;
+}
+
+bool plausible(const rilbed::quantum_t& q) {
+  auto finite = [](double v) { return std::isfinite(v); };
+  for (const rilbed::agent_input_t& in : q.inputs) {
+    if (in.has_pose && !(finite(in.x_m) && finite(in.y_m) && finite(in.theta_rad))) return false;
+    const rilbed::robot_sensors_t& s = in.sensors;
+    if (!s.proximity.empty() && s.proximity.size() != static_cast<std::size_t>(environment::kProximityCount)) return false;
+    for (const std::int16_t v : s.proximity) {
+      if (v < 0 || v > environment::kProximityMax) return false;
+    }
+    if (!std::all_of(s.range_m.begin(), s.range_m.end(), finite)) return false;
+    if (!std::all_of(s.beacon_bearing_rad.begin(), s.beacon_bearing_rad.end(), finite)) return false;
+    if (std::any_of(s.track.begin(), s.track.end(), [](std::int32_t v) { return v < 0; })) return false;
+  }
+  for (const rilbed::team_member_t& m : q.team) {
+    if (!(finite(m.x_m) && finite(m.y_m) && finite(m.theta_rad))) return false;
+  }
+  return true;
 }
 
 std::string_view intern_behaviour(std::string_view name) {

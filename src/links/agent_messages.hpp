@@ -11,6 +11,7 @@
 #include "agents/controller.hpp"
 #include "rilbed/agent_input_t.hpp"
 #include "rilbed/agent_output_t.hpp"
+#include "rilbed/quantum_t.hpp"
 #include "rilbed/team_member_t.hpp"
 
 namespace rilbed::links {
@@ -27,6 +28,12 @@ agents::TeamMessage from_lcm(const rilbed::team_member_t& message);
 rilbed::agent_output_t to_lcm(const agents::RemoteOutput& output);
 /// Wheel speeds clamped to +-kMaxWheelUnits; the behaviour interned.
 agents::RemoteOutput from_lcm(const rilbed::agent_output_t& message);
+
+/// Whether every input of a quantum from the network is one a controller can be handed:
+/// every pose, range, bearing and team pose finite, proximity either absent or eight values
+/// in 0..kProximityMax, track values not negative. (lcm-gen's decoder takes any bits; a NaN
+/// pose would reach a controller's arithmetic.)
+bool plausible(const rilbed::quantum_t& quantum);
 
 /// A behaviour name from the network as a string that lives as long as the program (as
 /// ControlOutput::behaviour must): the same view for the same name. Names are kept up to

@@ -67,7 +67,8 @@ void AgentServer::finish_run() {
 
 void AgentServer::on_quantum(const void* data, std::size_t size) {
   rilbed::quantum_t q;
-  if (!decode_checked(data, size, q)) {
+  // (A run always has a nonce: an empty one is nobody's.)
+  if (!decode_checked(data, size, q) || !plausible(q) || q.run.empty()) {
     ++counters_.refused;
     return;
   }

@@ -38,7 +38,7 @@ struct AgentServerCounters {
   std::int64_t steps = 0;        ///< quanta stepped
   std::int64_t repeats = 0;      ///< quanta answered again without stepping (the run's repeats)
   std::int64_t skipped = 0;      ///< quanta that never arrived before a later one (real time)
-  std::int64_t refused = 0;      ///< messages that were not well formed
+  std::int64_t refused = 0;      ///< messages that were not well formed, or held values no robot reads (plausible())
 };
 
 class AgentServer {
