@@ -124,14 +124,17 @@ QuantumModel::QuantumModel(AgentExchange& exchange, std::vector<AgentModel*> age
       period_us_(period_us),
       t_us_(first_us) {
   if (period_us <= 0) throw std::invalid_argument("quantum: period must be > 0");
+  std::sort(agents_.begin(), agents_.end(), [](const AgentModel* a, const AgentModel* b) { return a->body().id() < b->body().id(); });
 }
 
 void QuantumModel::internal_transition() {
   const TimeUs t = t_us_;
   for (const RemoteOutput& answer : exchange_.exchange(t)) {
-    for (AgentModel* a : agents_) {
-      if (a->body().id() == answer.robot_id) a->complete(answer);
-    }
+    // The agents are in ID order (a search: a world of 1,000 robots made this loop a
+    // million comparisons per step).
+    const auto it = std::lower_bound(agents_.begin(), agents_.end(), answer.robot_id,
+                                     [](const AgentModel* a, int id) { return a->body().id() < id; });
+    if (it != agents_.end() && (*it)->body().id() == answer.robot_id) (*it)->complete(answer);
   }
   if (record_) {
     for (const ExchangeNotice& n : exchange_.take_notices()) record_(t, n);

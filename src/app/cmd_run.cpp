@@ -25,6 +25,7 @@
 #include "agents/run_folder_writer.hpp"
 #include "agents/simulation.hpp"
 #include "agents/status_line.hpp"
+#include "app/agent_processes.hpp"
 #include "app/commands.hpp"
 #include "core/id_list.hpp"
 #include "core/statistics.hpp"
@@ -160,65 +161,6 @@ void print_result(const agents::RunResult& r) {
 }
 
 // Runs one seed of a batch (its options already hold the seed and out_dir).
-// The `rilbed agent` processes a scenario's `agents: {processes: N}` asks for, started on
-// this machine with the run's bus and stopped (SIGTERM, then waited for) when it goes.
-class AgentProcesses {
- public:
-  AgentProcesses() = default;
-  AgentProcesses(const AgentProcesses&) = delete;
-  AgentProcesses& operator=(const AgentProcesses&) = delete;
-  ~AgentProcesses() {
-    for (const pid_t pid : pids_) kill(pid, SIGTERM);
-    for (const pid_t pid : pids_) waitpid(pid, nullptr, 0);
-  }
-  /// Starts one process per group of robots; false (and the reason) when one cannot start.
-  bool start(const std::string& scenario_file, const std::vector<std::vector<int>>& groups, const std::string& url,
-             const std::string& prefix, std::string& error) {
-    char self[4096] = {};
-    const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
-    if (n <= 0) {
-      error = "cannot find rilbed's own binary to start the agents";
-      return false;
-    }
-    for (const std::vector<int>& group : groups) {
-      std::vector<std::string> args = {self, "agent", "--scenario", scenario_file, "--ids", id_list_arg(group),
-                                       "--lcm", url, "--quiet"};
-      if (!prefix.empty()) {
-        args.push_back("--channel-prefix");
-        args.push_back(prefix);
-      }
-      std::vector<char*> argv;
-      for (std::string& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      pid_t pid = 0;
-      if (const int rc = posix_spawn(&pid, self, nullptr, nullptr, argv.data(), environ); rc != 0) {
-        error = std::string("cannot start an agent process: ") + std::strerror(rc);
-        return false;
-      }
-      pids_.push_back(pid);
-    }
-    return true;
-  }
-
- private:
-  static std::string id_list_arg(const std::vector<int>& ids) {
-    std::string s;
-    for (const int id : ids) {
-    if (!s.empty()) s += ',';
-    s += std::to_string(id);
-  }
-    return s;
-  }
-  std::vector<pid_t> pids_;
-};
-
-// The scenario's remote robots in `processes` groups of consecutive IDs, as even as can be.
-std::vector<std::vector<int>> split_ids(const std::vector<int>& ids, int processes) {
-  std::vector<std::vector<int>> groups(static_cast<std::size_t>(processes));
-  for (std::size_t i = 0; i < ids.size(); ++i) groups[i * groups.size() / ids.size()].push_back(ids[i]);
-  return groups;
-}
-
 using SeedRunner = std::function<agents::RunResult(const agents::RunOptions&)>;
 
 int run_batch(const agents::Scenario& scenario, const RunArgs& args, agents::RunOptions base, const SeedRunner& run_seed,

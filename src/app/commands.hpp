@@ -32,6 +32,8 @@ void add_khepera_emu_command(CLI::App& app);
 
 /// `rilbed agent --scenario FILE --ids 3,4 --lcm URL`: runs those robots' controllers for a run on the bus.
 void add_agent_command(CLI::App& app);
+/// `rilbed quantum-bench`: time per lock-step quantum with the controllers in agent processes.
+void add_quantum_bench_command(CLI::App& app);
 
 /// `rilbed watch --lcm URL`: a terminal display of a run on an LCM bus.
 void add_watch_command(CLI::App& app);

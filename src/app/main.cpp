@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
   rilbed::app::add_khepera_emu_command(app);
   rilbed::app::add_watch_command(app);
   rilbed::app::add_agent_command(app);
+  rilbed::app::add_quantum_bench_command(app);
   rilbed::app::add_gui_command(app);
   rilbed::app::add_replay_command(app);
   rilbed::app::add_console_command(app);

@@ -215,6 +215,7 @@ void RemoteAgents::handle_for(std::chrono::milliseconds wait) {
 }
 
 std::vector<agents::RemoteOutput> RemoteAgents::exchange(TimeUs t_us) {
+  const auto called = Clock::now();
   // Announcements and stale answers that arrived since the last instant.
   while (lcm_.handleTimeout(0) > 0) {
   }
@@ -271,6 +272,9 @@ std::vector<agents::RemoteOutput> RemoteAgents::exchange(TimeUs t_us) {
   }
   pending_.clear();
   team_.clear();
+  if (config_.record_exchange_times) {
+    exchange_times_ms_.push_back(std::chrono::duration<double, std::milli>(Clock::now() - called).count());
+  }
   return out;
 }
 

@@ -48,6 +48,9 @@ struct RemoteAgentsConfig {
   int dead_after_ms = 750;
   /// Real time: how long an instant waits for its answers (wall time).
   int deadline_ms = 20;
+  /// Keep the wall time of every exchange() (exchange_times_ms(); for benchmarks: one
+  /// number per control step).
+  bool record_exchange_times = false;
 };
 
 /// What the exchange has counted since it was made.
@@ -80,6 +83,8 @@ class RemoteAgents final : public agents::AgentExchange {
   void end() override;
 
   const RemoteAgentsCounters& counters() const { return counters_; }
+  /// With config.record_exchange_times: each exchange()'s wall time, milliseconds.
+  const std::vector<double>& exchange_times_ms() const { return exchange_times_ms_; }
   /// The run's nonce, in every quantum (new for each RemoteAgents).
   const std::string& run_nonce() const { return run_; }
 
@@ -123,6 +128,7 @@ class RemoteAgents final : public agents::AgentExchange {
   std::vector<agents::RemoteOutput> late_;      // real time: answers that missed their instant
   std::vector<agents::ExchangeNotice> notices_;
   RemoteAgentsCounters counters_;
+  std::vector<double> exchange_times_ms_;
   std::unique_ptr<LcmSubscription> hello_sub_, reply_sub_;
 };
 
