@@ -61,6 +61,29 @@ for mode in distributed central; do
   echo "  (whole command: $(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.1f", b - a }') s)"
 done
 
+# Agents in other processes (issue 18): time per lock-step quantum over the paper's grid,
+# on loopback multicast inside a private network namespace (nothing leaves the machine),
+# then again with 10 % of LCM's packets dropped by nftables.
+echo
+if unshare -n true 2>/dev/null; then
+  URL='udpm://239.255.76.67:7667?ttl=0'
+  NS_SETUP='ip link set lo up; ip link set lo multicast on; ip route add 224.0.0.0/4 dev lo'
+  unshare -n bash -c "$NS_SETUP; '$BUILD_DIR/rilbed' quantum-bench --table --quanta 1000 --lcm '$URL'"
+  if unshare -n nft add table inet probe 2>/dev/null; then
+    echo
+    unshare -n bash -c "$NS_SETUP
+      nft add table inet loss
+      nft add chain inet loss in '{ type filter hook input priority 0; policy accept; }'
+      nft add rule inet loss in udp dport 7667 numgen random mod 10 0 drop
+      '$BUILD_DIR/rilbed' quantum-bench --robots 40 --processes 12 --quanta 1000 --lcm '$URL' \
+        --condition '10 % of the packets to LCM port 7667 dropped at random (nftables)'
+      '$BUILD_DIR/rilbed' quantum-bench --robots 1000 --processes 8 --quanta 200 --lcm '$URL' \
+        --condition '10 % of the packets to LCM port 7667 dropped at random (nftables)' | tail -1"
+  fi
+else
+  echo "(quantum-bench skipped: no network namespace here, unshare -n needs root)"
+fi
+
 # Robot in the loop: frame arrival to the D command on each real (emulated) robot's port.
 echo
 "$BUILD_DIR/rilbed" loop-bench --real 8 --virtual 100 --frames 300
