@@ -334,6 +334,9 @@ async function main(state) {
     await until('the editor to load convoy_mixed.yaml again', (n) => window.rilbedEditor.loads > n, loadsBefore);
     const tray4 = await page.evaluate(() => window.rilbedEditor.trayPosition(4));
     check(tray4, 'robot 4 of convoy_mixed.yaml (ids 4-5, pose random) is not in the tray');
+    // Loading a file may leave the page scrolled to the file's input (it did once in a CI
+    // run at -j2, the canvas 1069 px down): back to the canvas, as a person would scroll.
+    await canvas.evaluate((el) => el.scrollIntoView({ block: 'center' }));
     box = await canvasBox();
     await dragPx([box.x + tray4[0], box.y + tray4[1]], await at(0.3, 0.3));
     await until('robot 4 to leave its group with a pose', () => window.rilbedEditor.doc.robots.some((r) => r.id === 4 && Array.isArray(r.pose)));
