@@ -63,7 +63,7 @@ done
 
 # Agents in other processes (issue 18): time per lock-step quantum over the paper's grid,
 # on loopback multicast inside a private network namespace (nothing leaves the machine),
-# then again with 10 % of LCM's packets dropped by nftables.
+# then again with 10 % of the packets dropped by nftables (quanta on 7667, answers on 7668).
 echo
 if unshare -n true 2>/dev/null; then
   URL='udpm://239.255.76.67:7667?ttl=0'
@@ -74,11 +74,11 @@ if unshare -n true 2>/dev/null; then
     unshare -n bash -c "$NS_SETUP
       nft add table inet loss
       nft add chain inet loss in '{ type filter hook input priority 0; policy accept; }'
-      nft add rule inet loss in udp dport 7667 numgen random mod 10 0 drop
+      nft add rule inet loss in udp dport '{ 7667, 7668 }' numgen random mod 10 0 drop
       '$BUILD_DIR/rilbed' quantum-bench --robots 40 --processes 12 --quanta 1000 --lcm '$URL' \
-        --condition '10 % of the packets to LCM port 7667 dropped at random (nftables)'
+        --condition '10 % of the packets to ports 7667 (quanta) and 7668 (answers) dropped at random (nftables)'
       '$BUILD_DIR/rilbed' quantum-bench --robots 1000 --processes 8 --quanta 200 --lcm '$URL' \
-        --condition '10 % of the packets to LCM port 7667 dropped at random (nftables)' | tail -1"
+        --condition '10 % of the packets to ports 7667 (quanta) and 7668 (answers) dropped at random (nftables)' | tail -1"
   fi
 else
   echo "(quantum-bench skipped: no network namespace here, unshare -n needs root)"

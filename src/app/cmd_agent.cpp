@@ -74,8 +74,10 @@ int agent_command(const AgentArgs& args) {
     }
   }
   std::string error;
+  // Quanta come on the URL; answers and announcements go on the answer bus (the next port).
   std::unique_ptr<lcm::LCM> lcm = links::open_lcm(args.url, error);
-  if (!lcm) {
+  std::unique_ptr<lcm::LCM> answers = lcm ? links::open_lcm(links::agent_reply_url(args.url), error) : nullptr;
+  if (!lcm || !answers) {
     spdlog::error("agent: {}", error);
     return kExitFailure;
   }
@@ -84,7 +86,7 @@ int agent_command(const AgentArgs& args) {
   config.scenario_name = scenario.name;
   config.robot_ids = ids;
   config.once = args.once;
-  links::AgentServer server(*lcm, config, [&scenario](int id) {
+  links::AgentServer server(*lcm, *answers, config, [&scenario](int id) {
     const auto spec = std::find_if(scenario.robots.begin(), scenario.robots.end(), [&](const auto& r) { return r.id == id; });
     return agents::make_controller(scenario, *spec);
   });

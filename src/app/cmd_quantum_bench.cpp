@@ -83,7 +83,7 @@ agents::RunResult run_once(const agents::Scenario& scenario, std::uint64_t seed,
   return agents::run_scenario(scenario, o);
 }
 
-std::optional<Row> bench_one(const QuantumBenchArgs& args, lcm::LCM& lcm, const std::filesystem::path& dir, int robots,
+std::optional<Row> bench_one(const QuantumBenchArgs& args, lcm::LCM& lcm, lcm::LCM& answers, const std::filesystem::path& dir, int robots,
                              int processes, int quanta) {
   const std::filesystem::path file = write_scenario(dir, robots, quanta);
   agents::Scenario scenario = agents::load_scenario(file);
@@ -101,7 +101,7 @@ std::optional<Row> bench_one(const QuantumBenchArgs& args, lcm::LCM& lcm, const 
   config.scenario_name = scenario.name;
   config.robot_ids = ids;
   config.record_exchange_times = true;
-  links::RemoteAgents remote(lcm, config);
+  links::RemoteAgents remote(lcm, answers, config);
   if (const auto missing = remote.wait_for_agents(std::chrono::seconds(20))) {
     spdlog::error("quantum-bench: {}", *missing);
     return std::nullopt;
@@ -166,7 +166,8 @@ int quantum_bench_command(const QuantumBenchArgs& args) {
   }
   std::string error;
   std::unique_ptr<lcm::LCM> lcm = links::open_lcm(args.url, error);
-  if (!lcm || args.url.rfind("memq://", 0) == 0) {
+  std::unique_ptr<lcm::LCM> answers = lcm ? links::open_lcm(links::agent_reply_url(args.url), error) : nullptr;
+  if (!lcm || !answers || args.url.rfind("memq://", 0) == 0) {
     spdlog::error("quantum-bench: {}", lcm ? "the agents run in other processes: give a bus they reach, not memq://" : error);
     return kExitUsage;
   }
@@ -184,8 +185,9 @@ int quantum_bench_command(const QuantumBenchArgs& args) {
   std::printf("## Time per quantum (rilbed quantum-bench), after paper 000 section 10\n\n");
   std::printf("A lock-step run (fast mode) of N wandering Kheperas (8 IR sensors each, Braitenberg avoidance, the lab's "
               "density), their controllers in P `rilbed agent` processes on this machine (%s, %ld cores), on the bus %s%s%s. "
-              "One quantum is one control step of 100 ms simulated: every process gets its robots' sensor readings and "
-              "poses in one quantum_t and answers their wheel commands in one quantum_reply_t. Timed: the whole DEVS run "
+              "One quantum is one control step of 100 ms simulated: the processes get their robots' sensor readings and "
+              "poses in one quantum_t (one per process when all would not fit in a datagram) and each answers its robots' "
+              "wheel commands in one quantum_reply_t, on the next port. Timed: the whole DEVS run "
               "(world, sensors, exchange) divided by its quanta; the exchange alone (p50, p99: sending, the agents' "
               "work, the answers); the same run in one process; their difference, the bus's cost. Same result: the "
               "remote run's trajectories equal the in-process run's.\n\n",
@@ -195,7 +197,7 @@ int quantum_bench_command(const QuantumBenchArgs& args) {
               "exchange p99 ms | one process: ms per quantum | bus ms per quantum (share) | repeats | lost | same result |\n");
   std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |\n");
   for (const auto& [n, p] : grid) {
-    const auto row = bench_one(args, *lcm, dir, n, p, quanta_of[n]);
+    const auto row = bench_one(args, *lcm, *answers, dir, n, p, quanta_of[n]);
     if (!row) return kExitFailure;
     print_row(*row);
   }

@@ -475,7 +475,7 @@ int run_command(const RunArgs& args) {
   }
   // Controllers in other processes (issue 18): each run waits for every remote robot's
   // process to announce itself, then steps them one quantum per control instant.
-  std::unique_ptr<lcm::LCM> agents_lcm;
+  std::unique_ptr<lcm::LCM> agents_lcm, agents_answers_lcm;
   AgentProcesses agent_processes;
   if (scenario.agents) {
     const agents::AgentsSpec& spec = *scenario.agents;
@@ -487,7 +487,8 @@ int run_command(const RunArgs& args) {
     }
     std::string error;
     agents_lcm = links::open_lcm(args.lcm_url, error);
-    if (!agents_lcm) {
+    if (agents_lcm) agents_answers_lcm = links::open_lcm(links::agent_reply_url(args.lcm_url), error);
+    if (!agents_lcm || !agents_answers_lcm) {
       spdlog::error("{}", error);
       return kExitFailure;
     }
@@ -511,7 +512,7 @@ int run_command(const RunArgs& args) {
     const auto timeout = std::chrono::milliseconds(static_cast<std::int64_t>(spec.announce_timeout_s * 1000.0));
     run_seed = [&, config, timeout, inner = run_seed](const agents::RunOptions& given) {
       agents::RunOptions o = given;
-      links::RemoteAgents remote(*agents_lcm, config);
+      links::RemoteAgents remote(*agents_lcm, *agents_answers_lcm, config);
       if (const auto missing = remote.wait_for_agents(timeout)) throw agents::ScenarioError(args.scenario + ": " + *missing);
       o.remote_agents = &remote;
       agents::RunResult r = inner(o);

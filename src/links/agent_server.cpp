@@ -25,14 +25,14 @@ std::string host_name() {
 
 }  // namespace
 
-AgentServer::AgentServer(lcm::LCM& lcm, AgentServerConfig config, ControllerFactory make)
-    : lcm_(lcm), config_(std::move(config)), make_(std::move(make)) {
+AgentServer::AgentServer(lcm::LCM& quanta, lcm::LCM& answers, AgentServerConfig config, ControllerFactory make)
+    : quanta_(quanta), answers_(answers), config_(std::move(config)), make_(std::move(make)) {
   std::random_device rd;
   std::ostringstream s;
   s << host_name() << ":" << getpid() << ":" << std::hex << rd();
   session_ = s.str();
   quantum_sub_ = std::make_unique<LcmSubscription>(
-      lcm_, config_.channels.quantum, [this](const std::string&, const void* d, std::size_t n) { on_quantum(d, n); });
+      quanta_, config_.channels.quantum, [this](const std::string&, const void* d, std::size_t n) { on_quantum(d, n); });
 }
 
 AgentServer::~AgentServer() { finish_run(); }
@@ -45,7 +45,7 @@ void AgentServer::hello() {
   h.num_ids = static_cast<std::int32_t>(h.ids.size());
   h.host = host_name();
   h.pid = static_cast<std::int32_t>(getpid());
-  publish_encoded(lcm_, config_.channels.agent_hello, h);
+  publish_encoded(answers_, config_.channels.agent_hello, h);
 }
 
 void AgentServer::start_run(const std::string& run) {
@@ -72,7 +72,7 @@ void AgentServer::on_quantum(const void* data, std::size_t size) {
     ++counters_.refused;
     return;
   }
-  if (q.session != session_) return;  // for another process
+  if (std::find(q.sessions.begin(), q.sessions.end(), session_) == q.sessions.end()) return;  // for other processes
   last_quantum_at_ = Clock::now();
   if (q.run != run_) {
     if (q.end) return;  // the end of a run we never served
@@ -85,7 +85,9 @@ void AgentServer::on_quantum(const void* data, std::size_t size) {
     return;
   }
   if (q.quantum == last_quantum_) {  // the run did not hear our answer: the same again
-    publish_encoded(lcm_, config_.channels.quantum_reply, last_reply_);
+    for (int copy = 0; copy < std::max(1, config_.answer_copies); ++copy) {
+      publish_encoded(answers_, config_.channels.quantum_reply, last_reply_);
+    }
     ++counters_.repeats;
     return;
   }
@@ -114,7 +116,9 @@ void AgentServer::on_quantum(const void* data, std::size_t size) {
   reply.num_outputs = static_cast<std::int32_t>(reply.outputs.size());
   last_quantum_ = q.quantum;
   last_reply_ = reply;
-  publish_encoded(lcm_, config_.channels.quantum_reply, reply);
+  for (int copy = 0; copy < std::max(1, config_.answer_copies); ++copy) {
+    publish_encoded(answers_, config_.channels.quantum_reply, reply);
+  }
   ++counters_.steps;
 }
 
@@ -128,7 +132,7 @@ void AgentServer::serve(const std::atomic<bool>& stop) {
       hello();
       last_hello = now;
     }
-    lcm_.handleTimeout(std::min(100, config_.hello_ms));
+    quanta_.handleTimeout(std::min(100, config_.hello_ms));
     if (config_.once && run_ended_) break;
   }
   finish_run();

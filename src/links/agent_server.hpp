@@ -30,6 +30,11 @@ struct AgentServerConfig {
   /// reaching us, or a new run waits).
   int silence_ms = 1000;
   bool once = false;             ///< return after the first run ends
+  /// Each answer is sent this many times. A lock-step quantum waits for the last of its P
+  /// answers, so on a lossy bus one lost answer in P costs the whole step a repeat round
+  /// (with 10 % loss and 12 processes, 7 steps in 10); a second copy makes that 1 in 10.
+  /// Costs the run one more datagram per process and step; no other agent hears answers.
+  int answer_copies = 2;
 };
 
 /// What an agent process has counted.
@@ -45,8 +50,9 @@ class AgentServer {
  public:
   /// Builds a fresh controller for a robot, for each run.
   using ControllerFactory = std::function<std::unique_ptr<agents::Controller>(int robot_id)>;
-  /// `lcm` must outlive the server and be handled by no other thread.
-  AgentServer(lcm::LCM& lcm, AgentServerConfig config, ControllerFactory make);
+  /// `quanta` (handled here) and `answers` (published on only: answers and announcements)
+  /// must outlive the server and be handled by no other thread; they may be one instance.
+  AgentServer(lcm::LCM& quanta, lcm::LCM& answers, AgentServerConfig config, ControllerFactory make);
   ~AgentServer();
 
   /// Serves until `stop` becomes true (checked at least every 100 ms) or, with `once`,
@@ -71,7 +77,8 @@ class AgentServer {
   void start_run(const std::string& run);
   void finish_run();
 
-  lcm::LCM& lcm_;
+  lcm::LCM& quanta_;
+  lcm::LCM& answers_;
   AgentServerConfig config_;
   ControllerFactory make_;
   std::string session_;

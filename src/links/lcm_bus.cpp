@@ -30,6 +30,28 @@ void LcmSubscription::dispatch(const lcm_recv_buf_t* rbuf, const char* channel, 
   s->handler_(channel, rbuf->data, static_cast<std::size_t>(rbuf->data_size));
 }
 
+std::string agent_reply_url(const std::string& url) {
+  // udpm://GROUP:PORT?OPTIONS, or udpm:// (LCM's default 239.255.76.67:7667), or empty (the same).
+  std::string u = url.empty() ? "udpm://239.255.76.67:7667" : url;
+  if (u.rfind("udpm://", 0) != 0) return url;
+  const std::size_t opts = u.find('?');
+  std::string address = u.substr(7, opts == std::string::npos ? std::string::npos : opts - 7);
+  const std::string rest = opts == std::string::npos ? "" : u.substr(opts);
+  if (address.empty()) address = "239.255.76.67:7667";
+  const std::size_t colon = address.rfind(':');
+  int port = 7667;
+  if (colon != std::string::npos) {
+    try {
+      port = std::stoi(address.substr(colon + 1));
+    } catch (const std::exception&) {
+      return url;  // LCM will refuse it itself
+    }
+    address.resize(colon);
+  }
+  if (port < 1 || port >= 65535) return url;
+  return "udpm://" + address + ":" + std::to_string(port + 1) + rest;
+}
+
 Channels Channels::with_prefix(const std::string& prefix) {
   Channels c;
   c.poses = prefix + c.poses;

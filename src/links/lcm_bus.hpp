@@ -82,6 +82,12 @@ struct Channels {
 /// returns the reason when `prefix` is not one.
 std::optional<std::string> check_channel_prefix(const std::string& prefix);
 
+/// The bus an agent exchange's answers and announcements travel on, for a run whose quanta
+/// go on `url`: with udpm, the same group on the next port (so that an agent process's
+/// socket receives quanta only, not every other process's answers: with P processes a step
+/// would wake every process P times); any other URL is its own answer bus.
+std::string agent_reply_url(const std::string& url);
+
 /// Opens an LCM instance on `url` ("memq://", "udpm://239.255.76.67:7667?ttl=0", ...).
 /// Returns nullptr and the reason when LCM cannot use it.
 std::unique_ptr<lcm::LCM> open_lcm(const std::string& url, std::string& error);

@@ -254,11 +254,12 @@ void team_member(Walk& w) {
 }
 void fields(Walk& w, const rilbed::quantum_t*) {
   w.string();
-  w.string();
   w.i64();
   w.i64();
   w.boolean();
-  std::int32_t n = w.count(w.i32(), 4 + 1 + 24 + 4 + 1 + 1 + 1 + 2 + 1 + 16);
+  std::int32_t n = w.count(w.i32(), 5);
+  for (std::int32_t i = 0; i < n && w.ok(); ++i) w.string();
+  n = w.count(w.i32(), 4 + 1 + 24 + 4 + 1 + 1 + 1 + 2 + 1 + 16);
   for (std::int32_t i = 0; i < n && w.ok(); ++i) agent_input(w);
   w.boolean();
   n = w.count(w.i32(), 4 + 24 + 5 + 8);

@@ -38,12 +38,12 @@ int ms_between(Clock::time_point a, Clock::time_point b) {
 
 }  // namespace
 
-RemoteAgents::RemoteAgents(lcm::LCM& lcm, RemoteAgentsConfig config)
-    : lcm_(lcm), config_(std::move(config)), run_(make_nonce()) {
+RemoteAgents::RemoteAgents(lcm::LCM& quanta, lcm::LCM& answers, RemoteAgentsConfig config)
+    : quanta_(quanta), answers_(answers), config_(std::move(config)), run_(make_nonce()) {
   hello_sub_ = std::make_unique<LcmSubscription>(
-      lcm_, config_.channels.agent_hello, [this](const std::string&, const void* d, std::size_t n) { on_hello(d, n); });
+      answers_, config_.channels.agent_hello, [this](const std::string&, const void* d, std::size_t n) { on_hello(d, n); });
   reply_sub_ = std::make_unique<LcmSubscription>(
-      lcm_, config_.channels.quantum_reply, [this](const std::string&, const void* d, std::size_t n) { on_reply(d, n); });
+      answers_, config_.channels.quantum_reply, [this](const std::string&, const void* d, std::size_t n) { on_reply(d, n); });
 }
 
 RemoteAgents::~RemoteAgents() = default;
@@ -108,11 +108,11 @@ void RemoteAgents::on_reply(const void* data, std::size_t size) {
   if (s.awaiting && reply.quantum == *s.awaiting) {
     into = &answered_;
     s.awaiting.reset();
-    if (!s.repeated) {
-      const double ms = std::chrono::duration<double, std::milli>(s.last_heard - s.first_sent_at).count();
+    if (s.message < outgoing_.size() && !outgoing_[s.message].repeated) {
+      const double ms = std::chrono::duration<double, std::milli>(s.last_heard - outgoing_[s.message].first_sent_at).count();
       s.round_trip_ms = s.round_trip_ms < 0.0 ? ms : 0.9 * s.round_trip_ms + 0.1 * ms;
     }
-  } else if (config_.realtime && reply.quantum < s.next_quantum && reply.quantum > s.next_quantum - 3) {
+  } else if (config_.realtime && reply.quantum < next_quantum_ && reply.quantum > next_quantum_ - 3) {
     // Real time: the answer to an instant already gone, applied at the next one (once).
     into = &late_;
     ++counters_.late;
@@ -142,7 +142,7 @@ std::optional<std::string> RemoteAgents::wait_for_agents(std::chrono::millisecon
              " within " + std::to_string(timeout.count() / 1000.0).substr(0, 4) + " s (start `rilbed agent --ids " +
              join(missing) + "` on the bus " + config_.channels.agent_hello + " listens on)";
     }
-    lcm_.handleTimeout(std::max(1, std::min(100, ms_between(now, until))));
+    answers_.handleTimeout(std::max(1, std::min(100, ms_between(now, until))));
   }
 }
 
@@ -160,38 +160,71 @@ void RemoteAgents::submit(const agents::ControlInput& input) {
   }
 }
 
-void RemoteAgents::send(Session& s, TimeUs t_us, bool end) {
-  rilbed::quantum_t q;
+rilbed::quantum_t RemoteAgents::quantum_for(const std::vector<Session*>& sessions, std::int64_t k, TimeUs t_us,
+                                            bool end) const {
+  rilbed::quantum_t q{};
   q.run = run_;
-  q.session = s.name;
-  q.quantum = s.next_quantum++;
+  q.quantum = k;
   q.utime = t_us;
   q.end = end;
   bool reads_team = false;
-  if (!end) {
-    for (const int id : s.robot_ids) {
+  for (const Session* s : sessions) {
+    q.sessions.push_back(s->name);
+    if (end) continue;
+    for (const int id : s->robot_ids) {
       const auto it = pending_.find(id);
       if (it == pending_.end()) continue;
       q.inputs.push_back(to_lcm(it->second));
       reads_team = reads_team || config_.team_readers.contains(id);
     }
   }
+  q.num_sessions = static_cast<std::int32_t>(q.sessions.size());
   q.num_inputs = static_cast<std::int32_t>(q.inputs.size());
   q.has_team = reads_team;
   if (reads_team) {
     for (const agents::TeamMessage& m : team_) q.team.push_back(to_lcm(m));
   }
   q.num_team = static_cast<std::int32_t>(q.team.size());
-  s.bytes.resize(static_cast<std::size_t>(q.getEncodedSize()));
-  const int written = q.encode(s.bytes.data(), 0, static_cast<int>(s.bytes.size()));
-  s.bytes.resize(static_cast<std::size_t>(std::max(0, written)));
-  lcm_.publish(config_.channels.quantum, s.bytes.data(), static_cast<unsigned>(s.bytes.size()));
-  ++counters_.quanta_sent;
-  s.awaiting = q.quantum;
-  s.repeated = false;
-  s.sent_at = s.first_sent_at = Clock::now();
-  s.repeat_wait_ms = resend_after_ms(s);
-  if (!s.unanswered_since) s.unanswered_since = s.sent_at;
+  return q;
+}
+
+void RemoteAgents::send(const std::vector<Session*>& sessions, std::int64_t k, TimeUs t_us, bool end) {
+  if (sessions.empty()) return;
+  // One message for every process when it fits in one datagram (LCM sends larger ones in
+  // fragments, each a datagram that can be lost); else one per process, each with only
+  // its own robots.
+  constexpr int kOneDatagram = 60'000;
+  std::vector<rilbed::quantum_t> messages;
+  std::vector<std::vector<Session*>> addressed;
+  rilbed::quantum_t all = quantum_for(sessions, k, t_us, end);
+  if (sessions.size() == 1 || all.getEncodedSize() <= kOneDatagram) {
+    messages.push_back(std::move(all));
+    addressed.push_back(sessions);
+  } else {
+    for (Session* s : sessions) {
+      messages.push_back(quantum_for({s}, k, t_us, end));
+      addressed.push_back({s});
+    }
+  }
+  const auto now = Clock::now();
+  for (std::size_t m = 0; m < messages.size(); ++m) {
+    Outgoing out;
+    out.bytes.resize(static_cast<std::size_t>(messages[m].getEncodedSize()));
+    const int written = messages[m].encode(out.bytes.data(), 0, static_cast<int>(out.bytes.size()));
+    out.bytes.resize(static_cast<std::size_t>(std::max(0, written)));
+    quanta_.publish(config_.channels.quantum, out.bytes.data(), static_cast<unsigned>(out.bytes.size()));
+    ++counters_.quanta_sent;
+    out.first_sent_at = out.sent_at = now;
+    out.repeat_wait_ms = config_.resend_ms;
+    for (Session* s : addressed[m]) {
+      out.repeat_wait_ms = std::min(out.repeat_wait_ms, resend_after_ms(*s));
+      if (end) continue;
+      s->awaiting = k;
+      s->message = outgoing_.size();
+      if (!s->unanswered_since) s->unanswered_since = now;
+    }
+    outgoing_.push_back(std::move(out));
+  }
 }
 
 int RemoteAgents::resend_after_ms(const Session& s) const {
@@ -202,6 +235,7 @@ int RemoteAgents::resend_after_ms(const Session& s) const {
 void RemoteAgents::lose(Session& s, const char* why) {
   s.lost = true;
   s.awaiting.reset();
+  s.unanswered_since.reset();
   ++counters_.lost_processes;
   notices_.push_back({"agent", 0,
                       "lost: process " + s.host + ":" + std::to_string(s.pid) + " (robots " + join(s.robot_ids) + ") " + why});
@@ -209,15 +243,15 @@ void RemoteAgents::lose(Session& s, const char* why) {
 
 void RemoteAgents::handle_for(std::chrono::milliseconds wait) {
   // handleTimeout returns after one message or the timeout: drain what is there.
-  lcm_.handleTimeout(static_cast<int>(std::max<std::int64_t>(0, wait.count())));
-  while (lcm_.handleTimeout(0) > 0) {
+  answers_.handleTimeout(static_cast<int>(std::max<std::int64_t>(0, wait.count())));
+  while (answers_.handleTimeout(0) > 0) {
   }
 }
 
 std::vector<agents::RemoteOutput> RemoteAgents::exchange(TimeUs t_us) {
   const auto called = Clock::now();
   // Announcements and stale answers that arrived since the last instant.
-  while (lcm_.handleTimeout(0) > 0) {
+  while (answers_.handleTimeout(0) > 0) {
   }
   std::vector<agents::RemoteOutput> out;
   if (config_.realtime) {
@@ -225,19 +259,20 @@ std::vector<agents::RemoteOutput> RemoteAgents::exchange(TimeUs t_us) {
     late_.clear();
   }
   answered_.clear();
-  std::set<int> stopped;
-  // One quantum per live process that has inputs in it.
+  outgoing_.clear();
+  for (auto& [name, s] : sessions_) s.awaiting.reset();  // real time: an unanswered one is late now
+  // This instant's quantum, to every live process that has inputs in it.
+  std::vector<Session*> to;
   for (auto& [name, s] : sessions_) {
     if (s.lost) continue;
-    const bool any = std::any_of(s.robot_ids.begin(), s.robot_ids.end(), [&](int id) { return pending_.contains(id); });
-    if (any) send(s, t_us, false);
+    if (std::any_of(s.robot_ids.begin(), s.robot_ids.end(), [&](int id) { return pending_.contains(id); })) to.push_back(&s);
   }
-  const auto start = Clock::now();
-  const auto deadline = start + std::chrono::milliseconds(config_.deadline_ms);
+  const std::int64_t k = next_quantum_++;
+  send(to, k, t_us, false);
+  const auto deadline = called + std::chrono::milliseconds(config_.deadline_ms);
   for (;;) {
     const auto now = Clock::now();
-    bool waiting = false;
-    auto next_event = now + std::chrono::milliseconds(config_.resend_ms);
+    std::vector<bool> message_waits(outgoing_.size(), false);
     for (auto& [name, s] : sessions_) {
       if (s.lost || !s.awaiting) continue;
       if (s.unanswered_since && ms_between(*s.unanswered_since, now) >= config_.dead_after_ms &&
@@ -245,17 +280,24 @@ std::vector<agents::RemoteOutput> RemoteAgents::exchange(TimeUs t_us) {
         lose(s, "stopped answering");
         continue;
       }
-      if (config_.realtime && now >= deadline) continue;  // late: its answer goes to the next instant
+      message_waits[s.message] = true;
+    }
+    const bool past_deadline = config_.realtime && now >= deadline;
+    bool waiting = false;
+    auto next_event = now + std::chrono::milliseconds(config_.resend_ms);
+    for (std::size_t m = 0; m < outgoing_.size(); ++m) {
+      if (!message_waits[m] || past_deadline) continue;  // real time: late answers go to the next instant
       waiting = true;
-      if (now - s.sent_at >= std::chrono::milliseconds(s.repeat_wait_ms)) {
-        lcm_.publish(config_.channels.quantum, s.bytes.data(), static_cast<unsigned>(s.bytes.size()));
+      Outgoing& o = outgoing_[m];
+      if (now - o.sent_at >= std::chrono::milliseconds(o.repeat_wait_ms)) {
+        quanta_.publish(config_.channels.quantum, o.bytes.data(), static_cast<unsigned>(o.bytes.size()));
         ++counters_.repeats;
-        s.repeated = true;
-        s.sent_at = now;
+        o.repeated = true;
+        o.sent_at = now;
         // Backing off: a process that is gone, or slow, is not flooded.
-        s.repeat_wait_ms = std::min(config_.resend_ms, 2 * s.repeat_wait_ms);
+        o.repeat_wait_ms = std::min(config_.resend_ms, 2 * o.repeat_wait_ms);
       }
-      next_event = std::min(next_event, s.sent_at + std::chrono::milliseconds(s.repeat_wait_ms));
+      next_event = std::min(next_event, o.sent_at + std::chrono::milliseconds(o.repeat_wait_ms));
     }
     if (!waiting) break;
     if (config_.realtime) next_event = std::min(next_event, deadline);
@@ -284,10 +326,14 @@ void RemoteAgents::end() {
   // Told a few times, unanswered (a lost "end" only leaves the process waiting for the
   // next run, which its own silence timer then notices).
   pending_.clear();
+  std::vector<Session*> live;
+  for (auto& [name, s] : sessions_) {
+    if (!s.lost) live.push_back(&s);
+  }
+  const std::int64_t k = next_quantum_++;
   for (int round = 0; round < 3; ++round) {
-    for (auto& [name, s] : sessions_) {
-      if (!s.lost) send(s, 0, true);
-    }
+    outgoing_.clear();
+    send(live, k, 0, true);
     handle_for(std::chrono::milliseconds(2));
   }
 }

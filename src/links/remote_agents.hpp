@@ -2,8 +2,11 @@
 // run in `rilbed agent` processes, on this machine or others of the LAN.
 //
 // Each agent process announces itself (agent_hello_t, with its robots). At each control
-// instant the run sends every process one quantum_t holding only its own robots' inputs
-// (and the team broadcast when one of them reads it), and waits for the answers:
+// instant the run sends the processes their robots' inputs (and the team broadcast when one
+// of those robots reads it) in one quantum_t when that fits in one datagram, else one per
+// process (a world of 1,000 robots: each gets only its own), and waits for the answers.
+// Quanta go on one bus; answers and announcements come back on another (agent_reply_url),
+// so that no agent process hears the others' answers:
 // - lock-step (fast runs): until every process has answered; a quantum not answered
 //   within `resend_ms` is sent again, unchanged (UDP multicast loses messages; the
 //   process answers a repeat without stepping again);
@@ -28,6 +31,7 @@
 
 #include "agents/agent_exchange.hpp"
 #include "links/lcm_bus.hpp"
+#include "rilbed/quantum_t.hpp"
 
 namespace rilbed::links {
 
@@ -67,8 +71,9 @@ struct RemoteAgentsCounters {
 
 class RemoteAgents final : public agents::AgentExchange {
  public:
-  /// `lcm` must outlive the exchange and be handled by no other thread.
-  RemoteAgents(lcm::LCM& lcm, RemoteAgentsConfig config);
+  /// `quanta` (published on only) and `answers` (handled here) must outlive the exchange
+  /// and be handled by no other thread; they may be one instance (an in-process bus).
+  RemoteAgents(lcm::LCM& quanta, lcm::LCM& answers, RemoteAgentsConfig config);
   ~RemoteAgents() override;
 
   /// Waits until every listed robot's process has announced itself (handling the bus).
@@ -95,31 +100,37 @@ class RemoteAgents final : public agents::AgentExchange {
     int pid = 0;
     std::vector<int> robot_ids;
     bool lost = false;
-    std::int64_t next_quantum = 0;
     std::chrono::steady_clock::time_point last_heard;
-    // The quantum in flight: its bytes (sent again unchanged) and when it last went out.
-    std::optional<std::int64_t> awaiting;
-    std::vector<std::uint8_t> bytes;
-    std::chrono::steady_clock::time_point sent_at;
-    std::chrono::steady_clock::time_point first_sent_at;
-    bool repeated = false;       // the quantum in flight went out more than once
-    int repeat_wait_ms = 0;      // the wait before the next repeat (doubles with each)
+    std::optional<std::int64_t> awaiting;  // the quantum in flight, unanswered
+    std::size_t message = 0;               // which of outgoing_ carried it
     // Since when a quantum to it has gone unanswered (real time sends the next one
     // without waiting); cleared by any answer.
     std::optional<std::chrono::steady_clock::time_point> unanswered_since;
-    double round_trip_ms = -1.0; // smoothed, from answers to quanta sent once; < 0: none yet
+    double round_trip_ms = -1.0;  // smoothed, from answers to quanta sent once; < 0: none yet
+  };
+  // One quantum message in flight: its bytes (sent again unchanged) and its repeats.
+  struct Outgoing {
+    std::vector<std::uint8_t> bytes;
+    std::chrono::steady_clock::time_point first_sent_at, sent_at;
+    int repeat_wait_ms = 0;  // the wait before the next repeat (doubles with each)
+    bool repeated = false;
   };
   int resend_after_ms(const Session& s) const;
+  // Encodes and sends quantum `k` at `t_us` for `sessions` (their pending inputs).
+  void send(const std::vector<Session*>& sessions, std::int64_t k, TimeUs t_us, bool end);
   void on_hello(const void* data, std::size_t size);
   void on_reply(const void* data, std::size_t size);
   Session* session_of_robot(int robot_id);
-  void send(Session& s, TimeUs t_us, bool end);
+  rilbed::quantum_t quantum_for(const std::vector<Session*>& sessions, std::int64_t k, TimeUs t_us, bool end) const;
   void lose(Session& s, const char* why);
   void handle_for(std::chrono::milliseconds wait);
 
-  lcm::LCM& lcm_;
+  lcm::LCM& quanta_;
+  lcm::LCM& answers_;
   RemoteAgentsConfig config_;
   std::string run_;
+  std::int64_t next_quantum_ = 0;
+  std::vector<Outgoing> outgoing_;  // the messages of the quantum in flight
   std::map<std::string, Session> sessions_;     // by session name
   std::map<int, std::string> owner_;            // robot -> session name
   std::map<int, agents::ControlInput> pending_; // submitted for the coming quantum, by robot

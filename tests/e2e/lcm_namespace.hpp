@@ -13,7 +13,8 @@ namespace rilbed::e2e {
 
 // Runs `body` (shell lines, with $R the rilbed binary and $URL the bus) in a fresh network
 // namespace whose loopback carries multicast; with `lossy`, one UDP packet to port 7667 in
-// ten is dropped at random on the input hook (nft counters: the first rule counts every
+// ten (and to 7668, where agent processes answer a run: agent_reply_url) is dropped at
+// random on the input hook (nft counters: the first rule counts every
 // packet, the second the dropped ones). Returns the exit status, or -1 when the script did
 // not exit normally. The script has $XDG_RUNTIME_DIR in its folder (a run writes its token
 // there) and `listening N`, which waits until N sockets are bound to LCM's port.
@@ -24,8 +25,8 @@ inline int in_namespace(const std::filesystem::path& dir, const std::string& bod
   if (lossy) {
     out << "nft add table inet loss\n"
            "nft add chain inet loss in '{ type filter hook input priority 0; policy accept; }'\n"
-           "nft add rule inet loss in udp dport 7667 counter\n"
-           "nft add rule inet loss in udp dport 7667 numgen random mod 10 0 counter drop\n";
+           "nft add rule inet loss in udp dport '{ 7667, 7668 }' counter\n"
+           "nft add rule inet loss in udp dport '{ 7667, 7668 }' numgen random mod 10 0 counter drop\n";
   }
   out << "R='" << RILBED_BINARY << "'\nURL='udpm://239.255.76.67:7667?ttl=0'\ncd '" << dir.string() << "'\n"
       << "export XDG_RUNTIME_DIR=\"$PWD/xdg\"; mkdir -m 700 xdg\n"

@@ -92,7 +92,7 @@ void fuzz_server(const std::uint8_t* data, std::size_t size) {
   links::AgentServerConfig config;
   config.scenario_name = "fuzz";
   config.robot_ids = {1, 2, 3};
-  links::AgentServer server(*lcm, config, [](int) { return std::make_unique<TouchingController>(); });
+  links::AgentServer server(*lcm, *lcm, config, [](int) { return std::make_unique<TouchingController>(); });
   // The bytes as they are, and again with the session set to this server's (else nearly
   // every message would be for someone else).
   g_steps = 0;
@@ -103,7 +103,8 @@ void fuzz_server(const std::uint8_t* data, std::size_t size) {
     FUZZ_CHECK(server.counters().refused == 1 && g_steps == 0);
     return;
   }
-  q.session = server.session();
+  q.sessions.push_back(server.session());
+  q.num_sessions = static_cast<std::int32_t>(q.sessions.size());
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(q.getEncodedSize()));
   const int written = q.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
   if (written < 0) return;
@@ -135,7 +136,7 @@ void fuzz_run(const std::uint8_t* data, std::size_t size, bool hello) {
   links::RemoteAgentsConfig config;
   config.scenario_name = "fuzz";
   config.robot_ids = {1, 2};
-  links::RemoteAgents run(*lcm, config);
+  links::RemoteAgents run(*lcm, *lcm, config);
   rilbed::agent_hello_t h{};
   h.session = "known";
   h.scenario = "fuzz";

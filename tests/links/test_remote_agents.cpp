@@ -98,7 +98,7 @@ agents::RunResult run_through_exchange(const agents::Scenario& scenario, std::ui
   AgentServerConfig sc;
   sc.scenario_name = scenario.name;
   for (const auto& r : scenario.robots) sc.robot_ids.push_back(r.id);
-  auto server = std::make_unique<AgentServer>(*lcm, sc, [&scenario](int id) {
+  auto server = std::make_unique<AgentServer>(*lcm, *lcm, sc, [&scenario](int id) {
     return agents::make_controller(scenario, scenario.robots[static_cast<std::size_t>(id - 1)]);
   });
   RemoteAgentsConfig rc;
@@ -107,7 +107,7 @@ agents::RunResult run_through_exchange(const agents::Scenario& scenario, std::ui
   for (const int id : rc.robot_ids) rc.team_readers.insert(id);  // convoy controllers read the team
   rc.dead_after_ms = dead_after_ms;
   rc.resend_ms = 5;
-  RemoteAgents remote(*lcm, rc);
+  RemoteAgents remote(*lcm, *lcm, rc);
   server->announce();
   EXPECT_FALSE(remote.wait_for_agents(std::chrono::seconds(2)));
   // The server "dies" after some steps: a controller wrapper would be needed to time it
@@ -174,7 +174,7 @@ TEST(RemoteAgents, BytesThatAreNoMessageAreRefusedAndMissingRobotsNamed) {
   RemoteAgentsConfig rc;
   rc.scenario_name = "convoy_sim";
   rc.robot_ids = {3, 4};
-  RemoteAgents remote(*lcm, rc);
+  RemoteAgents remote(*lcm, *lcm, rc);
   const std::uint8_t junk[] = {1, 2, 3, 4, 5, 6, 7, 8, 0xFF, 0xFF, 0xFF, 0xFF};
   lcm->publish(rc.channels.agent_hello, junk, sizeof junk);
   lcm->publish(rc.channels.quantum_reply, junk, sizeof junk);
@@ -182,7 +182,7 @@ TEST(RemoteAgents, BytesThatAreNoMessageAreRefusedAndMissingRobotsNamed) {
   AgentServerConfig other;
   other.scenario_name = "wander";
   other.robot_ids = {3, 4};
-  AgentServer stranger(*lcm, other, [](int) { return std::unique_ptr<agents::Controller>(); });
+  AgentServer stranger(*lcm, *lcm, other, [](int) { return std::unique_ptr<agents::Controller>(); });
   stranger.announce();
   const auto missing = remote.wait_for_agents(std::chrono::milliseconds(300));
   ASSERT_TRUE(missing);
@@ -194,7 +194,7 @@ TEST(RemoteAgents, BytesThatAreNoMessageAreRefusedAndMissingRobotsNamed) {
   sc.scenario_name = "convoy_sim";
   sc.robot_ids = {3};
   int made = 0;
-  AgentServer server(*lcm, sc, [&made](int) {
+  AgentServer server(*lcm, *lcm, sc, [&made](int) {
     ++made;
     return std::unique_ptr<agents::Controller>();
   });
@@ -202,7 +202,8 @@ TEST(RemoteAgents, BytesThatAreNoMessageAreRefusedAndMissingRobotsNamed) {
   EXPECT_EQ(server.counters().refused, 1);
   rilbed::quantum_t q{};  // (lcm-gen leaves the numbers of a plain declaration unset)
   q.run = "r1";
-  q.session = "someone-else";
+  q.sessions = {"someone-else"};
+  q.num_sessions = 1;
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(q.getEncodedSize()));
   q.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
   server.handle_quantum(bytes.data(), bytes.size());
