@@ -105,6 +105,11 @@ void RemoteAgents::on_reply(const void* data, std::size_t size) {
   if (s.lost) return;
   s.unanswered_since.reset();
   std::vector<agents::RemoteOutput>* into = nullptr;
+  if (reply.quantum <= s.last_answered) {
+    // A second copy of an answer (agents send each twice), or a repeat's answer.
+    ++counters_.duplicates;
+    return;
+  }
   if (s.awaiting && reply.quantum == *s.awaiting) {
     into = &answered_;
     s.awaiting.reset();
@@ -121,6 +126,7 @@ void RemoteAgents::on_reply(const void* data, std::size_t size) {
     return;
   }
   ++counters_.answers;
+  s.last_answered = reply.quantum;
   for (const rilbed::agent_output_t& o : reply.outputs) {
     // Only this process's own robots.
     if (std::find(s.robot_ids.begin(), s.robot_ids.end(), o.id) == s.robot_ids.end()) continue;
@@ -139,8 +145,8 @@ std::optional<std::string> RemoteAgents::wait_for_agents(std::chrono::millisecon
     const auto now = Clock::now();
     if (now >= until) {
       return "no agent process announced robot" + std::string(missing.size() > 1 ? "s " : " ") + join(missing) +
-             " within " + std::to_string(timeout.count() / 1000.0).substr(0, 4) + " s (start `rilbed agent --ids " +
-             join(missing) + "` on the bus " + config_.channels.agent_hello + " listens on)";
+             " within " + std::to_string(timeout.count() / 1000.0).substr(0, 4) + " s (start `rilbed agent --scenario FILE --ids " +
+             join(missing) + " --lcm URL` with this run's URL and channel prefix)";
     }
     answers_.handleTimeout(std::max(1, std::min(100, ms_between(now, until))));
   }

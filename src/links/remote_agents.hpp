@@ -102,6 +102,7 @@ class RemoteAgents final : public agents::AgentExchange {
     bool lost = false;
     std::chrono::steady_clock::time_point last_heard;
     std::optional<std::int64_t> awaiting;  // the quantum in flight, unanswered
+    std::int64_t last_answered = -1;       // the latest quantum it answered (copies of it are duplicates)
     std::size_t message = 0;               // which of outgoing_ carried it
     // Since when a quantum to it has gone unanswered (real time sends the next one
     // without waiting); cleared by any answer.

@@ -169,6 +169,40 @@ TEST(RemoteAgents, AProcessThatStopsAnsweringIsLostAndItsRobotsStop) {
   }
 }
 
+TEST(RemoteAgents, InRealTimeEveryAnswerIsOnTimeAndItsSecondCopyIsNoLateAnswer) {
+  // The server answers within the run's own wait (one thread, memq), twice each time: the
+  // second copy must count as a duplicate, not as a late answer to apply at the next step.
+  const agents::Scenario scenario = convoy();
+  auto lcm = memq();
+  AgentServerConfig sc;
+  sc.scenario_name = scenario.name;
+  for (const auto& r : scenario.robots) sc.robot_ids.push_back(r.id);
+  AgentServer server(*lcm, *lcm, sc, [&scenario](int id) {
+    return agents::make_controller(scenario, scenario.robots[static_cast<std::size_t>(id - 1)]);
+  });
+  RemoteAgentsConfig rc;
+  rc.scenario_name = scenario.name;
+  rc.robot_ids = sc.robot_ids;
+  for (const int id : rc.robot_ids) rc.team_readers.insert(id);
+  rc.realtime = true;
+  RemoteAgents remote(*lcm, *lcm, rc);
+  server.announce();
+  ASSERT_FALSE(remote.wait_for_agents(std::chrono::seconds(2)));
+  agents::RunOptions o;
+  o.seed = 4;
+  o.duration_s = 3.0;
+  o.realtime = true;
+  o.rt_factor = 30.0;
+  o.keep_in_memory = true;
+  o.remote_agents = &remote;
+  const agents::RunResult r = agents::run_scenario(scenario, o);
+  EXPECT_EQ(r.ended_by, "duration");
+  EXPECT_EQ(remote.counters().answers, 31);  // steps at 0, 0.1, ..., 3.0 s
+  EXPECT_EQ(remote.counters().late, 0);
+  EXPECT_EQ(remote.counters().duplicates, 31);  // the second copies
+  for (const auto& s : r.trajectory) EXPECT_NE(s.behaviour, "lost");
+}
+
 TEST(RemoteAgents, BytesThatAreNoMessageAreRefusedAndMissingRobotsNamed) {
   auto lcm = memq();
   RemoteAgentsConfig rc;
