@@ -5,6 +5,7 @@
 // and its robots stop while the rest go on, and one started again for them rejoins.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -142,6 +143,42 @@ TEST(AgentsCli, ARunWhoseAgentsNeverComeNamesTheMissingRobots) {
   EXPECT_EQ(read_file(dir / "rc"), "1\n");
   EXPECT_NE(read_file(dir / "run.txt").find("no agent process announced robots 3,4"), std::string::npos)
       << read_file(dir / "run.txt");
+}
+
+// Two "machines": network namespaces joined by a veth pair, each with an address of a
+// private test range and a multicast route on its end of the pair. The run and robots 1-4's
+// agent process are on one, robots 5-8's on the other; the bus crosses the pair (ttl=1).
+TEST(AgentsCli, AgentsOnTwoMachinesJoinedByAVethPairGiveTheInProcessRun) {
+  SKIP_WITHOUT_NAMESPACES();
+  if (std::system("ip netns add rilbed_probe_$$ >/dev/null 2>&1 && ip netns del rilbed_probe_$$") != 0) {
+    GTEST_SKIP() << "cannot make named network namespaces here (ip netns add needs root)";
+  }
+  const fs::path dir = scratch_dir("agents_two_machines");
+  const fs::path scenario = convoy_with_agents(dir, "{processes: 0}");
+  const std::string s = "'" + scenario.string() + "'";
+  const fs::path script = dir / "machines.sh";
+  std::ofstream(script)
+      << "set -e\nR='" << RILBED_BINARY << "'\ncd '" << dir.string() << "'\n"
+      << "A=rilbed_a_$$; B=rilbed_b_$$\n"
+      << "cleanup() { [ -n \"$AGENTS\" ] && kill $AGENTS 2>/dev/null; wait 2>/dev/null; ip netns del $A 2>/dev/null; "
+         "ip netns del $B 2>/dev/null; true; }\ntrap cleanup EXIT\n"
+      << "ip netns add $A; ip netns add $B\n"
+      << "ip link add veth_a netns $A type veth peer name veth_b netns $B\n"
+      << "ip -n $A addr add 10.203.0.1/24 dev veth_a; ip -n $B addr add 10.203.0.2/24 dev veth_b\n"
+      << "for n in $A $B; do ip -n $n link set lo up; done\n"
+      << "ip -n $A link set veth_a up multicast on; ip -n $B link set veth_b up multicast on\n"
+      << "ip -n $A route add 224.0.0.0/4 dev veth_a; ip -n $B route add 224.0.0.0/4 dev veth_b\n"
+      << "URL='udpm://239.255.76.67:7667?ttl=1'\n"
+      << "\"$R\" run '" << (fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml").string()
+      << "' --fast --seed 6 --duration 30 --out local --quiet\n"
+      << "ip netns exec $A \"$R\" agent --scenario " << s << " --ids 1-4 --lcm \"$URL\" > agent_a.txt 2>&1 &\nAGENTS=$!\n"
+      << "ip netns exec $B \"$R\" agent --scenario " << s << " --ids 5-8 --lcm \"$URL\" > agent_b.txt 2>&1 &\n"
+      << "AGENTS=\"$AGENTS $!\"\n"
+      << "ip netns exec $A \"$R\" run " << s << " --fast --seed 6 --duration 30 --out remote --lcm \"$URL\" > run.txt 2>&1\n";
+  const int status = std::system(("/bin/bash '" + script.string() + "' > '" + (dir / "machines.log").string() + "' 2>&1").c_str());
+  ASSERT_EQ(status, 0) << read_file(dir / "machines.log") << read_file(dir / "run.txt") << read_file(dir / "agent_b.txt");
+  EXPECT_NE(read_file(dir / "run.txt").find("0 processes lost"), std::string::npos) << read_file(dir / "run.txt");
+  expect_same_run_folder(dir / "local", dir / "remote");
 }
 
 TEST(AgentsCli, AgentsInOtherProcessesNeedABusTheyReach) {
