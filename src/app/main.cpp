@@ -52,7 +52,10 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // CLI11 prints the reason (or the help, exit 0); a bad option is exit 2 whatever
+    // CLI11's own code for it (105 for a file that does not exist), as README promises.
+    const int code = app.exit(e);
+    return code == 0 ? 0 : rilbed::app::kExitUsage;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 1;

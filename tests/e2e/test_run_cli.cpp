@@ -64,8 +64,13 @@ TEST(RunCli, ABadScenarioNamesFileLineAndKey) {
   const CommandResult r = run_rilbed("run '" + bad.string() + "' --fast");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("bad.yaml:3: field.heigth_m: unknown key"), std::string::npos) << r.err;
+  // A file that does not exist is a bad option value: exit 2, as every malformed option
+  // (CLI11's own code for it was 105), and the reason said.
   const CommandResult missing = run_rilbed("run /nonexistent.yaml");
-  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("/nonexistent.yaml"), std::string::npos) << missing.err;
+  const CommandResult not_a_number = run_rilbed("run '" + bad.string() + "' --seed abc");
+  EXPECT_EQ(not_a_number.exit_code, 2);
   fs::remove_all(dir);
 }
 
