@@ -1,5 +1,7 @@
 #include "app/agent_processes.hpp"
 
+#include "core/id_list.hpp"
+
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -12,18 +14,6 @@ extern char** environ;
 
 namespace rilbed::app {
 
-namespace {
-
-std::string id_list_arg(const std::vector<int>& ids) {
-  std::string s;
-  for (const int id : ids) {
-    if (!s.empty()) s += ',';
-    s += std::to_string(id);
-  }
-  return s;
-}
-
-}  // namespace
 
 AgentProcesses::~AgentProcesses() { stop(); }
 
@@ -42,7 +32,7 @@ bool AgentProcesses::start(const std::string& scenario_file, const std::vector<s
     return false;
   }
   for (const std::vector<int>& group : groups) {
-    std::vector<std::string> args = {self, "agent", "--scenario", scenario_file, "--ids", id_list_arg(group),
+    std::vector<std::string> args = {self, "agent", "--scenario", scenario_file, "--ids", id_list_text(group),
                                      "--lcm", url, "--quiet"};
     if (!prefix.empty()) {
       args.push_back("--channel-prefix");
