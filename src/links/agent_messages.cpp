@@ -48,8 +48,8 @@ agents::TeamMessage from_lcm(const rilbed::team_member_t& m) {
 rilbed::agent_output_t to_lcm(const agents::RemoteOutput& output) {
   rilbed::agent_output_t m;
   m.id = output.robot_id;
-  m.left = static_cast<std::int16_t>(std::clamp(output.output.wheels.left, -agents::kMaxWheelUnits, agents::kMaxWheelUnits));
-  m.right = static_cast<std::int16_t>(std::clamp(output.output.wheels.right, -agents::kMaxWheelUnits, agents::kMaxWheelUnits));
+  m.left_units = static_cast<std::int16_t>(std::clamp(output.output.wheels.left, -agents::kMaxWheelUnits, agents::kMaxWheelUnits));
+  m.right_units = static_cast<std::int16_t>(std::clamp(output.output.wheels.right, -agents::kMaxWheelUnits, agents::kMaxWheelUnits));
   m.behaviour = std::string(output.output.behaviour);
   m.done = output.done;
   return m;
@@ -58,8 +58,8 @@ rilbed::agent_output_t to_lcm(const agents::RemoteOutput& output) {
 agents::RemoteOutput from_lcm(const rilbed::agent_output_t& m) {
   agents::RemoteOutput out;
   out.robot_id = m.id;
-  out.output.wheels = {std::clamp<int>(m.left, -agents::kMaxWheelUnits, agents::kMaxWheelUnits),
-                       std::clamp<int>(m.right, -agents::kMaxWheelUnits, agents::kMaxWheelUnits)};
+  out.output.wheels = {std::clamp<int>(m.left_units, -agents::kMaxWheelUnits, agents::kMaxWheelUnits),
+                       std::clamp<int>(m.right_units, -agents::kMaxWheelUnits, agents::kMaxWheelUnits)};
   out.output.behaviour = intern_behaviour(m.behaviour);
   out.done = m.done;
   return out;
