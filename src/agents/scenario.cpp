@@ -93,6 +93,18 @@ class Reader {
     if (!n.IsSequence() || n.size() != 2) fail_key(key, "must be a point [x_m, y_m]");
     return {as_number(n[0], key), as_number(n[1], key)};
   }
+  /// A list of text values (a single one counts as a list of one).
+  std::vector<std::string> words(const std::string& key) const {
+    const YAML::Node n = node_[key];
+    std::vector<std::string> out;
+    if (n.IsScalar()) return {n.as<std::string>()};
+    if (!n.IsSequence()) fail_key(key, "must be a list of text values");
+    for (const auto& w : n) {
+      if (!w.IsScalar()) fail_key(key, "must be a list of text values");
+      out.push_back(w.as<std::string>());
+    }
+    return out;
+  }
   std::vector<Vec2> points(const std::string& key) const {
     const YAML::Node n = node_[key];
     if (!n || !n.IsSequence()) fail_key(key, "must be a list of points [[x_m, y_m], ...]");
@@ -441,10 +453,29 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source) {
   }
   if (top.has("agents")) {
     const Reader a = top.child("agents");
-    a.allow({"processes", "ids", "announce_timeout_s", "resend_ms", "dead_after_ms", "deadline_ms"});
+    a.allow({"processes", "ids", "announce_timeout_s", "resend_ms", "dead_after_ms", "deadline_ms", "hosts", "launch",
+             "remote_rilbed"});
     AgentsSpec spec;
-    spec.processes = a.integer("processes", 0);
+    if (a.has("hosts")) spec.hosts = a.words("hosts");
+    for (const std::string& host : spec.hosts) {
+      // A host is one argument of the launch command: one starting with '-' would be taken
+      // for an option of ssh (e.g. -oProxyCommand=...), not a machine.
+      if (host.empty() || host.front() == '-' || host.find_first_of(" \t\r\n") != std::string::npos) {
+        a.fail_key("hosts", "'" + host + "' is not a host name (no spaces, not starting with '-')");
+      }
+    }
+    spec.processes = a.integer("processes", static_cast<int>(spec.hosts.size()));
     if (spec.processes < 0 || spec.processes > 64) a.fail_key("processes", "must be 0 to 64");
+    if (!spec.hosts.empty() && spec.processes < 1) a.fail_key("processes", "the hosts need at least one process");
+    if (a.has("launch")) {
+      spec.launch = a.words("launch");
+      if (spec.launch.empty() || spec.launch.front().empty()) a.fail_key("launch", "must name a program to start");
+      if (std::none_of(spec.launch.begin(), spec.launch.end(),
+                       [](const std::string& w) { return w.find("{command}") != std::string::npos; })) {
+        a.fail_key("launch", "must have a {command} item (the agent's command line)");
+      }
+    }
+    spec.remote_rilbed = a.text("remote_rilbed", "");
     if (a.has("ids")) {
       const auto parsed = parse_id_list(a.text("ids", ""), 1, 100000);
       if (!parsed.ok()) a.fail_key("ids", parsed.error);

@@ -111,6 +111,19 @@ struct AgentsSpec {
   int dead_after_ms = 750;
   /// Real-time runs: how long a control step waits for its answers (milliseconds).
   int deadline_ms = 20;
+  /// Machines to start the `processes` on, in turn (process i on hosts[i % size]), each with
+  /// `launch`; empty: on this machine. Each entry is what `launch` puts for `{host}`
+  /// (for ssh: `host`, `user@host`).
+  std::vector<std::string> hosts;
+  /// The command that starts one agent process on a host, one list item per argument:
+  /// `{host}` in an item becomes the host, `{command}` the agent's command line as one
+  /// shell-quoted text (what ssh hands to the remote shell). The scenario itself goes to
+  /// the command's standard input, which the agent keeps open as its lifeline: when the run
+  /// goes, the connection closes and the remote agent ends.
+  std::vector<std::string> launch = {"ssh", "-T", "-o", "BatchMode=yes", "{host}", "{command}"};
+  /// The rilbed binary on the hosts; empty: this binary's own absolute path (machines set
+  /// up alike, or a shared file system).
+  std::string remote_rilbed;
 };
 
 struct Scenario {

@@ -3,14 +3,18 @@
 // The controllers are built from the scenario exactly as `rilbed run` builds them, afresh
 // for each run; the run sends their inputs each control step and applies their answers.
 #include <signal.h>
+#include <unistd.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <csignal>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <set>
+#include <thread>
 #include <string>
 #include <vector>
 
@@ -30,6 +34,7 @@ extern "C" void on_agent_signal(int) { agent_interrupted.store(true); }
 
 struct AgentArgs {
   std::string scenario;
+  std::string scenario_stdin;  ///< the name of the scenario read from standard input
   std::string ids;
   std::string url;
   std::string prefix;
@@ -37,14 +42,64 @@ struct AgentArgs {
   bool quiet = false;
 };
 
+// The scenario's text from standard input, up to a line "..." (YAML's end of document) or
+// the end of the input; sets `lifeline` when the line came, the input still open.
+std::optional<std::string> read_scenario_from_stdin(bool& lifeline) {
+  std::string text;
+  char buffer[4096];
+  lifeline = false;
+  for (;;) {
+    const ssize_t n = read(STDIN_FILENO, buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) return std::nullopt;
+    if (n == 0) return text;
+    text.append(buffer, static_cast<std::size_t>(n));
+    const std::size_t end = text.starts_with("...\n") ? 0 : text.find("\n...\n");
+    if (end != std::string::npos) {
+      text.resize(end == 0 ? 0 : end + 1);
+      lifeline = true;
+      return text;
+    }
+    if (text.size() > (1u << 24)) return std::nullopt;  // 16 MB is no scenario
+  }
+}
+
+// Ends the agent (as Ctrl-C does) when its standard input closes: the launching run, or
+// the ssh connection to it, is gone.
+void watch_lifeline() {
+  std::thread([] {
+    char byte[256];
+    for (;;) {
+      const ssize_t n = read(STDIN_FILENO, byte, sizeof byte);
+      if (n == 0 || (n < 0 && errno != EINTR)) break;
+    }
+    agent_interrupted.store(true);
+  }).detach();
+}
+
 int agent_command(const AgentArgs& args) {
   if (const auto problem = links::check_channel_prefix(args.prefix)) {
     spdlog::error("agent: {}", *problem);
     return kExitUsage;
   }
+  if (args.scenario.empty() == args.scenario_stdin.empty()) {
+    spdlog::error("agent: give either --scenario FILE or --scenario-stdin NAME");
+    return kExitUsage;
+  }
   agents::Scenario scenario;
+  bool lifeline = false;
   try {
-    scenario = agents::load_scenario(args.scenario);
+    if (!args.scenario_stdin.empty()) {
+      const std::optional<std::string> text = read_scenario_from_stdin(lifeline);
+      if (!text) {
+        spdlog::error("agent: cannot read the scenario from standard input");
+        return kExitFailure;
+      }
+      scenario = agents::parse_scenario(*text, args.scenario_stdin);
+      scenario.source = args.scenario_stdin;
+    } else {
+      scenario = agents::load_scenario(args.scenario);
+    }
   } catch (const std::exception& e) {
     spdlog::error("agent: {}", e.what());
     return kExitFailure;
@@ -60,12 +115,12 @@ int agent_command(const AgentArgs& args) {
   for (const int id : ids) {
     const auto spec = std::find_if(scenario.robots.begin(), scenario.robots.end(), [&](const auto& r) { return r.id == id; });
     if (spec == scenario.robots.end()) {
-      spdlog::error("agent: {} has no robot {}", args.scenario, id);
+      spdlog::error("agent: {} has no robot {}", scenario.source.string(), id);
       return kExitUsage;
     }
     try {
       if (!agents::make_controller(scenario, *spec)) {
-        spdlog::error("agent: robot {} of {} has no controller (controller: none)", id, args.scenario);
+        spdlog::error("agent: robot {} of {} has no controller (controller: none)", id, scenario.source.string());
         return kExitUsage;
       }
     } catch (const std::exception& e) {
@@ -92,6 +147,7 @@ int agent_command(const AgentArgs& args) {
   });
   std::signal(SIGINT, on_agent_signal);
   std::signal(SIGTERM, on_agent_signal);
+  if (lifeline) watch_lifeline();
   if (!args.quiet) {
     std::printf("agent %s: robots %s of %s, on %s\n", server.session().c_str(), args.ids.c_str(), scenario.name.c_str(),
                 args.url.empty() ? "LCM's default bus" : args.url.c_str());
@@ -113,7 +169,13 @@ void add_agent_command(CLI::App& app) {
   auto args = std::make_shared<AgentArgs>();
   CLI::App* cmd = app.add_subcommand(
       "agent", "Run some robots' controllers in this process, for a run on an LCM bus that lists them as remote");
-  cmd->add_option("--scenario", args->scenario, "The run's scenario file")->required()->check(CLI::ExistingFile);
+  CLI::Option* file = cmd->add_option("--scenario", args->scenario, "The run's scenario file")->check(CLI::ExistingFile);
+  cmd->add_option("--scenario-stdin", args->scenario_stdin,
+                  "Read the scenario from standard input instead, up to a line '...' or its end; NAME is the file it "
+                  "came from (its default name, and in messages). After a '...' line the agent ends when its input "
+                  "closes (how `rilbed run` starts agents over ssh)")
+      ->option_text("NAME")
+      ->excludes(file);
   cmd->add_option("--ids", args->ids, "The robots whose controllers run here (e.g. 3,4 or 1-8)")->required();
   cmd->add_option("--lcm", args->url, "LCM URL of the run's bus (e.g. udpm://239.255.76.67:7667?ttl=0)")->required();
   cmd->add_option("--channel-prefix", args->prefix, "The run's channel prefix (rilbed run --channel-prefix)");

@@ -92,7 +92,7 @@ std::optional<Row> bench_one(const QuantumBenchArgs& args, lcm::LCM& lcm, lcm::L
   for (int id = 1; id <= robots; ++id) ids.push_back(id);
   AgentProcesses agents_here;
   std::string error;
-  if (!agents_here.start(file.string(), split_ids(ids, processes), args.url, args.prefix, error)) {
+  if (!agents_here.start({file.string(), args.url, args.prefix, {}, {}}, place_agents(ids, processes, {}), error)) {
     spdlog::error("quantum-bench: {}", error);
     return std::nullopt;
   }
@@ -102,7 +102,7 @@ std::optional<Row> bench_one(const QuantumBenchArgs& args, lcm::LCM& lcm, lcm::L
   config.robot_ids = ids;
   config.record_exchange_times = true;
   links::RemoteAgents remote(lcm, answers, config);
-  if (const auto missing = remote.wait_for_agents(std::chrono::seconds(20))) {
+  if (const auto missing = remote.wait_for_agents(std::chrono::seconds(20), [&] { return agents_here.ended_early(); })) {
     spdlog::error("quantum-bench: {}", *missing);
     return std::nullopt;
   }

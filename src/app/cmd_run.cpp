@@ -492,8 +492,9 @@ int run_command(const RunArgs& args) {
       spdlog::error("{}", error);
       return kExitFailure;
     }
-    if (spec.processes > 0 && !agent_processes.start(args.scenario, split_ids(spec.ids, spec.processes), args.lcm_url,
-                                                     args.channel_prefix, error)) {
+    const AgentLaunchConfig launch{args.scenario, args.lcm_url, args.channel_prefix, spec.launch, spec.remote_rilbed};
+    if (spec.processes > 0 &&
+        !agent_processes.start(launch, place_agents(spec.ids, spec.processes, spec.hosts), error)) {
       spdlog::error("{}", error);
       return kExitFailure;
     }
@@ -513,7 +514,9 @@ int run_command(const RunArgs& args) {
     run_seed = [&, config, timeout, inner = run_seed](const agents::RunOptions& given) {
       agents::RunOptions o = given;
       links::RemoteAgents remote(*agents_lcm, *agents_answers_lcm, config);
-      if (const auto missing = remote.wait_for_agents(timeout)) throw agents::ScenarioError(args.scenario + ": " + *missing);
+      if (const auto missing = remote.wait_for_agents(timeout, [&] { return agent_processes.ended_early(); })) {
+        throw agents::ScenarioError(args.scenario + ": " + *missing);
+      }
       o.remote_agents = &remote;
       agents::RunResult r = inner(o);
       const links::RemoteAgentsCounters& c = remote.counters();

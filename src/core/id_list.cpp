@@ -63,4 +63,17 @@ std::string id_list_text(const std::vector<int>& ids) {
   return text;
 }
 
+std::string id_ranges_text(const std::vector<int>& ids) {
+  std::string text;
+  for (std::size_t i = 0; i < ids.size();) {
+    std::size_t last = i;
+    while (last + 1 < ids.size() && ids[last] < ids[last + 1] && ids[last + 1] - ids[last] == 1) ++last;
+    if (!text.empty()) text.push_back(',');
+    text.append(std::to_string(ids[i]));
+    if (last > i) text.append("-").append(std::to_string(ids[last]));
+    i = last + 1;
+  }
+  return text;
+}
+
 }  // namespace rilbed

@@ -23,4 +23,8 @@ IdListResult parse_id_list(std::string_view text, int min_id, int max_id);
 /// IDs as people read them: "4, 5, 7" (in the order given; empty for none).
 std::string id_list_text(const std::vector<int>& ids);
 
+/// IDs as parse_id_list reads them, runs of consecutive IDs as ranges: "1-4,7,9-12" (in
+/// the order given; empty for none). A thousand robots make a short argument.
+std::string id_ranges_text(const std::vector<int>& ids);
+
 }  // namespace rilbed

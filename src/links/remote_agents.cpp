@@ -134,9 +134,13 @@ void RemoteAgents::on_reply(const void* data, std::size_t size) {
   }
 }
 
-std::optional<std::string> RemoteAgents::wait_for_agents(std::chrono::milliseconds timeout) {
+std::optional<std::string> RemoteAgents::wait_for_agents(std::chrono::milliseconds timeout,
+                                                         const std::function<std::optional<std::string>()>& give_up) {
   const auto until = Clock::now() + timeout;
   for (;;) {
+    if (give_up) {
+      if (auto reason = give_up()) return reason;
+    }
     std::vector<int> missing;
     for (const int id : config_.robot_ids) {
       if (!owner_.contains(id)) missing.push_back(id);

@@ -20,6 +20,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -78,8 +79,10 @@ class RemoteAgents final : public agents::AgentExchange {
 
   /// Waits until every listed robot's process has announced itself (handling the bus).
   /// Returns nothing when all have, else the error naming the robots still missing after
-  /// `timeout`.
-  std::optional<std::string> wait_for_agents(std::chrono::milliseconds timeout);
+  /// `timeout`. `give_up`, called every tenth of a second or so, ends the wait early with
+  /// the error it returns (an agent process that could not start).
+  std::optional<std::string> wait_for_agents(std::chrono::milliseconds timeout,
+                                             const std::function<std::optional<std::string>()>& give_up = {});
 
   bool serves(int robot_id) const override;
   void submit(const agents::ControlInput& input) override;

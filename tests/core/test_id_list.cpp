@@ -2,6 +2,8 @@
 
 #include "core/id_list.hpp"
 
+using rilbed::id_ranges_text;
+using rilbed::IdListResult;
 using rilbed::parse_id_list;
 
 TEST(IdList, ParsesRangesAndSingles) {
@@ -28,4 +30,20 @@ TEST(IdList, RejectsGarbage) {
   EXPECT_FALSE(parse_id_list("3-1", 1, 8).ok());
   EXPECT_FALSE(parse_id_list("1,,2", 1, 8).ok());
   EXPECT_FALSE(parse_id_list("1-", 1, 8).ok());
+}
+
+TEST(IdList, RangesTextIsShortAndReadsBackTheSameIds) {
+  EXPECT_EQ(id_ranges_text({}), "");
+  EXPECT_EQ(id_ranges_text({5}), "5");
+  EXPECT_EQ(id_ranges_text({1, 2, 3, 4, 7, 9, 10, 11, 12}), "1-4,7,9-12");
+  EXPECT_EQ(id_ranges_text({3, 2, 1}), "3,2,1");  // only rising runs become ranges: the order stays
+  std::vector<int> many;
+  for (int id = 1; id <= 1000; ++id) {
+    if (id % 97 != 0) many.push_back(id);
+  }
+  const std::string text = id_ranges_text(many);
+  EXPECT_LT(text.size(), 120u);
+  const IdListResult back = parse_id_list(text, 1, 1000);
+  ASSERT_TRUE(back.ok()) << back.error;
+  EXPECT_EQ(back.ids, many);
 }

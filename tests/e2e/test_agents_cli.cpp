@@ -5,6 +5,7 @@
 // and its robots stop while the rest go on, and one started again for them rejoins.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "app/agent_processes.hpp"
 #include "lcm_namespace.hpp"
 #include "run_command.hpp"
 
@@ -26,6 +28,13 @@ fs::path convoy_with_agents(const fs::path& dir, const std::string& agents_block
   std::ofstream out(file);
   out << read_file(fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml") << "\nagents: " << agents_block << "\n";
   return file;
+}
+
+// How often `needle` occurs in `text`.
+int count_of(const std::string& text, const std::string& needle) {
+  int n = 0;
+  for (std::size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + needle.size())) ++n;
+  return n;
 }
 
 // summary.json without the wall times (which no two runs share).
@@ -146,39 +155,142 @@ TEST(AgentsCli, ARunWhoseAgentsNeverComeNamesTheMissingRobots) {
 }
 
 // Two "machines": network namespaces joined by a veth pair, each with an address of a
-// private test range and a multicast route on its end of the pair. The run and robots 1-4's
-// agent process are on one, robots 5-8's on the other; the bus crosses the pair (ttl=1).
-TEST(AgentsCli, AgentsOnTwoMachinesJoinedByAVethPairGiveTheInProcessRun) {
-  SKIP_WITHOUT_NAMESPACES();
-  if (std::system("ip netns add rilbed_probe_$$ >/dev/null 2>&1 && ip netns del rilbed_probe_$$") != 0) {
-    GTEST_SKIP() << "cannot make named network namespaces here (ip netns add needs root)";
+// private test range (A 10.203.0.1, B 10.203.0.2) and a multicast route on its end of the
+// pair; the start of a bash script that makes them ($A, $B, $R the binary, $URL the bus,
+// ttl=1 so that it crosses the pair) and removes them when it ends, with every process
+// whose pid it added to $KEEP_PIDS.
+std::string two_machines_script(const fs::path& dir) {
+  std::ostringstream script;
+  script << "set -e\nR='" << RILBED_BINARY << "'\ncd '" << dir.string() << "'\n"
+         << "A=rilbed_a_$$; B=rilbed_b_$$; KEEP_PIDS=\n"
+         << "cleanup() { [ -n \"$KEEP_PIDS\" ] && kill $KEEP_PIDS 2>/dev/null; wait 2>/dev/null; ip netns del $A 2>/dev/null; "
+            "ip netns del $B 2>/dev/null; true; }\ntrap cleanup EXIT\n"
+         << "ip netns add $A; ip netns add $B\n"
+         << "ip link add veth_a netns $A type veth peer name veth_b netns $B\n"
+         << "ip -n $A addr add 10.203.0.1/24 dev veth_a; ip -n $B addr add 10.203.0.2/24 dev veth_b\n"
+         << "for n in $A $B; do ip -n $n link set lo up; done\n"
+         << "ip -n $A link set veth_a up multicast on; ip -n $B link set veth_b up multicast on\n"
+         << "ip -n $A route add 224.0.0.0/4 dev veth_a; ip -n $B route add 224.0.0.0/4 dev veth_b\n"
+         << "URL='udpm://239.255.76.67:7667?ttl=1'\n";
+  return script.str();
+}
+
+#define SKIP_WITHOUT_NAMED_NAMESPACES()                                                                  \
+  SKIP_WITHOUT_NAMESPACES();                                                                           \
+  if (std::system("ip netns add rilbed_probe_$$ >/dev/null 2>&1 && ip netns del rilbed_probe_$$") != 0) { \
+    GTEST_SKIP() << "cannot make named network namespaces here (ip netns add needs root)";             \
   }
+
+// The run and robots 1-4's agent process are on one machine, robots 5-8's on the other.
+TEST(AgentsCli, AgentsOnTwoMachinesJoinedByAVethPairGiveTheInProcessRun) {
+  SKIP_WITHOUT_NAMED_NAMESPACES();
   const fs::path dir = scratch_dir("agents_two_machines");
   const fs::path scenario = convoy_with_agents(dir, "{processes: 0}");
   const std::string s = "'" + scenario.string() + "'";
   const fs::path script = dir / "machines.sh";
   std::ofstream(script)
-      << "set -e\nR='" << RILBED_BINARY << "'\ncd '" << dir.string() << "'\n"
-      << "A=rilbed_a_$$; B=rilbed_b_$$\n"
-      << "cleanup() { [ -n \"$AGENTS\" ] && kill $AGENTS 2>/dev/null; wait 2>/dev/null; ip netns del $A 2>/dev/null; "
-         "ip netns del $B 2>/dev/null; true; }\ntrap cleanup EXIT\n"
-      << "ip netns add $A; ip netns add $B\n"
-      << "ip link add veth_a netns $A type veth peer name veth_b netns $B\n"
-      << "ip -n $A addr add 10.203.0.1/24 dev veth_a; ip -n $B addr add 10.203.0.2/24 dev veth_b\n"
-      << "for n in $A $B; do ip -n $n link set lo up; done\n"
-      << "ip -n $A link set veth_a up multicast on; ip -n $B link set veth_b up multicast on\n"
-      << "ip -n $A route add 224.0.0.0/4 dev veth_a; ip -n $B route add 224.0.0.0/4 dev veth_b\n"
-      << "URL='udpm://239.255.76.67:7667?ttl=1'\n"
-      << "\"$R\" run '" << (fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml").string()
+      << two_machines_script(dir) << "\"$R\" run '"
+      << (fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml").string()
       << "' --fast --seed 6 --duration 30 --out local --quiet\n"
-      << "ip netns exec $A \"$R\" agent --scenario " << s << " --ids 1-4 --lcm \"$URL\" > agent_a.txt 2>&1 &\nAGENTS=$!\n"
+      << "ip netns exec $A \"$R\" agent --scenario " << s << " --ids 1-4 --lcm \"$URL\" > agent_a.txt 2>&1 &\nKEEP_PIDS=$!\n"
       << "ip netns exec $B \"$R\" agent --scenario " << s << " --ids 5-8 --lcm \"$URL\" > agent_b.txt 2>&1 &\n"
-      << "AGENTS=\"$AGENTS $!\"\n"
+      << "KEEP_PIDS=\"$KEEP_PIDS $!\"\n"
       << "ip netns exec $A \"$R\" run " << s << " --fast --seed 6 --duration 30 --out remote --lcm \"$URL\" > run.txt 2>&1\n";
   const int status = std::system(("/bin/bash '" + script.string() + "' > '" + (dir / "machines.log").string() + "' 2>&1").c_str());
   ASSERT_EQ(status, 0) << read_file(dir / "machines.log") << read_file(dir / "run.txt") << read_file(dir / "agent_b.txt");
   EXPECT_NE(read_file(dir / "run.txt").find("0 processes lost"), std::string::npos) << read_file(dir / "run.txt");
   expect_same_run_folder(dir / "local", dir / "remote");
+}
+
+// `hosts:` starts the agent processes on another machine over ssh: a real OpenSSH server,
+// started by the test on machine B's address with a throwaway host key and user key, and a
+// launch command (the scenario's `launch:`) that uses that key and port. The run on machine
+// A gives the in-process run's folder; when it ends, the agents on B end too (their input,
+// the ssh connection, closed). A host whose ssh cannot connect fails the run at once,
+// named, not after the announce timeout.
+TEST(AgentsCli, HostsStartTheAgentsOnAnotherMachineOverSsh) {
+  SKIP_WITHOUT_NAMED_NAMESPACES();
+  if (!fs::exists("/usr/sbin/sshd") || std::system("command -v ssh > /dev/null && command -v ssh-keygen > /dev/null") != 0) {
+    GTEST_SKIP() << "OpenSSH (openssh-server, openssh-client) is not installed; ./run installs it";
+  }
+  const fs::path dir = scratch_dir("agents_ssh");
+  const auto launch = [&](int port) {
+    return "[ssh, -i, '" + (dir / "id").string() + "', -p, '" + std::to_string(port) +
+           "', -o, StrictHostKeyChecking=no, -o, UserKnownHostsFile=/dev/null, -o, BatchMode=yes, -o, LogLevel=ERROR, "
+           "-T, '{host}', '{command}']";
+  };
+  const fs::path scenario = convoy_with_agents(dir, "{hosts: [10.203.0.2], processes: 2, launch: " + launch(2222) + "}");
+  // A port nothing listens on, and a timeout that would make the test wait a minute.
+  std::ofstream(dir / "refused.yaml") << read_file(fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml")
+                                      << "\nagents: {hosts: [10.203.0.2], announce_timeout_s: 60, launch: " << launch(2223)
+                                      << "}\n";
+  const fs::path script = dir / "ssh.sh";
+  std::ofstream(script)
+      << two_machines_script(dir) << "\"$R\" run '"
+      << (fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml").string()
+      << "' --fast --seed 6 --duration 30 --out local --quiet\n"
+      << "ssh-keygen -q -t ed25519 -N '' -f host_key; ssh-keygen -q -t ed25519 -N '' -f id; cp id.pub authorized_keys\n"
+      << "printf '%s\\n' 'ListenAddress 10.203.0.2:2222' \"HostKey $PWD/host_key\" \"AuthorizedKeysFile $PWD/authorized_keys\" "
+         "\"PidFile $PWD/sshd.pid\" 'UsePAM no' 'StrictModes no' 'PasswordAuthentication no' "
+         "'KbdInteractiveAuthentication no' 'PermitRootLogin prohibit-password' > sshd_config\n"
+      << "mkdir -p /run/sshd\n"  // sshd's privilege separation directory (systemd makes it)
+      << "ip netns exec $B /usr/sbin/sshd -D -e -f \"$PWD/sshd_config\" > sshd.log 2>&1 &\nKEEP_PIDS=$!\n"
+      << "for i in $(seq 200); do ip netns exec $B ss -Hltn 'sport = :2222' | grep -q . && break; sleep 0.05; done\n"
+      << "ip netns exec $A \"$R\" run '" << scenario.string()
+      << "' --fast --seed 6 --duration 30 --out remote --lcm \"$URL\" > run.txt 2>&1\n"
+      // The agents end with their connection: machine B comes down to the listening sshd.
+      << "for i in $(seq 200); do [ \"$(ip netns pids $B | wc -l)\" -le 1 ] && break; sleep 0.05; done\n"
+      << "ip netns pids $B | wc -l > left_on_b.txt\n"
+      << "set +e\nip netns exec $A \"$R\" run '" << (dir / "refused.yaml").string()
+      << "' --fast --seed 6 --duration 30 --lcm \"$URL\" > refused.txt 2>&1\necho $? > refused_rc.txt\n";
+  const int status = std::system(("/bin/bash '" + script.string() + "' > '" + (dir / "ssh_test.log").string() + "' 2>&1").c_str());
+  ASSERT_EQ(status, 0) << read_file(dir / "ssh_test.log") << read_file(dir / "run.txt") << read_file(dir / "sshd.log");
+  const std::string run = read_file(dir / "run.txt");
+  EXPECT_NE(run.find("0 processes lost"), std::string::npos) << run;
+  expect_same_run_folder(dir / "local", dir / "remote");
+  // Both agent processes logged in to B's sshd with the throwaway key.
+  const std::string sshd = read_file(dir / "sshd.log");
+  EXPECT_EQ(count_of(sshd, "Accepted publickey"), 2) << sshd;
+  EXPECT_EQ(read_file(dir / "left_on_b.txt"), "1\n") << "agent processes outlived the run on machine B";
+  EXPECT_EQ(read_file(dir / "refused_rc.txt"), "1\n");
+  const std::string refused = read_file(dir / "refused.txt");
+  EXPECT_NE(refused.find("the agent process for robots 1-8 on 10.203.0.2 exited with status 255"), std::string::npos)
+      << refused;
+  EXPECT_NE(refused.find("Connection refused"), std::string::npos) << refused;
+}
+
+// The agent's command line crosses a remote shell (ssh hands `{command}` to the login
+// shell's -c): every argument must arrive as it was, whatever it holds.
+TEST(AgentLaunch, TheCommandReachesTheRemoteShellWordForWord) {
+  const std::vector<std::string> words = {"/opt/lab's rilbed/rilbed", "--lcm", "udpm://239.255.76.67:7667?ttl=1",
+                                          "$HOME `id` \"x\" \\ ;|&*", "", "a\nb"};
+  std::string command = "printf '<%s>'";
+  for (const std::string& w : words) command.append(" ").append(app::shell_quote(w));
+  const std::vector<std::string> argv = app::launch_arguments({"ssh", "-p", "22", "{host}", "{command}"}, "pi@h{command}", command);
+  ASSERT_EQ(argv.size(), 5u);
+  EXPECT_EQ(argv[3], "pi@h{command}");  // a host's text is put in, never searched again
+  EXPECT_EQ(argv[4], command);
+  FILE* shell = popen(argv[4].c_str(), "r");  // /bin/sh -c, as the login shell at the far end
+  ASSERT_NE(shell, nullptr);
+  std::string out;
+  char buffer[256];
+  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, shell)) > 0;) out.append(buffer, n);
+  ASSERT_EQ(pclose(shell), 0);
+  std::string expected;
+  for (const std::string& w : words) expected.append("<").append(w).append(">");
+  EXPECT_EQ(out, expected);
+}
+
+TEST(AgentLaunch, ProcessesTakeTheHostsInTurn) {
+  const std::vector<app::AgentPlacement> p = app::place_agents({1, 2, 3, 4, 5, 6, 7, 8}, 3, {"a", "b"});
+  ASSERT_EQ(p.size(), 3u);
+  EXPECT_EQ(p[0].ids, (std::vector<int>{1, 2, 3}));
+  EXPECT_EQ(p[0].host, "a");
+  EXPECT_EQ(p[1].ids, (std::vector<int>{4, 5, 6}));
+  EXPECT_EQ(p[1].host, "b");
+  EXPECT_EQ(p[2].ids, (std::vector<int>{7, 8}));
+  EXPECT_EQ(p[2].host, "a");
+  EXPECT_TRUE(app::place_agents({1, 2}, 2, {})[1].host.empty());
 }
 
 TEST(AgentsCli, AgentsInOtherProcessesNeedABusTheyReach) {
@@ -193,6 +305,17 @@ TEST(AgentsCli, AgentsInOtherProcessesNeedABusTheyReach) {
   const CommandResult bad = run_rilbed("run '" + (dir / "bad.yaml").string() + "' --fast");
   EXPECT_EQ(bad.exit_code, 1);
   EXPECT_NE(bad.err.find("agents.ids: there is no robot 9"), std::string::npos) << bad.err;
+  // A host that would be read as an option of ssh is refused.
+  std::ofstream(dir / "bad_host.yaml") << read_file(fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml")
+                                       << "\nagents: {hosts: [lab-pc, -oProxyCommand=touch /tmp/x]}\n";
+  const CommandResult host = run_rilbed("run '" + (dir / "bad_host.yaml").string() + "' --fast");
+  EXPECT_EQ(host.exit_code, 1);
+  EXPECT_NE(host.err.find("agents.hosts: '-oProxyCommand=touch /tmp/x' is not a host name"), std::string::npos) << host.err;
+  std::ofstream(dir / "bad_launch.yaml") << read_file(fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml")
+                                         << "\nagents: {hosts: [lab-pc], launch: [ssh, '{host}']}\n";
+  const CommandResult launch = run_rilbed("run '" + (dir / "bad_launch.yaml").string() + "' --fast");
+  EXPECT_EQ(launch.exit_code, 1);
+  EXPECT_NE(launch.err.find("agents.launch: must have a {command} item"), std::string::npos) << launch.err;
 }
 
 }  // namespace
