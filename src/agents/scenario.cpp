@@ -565,6 +565,13 @@ std::vector<Pose2> draw_initial_poses(const Scenario& scenario, std::mt19937_64&
         if (environment::distance_sq_to_segment(p, a, b) < margin * margin) return false;
       }
     }
+    // A moving obstacle where it starts, by its bounding circle (a polygon's vertices are
+    // relative to its position).
+    for (const auto& m : scenario.moving_obstacles) {
+      double reach_m = m.shape == environment::MovingShape::Disc ? m.radius_m : 0.0;
+      for (const Vec2& v : m.vertices_m) reach_m = std::max(reach_m, std::hypot(v.x, v.y));
+      if (environment::distance_sq(p, m.position_m) < (reach_m + margin) * (reach_m + margin)) return false;
+    }
     return true;
   };
   std::uniform_real_distribution<double> ux(margin, field.width_m - margin), uy(margin, field.height_m - margin);
