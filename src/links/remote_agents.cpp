@@ -110,7 +110,10 @@ void RemoteAgents::on_reply(const void* data, std::size_t size) {
     ++counters_.duplicates;
     return;
   }
-  if (s.awaiting && reply.quantum == *s.awaiting) {
+  // Real time: an answer handled after its instant's deadline is late even if the wait has
+  // not returned yet (its process, or this one, was held up): the contract is the deadline.
+  const bool past_deadline = config_.realtime && deadline_ && s.last_heard > *deadline_;
+  if (s.awaiting && reply.quantum == *s.awaiting && !past_deadline) {
     into = &answered_;
     s.awaiting.reset();
     if (s.message < outgoing_.size() && !outgoing_[s.message].repeated) {
@@ -121,6 +124,7 @@ void RemoteAgents::on_reply(const void* data, std::size_t size) {
     // Real time: the answer to an instant already gone, applied at the next one (once).
     into = &late_;
     ++counters_.late;
+    if (s.awaiting && reply.quantum == *s.awaiting) s.awaiting.reset();
   } else {
     ++counters_.duplicates;
     return;
@@ -280,6 +284,7 @@ std::vector<agents::RemoteOutput> RemoteAgents::exchange(TimeUs t_us) {
   const std::int64_t k = next_quantum_++;
   send(to, k, t_us, false);
   const auto deadline = called + std::chrono::milliseconds(config_.deadline_ms);
+  deadline_ = deadline;
   for (;;) {
     const auto now = Clock::now();
     std::vector<bool> message_waits(outgoing_.size(), false);

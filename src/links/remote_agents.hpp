@@ -141,6 +141,7 @@ class RemoteAgents final : public agents::AgentExchange {
   std::vector<agents::TeamMessage> team_;       // the team broadcast of the pending inputs
   std::vector<agents::RemoteOutput> answered_;  // answers taken for the quantum in flight
   std::vector<agents::RemoteOutput> late_;      // real time: answers that missed their instant
+  std::optional<std::chrono::steady_clock::time_point> deadline_;  // real time: the current instant's deadline
   std::vector<agents::ExchangeNotice> notices_;
   RemoteAgentsCounters counters_;
   std::vector<double> exchange_times_ms_;

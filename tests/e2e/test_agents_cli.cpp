@@ -68,6 +68,26 @@ TEST(AgentsCli, LockStepRunWithTwoAgentProcessesEqualsTheInProcessRun) {
   expect_same_run_folder(dir / "local", dir / "remote");
 }
 
+// A batch of seeds through the same agent processes (each run a new nonce, its controllers
+// built afresh), one of them a C controller (wander.yaml's robot 6, peek/poke): every seed's
+// folder is the in-process batch's.
+TEST(AgentsCli, ABatchWithACControllerInAgentProcessesEqualsTheInProcessBatch) {
+  SKIP_WITHOUT_NAMESPACES();
+  const fs::path dir = scratch_dir("agents_batch");
+  const fs::path wander = fs::path(RILBED_SOURCE_DIR) / "scenarios" / "wander.yaml";
+  const fs::path scenario = dir / "wander_agents.yaml";
+  std::ofstream(scenario) << read_file(wander) << "\nagents: {processes: 2}\n";
+  const int status = in_namespace(dir, "\"$R\" run '" + wander.string() +
+                                           "' --fast --seeds 3 --jobs 1 --duration 20 --out local --quiet\n"
+                                           "\"$R\" run '" + scenario.string() +
+                                           "' --fast --seeds 3 --jobs 1 --duration 20 --out remote --lcm \"$URL\" > run.txt 2>&1\n");
+  ASSERT_EQ(status, 0) << read_file(dir / "ns.log") << read_file(dir / "run.txt");
+  const std::string run = read_file(dir / "run.txt");
+  // Three runs, each 201 steps and its end (sent three times).
+  EXPECT_EQ(count_of(run, "agents: 204 quanta sent"), 3) << run;
+  for (const char* seed : {"seed_1", "seed_2", "seed_3"}) expect_same_run_folder(dir / "local" / seed, dir / "remote" / seed);
+}
+
 TEST(AgentsCli, EightAgentProcessesFormTheConvoyUnderTenPercentLossAsInOneProcess) {
   SKIP_WITHOUT_NFT();
   const fs::path dir = scratch_dir("agents_loss");

@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <random>
+#include <thread>
 
 #include "agents/scenario.hpp"
 #include "agents/simulation.hpp"
@@ -185,6 +186,7 @@ TEST(RemoteAgents, InRealTimeEveryAnswerIsOnTimeAndItsSecondCopyIsNoLateAnswer) 
   rc.robot_ids = sc.robot_ids;
   for (const int id : rc.robot_ids) rc.team_readers.insert(id);
   rc.realtime = true;
+  rc.deadline_ms = 500;  // the answers come at once; a loaded test machine must not make them late
   RemoteAgents remote(*lcm, *lcm, rc);
   server.announce();
   ASSERT_FALSE(remote.wait_for_agents(std::chrono::seconds(2)));
@@ -201,6 +203,71 @@ TEST(RemoteAgents, InRealTimeEveryAnswerIsOnTimeAndItsSecondCopyIsNoLateAnswer) 
   EXPECT_EQ(remote.counters().late, 0);
   EXPECT_EQ(remote.counters().duplicates, 31);  // the second copies
   for (const auto& s : r.trajectory) EXPECT_NE(s.behaviour, "lost");
+}
+
+// A controller that takes `delay` over its first step, then is its inner one.
+class SlowFirstStep : public agents::Controller {
+ public:
+  SlowFirstStep(std::unique_ptr<agents::Controller> inner, std::chrono::milliseconds delay)
+      : inner_(std::move(inner)), delay_(delay) {}
+  agents::ControlOutput step(const agents::ControlInput& input) override {
+    if (steps_++ == 0) std::this_thread::sleep_for(delay_);
+    return inner_->step(input);
+  }
+  bool wants_team() const override { return inner_->wants_team(); }
+
+ private:
+  std::unique_ptr<agents::Controller> inner_;
+  std::chrono::milliseconds delay_;
+  int steps_ = 0;
+};
+
+TEST(RemoteAgents, InRealTimeAnAnswerPastItsDeadlineIsCountedLateAndAppliedAtTheNextStep) {
+  // Robot 1's controller takes 40 ms over its first step, past the 10 ms deadline: the
+  // first instant ends without answers (the robots keep what they did), and the next
+  // instant applies the late answers first, then its own.
+  const agents::Scenario scenario = convoy();
+  auto lcm = memq();
+  AgentServerConfig sc;
+  sc.scenario_name = scenario.name;
+  for (const auto& r : scenario.robots) sc.robot_ids.push_back(r.id);
+  AgentServer server(*lcm, *lcm, sc, [&scenario](int id) -> std::unique_ptr<agents::Controller> {
+    auto inner = agents::make_controller(scenario, scenario.robots[static_cast<std::size_t>(id - 1)]);
+    if (id != 1) return inner;
+    return std::make_unique<SlowFirstStep>(std::move(inner), std::chrono::milliseconds(40));
+  });
+  RemoteAgentsConfig rc;
+  rc.scenario_name = scenario.name;
+  rc.robot_ids = sc.robot_ids;
+  rc.realtime = true;
+  rc.deadline_ms = 10;
+  RemoteAgents remote(*lcm, *lcm, rc);
+  server.announce();
+  ASSERT_FALSE(remote.wait_for_agents(std::chrono::seconds(2)));
+  const auto submit_all = [&](TimeUs t_us) {
+    for (const int id : rc.robot_ids) {
+      agents::ControlInput in;
+      in.t_us = t_us;
+      in.robot_id = id;
+      in.pose = Pose2{{0.1 * id, 0.2}, 0.0};
+      remote.submit(in);
+    }
+  };
+  submit_all(0);
+  const auto first = remote.exchange(0);
+  EXPECT_TRUE(first.empty()) << first.size() << " outputs at the first instant";
+  EXPECT_EQ(remote.counters().late, 1);  // one answer (the process's, for its 8 robots)
+  submit_all(100'000);
+  const auto second = remote.exchange(100'000);
+  EXPECT_EQ(remote.counters().late, 1);
+  ASSERT_EQ(second.size(), 2 * rc.robot_ids.size());
+  for (std::size_t i = 0; i < rc.robot_ids.size(); ++i) {
+    EXPECT_EQ(second[i].robot_id, rc.robot_ids[i]);  // the late answers first ...
+    EXPECT_EQ(second[rc.robot_ids.size() + i].robot_id, rc.robot_ids[i]);  // ... then this instant's
+    EXPECT_NE(second[i].output.behaviour, "lost");
+  }
+  EXPECT_EQ(remote.counters().answers, 2);
+  EXPECT_EQ(remote.counters().lost_processes, 0);
 }
 
 TEST(RemoteAgents, BytesThatAreNoMessageAreRefusedAndMissingRobotsNamed) {
