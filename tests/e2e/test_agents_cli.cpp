@@ -5,10 +5,13 @@
 // and its robots stop while the rest go on, and one started again for them rejoins.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -66,6 +69,73 @@ TEST(AgentsCli, LockStepRunWithTwoAgentProcessesEqualsTheInProcessRun) {
   // 401 steps, each one message for both processes (it fits in a datagram), and the end three times.
   EXPECT_NE(read_file(dir / "run.txt").find("agents: 404 quanta sent"), std::string::npos) << read_file(dir / "run.txt");
   expect_same_run_folder(dir / "local", dir / "remote");
+}
+
+// Safety: a real robot whose agent process dies is stopped over its serial link.
+// convoy_mixed's real (emulated) Kheperas 4 and 5 have their controllers in an agent
+// process, killed mid-run; from then on the camera sees both stand still.
+TEST(AgentsCli, RealRobotsWhoseAgentProcessDiesAreStoppedOverTheirLinks) {
+  SKIP_WITHOUT_NAMESPACES();
+  const fs::path dir = scratch_dir("agents_real_lost");
+  const fs::path scenario = dir / "mixed_agents.yaml";
+  std::ofstream(scenario) << read_file(fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_mixed.yaml")
+                          << "\nagents: {ids: 4-5, processes: 0}\n";
+  const std::string s = "'" + scenario.string() + "'";
+  const std::string wait_for =
+      "wait_for() { for i in $(seq 1 1200); do grep -q \"$2\" \"$1\" 2>/dev/null && return 0; sleep 0.05; done; "
+      "echo \"timed out waiting for $2 in $1\" >&2; return 1; }\n";
+  const int status = in_namespace(
+      dir, wait_for + "\"$R\" agent --scenario " + s + " --ids 4-5 --lcm \"$URL\" > agent.txt 2>&1 &\nA=$!\n" +
+               "\"$R\" run " + s + " --realtime --seed 2 --duration 9 --no-place --out run --lcm \"$URL\" > run.txt 2>&1 &\n"
+               "RUN=$!\n"
+               "wait_for run/trajectories.csv '^4\\.[0-9]*,4,'\n"
+               "kill -9 $A\n"
+               "wait_for run/events.csv 'lost: process'\n"
+               "wait $RUN\n");
+  ASSERT_EQ(status, 0) << read_file(dir / "ns.log") << read_file(dir / "run.txt") << read_file(dir / "run" / "events.csv");
+  const std::string run = read_file(dir / "run.txt");
+  EXPECT_NE(run.find("robot 4 (emulated): last speed 0 0"), std::string::npos) << run;
+  EXPECT_NE(run.find("robot 5 (emulated): last speed 0 0"), std::string::npos) << run;
+  // Poses of robots 4 and 5 as the camera saw them: t, x, y, and whether marked lost.
+  struct Row {
+    double t_s, x_m, y_m;
+    bool lost;
+  };
+  std::map<int, std::vector<Row>> rows;
+  std::istringstream in(read_file(dir / "run" / "trajectories.csv"));
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) f.push_back(cell);
+    if (f.size() < 6 || (f[1] != "4" && f[1] != "5")) continue;
+    rows[std::stoi(f[1])].push_back({std::stod(f[0]), std::stod(f[2]), std::stod(f[3]), f[5] == "lost"});
+  }
+  double moved_before_m = 0.0;
+  for (const int id : {4, 5}) {
+    const std::vector<Row>& r = rows[id];
+    const auto first_lost = std::find_if(r.begin(), r.end(), [](const Row& row) { return row.lost; });
+    ASSERT_NE(first_lost, r.end()) << "robot " << id << " was never marked lost";
+    // Every row from then on is lost, and after half a second (the last command's effect,
+    // the camera's latency) the robot stands still.
+    std::optional<Row> settled;
+    double drift_m = 0.0;
+    for (auto it = first_lost; it != r.end(); ++it) {
+      EXPECT_TRUE(it->lost) << "robot " << id << " at " << it->t_s;
+      if (it->t_s < first_lost->t_s + 0.5) continue;
+      if (!settled) settled = *it;
+      drift_m = std::max(drift_m, std::hypot(it->x_m - settled->x_m, it->y_m - settled->y_m));
+    }
+    ASSERT_TRUE(settled) << "robot " << id << ": no rows half a second after its loss";
+    EXPECT_GT(r.back().t_s - settled->t_s, 2.0) << "robot " << id;
+    EXPECT_LT(drift_m, 0.004) << "robot " << id << " moved after its stop";
+    // The second before the loss, for comparison.
+    for (auto it = r.begin(); it != first_lost; ++it) {
+      if (it->t_s >= first_lost->t_s - 1.0) moved_before_m = std::max(moved_before_m, std::hypot(it->x_m - first_lost->x_m, it->y_m - first_lost->y_m));
+    }
+  }
+  EXPECT_GT(moved_before_m, 0.01) << "neither real robot moved before its agent died: the test shows nothing";
 }
 
 // A batch of seeds through the same agent processes (each run a new nonce, its controllers
