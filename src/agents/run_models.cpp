@@ -1,5 +1,7 @@
 #include "agents/run_models.hpp"
 
+#include <chrono>
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -48,12 +50,15 @@ void AgentModel::internal_transition() {
 }
 
 void AgentModel::step() {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = profile_ ? Clock::now() : Clock::time_point{};
   ControlInput input;
   input.t_us = state_.t_us;
   input.robot_id = body_.id();
   input.sensors = body_.sense(state_.t_us);
   input.pose = body_.pose();
   if (state_.team) input.team = *state_.team;
+  const Clock::time_point sensed = profile_ ? Clock::now() : Clock::time_point{};
   if (remote_) {
     // Its answer comes back through complete(), later in this instant.
     remote_->submit(input);
@@ -62,6 +67,10 @@ void AgentModel::step() {
     body_.drive(state_.last.wheels);
   }
   state_.sensors = std::move(input.sensors);  // kept for the run's observer
+  if (profile_) {
+    profile_->sensing_s += std::chrono::duration<double>(sensed - start).count();
+    profile_->behaviours_s += std::chrono::duration<double>(Clock::now() - sensed).count();
+  }
 }
 
 void AgentModel::complete(const RemoteOutput& answer) {

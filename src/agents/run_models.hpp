@@ -17,6 +17,7 @@
 #include "agents/agent_exchange.hpp"
 #include "agents/body.hpp"
 #include "agents/controller.hpp"
+#include "agents/run_profile.hpp"
 #include "agents/convoy.hpp"
 #include "sim/atomic.hpp"
 #include "sim/time.hpp"
@@ -104,9 +105,13 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   const environment::SensorReadings& sensors() const { return state_.sensors; }
   /// Tells the controller the run ended (Controller::finish) and stops the body.
   void finish();
+  /// Times its sensing and its controller's steps into `profile` (may be null: not timed;
+  /// must outlive the model).
+  void set_profile(RunProfile* profile) { profile_ = profile; }
 
  private:
   Body& body_;
+  RunProfile* profile_ = nullptr;
   std::unique_ptr<Controller> controller_;
   TimeUs period_us_;
   AgentExchange* remote_ = nullptr;  // serves this robot, or null

@@ -228,6 +228,7 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     std::chrono::steady_clock::time_point wall_start;
     const sim::RealTimeClock* clock = nullptr;  // a realtime run's clock (for the loop's latency)
     const VisionModel* camera = nullptr;        // the overhead camera, if any (for its frame rate)
+    RunProfile* profile = nullptr;              // times its samples when set
   };
   explicit MonitorModel(Setup setup)
       : sim::AtomicModel<TimeUs>("monitor", 1), s_(std::move(setup)),
@@ -242,7 +243,13 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     t_us_ += state_;
     state_ = s_.period_us;
     const TimeUs t = t_us_ - 1;  // the control step just taken
-    sample(t);
+    if (s_.profile) {
+      const auto start = std::chrono::steady_clock::now();
+      sample(t);
+      s_.profile->monitor_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    } else {
+      sample(t);
+    }
     if (s_.options->interrupt && s_.options->interrupt->load()) end("interrupt");
   }
   bool formed() const { return formation_.formed(); }
@@ -776,6 +783,10 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
     agents.push_back(&root->emplace<AgentModel>(*bodies[i], std::move(controller), scenario.control_period_us, 0, commanded,
                                                 options.remote_agents));
   }
+  RunProfile profile;
+  if (options.profile) {
+    for (AgentModel* a : agents) a->set_profile(&profile);
+  }
   // The remote controllers' quantum, right after every agent of the instant has stepped.
   QuantumModel* quantum = nullptr;
   if (options.remote_agents &&
@@ -830,6 +841,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   sim::RealTimeClock real_clock(options.rt_factor);
   if (options.realtime) setup.clock = &real_clock;
   setup.camera = camera.get();
+  if (options.profile) setup.profile = &profile;
   auto& monitor = root->emplace<MonitorModel>(setup);
   if (quantum) {
     quantum->on_notice([&monitor](TimeUs t, const ExchangeNotice& n) {
@@ -915,6 +927,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
         [&coordinator, control_in](const ControlAction& a) { coordinator.inject(*control_in, a); });
   }
   std::exception_ptr failure;
+  const environment::WorldStepTimes world_times_before = world.step_times();
   const auto run_start = std::chrono::steady_clock::now();
   const double cpu_start = thread_cpu_seconds();
   try {
@@ -926,6 +939,11 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   if (options.control) options.control->detach();
   result.run_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
   result.run_cpu_s = thread_cpu_seconds() - cpu_start;
+  if (options.profile) {
+    profile.integration_s = world.step_times().integration_s - world_times_before.integration_s;
+    profile.collisions_s = world.step_times().collisions_s - world_times_before.collisions_s;
+    result.profile = profile;
+  }
   // Every body is stopped whatever happened (a real robot must not drive on).
   for (AgentModel* a : agents) a->finish();
   if (quantum) options.remote_agents->end();

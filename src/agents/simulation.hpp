@@ -24,6 +24,7 @@
 #include "agents/controller.hpp"
 #include "agents/run_control.hpp"
 #include "agents/run_observer.hpp"
+#include "agents/run_profile.hpp"
 #include "agents/run_recorder.hpp"
 #include "agents/scenario.hpp"
 #include "environment/world.hpp"
@@ -61,6 +62,8 @@ struct RunOptions {
   /// robot it serves is stepped through it, one quantum per control instant. May be null
   /// (every controller in this process). Must outlive the call.
   AgentExchange* remote_agents = nullptr;
+  /// Time the run's parts (RunResult::profile): a few clock reads per robot and step.
+  bool profile = false;
 };
 
 /// What a run came to.
@@ -76,6 +79,8 @@ struct RunResult {
   double wall_s = 0.0;                      ///< the whole call, building the world included
   double run_wall_s = 0.0;                  ///< the DEVS run alone (what sim-bench reports)
   double run_cpu_s = 0.0;                   ///< the calling thread's CPU time in the DEVS run
+  /// With RunOptions::profile: where run_wall_s went (the rest is the DEVS kernel's).
+  std::optional<RunProfile> profile;
   std::string ended_by;                     ///< "duration", "formed", "done" or "interrupt"
   std::vector<int> not_done;                ///< with stop_when_done: the robots whose agent was not done at the end
   std::vector<TrajectorySample> trajectory; ///< with keep_in_memory only

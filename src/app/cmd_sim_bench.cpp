@@ -1,5 +1,6 @@
 // `rilbed sim-bench`: how fast the simulation runs with many virtual Kheperas.
 #include <spdlog/spdlog.h>
+#include <sys/resource.h>
 
 #include <chrono>
 #include <algorithm>
@@ -28,7 +29,15 @@ struct BenchArgs {
   std::uint64_t seed = 1;
   int repeat = 3;
   std::vector<std::string> lcm_urls;  // also time each count with the run published on each of these buses
+  bool no_split = false;              // leave the run's parts untimed (RunOptions::profile)
 };
+
+// The process's peak resident set so far, MB (getrusage; Linux reports kilobytes).
+double peak_rss_mb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
 
 // N wandering Kheperas with their eight IR sensors in a field of constant density.
 agents::Scenario bench_scenario(int robots, const BenchArgs& args) {
@@ -36,6 +45,27 @@ agents::Scenario bench_scenario(int robots, const BenchArgs& args) {
   s.name = "sim-bench-" + std::to_string(robots);
   s.source = "(sim-bench)";
   return s;
+}
+
+// Where the time of each timed run went: each part's wall ms per simulated second and its
+// share of the run; the kernel's share is the rest (the DEVS coordinator's scheduling and
+// routing, the world model's own bookkeeping, and the clock reads themselves).
+template <class Split>
+void print_splits(const std::vector<Split>& splits) {
+  std::printf("\nWhere the time goes (each run above timed in parts with steady_clock, a few reads per robot and "
+              "step; `--no-split` leaves them out): wall ms per simulated second, and the share of the run.\n\n"
+              "| robots | sensing | behaviours | integration | collisions | recording | DEVS kernel and the rest |\n"
+              "| ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+  for (const Split& s : splits) {
+    const agents::RunProfile& p = s.profile;
+    const double parts[] = {p.sensing_s, p.behaviours_s, p.integration_s, p.collisions_s, p.monitor_s,
+                            std::max(0.0, s.run_s - p.sensing_s - p.behaviours_s - p.integration_s - p.collisions_s - p.monitor_s)};
+    std::printf("| %d |", s.robots);
+    for (const double part_s : parts) {
+      std::printf(" %.1f (%.0f %%) |", 1000.0 * part_s / s.simulated_s, 100.0 * part_s / std::max(1e-9, s.run_s));
+    }
+    std::printf("\n");
+  }
 }
 
 int bench_command(const BenchArgs& args) {
@@ -50,11 +80,17 @@ int bench_command(const BenchArgs& args) {
               "control period 100 ms, physics step %.0f ms (exact arcs, collision substeps as needed), a field of %.2f "
               "robots per m^2 (the lab's 8 robots on 1.5 x 1.2 m), random starts (seed %llu). One thread, the whole DEVS "
               "run (world model, one atomic model per agent, monitor; no files written), timed from the first event to the "
-              "last (building the world excluded); wall and the thread's CPU time, medians of --repeat runs.\n\n",
+              "last (building the world, the start-up column, excluded); wall and the thread's CPU time, medians of --repeat runs; peak memory is the process's resident peak so far (getrusage).\n\n",
               args.physics_step_ms, args.density_per_m2, static_cast<unsigned long long>(args.seed));
-  std::printf("| robots | field m | simulated s | wall s (median of %d) | CPU s (median) | wall ms per simulated s | real-time factor (wall) | real-time factor (CPU) | us per robot-step (CPU) | collisions | max overlap m |\n",
+  std::printf("| robots | field m | simulated s | start-up s | wall s (median of %d) | CPU s (median) | wall ms per simulated s | real-time factor (wall) | real-time factor (CPU) | us per robot-step (CPU) | peak memory MB | collisions | max overlap m |\n",
               args.repeat);
-  std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+  std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+  struct Split {
+    int robots;
+    double run_s, simulated_s;
+    agents::RunProfile profile;
+  };
+  std::vector<Split> splits;
   // With --lcm: each count also with every message of the run published on each bus
   // (nobody need listen), runs with and without it taking turns so that other load on
   // the machine falls on all alike.
@@ -79,7 +115,7 @@ int bench_command(const BenchArgs& args) {
     buses.push_back(std::move(bus));
   }
   struct Timing {
-    std::vector<double> walls, cpus;
+    std::vector<double> walls, cpus, startups;
     agents::RunResult r;
   };
   for (int n : counts.ids) {
@@ -93,6 +129,7 @@ int bench_command(const BenchArgs& args) {
         o.seed = args.seed;
         o.duration_s = args.seconds;
         if (k > 0) o.observer = buses[k - 1].publisher.get();
+        o.profile = k == 0 && !args.no_split;
         try {
           t.r = agents::run_scenario(s, o);
         } catch (const std::exception& e) {
@@ -101,18 +138,35 @@ int bench_command(const BenchArgs& args) {
         }
         t.walls.push_back(t.r.run_wall_s);
         t.cpus.push_back(t.r.run_cpu_s);
+        t.startups.push_back(t.r.wall_s - t.r.run_wall_s);
+        if (t.r.profile) {
+          // One row per count: the repeats' parts added up.
+          if (splits.empty() || splits.back().robots != n) splits.push_back({n, 0.0, 0.0, {}});
+          Split& split = splits.back();
+          split.run_s += t.r.run_wall_s;
+          split.simulated_s += t.r.simulated_s;
+          const agents::RunProfile& p = *t.r.profile;
+          split.profile.sensing_s += p.sensing_s;
+          split.profile.behaviours_s += p.behaviours_s;
+          split.profile.integration_s += p.integration_s;
+          split.profile.collisions_s += p.collisions_s;
+          split.profile.monitor_s += p.monitor_s;
+        }
       }
     }
     auto row = [&](Timing& t, const std::string& label) {
       std::sort(t.walls.begin(), t.walls.end());
       std::sort(t.cpus.begin(), t.cpus.end());
+      std::sort(t.startups.begin(), t.startups.end());
+      const double startup_s = t.startups[t.startups.size() / 2];
       const double wall_s = std::max(1e-9, t.walls[t.walls.size() / 2]);
       const double cpu_s = std::max(1e-9, t.cpus[t.cpus.size() / 2]);
       const agents::RunResult& r = t.r;
       const double steps = n * r.simulated_s / 0.1;
-      std::printf("| %d%s | %.1f x %.1f | %.1f | %.3f | %.3f | %.1f | %.1f | %.1f | %.2f | %d | %.2g |\n", n, label.c_str(),
-                  s.map.field.width_m, s.map.field.height_m, r.simulated_s, wall_s, cpu_s, 1000.0 * wall_s / r.simulated_s,
-                  r.simulated_s / wall_s, r.simulated_s / cpu_s, 1e6 * cpu_s / steps, r.collisions, r.max_overlap_m);
+      std::printf("| %d%s | %.1f x %.1f | %.1f | %.3f | %.3f | %.3f | %.1f | %.1f | %.1f | %.2f | %.0f | %d | %.2g |\n", n,
+                  label.c_str(), s.map.field.width_m, s.map.field.height_m, r.simulated_s, startup_s, wall_s, cpu_s,
+                  1000.0 * wall_s / r.simulated_s, r.simulated_s / wall_s, r.simulated_s / cpu_s, 1e6 * cpu_s / steps,
+                  peak_rss_mb(), r.collisions, r.max_overlap_m);
       return cpu_s;
     };
     const double plain_cpu = row(plain, "");
@@ -123,6 +177,7 @@ int bench_command(const BenchArgs& args) {
     }
     std::fflush(stdout);
   }
+  if (!splits.empty()) print_splits(splits);
   if (!buses.empty()) {
     std::printf("\nThe bus: every message of the run published on it (rows \"(bus ...)\"): the world and status every "
                 "simulated second; every robot's pose, wheel command and sensor readings every control step; each event. "
@@ -171,6 +226,9 @@ void add_sim_bench_command(CLI::App& app) {
   cmd->add_option("--lcm", args->lcm_urls,
                   "Also time each count with the run published on this LCM bus, nobody listening (repeatable; e.g. "
                   "memq:// as `rilbed run` publishes by default, or udpm://239.255.76.67:7667?ttl=0)");
+  cmd->add_flag("--no-split", args->no_split,
+                "Do not time the runs' parts (sensing, behaviours, integration, collisions, recording): the table of "
+                "where the time goes is left out, and the clock reads with it");
   cmd->callback([args] { exit_code() = bench_command(*args); });
 }
 

@@ -251,6 +251,9 @@ double World::substep_limit_m() const {
 std::span<const CollisionEvent> World::step(TimeUs dt_us, std::mt19937_64& rng) {
   if (dt_us < 0) throw std::invalid_argument("world: step dt_us must be >= 0");
   if (dt_us == 0) return {};
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point started = Clock::now();
+  double collisions_s = 0.0;
   const double dt_s = us_to_seconds(dt_us);
 
   // Wheel speeds for the whole step (commands are constant over a step), the counters,
@@ -315,7 +318,9 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us, std::mt19937_64& rng) 
       b.position_m = b.position_m + Vec2{m.heading.x * d.x - m.heading.y * d.y, m.heading.y * d.x + m.heading.x * d.y};
       m.heading = {m.heading.x * m.cos_turn - m.heading.y * m.sin_turn, m.heading.y * m.cos_turn + m.heading.x * m.sin_turn};
     }
+    const Clock::time_point resolving = Clock::now();
     resolver_.resolve(cs, t_us_ + dt_us * (k + 1) / substeps);
+    collisions_s += std::chrono::duration<double>(Clock::now() - resolving).count();
   }
 
   t_us_ += dt_us;
@@ -325,6 +330,8 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us, std::mt19937_64& rng) 
     r.pose = {bodies_[i].position_m, wrap_rad_pi(motion_[i].end_heading_rad)};
     r.pose_t_us = t_us_;
   }
+  step_times_.collisions_s += collisions_s;
+  step_times_.integration_s += std::chrono::duration<double>(Clock::now() - started).count() - collisions_s;
   return resolver_.end_step();
 }
 

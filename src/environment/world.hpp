@@ -9,6 +9,7 @@
 // step costs about linearly in the number of robots at constant density.
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <random>
 #include <span>
@@ -42,6 +43,12 @@ struct WorldConfig {
   CollisionConfig collision;
   /// The world's clock at construction.
   TimeUs start_t_us = 0;
+};
+
+/// Wall time the world's steps took, summed since it was built, seconds.
+struct WorldStepTimes {
+  double integration_s = 0.0;  ///< wheel speeds, arcs, moving bodies
+  double collisions_s = 0.0;   ///< CollisionResolver, every substep
 };
 
 /// The world. Owns everything in it. Not thread-safe for changes: one thread adds,
@@ -100,6 +107,8 @@ class World {
   /// the next step). dt_us == 0 does nothing. Same seed and same calls give the same
   /// world, on any standard library.
   std::span<const CollisionEvent> step(TimeUs dt_us, std::mt19937_64& rng);
+  /// How long the steps so far took, split (a few clock reads per step and substep).
+  const WorldStepTimes& step_times() const { return step_times_; }
   /// The events returned by the last step.
   std::span<const CollisionEvent> last_collisions() const { return resolver_.events(); }
 
@@ -157,6 +166,7 @@ class World {
   double min_radius_m_ = 0.0;
   std::vector<MovingObstacle> movers_;
   CollisionResolver resolver_;
+  WorldStepTimes step_times_;
   TimeUs t_us_ = 0;
 };
 
