@@ -35,12 +35,14 @@ void ProximitySensor::nearest_distances(const Scene& scene, int body, Vec2 headi
                                         std::array<double, kProximityCount>& distances_m) const {
   const Body& self = scene.bodies[static_cast<std::size_t>(body)];
   std::array<Wedge, kProximityCount> wedges;
-  for (std::size_t i = 0; i < wedges.size(); ++i) {
-    const Vec2 d = directions_[i];
-    const Vec2 axis{heading.x * d.x - heading.y * d.y, heading.y * d.x + heading.x * d.y};
-    wedges[i] = make_wedge(self.position_m + axis * self.radius_m, axis, cos_half_, sin_half_);
-  }
-  scene.nearest_in_wedges(self.position_m, self.radius_m + config_.range_m, body, wedges, distances_m);
+  auto make_wedges = [&](std::span<Wedge> out) {
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      const Vec2 d = directions_[i];
+      const Vec2 axis{heading.x * d.x - heading.y * d.y, heading.y * d.x + heading.x * d.y};
+      out[i] = make_wedge(self.position_m + axis * self.radius_m, axis, cos_half_, sin_half_);
+    }
+  };
+  scene.nearest_in_lazy_wedges(self.position_m, self.radius_m + config_.range_m, body, wedges, make_wedges, distances_m);
 }
 
 void ProximitySensor::sense(const Scene& scene, int body, Vec2 heading, std::mt19937_64& rng,

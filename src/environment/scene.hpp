@@ -4,6 +4,8 @@
 // and must not outlive the World's state it points to.
 #pragma once
 
+#include <algorithm>
+
 #include <span>
 
 #include "environment/body.hpp"
@@ -58,6 +60,36 @@ struct Scene {
   /// wedges.size().
   void nearest_in_wedges(Vec2 centre, double reach_m, int exclude_body, std::span<const Wedge> wedges,
                          std::span<double> out) const;
+
+  /// As nearest_in_wedges, with the wedges made by `make_wedges(wedges)` only once a
+  /// surface is within reach: in a swarm most robots have none near at most steps, and
+  /// skip setting up their wedges (same results).
+  template <class MakeWedges>
+  void nearest_in_lazy_wedges(Vec2 centre, double reach_m, int exclude_body, std::span<Wedge> wedges,
+                              MakeWedges&& make_wedges, std::span<double> out) const {
+    std::fill(out.begin(), out.end(), kNoHit);
+    bool made = false;
+    struct Visitor {
+      std::span<Wedge> wedges;
+      std::span<double> out;
+      MakeWedges& make;
+      bool& made;
+      void ready() {
+        if (!made) make(wedges);
+        made = true;
+      }
+      void disc(Vec2 c, double r) {
+        ready();
+        for (std::size_t k = 0; k < wedges.size(); ++k) out[k] = std::min(out[k], wedge_distance_to_disc(wedges[k], c, r));
+      }
+      void segment(Vec2 a, Vec2 b) {
+        ready();
+        for (std::size_t k = 0; k < wedges.size(); ++k)
+          out[k] = std::min(out[k], wedge_distance_to_segment(wedges[k], a, b));
+      }
+    };
+    for_each_surface_near(centre, reach_m, exclude_body, Visitor{wedges, out, make_wedges, made});
+  }
 
   /// Whether an obstacle (wall, static obstacle, moving obstacle) blocks the sight line
   /// [from, to]. Robots do not block (they are lower than the beacons).
