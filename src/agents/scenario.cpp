@@ -551,7 +551,8 @@ namespace {
 class PlacedPoints {
  public:
   PlacedPoints(double width_m, double height_m, double spacing_m)
-      : cell_m_(std::max(spacing_m, std::sqrt(std::max(width_m * height_m, 1e-12) / double(1 << 20)))),
+      // A hair wider than the spacing: two points nearer than it never round two cells apart.
+      : cell_m_(std::max(spacing_m, std::sqrt(std::max(width_m * height_m, 1e-12) / double(1 << 20))) * (1.0 + 1e-9)),
         nx_(cells_along(width_m)), ny_(cells_along(height_m)), head_(static_cast<std::size_t>(nx_) * ny_, -1) {}
   void add(Vec2 p) {
     const std::size_t c = cell(index_x(p.x), index_y(p.y));

@@ -120,7 +120,7 @@ struct AgentsSpec {
   /// shell-quoted text (what ssh hands to the remote shell). The scenario itself goes to
   /// the command's standard input, which the agent keeps open as its lifeline: when the run
   /// goes, the connection closes and the remote agent ends.
-  std::vector<std::string> launch = {"ssh", "-T", "-o", "BatchMode=yes", "{host}", "{command}"};
+  std::vector<std::string> launch = {"ssh", "-T", "-o", "BatchMode=yes", "-o", "ConnectTimeout=10", "{host}", "{command}"};
   /// The rilbed binary on the hosts; empty: this binary's own absolute path (machines set
   /// up alike, or a shared file system).
   std::string remote_rilbed;

@@ -101,7 +101,11 @@ bool AgentProcesses::spawn(const std::vector<std::string>& args, bool search_pat
     return false;
   }
   started.input_fd = pipe_fds[1];
-  // A scenario is a few kilobytes, within a pipe's buffer: this does not wait for ssh.
+  // A scenario is a few kilobytes, within a pipe's buffer: this does not wait for ssh to
+  // connect. The buffer is made as large as Linux allows (1 MB by default) for big ones.
+  if (started.input_fd >= 0 && input.size() > 60'000) {
+    fcntl(started.input_fd, F_SETPIPE_SZ, static_cast<int>(std::min<std::size_t>(input.size() + 4096, 1u << 20)));
+  }
   if (started.input_fd >= 0) write_all(started.input_fd, input);
   return true;
 }
@@ -144,7 +148,8 @@ bool AgentProcesses::start(const AgentLaunchConfig& config, const std::vector<Ag
       }
       std::string command = shell_quote(config.remote_rilbed.empty() ? *self : config.remote_rilbed);
       for (const std::string& a : agent) command.append(" ").append(shell_quote(a));
-      command.append(" --scenario-stdin ").append(shell_quote(config.scenario_file));
+      // With '=': a file name that starts with '-' stays the option's value.
+      command.append(" ").append(shell_quote("--scenario-stdin=" + config.scenario_file));
       if (!spawn(launch_arguments(config.launch, placement.host, command), true, scenario_text, started, error)) {
         return false;
       }

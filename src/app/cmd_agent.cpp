@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <string_view>
 #include <set>
 #include <thread>
 #include <string>
@@ -42,23 +43,30 @@ struct AgentArgs {
   bool quiet = false;
 };
 
-// The scenario's text from standard input, up to a line "..." (YAML's end of document) or
-// the end of the input; sets `lifeline` when the line came, the input still open.
+// The scenario's text from standard input, up to a line "..." (YAML's end of document;
+// trailing spaces and a CR allowed) or the end of the input; sets `lifeline` when the line
+// came, the input still open.
 std::optional<std::string> read_scenario_from_stdin(bool& lifeline) {
   std::string text;
   char buffer[4096];
   lifeline = false;
+  std::size_t line_start = 0;  // where the line not yet looked at begins
   for (;;) {
     const ssize_t n = read(STDIN_FILENO, buffer, sizeof buffer);
     if (n < 0 && errno == EINTR) continue;
     if (n < 0) return std::nullopt;
     if (n == 0) return text;
     text.append(buffer, static_cast<std::size_t>(n));
-    const std::size_t end = text.starts_with("...\n") ? 0 : text.find("\n...\n");
-    if (end != std::string::npos) {
-      text.resize(end == 0 ? 0 : end + 1);
-      lifeline = true;
-      return text;
+    // Each complete line once (a terminator split across reads is found when its line ends).
+    for (std::size_t end = text.find('\n', line_start); end != std::string::npos; end = text.find('\n', line_start)) {
+      std::string_view line(text.data() + line_start, end - line_start);
+      while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.remove_suffix(1);
+      if (line == "...") {
+        text.resize(line_start);
+        lifeline = true;
+        return text;
+      }
+      line_start = end + 1;
     }
     if (text.size() > (1u << 24)) return std::nullopt;  // 16 MB is no scenario
   }

@@ -378,6 +378,23 @@ TEST(AgentLaunch, TheCommandReachesTheRemoteShellWordForWord) {
   EXPECT_EQ(out, expected);
 }
 
+// How an agent started over ssh reads its scenario: up to YAML's end-of-document line
+// (here with CRLF line ends and trailing spaces), then it ends when its input closes.
+TEST(AgentLaunch, AScenarioOnStandardInputEndsAtItsDocumentEndAndTheAgentWithItsInput) {
+  const fs::path dir = scratch_dir("agent_stdin");
+  std::istringstream yaml(read_file(fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml"));
+  std::ofstream crlf(dir / "crlf.yaml", std::ios::binary);
+  for (std::string line; std::getline(yaml, line);) crlf << line << "\r\n";
+  crlf << "...  \r\n";
+  crlf.close();
+  const std::string command = std::string("cd '") + dir.string() + "' && '" + RILBED_BINARY +
+                              "' agent --scenario-stdin=convoy_sim.yaml --ids 1,2 --lcm memq:// < crlf.yaml > out.txt 2>&1;"
+                              " echo $? > rc";
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  EXPECT_EQ(read_file(dir / "rc"), "0\n") << read_file(dir / "out.txt");
+  EXPECT_NE(read_file(dir / "out.txt").find("robots 1,2 of convoy_sim"), std::string::npos) << read_file(dir / "out.txt");
+}
+
 TEST(AgentLaunch, ProcessesTakeTheHostsInTurn) {
   const std::vector<app::AgentPlacement> p = app::place_agents({1, 2, 3, 4, 5, 6, 7, 8}, 3, {"a", "b"});
   ASSERT_EQ(p.size(), 3u);
