@@ -6,6 +6,7 @@
 #include <csignal>
 #include <fstream>
 #include <filesystem>
+#include <regex>
 #include <string>
 #include <thread>
 
@@ -101,10 +102,28 @@ TEST(RunCli, RealTimeRunPrintsBehavioursAndStopsOnSigint) {
 TEST(SimBenchCli, PrintsItsTable) {
   const CommandResult r = run_rilbed("sim-bench --robots 50,100 --seconds 2");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("| robots | field m | simulated s | wall s (median of 3) | CPU s (median) | wall ms per simulated s |"),
+  EXPECT_NE(r.out.find("| robots | field m | simulated s | start-up s | wall s (median of 3) | CPU s (median) | wall ms per "
+                       "simulated s |"),
             std::string::npos)
       << r.out;
   EXPECT_NE(r.out.find("| 100 |"), std::string::npos) << r.out;
+  // Where the time went, one row per count, the parts' shares adding up to the run.
+  EXPECT_NE(r.out.find("| robots | sensing | behaviours | integration | collisions | recording | DEVS kernel and the rest |"),
+            std::string::npos)
+      << r.out;
+  std::smatch m;
+  const std::string out = r.out;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex(R"(\| 100 \| [0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \| )"
+                                                  R"([0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \|)")))
+      << out;
+  int total = 0;
+  for (int i = 1; i <= 6; ++i) total += std::stoi(m[i]);
+  EXPECT_NEAR(total, 100, 4) << out;  // each share rounded
+  EXPECT_GT(std::stoi(m[1]), 0) << "sensing took no time: " << out;
+  // --no-split leaves the timers and their table out.
+  const CommandResult plain = run_rilbed("sim-bench --robots 50 --seconds 1 --repeat 1 --no-split");
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_EQ(plain.out.find("Where the time goes"), std::string::npos) << plain.out;
 }
 
 }  // namespace
