@@ -35,7 +35,8 @@ std::optional<std::string> read_text(const std::string& path) {
   return text.str();
 }
 
-// Writes all of `text` to `fd`; false on an error (the reader gone: EPIPE, SIGPIPE ignored).
+// Writes all of `text` to `fd`; false on an error (the reader gone: EPIPE; main() ignores
+// SIGPIPE for the whole program).
 bool write_all(int fd, const std::string& text) {
   std::size_t done = 0;
   while (done < text.size()) {
@@ -117,8 +118,6 @@ bool AgentProcesses::start(const AgentLaunchConfig& config, const std::vector<Ag
     error = "cannot find rilbed's own binary to start the agents";
     return false;
   }
-  // A remote agent gone before its input is written must not kill this process.
-  signal(SIGPIPE, SIG_IGN);
   std::string scenario_text;
   for (const AgentPlacement& placement : placements) {
     std::vector<std::string> agent = {"agent", "--ids", id_ranges_text(placement.ids), "--lcm", config.url, "--quiet"};

@@ -32,6 +32,14 @@ std::unique_ptr<lcm::LCM> memq() {
   return lcm;
 }
 
+// An agent server's configuration for every robot of `scenario`.
+AgentServerConfig serving_every_robot(const agents::Scenario& scenario) {
+  AgentServerConfig sc;
+  sc.scenario_name = scenario.name;
+  for (const auto& r : scenario.robots) sc.robot_ids.push_back(r.id);
+  return sc;
+}
+
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 TEST(AgentMessages, AnInputAndAnOutputCrossTheWireExactly) {
@@ -96,9 +104,7 @@ TEST(AgentMessages, BehaviourNamesAreInternedAndBounded) {
 agents::RunResult run_through_exchange(const agents::Scenario& scenario, std::uint64_t seed, int dead_after_ms = 1000,
                                        bool kill_server_midway = false) {
   auto lcm = memq();
-  AgentServerConfig sc;
-  sc.scenario_name = scenario.name;
-  for (const auto& r : scenario.robots) sc.robot_ids.push_back(r.id);
+  const AgentServerConfig sc = serving_every_robot(scenario);
   auto server = std::make_unique<AgentServer>(*lcm, *lcm, sc, [&scenario](int id) {
     return agents::make_controller(scenario, scenario.robots[static_cast<std::size_t>(id - 1)]);
   });
@@ -175,9 +181,7 @@ TEST(RemoteAgents, InRealTimeEveryAnswerIsOnTimeAndItsSecondCopyIsNoLateAnswer) 
   // second copy must count as a duplicate, not as a late answer to apply at the next step.
   const agents::Scenario scenario = convoy();
   auto lcm = memq();
-  AgentServerConfig sc;
-  sc.scenario_name = scenario.name;
-  for (const auto& r : scenario.robots) sc.robot_ids.push_back(r.id);
+  const AgentServerConfig sc = serving_every_robot(scenario);
   AgentServer server(*lcm, *lcm, sc, [&scenario](int id) {
     return agents::make_controller(scenario, scenario.robots[static_cast<std::size_t>(id - 1)]);
   });
@@ -228,9 +232,7 @@ TEST(RemoteAgents, InRealTimeAnAnswerPastItsDeadlineIsCountedLateAndAppliedAtThe
   // instant applies the late answers first, then its own.
   const agents::Scenario scenario = convoy();
   auto lcm = memq();
-  AgentServerConfig sc;
-  sc.scenario_name = scenario.name;
-  for (const auto& r : scenario.robots) sc.robot_ids.push_back(r.id);
+  const AgentServerConfig sc = serving_every_robot(scenario);
   AgentServer server(*lcm, *lcm, sc, [&scenario](int id) -> std::unique_ptr<agents::Controller> {
     auto inner = agents::make_controller(scenario, scenario.robots[static_cast<std::size_t>(id - 1)]);
     if (id != 1) return inner;
