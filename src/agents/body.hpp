@@ -13,8 +13,9 @@
 
 namespace rilbed::agents {
 
-/// Sensors and actuators of one robot. Implementations are not thread-safe; the run
-/// calls them from its one simulation thread.
+/// Sensors and actuators of one robot. Implementations are not thread-safe: the run calls
+/// one body from one thread at a time (several bodies at once on `--threads N` only when
+/// they say so, concurrent()).
 class Body {
  public:
   virtual ~Body() = default;
@@ -34,6 +35,10 @@ class Body {
   /// it), "geofence", "link lost", "link unresponsive". A static string; the run records
   /// every change as an event.
   virtual std::string_view health() const { return "ok"; }
+  /// Whether this body's sense(), pose() and drive() may run at the same time as other
+  /// concurrent bodies' (each body from one thread): they read shared state only, and
+  /// write only this robot's. Default false.
+  virtual bool concurrent() const { return false; }
 };
 
 }  // namespace rilbed::agents

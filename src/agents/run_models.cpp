@@ -51,14 +51,14 @@ void AgentModel::internal_transition() {
 
 void AgentModel::step() {
   using Clock = std::chrono::steady_clock;
-  const Clock::time_point start = profile_ ? Clock::now() : Clock::time_point{};
+  const Clock::time_point start = profiled_ ? Clock::now() : Clock::time_point{};
   ControlInput input;
   input.t_us = state_.t_us;
   input.robot_id = body_.id();
   input.sensors = body_.sense(state_.t_us);
   input.pose = body_.pose();
   if (state_.team) input.team = *state_.team;
-  const Clock::time_point sensed = profile_ ? Clock::now() : Clock::time_point{};
+  const Clock::time_point sensed = profiled_ ? Clock::now() : Clock::time_point{};
   if (remote_) {
     // Its answer comes back through complete(), later in this instant.
     remote_->submit(input);
@@ -67,9 +67,9 @@ void AgentModel::step() {
     body_.drive(state_.last.wheels);
   }
   state_.sensors = std::move(input.sensors);  // kept for the run's observer
-  if (profile_) {
-    profile_->sensing_s += std::chrono::duration<double>(sensed - start).count();
-    profile_->behaviours_s += std::chrono::duration<double>(Clock::now() - sensed).count();
+  if (profiled_) {
+    times_.sensing_s += std::chrono::duration<double>(sensed - start).count();
+    times_.behaviours_s += std::chrono::duration<double>(Clock::now() - sensed).count();
   }
 }
 

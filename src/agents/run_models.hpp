@@ -105,13 +105,18 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   const environment::SensorReadings& sensors() const { return state_.sensors; }
   /// Tells the controller the run ended (Controller::finish) and stops the body.
   void finish();
-  /// Times its sensing and its controller's steps into `profile` (may be null: not timed;
-  /// must outlive the model).
-  void set_profile(RunProfile* profile) { profile_ = profile; }
+  /// Times its sensing and its controller's steps (times()), or not.
+  void set_profile(bool on) { profiled_ = on; }
+  /// Its sensing and behaviours times so far (set_profile); the rest of `RunProfile` is 0.
+  const RunProfile& times() const { return times_; }
+  /// Concurrent (Coordinator::set_workers) when its controller runs here and its body is
+  /// concurrent: an agent touches its own state, its controller and its body only.
+  bool transitions_concurrent() const override { return !remote_ && body_.concurrent(); }
 
  private:
   Body& body_;
-  RunProfile* profile_ = nullptr;
+  bool profiled_ = false;
+  RunProfile times_;  // its own (agents may step on several threads at once)
   std::unique_ptr<Controller> controller_;
   TimeUs period_us_;
   AgentExchange* remote_ = nullptr;  // serves this robot, or null

@@ -1,7 +1,10 @@
 #include "agents/simulation.hpp"
 
+#include "environment/random.hpp"
+
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <ctime>
 #include <cmath>
@@ -31,9 +34,12 @@ namespace {
 // A virtual robot's body: the world's robot, its virtual sensors and its wheels.
 class VirtualBody final : public Body {
  public:
-  VirtualBody(environment::World& world, int id, std::mt19937_64& rng) : world_(world), id_(id), rng_(rng) {}
+  VirtualBody(environment::World& world, int id) : world_(world), id_(id) {}
   int id() const override { return id_; }
-  environment::SensorReadings sense(TimeUs t_us) override { return world_.sense(id_, t_us, rng_); }
+  // Sensing reads the world (const, per-robot noise streams); driving writes this robot's
+  // wheel speeds only, which nothing reads before the world's next step.
+  bool concurrent() const override { return true; }
+  environment::SensorReadings sense(TimeUs t_us) override { return world_.sense(id_, t_us); }
   std::optional<Pose2> pose() const override { return world_.robot(id_).pose; }
   void drive(const WheelCommand& w) override {
     world_.set_wheel_speeds(id_, std::clamp(w.left, -kMaxWheelUnits, kMaxWheelUnits),
@@ -43,18 +49,17 @@ class VirtualBody final : public Body {
  private:
   environment::World& world_;
   int id_;
-  std::mt19937_64& rng_;
 };
 
 // The world as a DEVS model: one integration step every physics step. Collisions are
 // kept for the monitor, which drains them.
 class WorldModel final : public sim::AtomicModel<TimeUs> {  // state: time to the next step
  public:
-  WorldModel(environment::World& world, TimeUs step_us, std::mt19937_64& rng)
-      : sim::AtomicModel<TimeUs>("world", step_us), world_(world), step_us_(step_us), rng_(rng) {}
+  WorldModel(environment::World& world, TimeUs step_us)
+      : sim::AtomicModel<TimeUs>("world", step_us), world_(world), step_us_(step_us) {}
   TimeUs time_advance() const override { return state_; }
   void internal_transition() override {
-    for (const auto& e : world_.step(step_us_, rng_)) collisions_.push_back(e);
+    for (const auto& e : world_.step(step_us_)) collisions_.push_back(e);
     state_ = step_us_;
   }
   void external_transition(TimeUs elapsed_us) override { state_ -= elapsed_us; }
@@ -64,7 +69,6 @@ class WorldModel final : public sim::AtomicModel<TimeUs> {  // state: time to th
  private:
   environment::World& world_;
   TimeUs step_us_;
-  std::mt19937_64& rng_;
   std::vector<environment::CollisionEvent> collisions_;
 };
 
@@ -352,7 +356,12 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
       record({e.t_us, "collision", party_code(e.first), party_code(e.second),
               to_string(e.first) + " touched " + to_string(e.second)});
     }
-    r.max_overlap_m = std::max(r.max_overlap_m, s_.world->max_overlap_m());
+    // Overlaps are checked once per simulated second: the check visits every robot's
+    // neighbours, as much as a tenth of a swarm's step when done every control step.
+    if (t >= next_overlap_check_us_) {
+      r.max_overlap_m = std::max(r.max_overlap_m, s_.world->max_overlap_m());
+      next_overlap_check_us_ = (t / 1'000'000 + 1) * 1'000'000;
+    }
     samples_.clear();
     for (std::size_t i = 0; i < s_.agents.size(); ++i) {
       const AgentModel& a = *s_.agents[i];
@@ -371,6 +380,13 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
         }
         last_behaviour_[i] = behaviour;
       }
+    }
+    for (const TrajectorySample& sample : samples_) {
+      for (const std::uint64_t word : {static_cast<std::uint64_t>(sample.t_us), static_cast<std::uint64_t>(sample.id),
+                                       std::bit_cast<std::uint64_t>(sample.pose.position_m.x),
+                                       std::bit_cast<std::uint64_t>(sample.pose.position_m.y),
+                                       std::bit_cast<std::uint64_t>(sample.pose.heading_rad)})
+        r.trajectory_digest = environment::mix64(r.trajectory_digest ^ word) + 0x9e3779b97f4a7c15ULL;
     }
     if (s_.recorder) s_.recorder->add_samples(samples_);
     if (s_.options->keep_in_memory) r.trajectory.insert(r.trajectory.end(), samples_.begin(), samples_.end());
@@ -443,6 +459,7 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   FormationMonitor formation_;
   TimeUs t_us_ = 0;
   TimeUs next_report_us_ = 0;
+  TimeUs next_overlap_check_us_ = 0;
   std::vector<PoseReport> reports_;
   std::vector<WheelReport> wheel_reports_;
   std::vector<SensorReport> sensor_reports_;
@@ -719,8 +736,10 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   result.seed = options.seed;
   // Separate streams for the initial poses and for the run's noise, both from the seed,
   // so that changing a sensor's noise does not move the starting poses.
-  std::seed_seq noise_seed{options.seed, std::uint64_t{0x6e6f697365}};
-  std::mt19937_64 noise_rng(noise_seed);
+  std::seed_seq noise_seed_seq{options.seed, std::uint64_t{0x6e6f697365}};
+  std::array<std::uint32_t, 2> noise_seed_words{};
+  noise_seed_seq.generate(noise_seed_words.begin(), noise_seed_words.end());
+  const std::uint64_t noise_seed = (std::uint64_t{noise_seed_words[0]} << 32) | noise_seed_words[1];
 
   // The convoy: robots with the convoy controller, numbered 1..N.
   std::vector<int> convoy_ids;
@@ -740,7 +759,9 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
     throw ScenarioError(scenario.source.string() + ": robots " + id_list_text(real_ids) +
                         " are real and move in wall-clock time: they run in real time at a factor of 1");
   }
-  environment::World world(scenario.map);
+  environment::WorldConfig world_config;
+  world_config.noise_seed = noise_seed;
+  environment::World world(scenario.map, world_config);
   for (const auto& m : scenario.moving_obstacles) world.add_moving_obstacle(m);
   const std::vector<Pose2> poses = start_poses(scenario, options.seed);
   // The camera is checked (its calibration, device or footage) before any real robot's
@@ -761,20 +782,20 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
       throw ScenarioError(scenario.source.string() + ":" + std::to_string(spec.line) + ": " + e.what());
     }
     if (spec.kind == environment::RobotKind::Real) {
-      std::unique_ptr<Body> body = real_bodies ? real_bodies(spec, world, noise_rng) : nullptr;
+      std::unique_ptr<Body> body = real_bodies ? real_bodies(spec, world) : nullptr;
       if (!body) {
         throw ScenarioError(scenario.source.string() + ":" + std::to_string(spec.line) + ": robot " + std::to_string(spec.id) +
                             " is real, and this run has no serial links for real robots");
       }
       bodies.push_back(std::move(body));
     } else {
-      bodies.push_back(std::make_unique<VirtualBody>(world, spec.id, noise_rng));
+      bodies.push_back(std::make_unique<VirtualBody>(world, spec.id));
     }
   }
 
   // The coupled model, in the order that breaks ties (see the header).
   auto root = std::make_shared<sim::Coupled>("run");
-  auto& world_model = root->emplace<WorldModel>(world, scenario.physics_step_us, noise_rng);
+  auto& world_model = root->emplace<WorldModel>(world, scenario.physics_step_us);
   std::vector<AgentModel*> agents;
   const bool central = scenario.mode == ConvoyMode::kCentral;
   for (std::size_t i = 0; i < scenario.robots.size(); ++i) {
@@ -785,7 +806,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   }
   RunProfile profile;
   if (options.profile) {
-    for (AgentModel* a : agents) a->set_profile(&profile);
+    for (AgentModel* a : agents) a->set_profile(true);
   }
   // The remote controllers' quantum, right after every agent of the instant has stepped.
   QuantumModel* quantum = nullptr;
@@ -865,6 +886,13 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
     if (central_model) root->couple(control.orders(), *central_model->find_input("console"));
   }
   sim::Coordinator coordinator(root, clock);
+  if (options.threads < 1) throw std::invalid_argument("threads must be >= 1");
+  std::optional<core::WorkerPool> workers;
+  if (options.threads > 1) {
+    workers.emplace(options.threads);
+    coordinator.set_workers(&*workers);
+    world.set_workers(&*workers);
+  }
   coordinator_ptr = &coordinator;
   std::atomic<bool> paused{false};
   std::atomic<bool> central_now{central};
@@ -938,8 +966,12 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   }
   if (options.control) options.control->detach();
   result.run_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
-  result.run_cpu_s = thread_cpu_seconds() - cpu_start;
+  result.run_cpu_s = thread_cpu_seconds() - cpu_start + (workers ? workers->worker_cpu_seconds() : 0.0);
   if (options.profile) {
+    for (const AgentModel* a : agents) {
+      profile.sensing_s += a->times().sensing_s;
+      profile.behaviours_s += a->times().behaviours_s;
+    }
     profile.integration_s = world.step_times().integration_s - world_times_before.integration_s;
     profile.collisions_s = world.step_times().collisions_s - world_times_before.collisions_s;
     result.profile = profile;
@@ -960,6 +992,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   summary["mode"] = scenario.mode == ConvoyMode::kCentral ? "central" : "distributed";
   summary["robots"] = scenario.robots.size();
   summary["realtime"] = options.realtime;
+  summary["threads"] = options.threads;
   summary["real_robots"] = real_ids;
   summary["virtual_stand_ins"] = options.virtual_stand_ins;
   if (options.realtime) summary["rt_factor"] = options.rt_factor;

@@ -64,6 +64,11 @@ struct RunOptions {
   AgentExchange* remote_agents = nullptr;
   /// Time the run's parts (RunResult::profile): a few clock reads per robot and step.
   bool profile = false;
+  /// Threads that step the world and the agents (>= 1). The run folder and every result
+  /// are the same for any count (each robot's noise has its own stream, and what runs at
+  /// once depends on nothing that runs beside it); only the speed differs. Agents whose
+  /// controllers run in another process, and real robots, stay on the run's thread.
+  int threads = 1;
 };
 
 /// What a run came to.
@@ -74,11 +79,15 @@ struct RunResult {
   std::optional<double> formation_time_s;   ///< when the hold that formed it began
   int collisions = 0;                       ///< contact episodes (robot–anything)
   int robot_collisions = 0;                 ///< of those, robot–robot
-  double max_overlap_m = 0.0;               ///< largest overlap seen at any control step
+  double max_overlap_m = 0.0;               ///< largest overlap seen, checked at the first control step of every simulated second
   double simulated_s = 0.0;
   double wall_s = 0.0;                      ///< the whole call, building the world included
   double run_wall_s = 0.0;                  ///< the DEVS run alone (what sim-bench reports)
-  double run_cpu_s = 0.0;                   ///< the calling thread's CPU time in the DEVS run
+  double run_cpu_s = 0.0;                   ///< CPU time of the run's threads (the caller's and RunOptions::threads' workers) in the DEVS run
+  /// A 64-bit digest of every trajectory sample (time, id, position, heading, bit for
+  /// bit): equal digests mean, but for a 2^-64 chance, the same trajectories (runs on
+  /// different thread counts are compared by it).
+  std::uint64_t trajectory_digest = 0;
   /// With RunOptions::profile: where run_wall_s went (the rest is the DEVS kernel's).
   std::optional<RunProfile> profile;
   std::string ended_by;                     ///< "duration", "formed", "done" or "interrupt"
@@ -92,8 +101,8 @@ struct RunResult {
 };
 
 /// Makes the body of a real robot (the links module supplies it); nullptr if it cannot.
-/// `rng` is the run's noise stream (for the robot's virtual sensors).
-using RealBodyFactory = std::function<std::unique_ptr<Body>(const RobotSpec&, environment::World&, std::mt19937_64& rng)>;
+/// Its virtual sensors read the world (World::sense), with the world's noise streams.
+using RealBodyFactory = std::function<std::unique_ptr<Body>(const RobotSpec&, environment::World&)>;
 
 /// Makes the controller named in `spec` (nullptr for a commanded convoy agent in central
 /// mode, or "none"). Throws ScenarioError for an unknown name or parameter.

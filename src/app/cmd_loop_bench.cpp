@@ -101,7 +101,7 @@ int loop_bench(const LoopArgs& args) {
     }
     links::RealBodyConfig bc;
     bc.lost_timeout_ms = 1000;
-    bodies.push_back(std::make_unique<links::RealBody>(i + 1, world, std::move(link), bc, rng));
+    bodies.push_back(std::make_unique<links::RealBody>(i + 1, world, std::move(link), bc));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // handshakes
 
@@ -154,13 +154,13 @@ int loop_bench(const LoopArgs& args) {
     }
     // The rest of the frame's work in the run: the world moves, the virtual robots think.
     const auto rest = Clock::now();
-    world.step(frame_us, rng);
+    world.step(frame_us);
     if (frame % 3 == 0) {
       for (int i = args.real; i < args.real + args.virtual_robots; ++i) {
         agents::ControlInput in;
         in.t_us = t_us;
         in.robot_id = i + 1;
-        in.sensors = world.sense(i + 1, t_us, rng);
+        in.sensors = world.sense(i + 1, t_us);
         const agents::ControlOutput out = controllers[i].step(in);
         world.set_wheel_speeds(i + 1, out.wheels.left, out.wheels.right);
       }

@@ -90,6 +90,7 @@ struct RunArgs {
   int seeds = 0;
   std::string out;
   int jobs = 0;
+  int threads = 1;
   bool quiet = false;
   std::string mode;  // overrides the scenario's
   bool all_virtual = false;
@@ -285,6 +286,7 @@ int run_command(const RunArgs& args) {
   options.duration_s = args.duration_s;
   options.stop_when_formed = args.stop_when_formed;
   options.seed = args.seed;
+  options.threads = args.threads;
   options.interrupt = &interrupted;
   // The LCM bus: everything the run reports goes out on it while it runs, and the run's
   // own outputs (its folder, its status line) are subscribers of the same messages.
@@ -586,6 +588,11 @@ void add_run_command(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--out", args->out, "Write the run folder here (a batch: one folder per seed and batch.json)");
   cmd->add_option("--jobs", args->jobs, "Runs of a batch at once (default: one per core)")->check(CLI::PositiveNumber);
+  cmd->add_option("--threads", args->threads,
+                  "Threads that step each run's world and agents (the run folder is the same for any count; only the "
+                  "speed differs)")
+      ->check(CLI::Range(1, 256))
+      ->default_val(1);
   cmd->add_option("--mode", args->mode, "Override the scenario's convoy mode")
       ->check(CLI::IsMember({"central", "distributed"}));
   cmd->add_flag("--all-virtual", args->all_virtual,

@@ -8,6 +8,7 @@
 #include <vector>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <utility>
 
@@ -30,6 +31,7 @@ struct BenchArgs {
   int repeat = 3;
   std::vector<std::string> lcm_urls;  // also time each count with the run published on each of these buses
   bool no_split = false;              // leave the run's parts untimed (RunOptions::profile)
+  std::string threads = "1";          // thread counts to time each robot count with
 };
 
 // The process's peak resident set so far, MB (getrusage; Linux reports kilobytes).
@@ -53,14 +55,18 @@ agents::Scenario bench_scenario(int robots, const BenchArgs& args) {
 template <class Split>
 void print_splits(const std::vector<Split>& splits) {
   std::printf("\nWhere the time goes (each run above timed in parts with steady_clock, a few reads per robot and "
-              "step; `--no-split` leaves them out): wall ms per simulated second, and the share of the run.\n\n"
-              "| robots | sensing | behaviours | integration | collisions | recording | DEVS kernel and the rest |\n"
-              "| ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+              "step; `--no-split` leaves them out): wall ms per simulated second, and the share of the run. With "
+              "more than one thread, sensing and behaviours run on all threads at once: their columns are the time "
+              "summed over the threads, divided by the thread count.\n\n"
+              "| robots | threads | sensing | behaviours | integration | collisions | recording | DEVS kernel and the rest |\n"
+              "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
   for (const Split& s : splits) {
-    const agents::RunProfile& p = s.profile;
+    agents::RunProfile p = s.profile;
+    p.sensing_s /= s.threads;
+    p.behaviours_s /= s.threads;
     const double parts[] = {p.sensing_s, p.behaviours_s, p.integration_s, p.collisions_s, p.monitor_s,
                             std::max(0.0, s.run_s - p.sensing_s - p.behaviours_s - p.integration_s - p.collisions_s - p.monitor_s)};
-    std::printf("| %d |", s.robots);
+    std::printf("| %d | %d |", s.robots, s.threads);
     for (const double part_s : parts) {
       std::printf(" %.1f (%.0f %%) |", 1000.0 * part_s / s.simulated_s, 100.0 * part_s / std::max(1e-9, s.run_s));
     }
@@ -74,23 +80,38 @@ int bench_command(const BenchArgs& args) {
     spdlog::error("--robots: {}", counts.error);
     return kExitUsage;
   }
+  const auto thread_counts = parse_id_list(args.threads, 1, 256);
+  if (!thread_counts.ok()) {
+    spdlog::error("--threads: {}", thread_counts.error);
+    return kExitUsage;
+  }
+  if (!args.lcm_urls.empty() && thread_counts.ids != std::vector<int>{1}) {
+    spdlog::error("--lcm times the bus on one thread: give it without --threads");
+    return kExitUsage;
+  }
   std::printf("## Simulation speed (rilbed sim-bench)\n\n");
   std::printf("Virtual Kheperas (55 mm discs) with all 8 IR proximity sensors (cones of +-30 deg, 50 mm range, noise), "
               "the wander controller (Braitenberg avoidance), wheel slip 2 %%, collisions on (robot-robot, robot-wall), "
               "control period 100 ms, physics step %.0f ms (exact arcs, collision substeps as needed), a field of %.2f "
-              "robots per m^2 (the lab's 8 robots on 1.5 x 1.2 m), random starts (seed %llu). One thread, the whole DEVS "
-              "run (world model, one atomic model per agent, monitor; no files written), timed from the first event to the "
-              "last (building the world, the start-up column, excluded); wall and the thread's CPU time, medians of --repeat runs; peak memory is the process's resident peak so far (getrusage).\n\n",
+              "robots per m^2 (the lab's 8 robots on 1.5 x 1.2 m), random starts (seed %llu). The whole DEVS "
+              "run (world model, one atomic model per agent, monitor; no files written) on the given threads (`--threads`: "
+              "agents and robot motion spread over them, collisions and recording on the run's thread), timed from the "
+              "first event to the last (building the world, the start-up column, excluded); wall and the CPU time of the "
+              "run's threads, medians of --repeat runs; speed-up is against the same count on the fewest threads; peak "
+              "memory is the process's resident peak so far (getrusage). Every run of a count, on any threads, must give the "
+              "same trajectories (the \"same\" column).\n\n",
               args.physics_step_ms, args.density_per_m2, static_cast<unsigned long long>(args.seed));
-  std::printf("| robots | field m | simulated s | start-up s | wall s (median of %d) | CPU s (median) | wall ms per simulated s | real-time factor (wall) | real-time factor (CPU) | us per robot-step (CPU) | peak memory MB | collisions | max overlap m |\n",
+  std::printf("| robots | threads | field m | simulated s | start-up s | wall s (median of %d) | CPU s (median) | wall ms per simulated s | real-time factor (wall) | real-time factor (CPU) | us per robot-step (CPU) | speed-up | peak memory MB | collisions | max overlap m | same |\n",
               args.repeat);
-  std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+  std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |\n");
   struct Split {
     int robots;
+    int threads;
     double run_s, simulated_s;
     agents::RunProfile profile;
   };
   std::vector<Split> splits;
+  bool any_differs = false;
   // With --lcm: each count also with every message of the run published on each bus
   // (nobody need listen), runs with and without it taking turns so that other load on
   // the machine falls on all alike.
@@ -120,14 +141,20 @@ int bench_command(const BenchArgs& args) {
   };
   for (int n : counts.ids) {
     const agents::Scenario s = bench_scenario(n, args);
+    double first_threads_wall_s = 0.0;
+    std::optional<std::uint64_t> first_digest;
+    for (std::size_t ti = 0; ti < thread_counts.ids.size(); ++ti) {
+    const int threads = thread_counts.ids[ti];
     Timing plain;
     std::vector<Timing> bused(buses.size());
+    bool same = true;
     for (int rep = 0; rep < args.repeat; ++rep) {
       for (std::size_t k = 0; k <= buses.size(); ++k) {
         Timing& t = k == 0 ? plain : bused[k - 1];
         agents::RunOptions o;
         o.seed = args.seed;
         o.duration_s = args.seconds;
+        o.threads = threads;
         if (k > 0) o.observer = buses[k - 1].publisher.get();
         o.profile = k == 0 && !args.no_split;
         try {
@@ -136,12 +163,15 @@ int bench_command(const BenchArgs& args) {
           spdlog::error("{} robots: {}", n, e.what());
           return kExitFailure;
         }
+        if (!first_digest) first_digest = t.r.trajectory_digest;
+        same = same && t.r.trajectory_digest == *first_digest;
         t.walls.push_back(t.r.run_wall_s);
         t.cpus.push_back(t.r.run_cpu_s);
         t.startups.push_back(t.r.wall_s - t.r.run_wall_s);
         if (t.r.profile) {
-          // One row per count: the repeats' parts added up.
-          if (splits.empty() || splits.back().robots != n) splits.push_back({n, 0.0, 0.0, {}});
+          // One row per count and thread count: the repeats' parts added up.
+          if (splits.empty() || splits.back().robots != n || splits.back().threads != threads)
+            splits.push_back({n, threads, 0.0, 0.0, {}});
           Split& split = splits.back();
           split.run_s += t.r.run_wall_s;
           split.simulated_s += t.r.simulated_s;
@@ -161,12 +191,13 @@ int bench_command(const BenchArgs& args) {
       const double startup_s = t.startups[t.startups.size() / 2];
       const double wall_s = std::max(1e-9, t.walls[t.walls.size() / 2]);
       const double cpu_s = std::max(1e-9, t.cpus[t.cpus.size() / 2]);
+      if (ti == 0 && label.empty()) first_threads_wall_s = wall_s;
       const agents::RunResult& r = t.r;
       const double steps = n * r.simulated_s / 0.1;
-      std::printf("| %d%s | %.1f x %.1f | %.1f | %.3f | %.3f | %.3f | %.1f | %.1f | %.1f | %.2f | %.0f | %d | %.2g |\n", n,
-                  label.c_str(), s.map.field.width_m, s.map.field.height_m, r.simulated_s, startup_s, wall_s, cpu_s,
-                  1000.0 * wall_s / r.simulated_s, r.simulated_s / wall_s, r.simulated_s / cpu_s, 1e6 * cpu_s / steps,
-                  peak_rss_mb(), r.collisions, r.max_overlap_m);
+      std::printf("| %d%s | %d | %.1f x %.1f | %.1f | %.3f | %.3f | %.3f | %.1f | %.1f | %.1f | %.2f | %.2f | %.0f | %d | %.2g | %s |\n", n,
+                  label.c_str(), threads, s.map.field.width_m, s.map.field.height_m, r.simulated_s, startup_s, wall_s,
+                  cpu_s, 1000.0 * wall_s / r.simulated_s, r.simulated_s / wall_s, r.simulated_s / cpu_s, 1e6 * cpu_s / steps,
+                  first_threads_wall_s / wall_s, peak_rss_mb(), r.collisions, r.max_overlap_m, same ? "yes" : "NO");
       return cpu_s;
     };
     const double plain_cpu = row(plain, "");
@@ -176,8 +207,11 @@ int bench_command(const BenchArgs& args) {
       buses[k].core_shares.push_back(100.0 * (bused_cpu - plain_cpu) / std::max(1e-9, bused[k].r.simulated_s));
     }
     std::fflush(stdout);
+    if (!same) any_differs = true;
+    }
   }
   if (!splits.empty()) print_splits(splits);
+  if (any_differs) spdlog::error("runs of the same robot count gave different trajectories (the \"same\" column)");
   if (!buses.empty()) {
     std::printf("\nThe bus: every message of the run published on it (rows \"(bus ...)\"): the world and status every "
                 "simulated second; every robot's pose, wheel command and sensor readings every control step; each event. "
@@ -206,7 +240,7 @@ int bench_command(const BenchArgs& args) {
       }
     }
   }
-  return 0;
+  return any_differs ? kExitFailure : 0;
 }
 
 }  // namespace
@@ -226,6 +260,10 @@ void add_sim_bench_command(CLI::App& app) {
   cmd->add_option("--lcm", args->lcm_urls,
                   "Also time each count with the run published on this LCM bus, nobody listening (repeatable; e.g. "
                   "memq:// as `rilbed run` publishes by default, or udpm://239.255.76.67:7667?ttl=0)");
+  cmd->add_option("--threads", args->threads,
+                  "Thread counts to time each robot count with, a list (e.g. 1,2): the world and the agents stepped on "
+                  "that many threads; every count must give the same trajectories")
+      ->default_val(args->threads);
   cmd->add_flag("--no-split", args->no_split,
                 "Do not time the runs' parts (sensing, behaviours, integration, collisions, recording): the table of "
                 "where the time goes is left out, and the clock reads with it");

@@ -14,7 +14,7 @@ void validate(const BeaconFinderConfig& config, const std::string& what) {
     throw std::invalid_argument(what + ": beacon finder: bearing_noise_sd_rad must be >= 0");
 }
 
-void sense_beacons(const BeaconFinderConfig& config, const Scene& scene, Pose2 pose, std::mt19937_64& rng,
+void sense_beacons(const BeaconFinderConfig& config, const Scene& scene, Pose2 pose, NoiseRng& rng,
                    std::vector<BeaconSighting>& out) {
   out.clear();
   const double half_view = 0.5 * config.field_of_view_rad;
@@ -30,7 +30,7 @@ void sense_beacons(const BeaconFinderConfig& config, const Scene& scene, Pose2 p
     if (scene.sight_blocked(beacon.position_m, pose.position_m)) continue;
     double reported = bearing;
     if (config.bearing_noise_sd_rad > 0.0)
-      reported = wrap_rad_pi(bearing + config.bearing_noise_sd_rad * standard_normal(rng));
+      reported = wrap_rad_pi(bearing + config.bearing_noise_sd_rad * fast_normal(rng));
     out.push_back({beacon.id, reported});
   }
 }

@@ -2,7 +2,7 @@
 // each beacon in view, never the distance.
 #pragma once
 
-#include <random>
+#include "environment/random.hpp"
 #include <string>
 #include <vector>
 
@@ -32,7 +32,7 @@ void validate(const BeaconFinderConfig& config, const std::string& what);
 /// The beacons the robot in slot `body` with pose `pose` sees, in the map's beacon
 /// order, bearings wrapped to [-pi, pi). `out` is cleared first (its capacity reused).
 /// Draws one normal per sighting when bearing noise is on.
-void sense_beacons(const BeaconFinderConfig& config, const Scene& scene, Pose2 pose, std::mt19937_64& rng,
+void sense_beacons(const BeaconFinderConfig& config, const Scene& scene, Pose2 pose, NoiseRng& rng,
                    std::vector<BeaconSighting>& out);
 
 }  // namespace rilbed::environment

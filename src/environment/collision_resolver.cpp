@@ -57,6 +57,7 @@ void CollisionResolver::resolve(CollisionScene& s, TimeUs t_us) {
   active_.clear();
   all_active_ = true;
   s.grid.rebuild(n, [&](std::size_t i) { return s.bodies[i].position_m; });
+  find_contacts_ahead(s);
 
   for (int pass = 0; pass < config_.max_passes; ++pass) {
     moved_list_.clear();
@@ -79,6 +80,63 @@ void CollisionResolver::resolve(CollisionScene& s, TimeUs t_us) {
     all_active_ = false;
   }
   fall_back(s);
+}
+
+void CollisionResolver::find_contacts_ahead(const CollisionScene& s) {
+  const std::size_t n = s.bodies.size();
+  near_robot_.assign(n, 0);
+  near_static_.assign(n, 0);
+  dirty_.assign(n, 0);
+  auto check = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      near_robot_[i] = s.bodies[i].pushable && near_another_robot(s, i);
+      near_static_[i] = near_a_static(s, i);
+    }
+  };
+  if (workers_ && workers_->threads() > 1 && n > 1)
+    workers_->for_chunks(n, check);
+  else
+    check(0, n);
+}
+
+// Whether the first pass's visit of robot i would find another robot within contact
+// (the same test as robots_vs_robots, before any push).
+bool CollisionResolver::near_another_robot(const CollisionScene& s, std::size_t i) const {
+  const Body& bi = s.bodies[i];
+  const double margin = config_.contact_margin_m;
+  bool near = false;
+  s.grid.for_each_in_box(box_around(bi.position_m, bi.radius_m + s.max_body_radius_m + margin), [&](int jj) {
+    const auto j = static_cast<std::size_t>(jj);
+    if (j == i || near) return;
+    const Body& bj = s.bodies[j];
+    const double sum = bi.radius_m + bj.radius_m + margin;
+    if (distance_sq(bi.position_m, bj.position_m) < sum * sum) near = true;
+  });
+  return near;
+}
+
+// Whether robots_vs_statics's visit of robot i, unmoved since, would do anything.
+bool CollisionResolver::near_a_static(const CollisionScene& s, std::size_t i) const {
+  const Body& b = s.bodies[i];
+  const double margin = config_.contact_margin_m;
+  bool near = false;
+  const Box box = path_box(b.pushable ? b.previous_m : b.position_m, b.position_m, b.radius_m + margin);
+  s.statics.for_each_in_box(box, [&](const IndexedSegment& seg) {
+    if (near) return;
+    if (b.pushable && path_crosses_segment(b.previous_m, b.position_m, seg.a_m, seg.b_m)) near = true;
+    else if (disc_segment_contact(b.position_m, b.radius_m, seg.a_m, seg.b_m).separation_m < margin) near = true;
+  });
+  return near;
+}
+
+// After a push in the first pass: the robots near the pushed one's new place must be
+// visited even if nothing was near them at the start (their grid cells are current;
+// the pushed robot's is not, but it is visited anyway).
+void CollisionResolver::mark_near_dirty(const CollisionScene& s, std::size_t moved) {
+  const Body& b = s.bodies[moved];
+  dirty_[moved] = 1;
+  s.grid.for_each_in_box(box_around(b.position_m, b.radius_m + s.max_body_radius_m + config_.contact_margin_m),
+                         [&](int j) { dirty_[static_cast<std::size_t>(j)] = 1; });
 }
 
 bool CollisionResolver::robots_vs_robots(CollisionScene& s) {
@@ -120,15 +178,19 @@ bool CollisionResolver::robots_vs_robots(CollisionScene& s) {
         bi.position_m = bi.position_m + normal * (0.5 * overlap);
         bj.position_m = bj.position_m - normal * (0.5 * overlap);
         mark_moved(j);
+        if (all_active_) mark_near_dirty(s, j);
       } else {
         bi.position_m = bi.position_m + normal * overlap;
       }
       mark_moved(i);
+      if (all_active_) mark_near_dirty(s, i);
       corrected = true;
     });
   };
   if (all_active_) {
-    for (std::size_t i = 0; i < s.bodies.size(); ++i) visit(i);
+    // Only those that something is near: a visit of any other finds nothing to do.
+    for (std::size_t i = 0; i < s.bodies.size(); ++i)
+      if (near_robot_[i] || dirty_[i]) visit(i);
   } else {
     for (const int i : active_) visit(static_cast<std::size_t>(i));
   }
@@ -190,7 +252,9 @@ bool CollisionResolver::robots_vs_statics(CollisionScene& s) {
     });
   };
   if (all_active_) {
-    for (std::size_t i = 0; i < s.bodies.size(); ++i) visit(i);
+    // Only those near a static at the start, or moved since (by a push or a mover).
+    for (std::size_t i = 0; i < s.bodies.size(); ++i)
+      if (near_static_[i] || moved_[i]) visit(i);
   } else {
     for (const int i : active_) visit(static_cast<std::size_t>(i));
   }

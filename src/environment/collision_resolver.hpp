@@ -26,6 +26,7 @@
 #include <span>
 #include <vector>
 
+#include "core/worker_pool.hpp"
 #include "environment/body.hpp"
 #include "environment/collision_event.hpp"
 #include "environment/moving_obstacle.hpp"
@@ -75,6 +76,9 @@ class CollisionResolver {
   /// Ends the step: the pairs in contact during this step that were not in contact
   /// during the previous step become events, sorted by time, then parties.
   std::span<const CollisionEvent> end_step();
+  /// Looks for the robots that may be in contact on `pool`'s threads (null: on the
+  /// caller's); the resolution itself stays on the caller's thread. Same results.
+  void set_workers(core::WorkerPool* pool) { workers_ = pool; }
   /// The events of the last ended step.
   std::span<const CollisionEvent> events() const { return events_; }
 
@@ -93,6 +97,10 @@ class CollisionResolver {
   bool movers_vs_statics(CollisionScene& s);
   void mark_moved(std::size_t body);
   bool body_overlaps(const CollisionScene& s, std::size_t i) const;
+  void find_contacts_ahead(const CollisionScene& s);
+  bool near_another_robot(const CollisionScene& s, std::size_t i) const;
+  bool near_a_static(const CollisionScene& s, std::size_t i) const;
+  void mark_near_dirty(const CollisionScene& s, std::size_t moved);
   bool mover_overlaps(const CollisionScene& s, std::size_t m) const;
   void fall_back(CollisionScene& s);
 
@@ -109,6 +117,12 @@ class CollisionResolver {
   std::vector<std::uint8_t> moved_;
   std::vector<std::uint8_t> reverted_;
   bool all_active_ = true;
+  // The first pass visits only the robots that may touch something (found beforehand,
+  // on the workers when set) and those that a push in the pass brought near something.
+  std::vector<std::uint8_t> near_robot_;   // at the pass's start: another robot within contact
+  std::vector<std::uint8_t> near_static_;  // at the pass's start: a wall or obstacle within contact, or crossed
+  std::vector<std::uint8_t> dirty_;        // near a robot moved in this pass
+  core::WorkerPool* workers_ = nullptr;
 };
 
 }  // namespace rilbed::environment

@@ -5,7 +5,7 @@
 #pragma once
 
 #include <array>
-#include <random>
+#include "environment/random.hpp"
 #include <string>
 
 #include "environment/scene.hpp"
@@ -57,8 +57,9 @@ class ProximitySensor {
                          std::array<double, kProximityCount>& distances_m) const;
 
   /// The readings: response of each distance plus noise, rounded and clamped to
-  /// [0, 1023]. Draws four normal pairs from `rng` when noise_sd > 0.
-  void sense(const Scene& scene, int body, Vec2 heading, std::mt19937_64& rng, ProximityValues& out) const;
+  /// [0, 1023]. Draws eight normals from `rng` (fast_normal, in sensor order) when
+  /// noise_sd > 0.
+  void sense(const Scene& scene, int body, Vec2 heading, NoiseRng& rng, ProximityValues& out) const;
 
  private:
   ProximityConfig config_;

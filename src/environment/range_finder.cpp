@@ -26,7 +26,7 @@ RangeFinders::RangeFinders(std::vector<RangeFinderConfig> configs, const std::st
   }
 }
 
-void RangeFinders::sense(const Scene& scene, int body, Vec2 heading, std::mt19937_64& rng,
+void RangeFinders::sense(const Scene& scene, int body, Vec2 heading, NoiseRng& rng,
                          std::vector<RangeReading>& out) const {
   out.resize(configs_.size());
   if (configs_.empty()) return;  // most robots carry none: skip the wedge buffers
@@ -52,7 +52,7 @@ void RangeFinders::sense(const Scene& scene, int body, Vec2 heading, std::mt1993
       RangeReading& r = out[first + k];
       if (distances[k] <= c.max_range_m) {
         double d = distances[k];
-        if (c.noise_sd_m > 0.0) d = std::clamp(d + c.noise_sd_m * standard_normal(rng), 0.0, c.max_range_m);
+        if (c.noise_sd_m > 0.0) d = std::clamp(d + c.noise_sd_m * fast_normal(rng), 0.0, c.max_range_m);
         r = {true, d};
       } else {
         r = {false, c.max_range_m};

@@ -2,7 +2,7 @@
 // nearest object inside its cone, nothing about where in the cone it is.
 #pragma once
 
-#include <random>
+#include "environment/random.hpp"
 #include <string>
 #include <vector>
 
@@ -40,7 +40,7 @@ class RangeFinders {
   /// Fills out[k] for finder k of the robot in slot `body` facing `heading` (unit
   /// vector); out is resized to size(). Draws one normal per hit from `rng` for finders
   /// with noise.
-  void sense(const Scene& scene, int body, Vec2 heading, std::mt19937_64& rng, std::vector<RangeReading>& out) const;
+  void sense(const Scene& scene, int body, Vec2 heading, NoiseRng& rng, std::vector<RangeReading>& out) const;
 
  private:
   struct Precomputed {

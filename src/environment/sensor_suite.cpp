@@ -24,7 +24,7 @@ SensorSuite::SensorSuite(const SensorSuiteConfig& config, const std::string& wha
 }
 
 void SensorSuite::sense(const Scene& scene, int body, Pose2 pose, std::optional<OdometryReading> odometry,
-                        TimeUs t_us, std::mt19937_64& rng, SensorReadings& out) const {
+                        TimeUs t_us, NoiseRng& rng, SensorReadings& out) const {
   out.t_us = t_us;
   const Vec2 heading{std::cos(pose.heading_rad), std::sin(pose.heading_rad)};
   if (proximity_) {

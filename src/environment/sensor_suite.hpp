@@ -3,7 +3,7 @@
 #pragma once
 
 #include <optional>
-#include <random>
+#include "environment/random.hpp"
 #include <string>
 #include <vector>
 
@@ -36,7 +36,7 @@ class SensorSuite {
   /// reported when the suite has an odometer and it is given. Noise draws come from `rng`
   /// in a fixed order: proximity, range finders, beacons, track sensors.
   void sense(const Scene& scene, int body, Pose2 pose, std::optional<OdometryReading> odometry, TimeUs t_us,
-             std::mt19937_64& rng, SensorReadings& out) const;
+             NoiseRng& rng, SensorReadings& out) const;
 
   /// The IR ring, if carried.
   const std::optional<ProximitySensor>& proximity() const { return proximity_; }

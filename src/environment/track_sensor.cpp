@@ -106,11 +106,11 @@ int TrackSensor::covered_segments(const Scene& scene, Vec2 position_m, Vec2 head
   return covered;
 }
 
-int TrackSensor::reading(int covered, std::mt19937_64& rng) const {
+int TrackSensor::reading(int covered, NoiseRng& rng) const {
   const double max = config_.max_value;
   double value = 0.0;
   if (covered >= required_) value = config_.graded ? max * covered / config_.precision : max;
-  if (config_.error_level_percent > 0.0) value += standard_normal(rng) * config_.error_level_percent / 100.0 * max;
+  if (config_.error_level_percent > 0.0) value += fast_normal(rng) * config_.error_level_percent / 100.0 * max;
   return static_cast<int>(std::clamp(std::round(value), 0.0, max));
 }
 

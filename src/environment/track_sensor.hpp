@@ -25,7 +25,7 @@
 // [0, max_value].
 #pragma once
 
-#include <random>
+#include "environment/random.hpp"
 #include <string>
 #include <vector>
 
@@ -92,7 +92,7 @@ class TrackSensor {
   int covered_segments(const Scene& scene, Vec2 position_m, Vec2 heading) const;
   /// The reading for `covered` segments on a track. Draws one normal when the error level
   /// is non-zero.
-  int reading(int covered, std::mt19937_64& rng) const;
+  int reading(int covered, NoiseRng& rng) const;
 
  private:
   TrackSensorConfig config_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <stdexcept>
 
 #include "environment/random.hpp"
@@ -250,7 +251,7 @@ double World::substep_limit_m() const {
   return min_radius_m_ > 0.0 ? min_radius_m_ : kKheperaRadius_m;
 }
 
-std::span<const CollisionEvent> World::step(TimeUs dt_us, std::mt19937_64& rng) {
+std::span<const CollisionEvent> World::step(TimeUs dt_us) {
   if (dt_us < 0) throw std::invalid_argument("world: step dt_us must be >= 0");
   if (dt_us == 0) return {};
   using Clock = std::chrono::steady_clock;
@@ -259,50 +260,33 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us, std::mt19937_64& rng) 
   const double dt_s = us_to_seconds(dt_us);
 
   // Wheel speeds for the whole step (commands are constant over a step), the counters,
-  // and the longest distance anything travels.
+  // and the longest distance anything travels (each robot on its own: threads may share
+  // the robots, and the largest travel is the same whoever finds it).
+  std::mutex max_mutex;
   double max_travel_m = 0.0;
-  struct Speeds {
-    double left_mps, right_mps;
-  };
-  for (std::size_t i = 0; i < robots_.size(); ++i) {
-    RobotState& r = robots_[i];
-    if (r.kind != RobotKind::Virtual) continue;
-    const double left_cmd = speed_units_to_mps(r.left_speed_units);
-    const double right_cmd = speed_units_to_mps(r.right_speed_units);
-    double left_gain = 1.0 + r.noise.left_bias, right_gain = 1.0 + r.noise.right_bias;
-    if (r.noise.slip_sd > 0.0) {
-      const auto [a, b] = standard_normal_pair(rng);
-      left_gain += r.noise.slip_sd * a;
-      right_gain += r.noise.slip_sd * b;
-    }
-    const Speeds actual{left_cmd * left_gain, right_cmd * right_gain};
-    if (r.noise.odometer_counts_slip) {
-      r.left_wheel_travel_m += actual.left_mps * dt_s;
-      r.right_wheel_travel_m += actual.right_mps * dt_s;
-    } else {
-      r.left_wheel_travel_m += left_cmd * dt_s;
-      r.right_wheel_travel_m += right_cmd * dt_s;
-    }
-    max_travel_m = std::max(max_travel_m, std::abs(0.5 * (actual.left_mps + actual.right_mps)) * dt_s);
-    // Stash the speeds in the motion record; the substep arc needs the substep count.
-    motion_[i].local_step_m = {actual.left_mps, actual.right_mps};
-  }
+  for_robot_slots([&](std::size_t begin, std::size_t end) {
+    const double travel_m = start_wheels(begin, end, dt_s);
+    std::lock_guard lock(max_mutex);
+    max_travel_m = std::max(max_travel_m, travel_m);
+  });
   for (const MovingObstacle& m : movers_) max_travel_m = std::max(max_travel_m, m.velocity_mps().norm() * dt_s);
 
   constexpr double kMaxSubsteps = 100000.0;
   const int substeps = static_cast<int>(std::clamp(std::ceil(max_travel_m / substep_limit_m()), 1.0, kMaxSubsteps));
   const double h_s = dt_s / substeps;
-  for (std::size_t i = 0; i < robots_.size(); ++i) {
-    const RobotState& r = robots_[i];
-    if (r.kind != RobotKind::Virtual) continue;
-    Motion& m = motion_[i];
-    const ArcStep arc = diff_drive_arc(m.local_step_m.x, m.local_step_m.y, r.wheel_base_m, h_s);
-    m.local_step_m = arc.local_displacement_m;
-    m.cos_turn = arc.cos_heading_change;
-    m.sin_turn = arc.sin_heading_change;
-    m.heading = {std::cos(r.pose.heading_rad), std::sin(r.pose.heading_rad)};
-    m.end_heading_rad = r.pose.heading_rad + arc.heading_change_rad * substeps;
-  }
+  for_robot_slots([&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const RobotState& r = robots_[i];
+      if (r.kind != RobotKind::Virtual) continue;
+      Motion& m = motion_[i];
+      const ArcStep arc = diff_drive_arc(m.local_step_m.x, m.local_step_m.y, r.wheel_base_m, h_s);
+      m.local_step_m = arc.local_displacement_m;
+      m.cos_turn = arc.cos_heading_change;
+      m.sin_turn = arc.sin_heading_change;
+      m.heading = {std::cos(r.pose.heading_rad), std::sin(r.pose.heading_rad)};
+      m.end_heading_rad = r.pose.heading_rad + arc.heading_change_rad * substeps;
+    }
+  });
 
   CollisionScene cs{bodies_, ids_, grid_, statics_, movers_, max_radius_m_};
   resolver_.begin_step();
@@ -326,36 +310,79 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us, std::mt19937_64& rng) 
   }
 
   t_us_ += dt_us;
-  for (std::size_t i = 0; i < robots_.size(); ++i) {
-    RobotState& r = robots_[i];
-    if (r.kind != RobotKind::Virtual) continue;
-    r.pose = {bodies_[i].position_m, wrap_rad_pi(motion_[i].end_heading_rad)};
-    r.pose_t_us = t_us_;
-  }
+  for_robot_slots([&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      RobotState& r = robots_[i];
+      if (r.kind != RobotKind::Virtual) continue;
+      r.pose = {bodies_[i].position_m, wrap_rad_pi(motion_[i].end_heading_rad)};
+      r.pose_t_us = t_us_;
+    }
+  });
   step_times_.collisions_s += collisions_s;
   step_times_.integration_s += std::chrono::duration<double>(Clock::now() - started).count() - collisions_s;
   return resolver_.end_step();
 }
 
-SensorReadings World::sense(int id, TimeUs t_us, std::mt19937_64& rng) const {
+double World::start_wheels(std::size_t begin, std::size_t end, double dt_s) {
+  double max_travel_m = 0.0;
+  for (std::size_t i = begin; i < end; ++i) {
+    RobotState& r = robots_[i];
+    if (r.kind != RobotKind::Virtual) continue;
+    const double left_cmd = speed_units_to_mps(r.left_speed_units);
+    const double right_cmd = speed_units_to_mps(r.right_speed_units);
+    double left_gain = 1.0 + r.noise.left_bias, right_gain = 1.0 + r.noise.right_bias;
+    if (r.noise.slip_sd > 0.0) {
+      NoiseRng rng = NoiseRng::keyed(config_.noise_seed, r.id, t_us_, NoisePurpose::kWheels);
+      left_gain += r.noise.slip_sd * fast_normal(rng);
+      right_gain += r.noise.slip_sd * fast_normal(rng);
+    }
+    const double left_mps = left_cmd * left_gain, right_mps = right_cmd * right_gain;
+    if (r.noise.odometer_counts_slip) {
+      r.left_wheel_travel_m += left_mps * dt_s;
+      r.right_wheel_travel_m += right_mps * dt_s;
+    } else {
+      r.left_wheel_travel_m += left_cmd * dt_s;
+      r.right_wheel_travel_m += right_cmd * dt_s;
+    }
+    max_travel_m = std::max(max_travel_m, std::abs(0.5 * (left_mps + right_mps)) * dt_s);
+    // Stash the speeds in the motion record; the substep arc needs the substep count.
+    motion_[i].local_step_m = {left_mps, right_mps};
+  }
+  return max_travel_m;
+}
+
+SensorReadings World::sense(int id, TimeUs t_us) const {
+  SensorReadings out;
+  sense_into(id, t_us, out);
+  return out;
+}
+
+SensorReadings World::sense(int id, TimeUs t_us, NoiseRng& rng) const {
   const std::size_t s = slot(id);
   const RobotState& r = robots_[s];
-  SensorReadings out;
   std::optional<OdometryReading> odometry;
   if (r.kind == RobotKind::Virtual) odometry = r.odometer();
+  SensorReadings out;
   suites_[s].sense(scene(), static_cast<int>(s), r.pose, odometry, t_us, rng, out);
   return out;
 }
 
-void World::sense_all(TimeUs t_us, std::mt19937_64& rng, std::vector<SensorReadings>& out) const {
+void World::sense_into(int id, TimeUs t_us, SensorReadings& out) const {
+  sense_slot(scene(), slot(id), t_us, out);
+}
+
+void World::sense_slot(const Scene& scene, std::size_t s, TimeUs t_us, SensorReadings& out) const {
+  const RobotState& r = robots_[s];
+  std::optional<OdometryReading> odometry;
+  if (r.kind == RobotKind::Virtual) odometry = r.odometer();
+  NoiseRng rng = NoiseRng::keyed(config_.noise_seed, r.id, t_us, NoisePurpose::kSensing);
+  suites_[s].sense(scene, static_cast<int>(s), r.pose, odometry, t_us, rng, out);
+}
+
+void World::sense_all(TimeUs t_us, std::vector<SensorReadings>& out) const {
   out.resize(robots_.size());
   const Scene sc = scene();
-  for (std::size_t s = 0; s < robots_.size(); ++s) {
-    const RobotState& r = robots_[s];
-    std::optional<OdometryReading> odometry;
-    if (r.kind == RobotKind::Virtual) odometry = r.odometer();
-    suites_[s].sense(sc, static_cast<int>(s), r.pose, odometry, t_us, rng, out[s]);
-  }
+  for (std::size_t s = 0; s < robots_.size(); ++s) sense_slot(sc, s, t_us, out[s]);
 }
 
 WorldSnapshot World::snapshot() const {

@@ -11,12 +11,13 @@
 
 #include <chrono>
 #include <cstddef>
-#include <random>
+#include <cstdint>
 #include <span>
 #include <unordered_map>
 #include <vector>
 
 #include "core/time.hpp"
+#include "core/worker_pool.hpp"
 #include "environment/collision_resolver.hpp"
 #include "environment/robot_state.hpp"
 #include "environment/scene.hpp"
@@ -43,6 +44,10 @@ struct WorldConfig {
   CollisionConfig collision;
   /// The world's clock at construction.
   TimeUs start_t_us = 0;
+  /// Seed of every noise in the world (sensors, wheel slip). Each robot's noise at each
+  /// instant is drawn from its own stream keyed by (seed, robot id, time), so results do
+  /// not depend on the order in which robots sense or on threads.
+  std::uint64_t noise_seed = 0;
 };
 
 /// Wall time the world's steps took, summed since it was built, seconds.
@@ -101,25 +106,41 @@ class World {
   /// The moving obstacles, by index.
   std::span<const MovingObstacle> moving_obstacles() const { return movers_; }
 
-  /// Advances the world by dt_us >= 0: virtual robots drive (wheel noise drawn from
-  /// `rng`, in robot order), moving obstacles drift, collisions are resolved, the clock
-  /// advances. Returns the collision events that began during this step (valid until
-  /// the next step). dt_us == 0 does nothing. Same seed and same calls give the same
-  /// world, on any standard library.
-  std::span<const CollisionEvent> step(TimeUs dt_us, std::mt19937_64& rng);
+  /// Advances the world by dt_us >= 0: virtual robots drive (each robot's wheel slip
+  /// drawn from its stream for the step's start time), moving obstacles drift, collisions
+  /// are resolved, the clock advances. Returns the collision events that began during
+  /// this step (valid until the next step). dt_us == 0 does nothing. Same seed and same
+  /// calls give the same world, on any standard library.
+  std::span<const CollisionEvent> step(TimeUs dt_us);
+  /// Moves the robots of a step, and looks for their contacts, on `pool`'s threads from
+  /// now on (null: this thread only). Collisions are still resolved on the stepping
+  /// thread. Results are the same for any number of threads. The pool must outlive the
+  /// steps.
+  void set_workers(core::WorkerPool* pool) {
+    workers_ = pool;
+    resolver_.set_workers(pool);
+  }
+
   /// How long the steps so far took, split (a few clock reads per step and substep).
   const WorldStepTimes& step_times() const { return step_times_; }
   /// The events returned by the last step.
   std::span<const CollisionEvent> last_collisions() const { return resolver_.events(); }
 
-  /// Reads every virtual sensor robot `id` carries, stamped t_us (noise from `rng`).
+  /// Reads every virtual sensor robot `id` carries, stamped t_us. The noise comes from
+  /// the robot's stream for t_us: reading twice at one instant gives the same values.
   /// Works for real robots too: their virtual sensors see virtual and real robots,
   /// walls and obstacles. The odometer is filled for virtual robots only (a real robot's
   /// counters come from its link). Throws std::invalid_argument for an unknown id.
-  SensorReadings sense(int id, TimeUs t_us, std::mt19937_64& rng) const;
+  SensorReadings sense(int id, TimeUs t_us) const;
+  /// As sense(id, t_us), with the noise drawn from `rng` instead of the robot's stream
+  /// (tests that want many independent readings of one instant).
+  SensorReadings sense(int id, TimeUs t_us, NoiseRng& rng) const;
+  /// As sense(id, t_us), into `out` (its buffers reused, so a caller that keeps `out`
+  /// allocates nothing).
+  void sense_into(int id, TimeUs t_us, SensorReadings& out) const;
   /// Reads every robot's sensors into out[i] for robots()[i] (out is resized; its
-  /// elements' buffers are reused, so a caller that keeps `out` allocates nothing).
-  void sense_all(TimeUs t_us, std::mt19937_64& rng, std::vector<SensorReadings>& out) const;
+  /// elements' buffers are reused).
+  void sense_all(TimeUs t_us, std::vector<SensorReadings>& out) const;
 
   /// A copy of the moving state, with the last step's events.
   WorldSnapshot snapshot() const;
@@ -144,10 +165,20 @@ class World {
   };
 
   std::size_t slot(int id) const;
+  void sense_slot(const Scene& scene, std::size_t s, TimeUs t_us, SensorReadings& out) const;
   std::string label(int id) const { return "robot " + std::to_string(id); }
   void check_placement_free(const std::string& what, Vec2 position_m, double radius_m, int exclude_slot) const;
   void refresh_max_radius();
   double substep_limit_m() const;
+  // Calls body(begin, end) over robot slots [0, robots), on the workers when set.
+  template <class Body>
+  void for_robot_slots(Body&& body) {
+    if (workers_ && workers_->threads() > 1 && robots_.size() > 1)
+      workers_->for_chunks(robots_.size(), body);
+    else
+      body(0, robots_.size());
+  }
+  double start_wheels(std::size_t begin, std::size_t end, double dt_s);
 
   WorldConfig config_;
   StaticMap map_;
@@ -167,6 +198,7 @@ class World {
   std::vector<MovingObstacle> movers_;
   CollisionResolver resolver_;
   WorldStepTimes step_times_;
+  core::WorkerPool* workers_ = nullptr;
   TimeUs t_us_ = 0;
 };
 

@@ -8,9 +8,8 @@
 
 namespace rilbed::links {
 
-RealBody::RealBody(int id, environment::World& world, std::shared_ptr<KheperaLink> link, RealBodyConfig config,
-                   std::mt19937_64& rng)
-    : id_(id), world_(world), link_(std::move(link)), config_(config), rng_(rng) {
+RealBody::RealBody(int id, environment::World& world, std::shared_ptr<KheperaLink> link, RealBodyConfig config)
+    : id_(id), world_(world), link_(std::move(link)), config_(config) {
   if (!link_) throw std::invalid_argument("robot " + std::to_string(id) + ": no link");
   if (!world_.has_robot(id) || world_.robot(id).kind != environment::RobotKind::Real) {
     throw std::invalid_argument("robot " + std::to_string(id) + " is not a real robot of the world");
@@ -44,7 +43,7 @@ RealBody::~RealBody() {
 
 environment::SensorReadings RealBody::sense(TimeUs t_us) {
   // Virtual sensors at the camera's pose: walls, obstacles and every robot, virtual or real.
-  environment::SensorReadings r = world_.sense(id_, t_us, rng_);
+  environment::SensorReadings r = world_.sense(id_, t_us);
   if (const auto real = link_->latest_proximity()) {
     if (!r.proximity) r.proximity = environment::ProximityValues{};
     // On the Khepera's scale (an e-puck's sensors read 0..4095), then a real obstacle and

@@ -36,10 +36,9 @@ struct RealBodyConfig {
 /// own thread.
 class RealBody final : public agents::Body {
  public:
-  /// `world` and `rng` must outlive the body; the robot `id` must be in the world as a
+  /// `world` must outlive the body; the robot `id` must be in the world as a
   /// real robot. `link` must be started.
-  RealBody(int id, environment::World& world, std::shared_ptr<KheperaLink> link, RealBodyConfig config,
-           std::mt19937_64& rng);
+  RealBody(int id, environment::World& world, std::shared_ptr<KheperaLink> link, RealBodyConfig config);
   /// Stops the robot and waits for its acknowledgement if the line allows (the link stays
   /// open for its other owners; it closes, with another stop, when the last one lets go).
   ~RealBody() override;
@@ -68,7 +67,6 @@ class RealBody final : public agents::Body {
   environment::World& world_;
   std::shared_ptr<KheperaLink> link_;
   RealBodyConfig config_;
-  std::mt19937_64& rng_;
   std::string held_by_;
 };
 

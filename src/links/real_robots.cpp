@@ -121,12 +121,12 @@ std::shared_ptr<KheperaLink> RealRobots::connect(const agents::RobotSpec& spec, 
 }
 
 agents::RealBodyFactory RealRobots::body_factory() {
-  return [this](const agents::RobotSpec& spec, environment::World& world, std::mt19937_64& rng) -> std::unique_ptr<agents::Body> {
+  return [this](const agents::RobotSpec& spec, environment::World& world) -> std::unique_ptr<agents::Body> {
     std::shared_ptr<KheperaLink> link = connect(spec, world.robot(spec.id).pose);
     RealBodyConfig body;
     body.lost_timeout_ms = scenario_.lost_timeout_ms;
     body.geofence_margin_m = scenario_.geofence_margin_m;
-    return std::make_unique<RealBody>(spec.id, world, std::move(link), body, rng);
+    return std::make_unique<RealBody>(spec.id, world, std::move(link), body);
   };
 }
 

@@ -19,7 +19,9 @@ namespace rilbed::sim {
 /// Typical use: declare ports as reference members initialised with
 /// add_input<T>("name") / add_output<T>("name") in the constructor.
 /// Models know no absolute time: only durations. Not thread-safe (the coordinator's
-/// thread calls everything).
+/// thread calls everything), except that a model whose transitions_concurrent() is true
+/// may have its transitions run on a worker thread at the same time as other such
+/// models' (Coordinator::set_workers).
 class Atomic : public Component {
  public:
   using Component::Component;
@@ -39,6 +41,11 @@ class Atomic : public Component {
   /// The output function (λ), called just before an internal or confluent transition:
   /// writes messages to the output ports and must not change the state.
   virtual void output() = 0;
+  /// Whether this model's transitions may run at the same time as those of other models
+  /// that say so, in the same step: they touch only the model's own state and data that
+  /// no other such model writes, and their result does not depend on which of them runs
+  /// first. Default false (always run on the coordinator's thread, in flat order).
+  virtual bool transitions_concurrent() const { return false; }
 };
 
 /// An atomic model whose whole state is one value of type State, so that tests,

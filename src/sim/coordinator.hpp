@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/worker_pool.hpp"
 #include "sim/atomic.hpp"
 #include "sim/clock.hpp"
 #include "sim/coupled.hpp"
@@ -50,6 +51,12 @@ struct StepReport {
 /// imminent atomic in flat order gets its confluent, internal or external transition;
 /// bags are cleared and the schedule updated; step observers are called. With a
 /// FastClock nothing depends on wall time, so runs are reproducible.
+///
+/// Worker threads (set_workers): in a step, each run of consecutive active atomics (in
+/// flat order) whose transitions_concurrent() is true has its transitions spread over
+/// the pool's threads; everything else stays on the running thread and in flat order.
+/// Since such models do not depend on each other's transitions, the run's results are
+/// the same for any number of threads.
 ///
 /// Threading: run_until(), step() and the registration calls belong to one thread;
 /// inject(), stop() and now_us() may be called from any thread. Listeners and
@@ -119,8 +126,14 @@ class Coordinator {
   /// Calls `observer` after every step (after all transitions of that step).
   void on_step(std::function<void(const StepReport&)> observer);
 
+  /// Runs concurrent transitions on `pool` from now on (null: all on the running thread).
+  /// The pool must outlive the coordinator's runs.
+  void set_workers(core::WorkerPool* pool) { workers_ = pool; }
+
  private:
   static constexpr std::size_t kNotAtomic = static_cast<std::size_t>(-1);
+  // A step is "bulk" when at least 1/kBulkShare of the atomics take part (see do_step).
+  static constexpr std::size_t kBulkShare = 8;
   struct Destination {
     PortBase* port;
     std::size_t atomic;  // flat index of the owner, or kNotAtomic for a root output
@@ -146,6 +159,8 @@ class Coordinator {
   void check_usable() const;
   Progress advance(TimeUs t_limit_us);
   void do_step(TimeUs t_us);
+  void transition(std::size_t index, TimeUs t_us);
+  void transitions(TimeUs t_us);
   void route(const Route& route);
   void deliver_injections();
   TimeUs next_time(std::size_t index, TimeUs t_us) const;
@@ -159,6 +174,8 @@ class Coordinator {
   detail::EventHeap schedule_;
   std::vector<std::size_t> active_;        // scratch: imminent then influenced indices
   std::vector<Atomic*> transitioned_;      // scratch for StepReport
+  core::WorkerPool* workers_ = nullptr;    // runs concurrent transitions, when set
+  std::vector<TimeUs> next_times_;         // scratch: next event time of active_[k]
   std::vector<OutputListener> output_listeners_;
   std::vector<std::function<void(const StepReport&)>> step_observers_;
   std::atomic<TimeUs> now_us_{0};

@@ -42,6 +42,23 @@ class EventHeap {
       sift_down(position_[item]);
   }
 
+  /// Sets `item`'s time without restoring heap order (O(1)); reheap() must follow before
+  /// any other call. For a step that re-keys a large share of the items at once, where
+  /// one O(n) reheap beats k sifts of O(log n) with a cache miss at each level.
+  void set_time_unordered(std::size_t item, TimeUs t_us) { times_us_[item] = t_us; }
+  /// Restores heap order after set_time_unordered() calls (Floyd's heap construction, O(n)).
+  void reheap() {
+    for (std::size_t pos = heap_.size() / 2; pos-- > 0;) sift_down(pos);
+  }
+
+  /// Appends to `items`, in increasing item order, every item whose time is `t_us`, by one
+  /// pass over all items (O(n), sequential): cheaper than collect_at() and a sort when a
+  /// large share of the items is due.
+  void collect_all_at(TimeUs t_us, std::vector<std::size_t>& items) const {
+    for (std::size_t i = 0; i < times_us_.size(); ++i)
+      if (times_us_[i] == t_us) items.push_back(i);
+  }
+
   /// Appends to `items` every item whose time is `t_us`, in no particular order.
   /// Only the subtrees whose root is due are visited (heap order).
   void collect_at(TimeUs t_us, std::vector<std::size_t>& items) {

@@ -99,21 +99,82 @@ TEST(RunCli, RealTimeRunPrintsBehavioursAndStopsOnSigint) {
   fs::remove_all(dir);
 }
 
+// --threads: the same scenario and seed give the same run folder on any number of threads.
+std::string run_folder_summary_without_times(const fs::path& folder) {
+  auto summary = nlohmann::json::parse(read_file(folder / "summary.json"));
+  for (auto it = summary.begin(); it != summary.end();) {
+    const std::string& key = it.key();
+    if (key.find("wall") != std::string::npos || key.find("cpu") != std::string::npos || key == "threads")
+      it = summary.erase(it);
+    else
+      ++it;
+  }
+  return summary.dump();
+}
+
+void expect_same_folders(const fs::path& a, const fs::path& b) {
+  for (const char* f : {"trajectories.csv", "events.csv"}) {
+    const std::string fa = read_file(a / f), fb = read_file(b / f);
+    EXPECT_FALSE(fa.empty()) << (a / f);
+    EXPECT_TRUE(fa == fb) << f << " differs between " << a << " and " << b;
+  }
+  EXPECT_EQ(run_folder_summary_without_times(a), run_folder_summary_without_times(b));
+}
+
+TEST(RunCli, AnyNumberOfThreadsGivesTheSameRunFolderForTheConvoy) {
+  const fs::path dir = scratch_dir("run_threads_convoy");
+  for (const char* threads : {"1", "2", "3"}) {
+    const CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_sim") + " --duration 30 --seed 7 --threads " +
+                                       threads + " --out '" + (dir / threads).string() + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  expect_same_folders(dir / "1", dir / "2");
+  expect_same_folders(dir / "1", dir / "3");
+  // The convoy bumps into things: the events compared are not empty.
+  EXPECT_NE(read_file(dir / "1" / "events.csv").find("collision"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(RunCli, AnyNumberOfThreadsGivesTheSameRunFolderForTenThousandRobots) {
+  const fs::path dir = scratch_dir("run_threads_10k");
+  // sim-bench's world: 10,000 wandering Kheperas at the lab's density, with wheel slip.
+  const fs::path scenario = dir / "swarm.yaml";
+  std::ofstream(scenario) << "name: swarm\nfield: {width_m: 53.0, height_m: 42.4}\nduration_s: 3\n"
+                             "robots:\n  - ids: 1-10000\n    pose: random\n    controller: wander\n"
+                             "    noise: {slip_sd: 0.02}\n";
+  for (const char* threads : {"1", "2"}) {
+    const CommandResult r = run_rilbed("run '" + scenario.string() + "' --seed 11 --threads " + threads + " --out '" +
+                                       (dir / threads).string() + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  expect_same_folders(dir / "1", dir / "2");
+  fs::remove_all(dir);
+}
+
+TEST(RunCli, ThreadsMustBeAPositiveCount) {
+  const CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_sim") + " --threads 0");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("--threads"), std::string::npos) << r.err;
+}
+
 TEST(SimBenchCli, PrintsItsTable) {
-  const CommandResult r = run_rilbed("sim-bench --robots 50,100 --seconds 2");
+  const CommandResult r = run_rilbed("sim-bench --robots 50,100 --seconds 2 --threads 1,2");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("| robots | field m | simulated s | start-up s | wall s (median of 3) | CPU s (median) | wall ms per "
-                       "simulated s |"),
+  EXPECT_NE(r.out.find("| robots | threads | field m | simulated s | start-up s | wall s (median of 3) | CPU s (median) | "
+                       "wall ms per simulated s |"),
             std::string::npos)
       << r.out;
-  EXPECT_NE(r.out.find("| 100 |"), std::string::npos) << r.out;
-  // Where the time went, one row per count, the parts' shares adding up to the run.
-  EXPECT_NE(r.out.find("| robots | sensing | behaviours | integration | collisions | recording | DEVS kernel and the rest |"),
+  EXPECT_NE(r.out.find("| 100 | 1 |"), std::string::npos) << r.out;
+  // Two threads give the same trajectories as one (the "same" column).
+  EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(\| 100 \| 2 \|[^\n]*\| yes \|)"))) << r.out;
+  EXPECT_EQ(r.out.find("| NO |"), std::string::npos) << r.out;
+  // Where the time went, one row per count and thread count, the parts' shares adding up to the run.
+  EXPECT_NE(r.out.find("| robots | threads | sensing | behaviours | integration | collisions | recording | DEVS kernel and the rest |"),
             std::string::npos)
       << r.out;
   std::smatch m;
   const std::string out = r.out;
-  ASSERT_TRUE(std::regex_search(out, m, std::regex(R"(\| 100 \| [0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \| )"
+  ASSERT_TRUE(std::regex_search(out, m, std::regex(R"(\| 100 \| 1 \| [0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \| )"
                                                   R"([0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \|)")))
       << out;
   int total = 0;

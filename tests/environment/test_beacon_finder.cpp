@@ -24,7 +24,7 @@ RobotConfig with_finder(int id, double x, double y, double heading, BeaconFinder
 }
 
 std::vector<BeaconSighting> sightings(const World& world, int id) {
-  std::mt19937_64 rng(1);
+  NoiseRng rng(1);
   return world.sense(id, 0, rng).beacons;
 }
 }  // namespace
@@ -113,7 +113,7 @@ TEST(BeaconFinder, BearingNoise) {
   BeaconFinderConfig f;
   f.bearing_noise_sd_rad = 0.05;
   world.add_robot(with_finder(1, 1.6, 1.0, kPi, f));
-  std::mt19937_64 rng(8);
+  NoiseRng rng(8);
   double sum = 0, sum_sq = 0;
   const int n = 2000;
   for (int k = 0; k < n; ++k) {

@@ -20,10 +20,9 @@ TEST(Collisions, RobotDrivingIntoAWallStopsFlushAtItsRadius) {
   World world(empty_field(1, 1));
   world.add_robot(quiet_robot(1, 0.5, 0.5, 0.0));
   world.set_wheel_speeds(1, 127, 127);  // 1.016 m/s: reaches the wall in well under a second
-  std::mt19937_64 rng(1);
   int wall_events = 0;
   for (int i = 0; i < 20; ++i) {
-    for (const CollisionEvent& e : world.step(kTick, rng)) {
+    for (const CollisionEvent& e : world.step(kTick)) {
       EXPECT_EQ(e.first, (BodyRef{BodyKind::Robot, 1}));
       EXPECT_EQ(e.second, (BodyRef{BodyKind::Wall, kWallRight}));
       ++wall_events;
@@ -37,10 +36,9 @@ TEST(Collisions, RobotDrivingIntoAWallStopsFlushAtItsRadius) {
 TEST(Collisions, EpisodesEndWhenTheRobotBacksOff) {
   World world(empty_field(1, 1));
   world.add_robot(quiet_robot(1, 0.9, 0.5, 0.0));
-  std::mt19937_64 rng(1);
   auto events_over = [&](int steps) {
     int n = 0;
-    for (int i = 0; i < steps; ++i) n += static_cast<int>(world.step(kTick, rng).size());
+    for (int i = 0; i < steps; ++i) n += static_cast<int>(world.step(kTick).size());
     return n;
   };
   world.set_wheel_speeds(1, 50, 50);
@@ -57,10 +55,9 @@ TEST(Collisions, HeadOnRobotsSeparateToExactlyTouching) {
   world.add_robot(quiet_robot(2, 0.7, 0.5, kPi));
   world.set_wheel_speeds(1, 50, 50);
   world.set_wheel_speeds(2, 50, 50);
-  std::mt19937_64 rng(1);
   std::vector<CollisionEvent> events;
   for (int i = 0; i < 20; ++i)
-    for (const CollisionEvent& e : world.step(kTick, rng)) events.push_back(e);
+    for (const CollisionEvent& e : world.step(kTick)) events.push_back(e);
   const Vec2 a = world.robot(1).pose.position_m, b = world.robot(2).pose.position_m;
   EXPECT_NEAR((b - a).norm(), 2 * kR, 1e-9);
   EXPECT_NEAR(a.x, 0.5 - kR, 1e-9);
@@ -82,10 +79,9 @@ TEST(Collisions, RobotAgainstAPolygonCorner) {
   // diagonal with its rim on the corner.
   world.add_robot(quiet_robot(1, 0.4, 0.4, kPi / 4));
   world.set_wheel_speeds(1, 40, 40);
-  std::mt19937_64 rng(1);
   bool saw_event = false;
   for (int i = 0; i < 15; ++i) {
-    for (const CollisionEvent& e : world.step(kTick, rng)) {
+    for (const CollisionEvent& e : world.step(kTick)) {
       EXPECT_EQ(e.second, (BodyRef{BodyKind::Obstacle, 0}));
       saw_event = true;
     }
@@ -106,9 +102,8 @@ TEST(Collisions, RobotGlancingOffACornerSlidesAlongTheEdge) {
   // flank slides along the bottom edge (y = 0.6) until it passes the far corner.
   world.add_robot(quiet_robot(1, 0.4, 0.59, 0.0));
   world.set_wheel_speeds(1, 30, 30);
-  std::mt19937_64 rng(1);
   for (int i = 0; i < 30; ++i) {
-    world.step(kTick, rng);
+    world.step(kTick);
     EXPECT_LE(world.max_overlap_m(), 1e-9);
     EXPECT_GE(distance_to_polygon(world.robot(1).pose.position_m, map.obstacles[0].vertices_m), kR - 1e-9);
   }
@@ -124,8 +119,7 @@ TEST(Collisions, FastRobotDoesNotTunnelThroughAThinWall) {
   World world(map, config);
   world.add_robot(quiet_robot(1, 0.5, 0.5, 0.0));
   world.set_wheel_speeds(1, 127, 127);
-  std::mt19937_64 rng(1);
-  run(world, 20, kTick, rng);
+  run(world, 20, kTick);
   EXPECT_NEAR(world.robot(1).pose.position_m.x, 1.0 - kR, 1e-12);
 }
 
@@ -136,9 +130,8 @@ TEST(Collisions, RealRobotIsNeverPushed) {
   world.add_robot(real);
   world.add_robot(quiet_robot(1, 0.3, 0.5, 0.0));
   world.set_wheel_speeds(1, 60, 60);
-  std::mt19937_64 rng(1);
   int events = 0;
-  for (int i = 0; i < 10; ++i) events += static_cast<int>(world.step(kTick, rng).size());
+  for (int i = 0; i < 10; ++i) events += static_cast<int>(world.step(kTick).size());
   EXPECT_EQ(world.robot(7).pose.position_m, (Vec2{0.5, 0.5}));
   EXPECT_NEAR(world.robot(1).pose.position_m.x, 0.5 - 2 * kR, 1e-12);
   EXPECT_EQ(events, 1);
@@ -147,7 +140,7 @@ TEST(Collisions, RealRobotIsNeverPushed) {
   // makes way, the real one stays where it was seen.
   world.set_wheel_speeds(1, 0, 0);
   world.set_observed_pose(7, {{0.5 - 2 * kR - 0.01, 0.5}, 0.0}, world.time_us());
-  world.step(kTick, rng);
+  world.step(kTick);
   EXPECT_EQ(world.robot(7).pose.position_m, (Vec2{0.5 - 2 * kR - 0.01, 0.5}));
   EXPECT_NEAR((world.robot(1).pose.position_m - world.robot(7).pose.position_m).norm(), 2 * kR, 1e-9);
   EXPECT_LE(world.max_overlap_m(), 1e-9);
@@ -160,10 +153,9 @@ TEST(Collisions, MovingDiscBouncesOffAWall) {
   disc.position_m = {0.5, 0.5};
   disc.velocity_mps = {1.0, 0.0};
   EXPECT_EQ(world.add_moving_obstacle(disc), 0);
-  std::mt19937_64 rng(1);
   std::vector<CollisionEvent> events;
   for (int i = 0; i < 10; ++i)
-    for (const CollisionEvent& e : world.step(kTick, rng)) events.push_back(e);
+    for (const CollisionEvent& e : world.step(kTick)) events.push_back(e);
   // Touches the right wall at x = 0.9 after 0.4 s, comes back 0.6 m: x = 0.3.
   const MovingObstacle& m = world.moving_obstacles()[0];
   EXPECT_NEAR(m.position_m().x, 0.3, 1e-12);
@@ -184,8 +176,7 @@ TEST(Collisions, MovingPolygonBouncesOffAnObstacleAtAnAngle) {
   box.position_m = {1.0, 0.5};
   box.velocity_mps = {0.5, 0.5};
   world.add_moving_obstacle(box);
-  std::mt19937_64 rng(1);
-  run(world, 15, kTick, rng);  // reaches x = 1.45 after 0.9 s, then 0.6 s back
+  run(world, 15, kTick);  // reaches x = 1.45 after 0.9 s, then 0.6 s back
   const MovingObstacle& m = world.moving_obstacles()[0];
   EXPECT_NEAR(m.velocity_mps().x, -0.5, 1e-12);
   EXPECT_NEAR(m.velocity_mps().y, 0.5, 1e-12);
@@ -201,8 +192,7 @@ TEST(Collisions, MovingObstaclePushesVirtualRobotsAndBouncesOffRealOnes) {
   disc.position_m = {0.5, 0.5};
   disc.velocity_mps = {0.2, 0.0};
   world.add_moving_obstacle(disc);
-  std::mt19937_64 rng(1);
-  run(world, 30, kTick, rng);  // the disc would reach x = 1.1: it shoves the robot along
+  run(world, 30, kTick);  // the disc would reach x = 1.1: it shoves the robot along
   const double disc_x = world.moving_obstacles()[0].position_m().x;
   EXPECT_NEAR(disc_x, 1.1, 1e-9);
   EXPECT_NEAR(world.robot(1).pose.position_m.x, disc_x + 0.05 + kR, 1e-9);
@@ -213,7 +203,7 @@ TEST(Collisions, MovingObstaclePushesVirtualRobotsAndBouncesOffRealOnes) {
   real.kind = RobotKind::Real;
   with_real.add_robot(real);
   with_real.add_moving_obstacle(disc);
-  run(with_real, 30, kTick, rng);
+  run(with_real, 30, kTick);
   EXPECT_EQ(with_real.robot(2).pose.position_m, (Vec2{1.0, 0.5}));
   EXPECT_NEAR(with_real.moving_obstacles()[0].velocity_mps().x, -0.2, 1e-12);
   EXPECT_LE(with_real.moving_obstacles()[0].position_m().x, 1.0 - 0.05 - kR + 1e-9);
@@ -222,7 +212,6 @@ TEST(Collisions, MovingObstaclePushesVirtualRobotsAndBouncesOffRealOnes) {
 namespace {
 void crowd_into_corner(const WorldConfig& config) {
   World world(empty_field(0.6, 0.6), config);
-  std::mt19937_64 rng(3);
   int id = 0;
   for (int row = 0; row < 7; ++row)
     for (int col = 0; col < 7; ++col) {
@@ -231,7 +220,7 @@ void crowd_into_corner(const WorldConfig& config) {
       ++id;
     }
   for (int i = 0; i < 40; ++i) {
-    world.step(kTick, rng);
+    world.step(kTick);
     const auto robots = world.robots();
     for (std::size_t a = 0; a < robots.size(); ++a) {
       const Vec2 p = robots[a].pose.position_m;

@@ -21,8 +21,7 @@ TEST(Kinematics, StraightLineAndOdometryPulses) {
   World world(empty_field(2, 2));
   world.add_robot(quiet_robot(1, 0.5, 1.0, 0.0));
   world.set_wheel_speeds(1, 10, 10);  // 80 mm/s
-  std::mt19937_64 rng(1);
-  run(world, 10, 100'000, rng);       // 1 s
+  run(world, 10, 100'000);       // 1 s
   const RobotState& r = world.robot(1);
   EXPECT_NEAR(r.pose.position_m.x, 0.58, 1e-12);
   EXPECT_NEAR(r.pose.position_m.y, 1.0, 1e-12);
@@ -37,8 +36,7 @@ TEST(Kinematics, SpinInPlace) {
   World world(empty_field(2, 2));
   world.add_robot(quiet_robot(1, 1.0, 1.0, 0.0));
   world.set_wheel_speeds(1, -10, 10);
-  std::mt19937_64 rng(1);
-  run(world, 5, 100'000, rng);  // 0.5 s: wheels 40 mm each, turn 2 * 0.04 / 0.053 rad
+  run(world, 5, 100'000);  // 0.5 s: wheels 40 mm each, turn 2 * 0.04 / 0.053 rad
   const RobotState& r = world.robot(1);
   EXPECT_NEAR(r.pose.position_m.x, 1.0, 1e-12);
   EXPECT_NEAR(r.pose.position_m.y, 1.0, 1e-12);
@@ -56,10 +54,9 @@ TEST(Kinematics, ArcRadiusFromWheelSpeeds) {
   World world(empty_field(2, 2));
   world.add_robot(quiet_robot(1, 1.0, 1.0, 0.0));
   world.set_wheel_speeds(1, 10, 20);
-  std::mt19937_64 rng(1);
   const Vec2 centre{1.0, 1.0 + 0.0795};  // heading +x, turning left
   for (int i = 0; i < 7; ++i) {
-    world.step(100'000, rng);
+    world.step(100'000);
     const RobotState& r = world.robot(1);
     EXPECT_NEAR((r.pose.position_m - centre).norm(), 0.0795, 1e-12);
     EXPECT_NEAR(r.pose.heading_rad, wrap_rad_pi((i + 1) * 0.1 * 0.08 / 0.053), 1e-12);
@@ -92,8 +89,7 @@ TEST(Kinematics, SystematicBiasCurvesAStraightCommand) {
   c.noise.left_bias = 0.1;  // left wheel 10 % fast: the robot veers right
   world.add_robot(c);
   world.set_wheel_speeds(1, 10, 10);
-  std::mt19937_64 rng(1);
-  run(world, 10, 100'000, rng);
+  run(world, 10, 100'000);
   const RobotState& r = world.robot(1);
   // Left 88 mm/s, right 80 mm/s for 1 s: turn -(0.008 / 0.053) rad.
   EXPECT_NEAR(r.pose.heading_rad, -0.008 / 0.053, 1e-12);
@@ -104,14 +100,15 @@ TEST(Kinematics, SystematicBiasCurvesAStraightCommand) {
 
 TEST(Kinematics, SlipNoiseIsSeededAndCanHideFromTheCounters) {
   auto drive = [](std::uint64_t seed, bool counts_slip) {
-    World world(empty_field(3, 3));
+    WorldConfig config;
+    config.noise_seed = seed;
+    World world(empty_field(3, 3), config);
     RobotConfig c = quiet_robot(1, 0.5, 1.5, 0.0);
     c.noise.slip_sd = 0.05;
     c.noise.odometer_counts_slip = counts_slip;
     world.add_robot(c);
     world.set_wheel_speeds(1, 20, 20);
-    std::mt19937_64 rng(seed);
-    run(world, 50, 100'000, rng);
+    run(world, 50, 100'000);
     return world.robot(1);
   };
   const RobotState a = drive(5, true), b = drive(5, true), other = drive(6, true);
@@ -131,8 +128,7 @@ TEST(Kinematics, OdometerCanBeSet) {
   world.add_robot(quiet_robot(1, 0.5, 1.0, 0.0));
   world.set_odometer(1, {100, -7});
   world.set_wheel_speeds(1, 1, 1);
-  std::mt19937_64 rng(1);
-  world.step(10'000, rng);  // one pulse per 10 ms
+  world.step(10'000);  // one pulse per 10 ms
   EXPECT_EQ(world.robot(1).odometer().left_pulses, 101);
   EXPECT_EQ(world.robot(1).odometer().right_pulses, -6);
 }

@@ -19,7 +19,7 @@ double expected_response(double d_m) {
 }
 
 ProximityValues sense_proximity(const World& world, int id, std::uint64_t seed = 1) {
-  std::mt19937_64 rng(seed);
+  NoiseRng rng(seed);
   return *world.sense(id, 0, rng).proximity;
 }
 }  // namespace
@@ -98,7 +98,7 @@ TEST(Proximity, NothingInRangeReadsAboutZero) {
   RobotConfig c = quiet_robot(2, 0.5, 0.5, 0.3);
   c.sensors.proximity->noise_sd = 3.0;
   noisy.add_robot(c);
-  std::mt19937_64 rng(9);
+  NoiseRng rng(9);
   double sum = 0;
   int max = 0;
   for (int k = 0; k < 500; ++k) {
@@ -118,7 +118,7 @@ TEST(Proximity, NoiseHasTheConfiguredSpread) {
   RobotConfig c = quiet_robot(1, 1.0 - 0.010 - kR * std::cos(deg_to_rad(10)), 0.5, 0.0);
   c.sensors.proximity->noise_sd = 3.0;
   world.add_robot(c);
-  std::mt19937_64 rng(4);
+  NoiseRng rng(4);
   double sum = 0, sum_sq = 0;
   const int n = 4000;
   for (int k = 0; k < n; ++k) {

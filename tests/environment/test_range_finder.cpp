@@ -26,7 +26,7 @@ RangeFinderConfig finder(double mount_deg, double opening_deg = 30.0, double max
 }
 
 std::vector<RangeReading> ranges_of(const World& world, int id) {
-  std::mt19937_64 rng(1);
+  NoiseRng rng(1);
   return world.sense(id, 0, rng).ranges;
 }
 }  // namespace
@@ -90,7 +90,7 @@ TEST(RangeFinder, SeesRobotsAndReportsNoisyDistances) {
   noisy.noise_sd_m = 0.01;
   world.add_robot(with_range_finders(quiet_robot(1, 1.0, 1.5, 0.0), {noisy}));
   world.add_robot(quiet_robot(2, 1.5, 1.5, 0.0));
-  std::mt19937_64 rng(3);
+  NoiseRng rng(3);
   double sum = 0, sum_sq = 0;
   const int n = 2000;
   for (int k = 0; k < n; ++k) {

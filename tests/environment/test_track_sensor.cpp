@@ -38,7 +38,7 @@ World track_world(Vec2 a, Vec2 b, double width_m, Pose2 robot, std::vector<Track
 }
 
 std::vector<int> track_readings(const World& world, std::uint64_t seed = 1) {
-  std::mt19937_64 rng(seed);
+  NoiseRng rng(seed);
   return world.sense(1, 0, rng).track;
 }
 }  // namespace
@@ -146,7 +146,7 @@ TEST(TrackSensor, ErrorLevelAddsNoiseWithinRange) {
   c.error_level_percent = 5.0;  // sd 12.75
   const World on = track_world({0.1, 0.5}, {0.9, 0.5}, 0.02, {{0.5, 0.5}, 0.0}, {c});
   const World off = track_world({0.1, 0.5}, {0.9, 0.5}, 0.02, {{0.5, 0.7}, 0.0}, {c});
-  std::mt19937_64 rng(2);
+  NoiseRng rng(2);
   double sum_on = 0, sum_off = 0;
   int distinct_below_max = 0;
   const int n = 2000;

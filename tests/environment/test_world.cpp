@@ -4,6 +4,7 @@
 #include <string>
 
 #include "environment/random.hpp"
+#include "core/worker_pool.hpp"
 #include "environment/world.hpp"
 #include "world_fixtures.hpp"
 
@@ -129,8 +130,7 @@ TEST(WorldValidation, BadRobotsAreRejectedNamingTheRobot) {
   expect_invalid([&] { world.add_robot(quiet_robot(4, 0.33, 0.3, 0.0)); }, "robot 4: placed overlapping robot 3");
   expect_invalid([&] { world.robot(99); }, "no robot with id 99");
   expect_invalid([&] { world.set_observed_pose(3, {{0.5, 0.5}, 0.0}, 0); }, "robot 3: set_observed_pose is for real robots");
-  std::mt19937_64 rng(1);
-  expect_invalid([&] { world.step(-1, rng); }, "dt_us");
+  expect_invalid([&] { world.step(-1); }, "dt_us");
   // A real robot may be seen anywhere, even overlapping a virtual one.
   RobotConfig real = quiet_robot(5, 0.32, 0.3, 0.0);
   real.kind = RobotKind::Real;
@@ -181,8 +181,7 @@ TEST(World, SnapshotCopiesTheMovingState) {
   m.position_m = {0.2, 0.2};
   m.velocity_mps = {0.1, 0.0};
   world.add_moving_obstacle(m);
-  std::mt19937_64 rng(1);
-  world.step(kTick, rng);
+  world.step(kTick);
   const WorldSnapshot s = world.snapshot();
   EXPECT_EQ(s.t_us, kTick);
   ASSERT_EQ(s.robots.size(), 1u);
@@ -197,7 +196,9 @@ TEST(World, SnapshotCopiesTheMovingState) {
 
 TEST(World, SameSeedSameWorldDifferentSeedDifferentWorld) {
   auto run_world = [](std::uint64_t seed) {
-    World world(cluttered_field());
+    WorldConfig config;
+    config.noise_seed = seed;
+    World world(cluttered_field(), config);
     std::mt19937_64 rng(seed);
     populate(world, 60, rng);
     std::vector<SensorReadings> readings;
@@ -206,8 +207,8 @@ TEST(World, SameSeedSameWorldDifferentSeedDifferentWorld) {
       if (step % 10 == 0)
         for (const RobotState& r : world.robots())
           world.set_wheel_speeds(r.id, static_cast<int>(uniform01(rng) * 120) - 40, static_cast<int>(uniform01(rng) * 120) - 40);
-      world.step(kTick, rng);
-      world.sense_all(world.time_us(), rng, readings);
+      world.step(kTick);
+      world.sense_all(world.time_us(), readings);
       int sum = 0;
       for (const SensorReadings& s : readings) for (const int v : *s.proximity) sum += v;
       proximity_sums.push_back(sum);
@@ -235,11 +236,10 @@ TEST(World, SenseAllMatchesSenseOneByOne) {
   std::mt19937_64 rng(5);
   populate(world, 40, rng, 0.06);
   std::vector<SensorReadings> all;
-  std::mt19937_64 rng_all(9), rng_one(9);
-  world.sense_all(123, rng_all, all);
+  world.sense_all(123, all);
   ASSERT_EQ(all.size(), world.robots().size());
   for (std::size_t i = 0; i < all.size(); ++i) {
-    const SensorReadings one = world.sense(world.robots()[i].id, 123, rng_one);
+    const SensorReadings one = world.sense(world.robots()[i].id, 123);
     EXPECT_EQ(one.t_us, 123);
     EXPECT_EQ(*one.proximity, *all[i].proximity);
     EXPECT_EQ(one.odometry->left_pulses, all[i].odometry->left_pulses);
@@ -253,13 +253,13 @@ TEST(World, RealRobotsGetVirtualSensorsButNoVirtualOdometry) {
   world.add_robot(real);
   world.set_observed_pose(1, {{1.0 - kR - 0.01, 0.5}, 0.0}, 5);
   EXPECT_EQ(world.robot(1).pose_t_us, 5);
-  std::mt19937_64 rng(1);
+  NoiseRng rng(1);
   const SensorReadings s = world.sense(1, 5, rng);
   EXPECT_GT((*s.proximity)[2], 400);  // the virtual wall, 10 mm ahead
   EXPECT_FALSE(s.odometry.has_value());
   // Stepping leaves a real robot where it was seen, whatever its wheel commands.
   world.set_wheel_speeds(1, 100, 100);
-  world.step(kTick, rng);
+  world.step(kTick);
   EXPECT_EQ(world.robot(1).pose.position_m, (Vec2{1.0 - kR - 0.01, 0.5}));
 }
 
@@ -285,8 +285,8 @@ TEST(World, LongRandomRunOf200RobotsNeverOverlaps) {
                                base + static_cast<int>(uniform01(rng) * 40) - 20);
       }
     }
-    collisions += static_cast<int>(world.step(kTick, rng).size());
-    world.sense_all(world.time_us(), rng, readings);
+    collisions += static_cast<int>(world.step(kTick).size());
+    world.sense_all(world.time_us(), readings);
     const double overlap = brute_force_overlap(world);
     worst = std::max(worst, overlap);
     ASSERT_LE(overlap, 1e-6) << "at step " << step;
@@ -294,4 +294,72 @@ TEST(World, LongRandomRunOf200RobotsNeverOverlaps) {
   }
   EXPECT_GT(collisions, 200) << "the run should be crowded enough to collide a lot";
   RecordProperty("worst_overlap_m", std::to_string(worst));
+}
+
+// --threads: a crowded world stepped with its robots' motion and contact search spread
+// over worker threads moves exactly as on one thread, contacts and readings included.
+TEST(World, ThreadsChangeNothing) {
+  WorldConfig config;
+  config.noise_seed = 77;
+  World one(cluttered_field(), config), three(cluttered_field(), config);
+  core::WorkerPool pool(3);
+  three.set_workers(&pool);
+  std::mt19937_64 rng_one(31), rng_three(31);
+  populate(one, 200, rng_one);
+  populate(three, 200, rng_three);
+  MovingObstacleConfig disc;
+  disc.radius_m = 0.06;
+  disc.position_m = {0.75, 1.1};
+  disc.velocity_mps = {0.23, -0.17};
+  one.add_moving_obstacle(disc);
+  three.add_moving_obstacle(disc);
+  std::mt19937_64 commands(5);
+  std::vector<SensorReadings> readings_one, readings_three;
+  int events = 0;
+  for (int step = 0; step < 300; ++step) {
+    if (step % 5 == 0) {
+      for (const RobotState& r : one.robots()) {
+        const int base = static_cast<int>(uniform01(commands) * 160) - 30;
+        const int left = base + static_cast<int>(uniform01(commands) * 40) - 20;
+        const int right = base + static_cast<int>(uniform01(commands) * 40) - 20;
+        one.set_wheel_speeds(r.id, left, right);
+        three.set_wheel_speeds(r.id, left, right);
+      }
+    }
+    const auto e1 = one.step(kTick);
+    const std::vector<CollisionEvent> events_one(e1.begin(), e1.end());
+    const auto e3 = three.step(kTick);
+    ASSERT_EQ(events_one.size(), e3.size()) << "at step " << step;
+    for (std::size_t k = 0; k < e3.size(); ++k) {
+      ASSERT_EQ(to_string(events_one[k].first), to_string(e3[k].first));
+      ASSERT_EQ(to_string(events_one[k].second), to_string(e3[k].second));
+      ASSERT_EQ(events_one[k].t_us, e3[k].t_us);
+    }
+    events += static_cast<int>(e3.size());
+    for (std::size_t i = 0; i < one.robots().size(); ++i) {
+      ASSERT_EQ(one.robots()[i].pose.position_m, three.robots()[i].pose.position_m) << "robot " << i << " at step " << step;
+      ASSERT_EQ(one.robots()[i].pose.heading_rad, three.robots()[i].pose.heading_rad);
+    }
+    one.sense_all(one.time_us(), readings_one);
+    three.sense_all(three.time_us(), readings_three);
+    for (std::size_t i = 0; i < readings_one.size(); ++i) ASSERT_EQ(*readings_one[i].proximity, *readings_three[i].proximity);
+  }
+  EXPECT_GT(events, 100) << "crowded enough to collide";
+}
+
+// Each robot's noise comes from its own stream: what it reads does not depend on who
+// read before it, and reading again at the same instant gives the same values.
+TEST(World, ARobotsNoiseDoesNotDependOnWhoSensedFirst) {
+  WorldConfig config;
+  config.noise_seed = 3;
+  World world(cluttered_field(), config);
+  std::mt19937_64 rng(8);
+  populate(world, 30, rng, 0.06);
+  const SensorReadings first = world.sense(7, 500'000);
+  for (const RobotState& r : world.robots()) world.sense(r.id, 500'000);
+  EXPECT_EQ(*world.sense(7, 500'000).proximity, *first.proximity);
+  // Another instant draws other noise.
+  bool differs = false;
+  for (int k = 1; k < 20 && !differs; ++k) differs = *world.sense(7, 500'000 + k).proximity != *first.proximity;
+  EXPECT_TRUE(differs);
 }

@@ -31,8 +31,8 @@ inline RobotConfig quiet_robot(int id, double x, double y, double heading_rad) {
 }
 
 /// Runs `steps` steps of dt_us.
-inline void run(World& world, int steps, TimeUs dt_us, std::mt19937_64& rng) {
-  for (int i = 0; i < steps; ++i) world.step(dt_us, rng);
+inline void run(World& world, int steps, TimeUs dt_us) {
+  for (int i = 0; i < steps; ++i) world.step(dt_us);
 }
 
 /// Distance from p to the nearest edge of a closed polygon.

@@ -61,7 +61,7 @@ class RealBodyTest : public ::testing::Test {
     world_.add_robot(rc);
     // Observations are made at the world's current time; start it off zero so that a
     // sighting is not mistaken for "never seen" (RealBody treats pose_t_us == 0 so).
-    world_.step(10'000, rng_);
+    world_.step(10'000);
     emulator_ = std::make_unique<KheperaEmulator>(emulated_);
   }
 
@@ -82,7 +82,7 @@ class RealBodyTest : public ::testing::Test {
     RealBodyConfig body;
     body.lost_timeout_ms = kLostTimeoutMs;
     body.geofence_margin_m = kMargin_m;
-    body_ = std::make_unique<RealBody>(kRealId, world_, std::move(link), body, rng_);
+    body_ = std::make_unique<RealBody>(kRealId, world_, std::move(link), body);
   }
 
   // The camera sees the robot now.
@@ -104,7 +104,6 @@ class RealBodyTest : public ::testing::Test {
   ::testing::AssertionResult drive_stopped(int left, int right) { return drive_expecting(left, right, {0, 0}); }
 
   EmulatorConfig emulated_;
-  std::mt19937_64 rng_{42};
   environment::World world_ = make_world();
   LogSink log_;
   std::unique_ptr<KheperaEmulator> emulator_;
@@ -155,19 +154,19 @@ TEST_F(RealBodyTest, ARobotLostByTheCameraIsStoppedAndResumesWhenSeenAgain) {
   ASSERT_TRUE(drive_obeyed(30, 30));
 
   // Exactly the timeout since the sighting: still seen.
-  world_.step(static_cast<TimeUs>(kLostTimeoutMs) * 1000, rng_);
+  world_.step(static_cast<TimeUs>(kLostTimeoutMs) * 1000);
   ASSERT_TRUE(body_->pose().has_value());
   ASSERT_TRUE(drive_obeyed(35, 35));
   EXPECT_EQ(body_->health(), "ok");
 
   // Beyond it: lost.
-  world_.step(1'000, rng_);
+  world_.step(1'000);
   EXPECT_FALSE(body_->pose().has_value());
   ASSERT_TRUE(drive_stopped(20, 20));
   EXPECT_EQ(body_->held_by(), "lost");
   EXPECT_EQ(body_->health(), "unseen");
   // Still lost after more time: every drive is a stop.
-  world_.step(200'000, rng_);
+  world_.step(200'000);
   body_->drive({-20, 20});
   EXPECT_EQ(body_->health(), "unseen");
   std::this_thread::sleep_for(50ms);
@@ -259,8 +258,7 @@ TEST_F(RealBodySenseTest, CombinesTheRobotsOwnProximityWithVirtualWallsPerSensor
   ASSERT_TRUE(eventually([&] { return body_->link().latest_counters().has_value(); })) << log_.text();
 
   // The virtual readings the body will combine: same world, same random stream.
-  std::mt19937_64 rng_copy = rng_;
-  const environment::SensorReadings virtual_only = world_.sense(kRealId, world_.time_us(), rng_copy);
+  const environment::SensorReadings virtual_only = world_.sense(kRealId, world_.time_us());
   ASSERT_TRUE(virtual_only.proximity.has_value());
   const environment::ProximityValues& v = *virtual_only.proximity;
   // The wall is seen by the front sensors only (sanity of the setup).
@@ -287,8 +285,7 @@ TEST_F(RealBodySenseTest, TheRobotsZerosLeaveTheVirtualReadings) {
   make_body();
   observe(1.5 - world_.robot(kRealId).radius_m - 0.01, 0.6, 0.0);
   ASSERT_TRUE(eventually([&] { return body_->link().latest_proximity().has_value(); })) << log_.text();
-  std::mt19937_64 rng_copy = rng_;
-  const environment::SensorReadings virtual_only = world_.sense(kRealId, world_.time_us(), rng_copy);
+  const environment::SensorReadings virtual_only = world_.sense(kRealId, world_.time_us());
   ASSERT_TRUE(virtual_only.proximity.has_value());
   const environment::SensorReadings r = body_->sense(world_.time_us());
   ASSERT_TRUE(r.proximity.has_value());
@@ -312,9 +309,9 @@ TEST_F(RealBodyTest, RejectsARobotThatIsNotARealOneOfTheWorld) {
   rc.pose = {{0.3, 0.3}, 0.0};
   world_.add_robot(rc);
   RealBodyConfig body;
-  EXPECT_THROW(RealBody(3, world_, std::make_unique<KheperaLink>(link_config()), body, rng_), std::invalid_argument);
-  EXPECT_THROW(RealBody(99, world_, std::make_unique<KheperaLink>(link_config()), body, rng_), std::invalid_argument);
-  EXPECT_THROW(RealBody(kRealId, world_, nullptr, body, rng_), std::invalid_argument);
+  EXPECT_THROW(RealBody(3, world_, std::make_unique<KheperaLink>(link_config()), body), std::invalid_argument);
+  EXPECT_THROW(RealBody(99, world_, std::make_unique<KheperaLink>(link_config()), body), std::invalid_argument);
+  EXPECT_THROW(RealBody(kRealId, world_, nullptr, body), std::invalid_argument);
 }
 
 class RealBodyReplugTest : public RealBodyTest {
@@ -338,7 +335,7 @@ TEST_F(RealBodyReplugTest, HealthShowsTheLinkLostAndRecovered) {
   ASSERT_TRUE(eventually([&] { return body_->link().state() == LinkState::kLost; })) << log_.text();
   EXPECT_EQ(body_->health(), "link lost");
   // The link's trouble outranks the camera's: still "link lost" when also unseen.
-  world_.step(static_cast<TimeUs>(kLostTimeoutMs + 1) * 1000, rng_);
+  world_.step(static_cast<TimeUs>(kLostTimeoutMs + 1) * 1000);
   body_->drive({10, 10});
   EXPECT_EQ(body_->held_by(), "link");
   EXPECT_EQ(body_->health(), "link lost");

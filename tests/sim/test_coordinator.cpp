@@ -380,3 +380,101 @@ TEST(Coordinator, StoppedClockEndsTheRun) {
   coordinator.run_until(1'000'000 * kMs);  // returns at once
   EXPECT_TRUE(chain.sink->state().received.empty());
 }
+
+namespace {
+
+// A model that may run concurrently: counts its internal transitions every period, and
+// throws at a given count (0: never).
+class Ticker final : public AtomicModel<int> {
+ public:
+  Ticker(std::string id, TimeUs period_us, int throw_at = 0)
+      : AtomicModel<int>(std::move(id), 0), period_us_(period_us), throw_at_(throw_at) {}
+  TimeUs time_advance() const override { return period_us_; }
+  void internal_transition() override {
+    ++state_;
+    if (state_ == throw_at_) throw std::runtime_error("tick " + std::to_string(state_));
+  }
+  void external_transition(TimeUs) override {}
+  void output() override {}
+  bool transitions_concurrent() const override { return true; }
+
+ private:
+  TimeUs period_us_;
+  int throw_at_;
+};
+
+// Not concurrent: at each of its transitions, notes the counts of the tickers before and
+// after it in flat order.
+class Watcher final : public AtomicModel<int> {
+ public:
+  explicit Watcher(TimeUs period_us) : AtomicModel<int>("watcher", 0), period_us_(period_us) {}
+  void watch(std::vector<const Ticker*> before, std::vector<const Ticker*> after) {
+    before_ = std::move(before);
+    after_ = std::move(after);
+  }
+  TimeUs time_advance() const override { return period_us_; }
+  void internal_transition() override {
+    ++state_;
+    for (const Ticker* t : before_) ok_ = ok_ && t->state() == state_;   // already stepped
+    for (const Ticker* t : after_) ok_ = ok_ && t->state() == state_ - 1;  // not yet
+  }
+  void external_transition(TimeUs) override {}
+  void output() override {}
+  bool ok() const { return ok_; }
+
+ private:
+  std::vector<const Ticker*> before_, after_;
+  TimeUs period_us_;
+  bool ok_ = true;
+};
+
+struct TickerWorld {
+  std::shared_ptr<Coupled> top = std::make_shared<Coupled>("top");
+  std::vector<Ticker*> tickers;
+  Watcher* watcher = nullptr;
+  // 40 tickers, the watcher in the middle of flat order; ticker `failing` throws at its 3rd tick.
+  explicit TickerWorld(int failing = -1, int second_failing = -1) {
+    std::vector<const Ticker*> before, after;
+    for (int i = 0; i < 20; ++i) {
+      tickers.push_back(&top->emplace<Ticker>("t" + std::to_string(i), 10 * kMs, i == failing || i == second_failing ? 3 : 0));
+      before.push_back(tickers.back());
+    }
+    watcher = &top->emplace<Watcher>(10 * kMs);
+    for (int i = 20; i < 40; ++i) {
+      tickers.push_back(&top->emplace<Ticker>("t" + std::to_string(i), 10 * kMs, i == failing || i == second_failing ? 3 : 0));
+      after.push_back(tickers.back());
+    }
+    watcher->watch(before, after);
+  }
+};
+
+}  // namespace
+
+TEST(Coordinator, WorkersRunConcurrentModelsAroundTheOthersInFlatOrder) {
+  for (const int threads : {1, 2, 3}) {
+    TickerWorld world;
+    FastClock clock;
+    Coordinator coordinator(world.top, clock);
+    rilbed::core::WorkerPool pool(threads);
+    coordinator.set_workers(&pool);
+    coordinator.run_until(1000 * kMs);
+    for (const Ticker* t : world.tickers) EXPECT_EQ(t->state(), 100) << t->path() << " on " << threads << " threads";
+    EXPECT_EQ(world.watcher->state(), 100);
+    EXPECT_TRUE(world.watcher->ok()) << "the watcher saw the tickers out of flat order on " << threads << " threads";
+  }
+}
+
+TEST(Coordinator, AConcurrentModelsErrorNamesTheFirstFailingModelInFlatOrder) {
+  TickerWorld world(27, 33);
+  FastClock clock;
+  Coordinator coordinator(world.top, clock);
+  rilbed::core::WorkerPool pool(3);
+  coordinator.set_workers(&pool);
+  try {
+    coordinator.run_until(1000 * kMs);
+    FAIL() << "no error";
+  } catch (const ModelError& e) {
+    EXPECT_EQ(e.model_path(), "top/t27");
+    EXPECT_NE(std::string(e.what()).find("tick 3"), std::string::npos) << e.what();
+  }
+}
