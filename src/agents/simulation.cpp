@@ -72,6 +72,36 @@ class WorldModel final : public sim::AtomicModel<TimeUs> {  // state: time to th
   std::vector<environment::CollisionEvent> collisions_;
 };
 
+// The world's sensors swept at every control instant, before the agents read them
+// (World::sense_ahead): one pass over the robots in memory order, spread over the
+// workers, instead of each agent computing its own reading where it happens to be. The
+// readings are the same either way; the sweep keeps neighbours in cache.
+class SensingModel final : public sim::AtomicModel<TimeUs> {  // state: time to the next sweep
+ public:
+  SensingModel(environment::World& world, TimeUs period_us, TimeUs first_us)
+      : sim::AtomicModel<TimeUs>("sensing", first_us), world_(world), period_us_(period_us), t_us_(first_us) {}
+  TimeUs time_advance() const override { return state_; }
+  void internal_transition() override {
+    using Clock = std::chrono::steady_clock;
+    const Clock::time_point start = profiled_ ? Clock::now() : Clock::time_point{};
+    world_.sense_ahead(t_us_);
+    if (profiled_) sensing_s_ += std::chrono::duration<double>(Clock::now() - start).count();
+    t_us_ += period_us_;
+    state_ = period_us_;
+  }
+  void external_transition(TimeUs elapsed_us) override { state_ -= elapsed_us; }
+  void output() override {}
+  void set_profile(bool on) { profiled_ = on; }
+  double sensing_s() const { return sensing_s_; }
+
+ private:
+  environment::World& world_;
+  TimeUs period_us_;
+  TimeUs t_us_;  // the instant of the next sweep
+  bool profiled_ = false;
+  double sensing_s_ = 0.0;
+};
+
 // The overhead camera as a DEVS model: every frame period it takes a frame, tracks the
 // real robots' markers and places them in the world (World::set_observed_pose). Virtual
 // robots are not on camera; they live only in the world model (paper 001).
@@ -233,12 +263,15 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     const sim::RealTimeClock* clock = nullptr;  // a realtime run's clock (for the loop's latency)
     const VisionModel* camera = nullptr;        // the overhead camera, if any (for its frame rate)
     RunProfile* profile = nullptr;              // times its samples when set
+    core::WorkerPool* workers = nullptr;        // reads the agents on these threads when set
   };
   explicit MonitorModel(Setup setup)
       : sim::AtomicModel<TimeUs>("monitor", 1), s_(std::move(setup)),
         formation_(std::max<int>(1, static_cast<int>(s_.convoy_ids.size()))) {
     last_behaviour_.assign(s_.agents.size(), {});
     last_health_.assign(s_.agents.size(), "ok");
+    all_concurrent_ = std::all_of(s_.agents.begin(), s_.agents.end(),
+                                  [](const AgentModel* a) { return a->transitions_concurrent(); });
   }
   TimeUs time_advance() const override { return state_; }
   void external_transition(TimeUs elapsed_us) override { state_ -= elapsed_us; }
@@ -362,13 +395,12 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
       r.max_overlap_m = std::max(r.max_overlap_m, s_.world->max_overlap_m());
       next_overlap_check_us_ = (t / 1'000'000 + 1) * 1'000'000;
     }
-    samples_.clear();
+    read_agents(t);
+    // Changes of health and behaviour, in agent order.
     for (std::size_t i = 0; i < s_.agents.size(); ++i) {
+      if (!reads_[i].changed) continue;
       const AgentModel& a = *s_.agents[i];
-      const auto pose = a.body().pose();
-      const std::string_view behaviour = a.behaviour();
-      if (pose) samples_.push_back({t, a.body().id(), *pose, behaviour});
-      const std::string_view health = a.body().health();
+      const std::string_view behaviour = a.behaviour(), health = a.body().health();
       if (health != last_health_[i]) {
         record({t, "health", a.body().id(), 0, std::string(last_health_[i]) + " -> " + std::string(health)});
         last_health_[i] = health;
@@ -381,12 +413,11 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
         last_behaviour_[i] = behaviour;
       }
     }
-    for (const TrajectorySample& sample : samples_) {
-      for (const std::uint64_t word : {static_cast<std::uint64_t>(sample.t_us), static_cast<std::uint64_t>(sample.id),
-                                       std::bit_cast<std::uint64_t>(sample.pose.position_m.x),
-                                       std::bit_cast<std::uint64_t>(sample.pose.position_m.y),
-                                       std::bit_cast<std::uint64_t>(sample.pose.heading_rad)})
-        r.trajectory_digest = environment::mix64(r.trajectory_digest ^ word) + 0x9e3779b97f4a7c15ULL;
+    samples_.clear();
+    for (const AgentRead& read : reads_) {
+      if (!read.sample) continue;
+      samples_.push_back(*read.sample);
+      r.trajectory_digest += read.digest;  // a sum: the same whatever thread made each term
     }
     if (s_.recorder) s_.recorder->add_samples(samples_);
     if (s_.options->keep_in_memory) r.trajectory.insert(r.trajectory.end(), samples_.begin(), samples_.end());
@@ -403,6 +434,43 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     if (s_.options->stop_when_done &&
         std::all_of(s_.agents.begin(), s_.agents.end(), [](const AgentModel* a) { return a->done(); })) {
       end("done");
+    }
+  }
+
+  // What the monitor reads of each agent at a step, read on the workers when there are.
+  struct AgentRead {
+    std::optional<TrajectorySample> sample;  // none for a real robot with no pose
+    std::uint64_t digest = 0;                // of the sample's time, id, position and heading, bit for bit
+    bool changed = false;                    // its health or behaviour changed
+  };
+  void read_agents(TimeUs t) {
+    reads_.resize(s_.agents.size());
+    auto read = [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const AgentModel& a = *s_.agents[i];
+        AgentRead& out = reads_[i];
+        const auto pose = a.body().pose();
+        const std::string_view behaviour = a.behaviour();
+        out.changed = a.body().health() != last_health_[i] || behaviour != last_behaviour_[i];
+        out.sample.reset();
+        out.digest = 0;
+        if (!pose) continue;
+        out.sample = TrajectorySample{t, a.body().id(), *pose, behaviour};
+        std::uint64_t h = 0x6a09e667f3bcc909ULL;
+        for (const std::uint64_t word : {static_cast<std::uint64_t>(t), static_cast<std::uint64_t>(a.body().id()),
+                                         std::bit_cast<std::uint64_t>(pose->position_m.x),
+                                         std::bit_cast<std::uint64_t>(pose->position_m.y),
+                                         std::bit_cast<std::uint64_t>(pose->heading_rad)})
+          h = environment::mix64(h ^ word) + 0x9e3779b97f4a7c15ULL;
+        out.digest = h;
+      }
+    };
+    // Real bodies read their links' state: only runs whose agents all step concurrently
+    // (virtual bodies, in-process controllers) read on the workers.
+    if (s_.workers && s_.workers->threads() > 1 && all_concurrent_) {
+      s_.workers->for_chunks(s_.agents.size(), read);
+    } else {
+      read(0, s_.agents.size());
     }
   }
 
@@ -460,6 +528,8 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   TimeUs t_us_ = 0;
   TimeUs next_report_us_ = 0;
   TimeUs next_overlap_check_us_ = 0;
+  std::vector<AgentRead> reads_;
+  bool all_concurrent_ = false;
   std::vector<PoseReport> reports_;
   std::vector<WheelReport> wheel_reports_;
   std::vector<SensorReport> sensor_reports_;
@@ -762,6 +832,12 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   environment::WorldConfig world_config;
   world_config.noise_seed = noise_seed;
   environment::World world(scenario.map, world_config);
+  if (options.threads < 1) throw std::invalid_argument("threads must be >= 1");
+  std::optional<core::WorkerPool> workers;
+  if (options.threads > 1) {
+    workers.emplace(options.threads);
+    world.set_workers(&*workers);
+  }
   for (const auto& m : scenario.moving_obstacles) world.add_moving_obstacle(m);
   const std::vector<Pose2> poses = start_poses(scenario, options.seed);
   // The camera is checked (its calibration, device or footage) before any real robot's
@@ -796,6 +872,8 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   // The coupled model, in the order that breaks ties (see the header).
   auto root = std::make_shared<sim::Coupled>("run");
   auto& world_model = root->emplace<WorldModel>(world, scenario.physics_step_us);
+  // After the world (it has moved to the instant) and before the agents (they read).
+  auto& sensing = root->emplace<SensingModel>(world, scenario.control_period_us, 0);
   std::vector<AgentModel*> agents;
   const bool central = scenario.mode == ConvoyMode::kCentral;
   for (std::size_t i = 0; i < scenario.robots.size(); ++i) {
@@ -807,6 +885,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   RunProfile profile;
   if (options.profile) {
     for (AgentModel* a : agents) a->set_profile(true);
+    sensing.set_profile(true);
   }
   // The remote controllers' quantum, right after every agent of the instant has stepped.
   QuantumModel* quantum = nullptr;
@@ -841,6 +920,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   sim::Coordinator* coordinator_ptr = nullptr;
   MonitorModel::Setup setup;
   setup.world = &world;
+  setup.workers = workers ? &*workers : nullptr;
   setup.world_model = &world_model;
   setup.agents = agents;
   setup.convoy_ids = convoy_ids;
@@ -886,13 +966,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
     if (central_model) root->couple(control.orders(), *central_model->find_input("console"));
   }
   sim::Coordinator coordinator(root, clock);
-  if (options.threads < 1) throw std::invalid_argument("threads must be >= 1");
-  std::optional<core::WorkerPool> workers;
-  if (options.threads > 1) {
-    workers.emplace(options.threads);
-    coordinator.set_workers(&*workers);
-    world.set_workers(&*workers);
-  }
+  if (workers) coordinator.set_workers(&*workers);
   coordinator_ptr = &coordinator;
   std::atomic<bool> paused{false};
   std::atomic<bool> central_now{central};
@@ -968,6 +1042,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   result.run_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
   result.run_cpu_s = thread_cpu_seconds() - cpu_start + (workers ? workers->worker_cpu_seconds() : 0.0);
   if (options.profile) {
+    profile.sensing_s += sensing.sensing_s() * options.threads;  // summed over threads, as the agents' are
     for (const AgentModel* a : agents) {
       profile.sensing_s += a->times().sensing_s;
       profile.behaviours_s += a->times().behaviours_s;

@@ -84,9 +84,9 @@ struct RunResult {
   double wall_s = 0.0;                      ///< the whole call, building the world included
   double run_wall_s = 0.0;                  ///< the DEVS run alone (what sim-bench reports)
   double run_cpu_s = 0.0;                   ///< CPU time of the run's threads (the caller's and RunOptions::threads' workers) in the DEVS run
-  /// A 64-bit digest of every trajectory sample (time, id, position, heading, bit for
-  /// bit): equal digests mean, but for a 2^-64 chance, the same trajectories (runs on
-  /// different thread counts are compared by it).
+  /// A 64-bit digest of every trajectory sample (the sum of a hash of each sample's time,
+  /// id, position and heading, bit for bit): equal digests mean, but for a tiny chance,
+  /// the same trajectories (runs on different thread counts are compared by it).
   std::uint64_t trajectory_digest = 0;
   /// With RunOptions::profile: where run_wall_s went (the rest is the DEVS kernel's).
   std::optional<RunProfile> profile;

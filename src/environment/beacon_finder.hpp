@@ -24,6 +24,7 @@ struct BeaconFinderConfig {
   double field_of_view_rad = 2.0 * kPi;
   /// Standard deviation of Gaussian noise added to each bearing, radians. 0: none.
   double bearing_noise_sd_rad = 0.0;
+  bool operator==(const BeaconFinderConfig&) const = default;
 };
 
 /// Validates `config`; throws std::invalid_argument prefixed with `what`.

@@ -87,8 +87,10 @@ void CollisionResolver::find_contacts_ahead(const CollisionScene& s) {
   near_robot_.assign(n, 0);
   near_static_.assign(n, 0);
   dirty_.assign(n, 0);
+  const bool ordered = s.search_order.size() == n;
   auto check = [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::size_t i = ordered ? s.search_order[k] : k;
       near_robot_[i] = s.bodies[i].pushable && near_another_robot(s, i);
       near_static_[i] = near_a_static(s, i);
     }

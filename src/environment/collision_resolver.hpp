@@ -57,6 +57,9 @@ struct CollisionScene {
   const SegmentIndex& statics;     ///< walls and obstacle edges
   std::span<MovingObstacle> movers;  ///< by index
   double max_body_radius_m = 0.0;
+  /// The order in which to search the robots for contacts (slots, each once; by place, so
+  /// that neighbours stay in cache), or empty for slot order. Results do not depend on it.
+  std::span<const std::uint32_t> search_order;
 };
 
 /// Resolves overlaps and records contact episodes. Keeps scratch buffers between calls

@@ -56,9 +56,11 @@ void ProximitySensor::sense(const Scene& scene, int body, Vec2 heading, NoiseRng
   std::array<double, kProximityCount> distances;
   nearest_distances(scene, body, heading, distances);
   const bool noisy = config_.noise_sd > 0.0;
+  std::array<double, kProximityCount> noise;
+  if (noisy) fast_normals(rng, noise);
   for (std::size_t i = 0; i < out.size(); ++i) {
     double v = response(distances[i]);
-    if (noisy) v += fast_normal(rng) * config_.noise_sd;
+    if (noisy) v += noise[i] * config_.noise_sd;
     // Clamp, then round half up (cheaper than std::round, a library call, in this loop).
     v = std::clamp(v, 0.0, static_cast<double>(kProximityMax));
     out[i] = static_cast<int>(v + 0.5);

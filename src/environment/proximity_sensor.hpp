@@ -35,6 +35,7 @@ struct ProximityConfig {
   double noise_sd = 3.0;
   /// Mounting angles, radians counter-clockwise from the robot's forward direction.
   std::array<double, kProximityCount> mount_angles_rad = kProximityAngles_rad;
+  bool operator==(const ProximityConfig&) const = default;
 };
 
 /// A robot's proximity sensor ring, ready to sense (directions precomputed).

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <span>
 #include <utility>
 
 namespace rilbed::environment {
@@ -139,14 +140,9 @@ inline double uniform_open01(Rng& rng) {
 }
 }  // namespace detail
 
-/// One standard normal number by the ziggurat method (Marsaglia and Tsang 2000, in
-/// Doornik's 2005 form, which takes the layer from bits independent of the uniform):
-/// exactly normal, and about 99 % of draws cost one 64-bit draw and a multiply, against a
-/// logarithm and a square root per pair for the polar method. The run's sensor and wheel
-/// noise use it.
+namespace detail {
 template <class Rng>
-inline double fast_normal(Rng& rng) {
-  const detail::ZigguratTables& z = detail::ziggurat_tables();
+inline double fast_normal(Rng& rng, const ZigguratTables& z) {
   for (;;) {
     const std::uint64_t bits = rng();
     const double u = 2.0 * (static_cast<double>(bits >> 11) * 0x1.0p-53) - 1.0;  // top 53 bits
@@ -156,10 +152,10 @@ inline double fast_normal(Rng& rng) {
       // The bottom layer's tail beyond R (Marsaglia 1964).
       double x, y;
       do {
-        x = std::log(detail::uniform_open01(rng)) / detail::ZigguratTables::kTailStart;
-        y = std::log(detail::uniform_open01(rng));
+        x = std::log(uniform_open01(rng)) / ZigguratTables::kTailStart;
+        y = std::log(uniform_open01(rng));
       } while (-2.0 * y < x * x);
-      return u < 0.0 ? x - detail::ZigguratTables::kTailStart : detail::ZigguratTables::kTailStart - x;
+      return u < 0.0 ? x - ZigguratTables::kTailStart : ZigguratTables::kTailStart - x;
     }
     // The wedge between this layer's rectangle and the curve.
     const double x = u * z.x[i];
@@ -167,6 +163,27 @@ inline double fast_normal(Rng& rng) {
     const double f1 = std::exp(-0.5 * (z.x[i + 1] * z.x[i + 1] - x * x));
     if (f1 + uniform01(rng) * (f0 - f1) < 1.0) return x;
   }
+}
+}  // namespace detail
+
+/// One standard normal number by the ziggurat method (Marsaglia and Tsang 2000, in
+/// Doornik's 2005 form, which takes the layer from bits independent of the uniform):
+/// exactly normal, and about 99 % of draws cost one 64-bit draw and a multiply, against a
+/// logarithm and a square root per pair for the polar method. The run's sensor and wheel
+/// noise use it.
+template <class Rng>
+inline double fast_normal(Rng& rng) {
+  return detail::fast_normal(rng, detail::ziggurat_tables());
+}
+
+/// Fills `out` with standard normals: the same numbers as out.size() calls of
+/// fast_normal, drawn with the generator's state and the tables held locally.
+template <class Rng>
+inline void fast_normals(Rng& rng, std::span<double> out) {
+  const detail::ZigguratTables& z = detail::ziggurat_tables();
+  Rng local = rng;
+  for (double& v : out) v = detail::fast_normal(local, z);
+  rng = local;
 }
 
 }  // namespace rilbed::environment

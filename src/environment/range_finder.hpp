@@ -23,6 +23,7 @@ struct RangeFinderConfig {
   /// Standard deviation of additive Gaussian noise on a hit's distance, metres (the
   /// result is clamped to [0, max_range_m]). 0: none, and no draw.
   double noise_sd_m = 0.0;
+  bool operator==(const RangeFinderConfig&) const = default;
 };
 
 /// The range finders of one robot, sensed together (one neighbour query for all).

@@ -23,10 +23,9 @@ SensorSuite::SensorSuite(const SensorSuiteConfig& config, const std::string& wha
   if (beacon_finder_) validate(*beacon_finder_, what);
 }
 
-void SensorSuite::sense(const Scene& scene, int body, Pose2 pose, std::optional<OdometryReading> odometry,
+void SensorSuite::sense(const Scene& scene, int body, Pose2 pose, Vec2 heading, std::optional<OdometryReading> odometry,
                         TimeUs t_us, NoiseRng& rng, SensorReadings& out) const {
   out.t_us = t_us;
-  const Vec2 heading{std::cos(pose.heading_rad), std::sin(pose.heading_rad)};
   if (proximity_) {
     if (!out.proximity) out.proximity.emplace();
     proximity_->sense(scene, body, heading, rng, *out.proximity);

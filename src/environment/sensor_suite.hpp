@@ -2,6 +2,7 @@
 // reads all of them at once into a SensorReadings.
 #pragma once
 
+#include <cmath>
 #include <optional>
 #include "environment/random.hpp"
 #include <string>
@@ -22,6 +23,7 @@ struct SensorSuiteConfig {
   std::optional<BeaconFinderConfig> beacon_finder;               ///< nullopt: none
   std::vector<TrackSensorConfig> track_sensors;                  ///< elements, in reading order
   bool odometer = true;                                          ///< report the wheel counters
+  bool operator==(const SensorSuiteConfig&) const = default;
 };
 
 /// A robot's sensors, validated and precomputed (footprints, directions).
@@ -36,7 +38,12 @@ class SensorSuite {
   /// reported when the suite has an odometer and it is given. Noise draws come from `rng`
   /// in a fixed order: proximity, range finders, beacons, track sensors.
   void sense(const Scene& scene, int body, Pose2 pose, std::optional<OdometryReading> odometry, TimeUs t_us,
-             NoiseRng& rng, SensorReadings& out) const;
+             NoiseRng& rng, SensorReadings& out) const {
+    sense(scene, body, pose, Vec2{std::cos(pose.heading_rad), std::sin(pose.heading_rad)}, odometry, t_us, rng, out);
+  }
+  /// As above, with the heading's unit vector (cos, sin of pose.heading_rad) given.
+  void sense(const Scene& scene, int body, Pose2 pose, Vec2 heading, std::optional<OdometryReading> odometry,
+             TimeUs t_us, NoiseRng& rng, SensorReadings& out) const;
 
   /// The IR ring, if carried.
   const std::optional<ProximitySensor>& proximity() const { return proximity_; }

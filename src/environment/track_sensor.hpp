@@ -53,6 +53,7 @@ struct TrackSensorConfig {
   /// false (default): binary output, max_value or 0, like the real device's high bit.
   /// true: max_value times the covered fraction when triggered.
   bool graded = false;
+  bool operator==(const TrackSensorConfig&) const = default;
 };
 
 /// Where the segments of one element fall on the floor.

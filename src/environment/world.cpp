@@ -12,6 +12,8 @@ namespace rilbed::environment {
 namespace {
 
 constexpr double kDefaultCell_m = 0.1;
+// How many robots ahead the sensor sweep asks for a robot's records (World::sense_ahead).
+constexpr std::size_t kSweepPrefetch = 8;
 
 bool finite(Vec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); }
 
@@ -75,6 +77,12 @@ World::World(StaticMapConfig map, WorldConfig config)
       t_us_(config_.start_t_us) {}
 
 std::size_t World::slot(int id) const {
+  // Small ids (the usual 1..N) through the dense table: every agent looks its robot up
+  // several times a step, and a hash lookup was a cache miss each at 10,000 robots.
+  if (id >= 0 && static_cast<std::size_t>(id) < dense_slot_.size()) {
+    const std::int32_t s = dense_slot_[static_cast<std::size_t>(id)];
+    if (s >= 0) return static_cast<std::size_t>(s);
+  }
   const auto it = slot_of_.find(id);
   if (it == slot_of_.end()) throw std::invalid_argument("no robot with id " + std::to_string(id));
   return it->second;
@@ -148,16 +156,21 @@ void World::add_robot(const RobotConfig& c) {
   const std::size_t s = robots_.size();
   if (s == robots_.capacity()) {
     const std::size_t want = std::max<std::size_t>(16, 2 * s);
-    robots_.reserve(want), bodies_.reserve(want), ids_.reserve(want), suites_.reserve(want), motion_.reserve(want);
+    robots_.reserve(want), bodies_.reserve(want), ids_.reserve(want), suite_of_.reserve(want), motion_.reserve(want);
+    headings_.reserve(want);
     slot_of_.reserve(want);
   }
   robots_.push_back(std::move(state));
   bodies_.push_back({c.pose.position_m, c.pose.position_m, c.radius_m, c.kind == RobotKind::Virtual});
   ids_.push_back(c.id);
-  suites_.push_back(std::move(suite));
+  suite_of_.push_back(pooled_suite(c.sensors, std::move(suite)));
   motion_.emplace_back();
   slot_of_.emplace(c.id, s);
+  const double heading_rad = robots_.back().pose.heading_rad;
+  headings_.push_back({std::cos(heading_rad), std::sin(heading_rad)});
+  set_dense_slot(c.id, static_cast<std::int32_t>(s));
   grid_.push_back(c.pose.position_m);
+  changed();
   // The new radius only (a full refresh made adding n robots cost O(n^2): 7 s for 100,000).
   max_radius_m_ = s == 0 ? c.radius_m : std::max(max_radius_m_, c.radius_m);
   min_radius_m_ = s == 0 ? c.radius_m : std::min(min_radius_m_, c.radius_m);
@@ -170,14 +183,41 @@ void World::remove_robot(int id) {
     robots_[s] = std::move(robots_[last]);
     bodies_[s] = bodies_[last];
     ids_[s] = ids_[last];
-    suites_[s] = std::move(suites_[last]);
+    suite_of_[s] = suite_of_[last];
     motion_[s] = motion_[last];
+    headings_[s] = headings_[last];
     slot_of_[ids_[s]] = s;
+    set_dense_slot(ids_[s], static_cast<std::int32_t>(s));
   }
-  robots_.pop_back(), bodies_.pop_back(), ids_.pop_back(), suites_.pop_back(), motion_.pop_back();
+  robots_.pop_back(), bodies_.pop_back(), ids_.pop_back(), suite_of_.pop_back(), motion_.pop_back(), headings_.pop_back();
   slot_of_.erase(id);
+  set_dense_slot(id, -1);
+  changed();
   grid_.rebuild(bodies_.size(), [&](std::size_t i) { return bodies_[i].position_m; });
   refresh_max_radius();
+}
+
+std::uint32_t World::pooled_suite(const SensorSuiteConfig& config, SensorSuite&& suite) {
+  // Robots of a scenario mostly carry the same sensors: one suite serves them all (a
+  // suite is 360 bytes of configuration that every reading goes through).
+  const std::size_t look_back = std::min<std::size_t>(suite_configs_.size(), 16);
+  for (std::size_t k = suite_configs_.size(); k-- > suite_configs_.size() - look_back;)
+    if (suite_configs_[k] == config) return static_cast<std::uint32_t>(k);
+  suite_configs_.push_back(config);
+  suite_pool_.push_back(std::move(suite));
+  return static_cast<std::uint32_t>(suite_pool_.size() - 1);
+}
+
+void World::set_dense_slot(int id, std::int32_t s) {
+  if (id < 0) return;
+  const auto i = static_cast<std::size_t>(id);
+  if (i >= dense_slot_.size()) {
+    // Only ids within a few times the robot count get a dense entry (memory stays
+    // proportional to the robots); others go through the hash map alone.
+    if (s < 0 || i >= 4 * robots_.size() + 4096) return;
+    dense_slot_.resize(std::max(i + 1, 2 * dense_slot_.size()), -1);
+  }
+  dense_slot_[i] = s;
 }
 
 void World::refresh_max_radius() {
@@ -204,6 +244,8 @@ void World::set_observed_pose(int id, Pose2 pose, TimeUs t_us) {
   r.pose = {pose.position_m, wrap_rad_pi(pose.heading_rad)};
   r.pose_t_us = t_us;
   r.observed = true;
+  headings_[s] = {std::cos(r.pose.heading_rad), std::sin(r.pose.heading_rad)};
+  changed();
   bodies_[s].position_m = bodies_[s].previous_m = pose.position_m;
   grid_.move(s, pose.position_m);
 }
@@ -212,6 +254,7 @@ void World::set_odometer(int id, OdometryReading counters) {
   RobotState& r = robots_[slot(id)];
   r.left_wheel_travel_m = static_cast<double>(counters.left_pulses) * kKheperaPulse_m;
   r.right_wheel_travel_m = static_cast<double>(counters.right_pulses) * kKheperaPulse_m;
+  changed();
 }
 
 int World::add_moving_obstacle(const MovingObstacleConfig& config) {
@@ -243,6 +286,7 @@ int World::add_moving_obstacle(const MovingObstacleConfig& config) {
     if (c.separation_m < -tol) throw std::invalid_argument(what + ": placed overlapping " + label(ids_[j]));
   }
   movers_.push_back(std::move(mover));
+  changed();
   return static_cast<int>(movers_.size() - 1);
 }
 
@@ -254,6 +298,8 @@ double World::substep_limit_m() const {
 std::span<const CollisionEvent> World::step(TimeUs dt_us) {
   if (dt_us < 0) throw std::invalid_argument("world: step dt_us must be >= 0");
   if (dt_us == 0) return {};
+  changed();
+  if (config_.reorder_every_steps > 0 && ++steps_ % config_.reorder_every_steps == 0) sweep_order_.clear();
   using Clock = std::chrono::steady_clock;
   const Clock::time_point started = Clock::now();
   double collisions_s = 0.0;
@@ -283,12 +329,12 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us) {
       m.local_step_m = arc.local_displacement_m;
       m.cos_turn = arc.cos_heading_change;
       m.sin_turn = arc.sin_heading_change;
-      m.heading = {std::cos(r.pose.heading_rad), std::sin(r.pose.heading_rad)};
+      m.heading = headings_[i];  // cos and sin of r.pose.heading_rad
       m.end_heading_rad = r.pose.heading_rad + arc.heading_change_rad * substeps;
     }
   });
 
-  CollisionScene cs{bodies_, ids_, grid_, statics_, movers_, max_radius_m_};
+  CollisionScene cs{bodies_, ids_, grid_, statics_, movers_, max_radius_m_, sweep_order()};
   resolver_.begin_step();
   for (int k = 0; k < substeps; ++k) {
     for (MovingObstacle& m : movers_) {
@@ -316,6 +362,7 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us) {
       if (r.kind != RobotKind::Virtual) continue;
       r.pose = {bodies_[i].position_m, wrap_rad_pi(motion_[i].end_heading_rad)};
       r.pose_t_us = t_us_;
+      headings_[i] = {std::cos(r.pose.heading_rad), std::sin(r.pose.heading_rad)};
     }
   });
   step_times_.collisions_s += collisions_s;
@@ -363,12 +410,58 @@ SensorReadings World::sense(int id, TimeUs t_us, NoiseRng& rng) const {
   std::optional<OdometryReading> odometry;
   if (r.kind == RobotKind::Virtual) odometry = r.odometer();
   SensorReadings out;
-  suites_[s].sense(scene(), static_cast<int>(s), r.pose, odometry, t_us, rng, out);
+  suite_pool_[suite_of_[s]].sense(scene(), static_cast<int>(s), r.pose, headings_[s], odometry, t_us, rng, out);
   return out;
 }
 
 void World::sense_into(int id, TimeUs t_us, SensorReadings& out) const {
-  sense_slot(scene(), slot(id), t_us, out);
+  const std::size_t s = slot(id);
+  if (ahead_valid_ && ahead_t_us_ == t_us) {
+    out = ahead_[s];
+    return;
+  }
+  sense_slot(scene(), s, t_us, out);
+}
+
+void World::sense_ahead(TimeUs t_us) {
+  if (ahead_valid_ && ahead_t_us_ == t_us) return;
+  ahead_.resize(robots_.size());
+  const Scene sc = scene();
+  const std::span<const std::uint32_t> order = sweep_order();
+  for_robot_slots([&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      // The sweep goes by place, so each robot's own records are far from the last one's
+      // in memory: ask for them a few robots ahead (a hint; GCC and Clang on any CPU).
+      if (k + kSweepPrefetch < end) {
+        const std::uint32_t ahead = order[k + kSweepPrefetch];
+        __builtin_prefetch(&robots_[ahead]);
+        __builtin_prefetch(&headings_[ahead]);
+        __builtin_prefetch(&bodies_[ahead]);
+        __builtin_prefetch(&ahead_[ahead], 1);
+      }
+      sense_slot(sc, order[k], t_us, ahead_[order[k]]);
+    }
+  });
+  ahead_t_us_ = t_us;
+  ahead_valid_ = true;
+}
+
+void World::refresh_sweep_order() {
+  const std::size_t n = robots_.size();
+  // Tiles of 8 x 8 cells, row by row; cells row by row within a tile.
+  constexpr int kTile = 8;
+  const GridGeometry& g = grid_geometry_;
+  const std::uint64_t tiles_x = static_cast<std::uint64_t>(g.nx / kTile + 1);
+  sweep_keys_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const int col = g.column(bodies_[i].position_m.x), row = g.row(bodies_[i].position_m.y);
+    const std::uint64_t tile = static_cast<std::uint64_t>(row / kTile) * tiles_x + static_cast<std::uint64_t>(col / kTile);
+    sweep_keys_[i] = {(tile * kTile + static_cast<std::uint64_t>(row % kTile)) * kTile + static_cast<std::uint64_t>(col % kTile),
+                      static_cast<std::uint32_t>(i)};
+  }
+  std::sort(sweep_keys_.begin(), sweep_keys_.end());
+  sweep_order_.resize(n);
+  for (std::size_t k = 0; k < n; ++k) sweep_order_[k] = sweep_keys_[k].second;
 }
 
 void World::sense_slot(const Scene& scene, std::size_t s, TimeUs t_us, SensorReadings& out) const {
@@ -376,7 +469,7 @@ void World::sense_slot(const Scene& scene, std::size_t s, TimeUs t_us, SensorRea
   std::optional<OdometryReading> odometry;
   if (r.kind == RobotKind::Virtual) odometry = r.odometer();
   NoiseRng rng = NoiseRng::keyed(config_.noise_seed, r.id, t_us, NoisePurpose::kSensing);
-  suites_[s].sense(scene, static_cast<int>(s), r.pose, odometry, t_us, rng, out);
+  suite_pool_[suite_of_[s]].sense(scene, static_cast<int>(s), r.pose, headings_[s], odometry, t_us, rng, out);
 }
 
 void World::sense_all(TimeUs t_us, std::vector<SensorReadings>& out) const {

@@ -48,6 +48,11 @@ struct WorldConfig {
   /// instant is drawn from its own stream keyed by (seed, robot id, time), so results do
   /// not depend on the order in which robots sense or on threads.
   std::uint64_t noise_seed = 0;
+  /// Every this many steps the world sorts its robots by where they are (tiles of the
+  /// grid) into the order its sweeps visit them (sense_ahead, the collision search), so
+  /// that a robot's neighbours were just visited and are still in cache; 0 sorts only
+  /// when robots are added or removed. Costs a sort of the robots each time.
+  int reorder_every_steps = 20;
 };
 
 /// Wall time the world's steps took, summed since it was built, seconds.
@@ -141,6 +146,12 @@ class World {
   /// Reads every robot's sensors into out[i] for robots()[i] (out is resized; its
   /// elements' buffers are reused).
   void sense_all(TimeUs t_us, std::vector<SensorReadings>& out) const;
+  /// Reads every robot's sensors at t_us into the world's own store, robot after robot
+  /// in memory order (on the workers when set), so that sense(id, t_us) and
+  /// sense_into(id, t_us) return the stored reading until the world next changes. The
+  /// same readings as computed one by one (each robot's noise has its own stream): a
+  /// sweep only keeps neighbours in cache and spreads the work.
+  void sense_ahead(TimeUs t_us);
 
   /// A copy of the moving state, with the last step's events.
   WorldSnapshot snapshot() const;
@@ -169,6 +180,8 @@ class World {
   std::string label(int id) const { return "robot " + std::to_string(id); }
   void check_placement_free(const std::string& what, Vec2 position_m, double radius_m, int exclude_slot) const;
   void refresh_max_radius();
+  void set_dense_slot(int id, std::int32_t s);
+  std::uint32_t pooled_suite(const SensorSuiteConfig& config, SensorSuite&& suite);
   double substep_limit_m() const;
   // Calls body(begin, end) over robot slots [0, robots), on the workers when set.
   template <class Body>
@@ -179,6 +192,14 @@ class World {
       body(0, robots_.size());
   }
   double start_wheels(std::size_t begin, std::size_t end, double dt_s);
+  // What can change a reading happened: sense_ahead's store is stale.
+  void changed() { ahead_valid_ = false; }
+  void refresh_sweep_order();
+  // Slots in the order sweeps visit them (by place), refreshed when stale.
+  std::span<const std::uint32_t> sweep_order() {
+    if (sweep_order_.size() != robots_.size()) refresh_sweep_order();
+    return sweep_order_;
+  }
 
   WorldConfig config_;
   StaticMap map_;
@@ -190,15 +211,25 @@ class World {
   std::vector<RobotState> robots_;
   std::vector<Body> bodies_;
   std::vector<int> ids_;
-  std::vector<SensorSuite> suites_;
+  std::vector<std::uint32_t> suite_of_;          // per slot: its suite in suite_pool_
+  std::vector<SensorSuite> suite_pool_;          // the distinct suites
+  std::vector<SensorSuiteConfig> suite_configs_; // their configurations
   std::vector<Motion> motion_;
+  std::vector<Vec2> headings_;  // unit vector of each robot's heading (cos, sin), kept with the pose
   std::unordered_map<int, std::size_t> slot_of_;
+  std::vector<std::int32_t> dense_slot_;  // slot by id for small ids, -1 for none
   double max_radius_m_ = 0.0;
   double min_radius_m_ = 0.0;
   std::vector<MovingObstacle> movers_;
   CollisionResolver resolver_;
   WorldStepTimes step_times_;
   core::WorkerPool* workers_ = nullptr;
+  std::vector<SensorReadings> ahead_;  // sense_ahead's readings, by slot
+  TimeUs ahead_t_us_ = 0;
+  bool ahead_valid_ = false;
+  long steps_ = 0;
+  std::vector<std::uint32_t> sweep_order_;  // empty or stale: rebuilt by sweep_order()
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> sweep_keys_;  // scratch
   TimeUs t_us_ = 0;
 };
 

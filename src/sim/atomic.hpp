@@ -44,7 +44,8 @@ class Atomic : public Component {
   /// Whether this model's transitions may run at the same time as those of other models
   /// that say so, in the same step: they touch only the model's own state and data that
   /// no other such model writes, and their result does not depend on which of them runs
-  /// first. Default false (always run on the coordinator's thread, in flat order).
+  /// first. Default false (always run on the coordinator's thread, in flat order). Asked
+  /// once, when the coordinator is built: the answer must not change.
   virtual bool transitions_concurrent() const { return false; }
 };
 

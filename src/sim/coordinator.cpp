@@ -81,6 +81,7 @@ Coordinator::Coordinator(std::shared_ptr<Component> root, Clock& clock)
   slots_.reserve(atomics_.size());
   for (Atomic* atomic : atomics_) {
     Slot slot{atomic, {}};
+    slot.concurrent = atomic->transitions_concurrent();
     for (const auto& port : atomic->outputs()) slot.outputs.push_back(resolve(*port));
     slots_.push_back(std::move(slot));
   }
@@ -223,28 +224,48 @@ void Coordinator::transition(std::size_t index, TimeUs t_us) {
     guarded(model, "external_transition", t_us, [&] { model.external_transition(elapsed_us); });
 }
 
-void Coordinator::transitions(TimeUs t_us) {
+void Coordinator::settle(std::size_t k, TimeUs t_us, TimeUs next_us, bool bulk) {
+  const std::size_t index = active_[k];
+  Slot& slot = slots_[index];
+  Atomic& model = *slot.model;
+  if (slot.influenced)
+    for (const auto& input : model.inputs()) input->clear();
+  slot.imminent = slot.influenced = false;
+  slot.last_t_us = t_us;
+  if (bulk)
+    schedule_.set_time_unordered(index, next_us);  // distinct items: safe from several threads
+  else
+    schedule_.update(index, next_us);
+  transitioned_[k] = &model;
+}
+
+void Coordinator::transitions(TimeUs t_us, bool bulk) {
   const std::size_t n = active_.size();
+  transitioned_.resize(n);
   next_times_.resize(n);
   for (std::size_t k = 0; k < n;) {
     std::size_t end = k;
     if (workers_ && workers_->threads() > 1)
-      while (end < n && slots_[active_[end]].model->transitions_concurrent()) ++end;
+      while (end < n && slots_[active_[end]].concurrent) ++end;
     if (end - k < 2) {
       transition(active_[k], t_us);  // flat order, this thread
-      next_times_[k] = next_time(active_[k], t_us);
+      settle(k, t_us, next_time(active_[k], t_us), bulk);
       ++k;
       continue;
     }
-    // A run of concurrent models: split over the workers. The pool rethrows the lowest
-    // chunk's error, which is the first in flat order among the chunks that failed.
+    // A run of concurrent models: split over the workers, each model's bookkeeping with
+    // it when the schedule is re-keyed in bulk. The pool rethrows the lowest chunk's
+    // error, which is the first in flat order among the chunks that failed.
     const std::size_t first = k;
     workers_->for_chunks(end - first, [&](std::size_t b, std::size_t e) {
       for (std::size_t j = first + b; j < first + e; ++j) {
         transition(active_[j], t_us);
         next_times_[j] = next_time(active_[j], t_us);
+        if (bulk) settle(j, t_us, next_times_[j], true);
       }
     });
+    if (!bulk)
+      for (std::size_t j = first; j < end; ++j) settle(j, t_us, next_times_[j], false);
     k = end;
   }
 }
@@ -269,7 +290,9 @@ void Coordinator::do_step(TimeUs t_us) {
   for (std::size_t i = 0; i < imminent_count; ++i) {
     Slot& slot = slots_[active_[i]];
     slot.imminent = true;
-    guarded(*slot.model, "output", t_us, [&] { slot.model->output(); });
+    // A model without output ports has nothing to output (output() must not change its
+    // state): not calling it spares a swarm's agents a visit each.
+    if (!slot.outputs.empty()) guarded(*slot.model, "output", t_us, [&] { slot.model->output(); });
   }
   for (std::size_t i = 0; i < imminent_count; ++i)
     for (const Route& output : slots_[active_[i]].outputs) route(output);
@@ -284,22 +307,7 @@ void Coordinator::do_step(TimeUs t_us) {
   // Influenced atomics were appended after the imminent ones: restore flat order (the
   // imminent ones are sorted already, so with no message in flight there is nothing to do).
   if (active_.size() > imminent_count) std::sort(active_.begin(), active_.end());
-  transitions(t_us);
-  transitioned_.clear();
-  for (std::size_t k = 0; k < active_.size(); ++k) {
-    const std::size_t index = active_[k];
-    Slot& slot = slots_[index];
-    Atomic& model = *slot.model;
-    if (slot.influenced)
-      for (const auto& input : model.inputs()) input->clear();
-    slot.imminent = slot.influenced = false;
-    slot.last_t_us = t_us;
-    if (bulk)
-      schedule_.set_time_unordered(index, next_times_[k]);
-    else
-      schedule_.update(index, next_times_[k]);
-    transitioned_.push_back(&model);
-  }
+  transitions(t_us, bulk);
   if (bulk) schedule_.reheap();
   now_us_.store(t_us, std::memory_order_relaxed);
 

@@ -45,7 +45,7 @@ struct StepReport {
 /// not change afterwards.
 ///
 /// One step at time t (the earliest next-event time, or the clock's time when an
-/// external event arrives first): output() of the imminent atomics in flat order;
+/// external event arrives first): output() of the imminent atomics that have output ports, in flat order;
 /// messages routed (a bag keeps the order: sender in flat order, port, message);
 /// injected messages delivered; root-output listeners called; then each influenced or
 /// imminent atomic in flat order gets its confluent, internal or external transition;
@@ -148,6 +148,7 @@ class Coordinator {
     TimeUs last_t_us = 0;
     bool imminent = false;
     bool influenced = false;
+    bool concurrent = false;  // model->transitions_concurrent(), asked once
   };
   struct OutputListener {
     PortBase* port;
@@ -160,7 +161,8 @@ class Coordinator {
   Progress advance(TimeUs t_limit_us);
   void do_step(TimeUs t_us);
   void transition(std::size_t index, TimeUs t_us);
-  void transitions(TimeUs t_us);
+  void transitions(TimeUs t_us, bool bulk);
+  void settle(std::size_t k, TimeUs t_us, TimeUs next_us, bool bulk);
   void route(const Route& route);
   void deliver_injections();
   TimeUs next_time(std::size_t index, TimeUs t_us) const;

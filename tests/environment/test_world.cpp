@@ -363,3 +363,43 @@ TEST(World, ARobotsNoiseDoesNotDependOnWhoSensedFirst) {
   for (int k = 1; k < 20 && !differs; ++k) differs = *world.sense(7, 500'000 + k).proximity != *first.proximity;
   EXPECT_TRUE(differs);
 }
+
+// The sensor sweep (sense_ahead) stores the readings that sense() would compute, and a
+// change to the world makes sense() compute afresh.
+TEST(World, TheSensorSweepGivesTheReadingsOfOneByOne) {
+  for (const int threads : {1, 3}) {
+    WorldConfig config;
+    config.noise_seed = 12;
+    config.reorder_every_steps = 3;
+    World world(cluttered_field(), config);
+    core::WorkerPool pool(threads);
+    world.set_workers(&pool);
+    std::mt19937_64 rng(4);
+    populate(world, 150, rng, 0.06);
+    for (const RobotState& r : world.robots()) world.set_wheel_speeds(r.id, 60, 50);
+    std::vector<SensorReadings> fresh;
+    for (int step = 0; step < 8; ++step) {
+      world.step(kTick);
+      const TimeUs t = world.time_us();
+      world.sense_all(t, fresh);  // computed robot by robot, never from the store
+      world.sense_ahead(t);
+      for (std::size_t i = 0; i < fresh.size(); ++i) {
+        const SensorReadings stored = world.sense(world.robots()[i].id, t);
+        ASSERT_EQ(*stored.proximity, *fresh[i].proximity) << "robot " << world.robots()[i].id << " at step " << step;
+        ASSERT_EQ(stored.odometry->left_pulses, fresh[i].odometry->left_pulses);
+        ASSERT_EQ(stored.t_us, t);
+      }
+      // Another instant is computed, not taken from the store.
+      EXPECT_EQ(world.sense(world.robots()[0].id, t + 1).t_us, t + 1);
+    }
+    // A robot moved by hand (a real robot's observed pose) is read where it now is.
+    RobotConfig real = quiet_robot(9999, 0.3, 0.3, 0.0);
+    real.kind = RobotKind::Real;
+    world.add_robot(real);
+    world.sense_ahead(world.time_us());
+    world.set_observed_pose(9999, {{1.2, 0.2}, 1.0}, world.time_us());
+    world.sense_all(world.time_us(), fresh);
+    const SensorReadings after = world.sense(9999, world.time_us());
+    EXPECT_EQ(*after.proximity, *fresh.back().proximity);
+  }
+}
