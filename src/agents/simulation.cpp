@@ -413,10 +413,12 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
         last_behaviour_[i] = behaviour;
       }
     }
+    // The samples in one list only for those who read them (a swarm's benchmark has none).
+    const bool listed = s_.recorder || s_.options->keep_in_memory || !s_.convoy_ids.empty();
     samples_.clear();
     for (const AgentRead& read : reads_) {
       if (!read.sample) continue;
-      samples_.push_back(*read.sample);
+      if (listed) samples_.push_back(*read.sample);
       r.trajectory_digest += read.digest;  // a sum: the same whatever thread made each term
     }
     if (s_.recorder) s_.recorder->add_samples(samples_);

@@ -106,9 +106,9 @@ int bench_command(const BenchArgs& args) {
               args.repeat);
   std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |\n");
   struct Split {
-    int robots;
-    int threads;
-    double run_s, simulated_s;
+    int robots = 0;
+    int threads = 1;
+    double run_s = 0.0, simulated_s = 0.0;
     agents::RunProfile profile;
   };
   std::vector<Split> splits;
@@ -142,80 +142,86 @@ int bench_command(const BenchArgs& args) {
   };
   for (int n : counts.ids) {
     const agents::Scenario s = bench_scenario(n, args);
-    double first_threads_wall_s = 0.0;
     std::optional<std::uint64_t> first_digest;
-    for (std::size_t ti = 0; ti < thread_counts.ids.size(); ++ti) {
-    const int threads = thread_counts.ids[ti];
-    Timing plain;
-    std::vector<Timing> bused(buses.size());
-    bool same = true;
-    // The timed runs carry no timers (they cost 3-8 %); one more run, after them, is
-    // timed in parts for the split table.
-    const int runs = args.repeat + (args.no_split ? 0 : 1);
-    for (int rep = 0; rep < runs; ++rep) {
+    const std::size_t thread_rows = thread_counts.ids.size();
+    // Per thread count: the plain runs and each bus's.
+    std::vector<Timing> plain(thread_rows);
+    std::vector<std::vector<Timing>> bused(thread_rows, std::vector<Timing>(buses.size()));
+    std::vector<Split> row_splits(thread_rows);
+    std::vector<char> same(thread_rows, 1);
+    // The timed runs carry no timers (they cost 3-8 %); one more round, after them, is
+    // timed in parts for the split table. Each round runs every thread count (and bus) in
+    // turn, so that other load on the machine falls on all of them alike.
+    const int rounds = args.repeat + (args.no_split ? 0 : 1);
+    for (int rep = 0; rep < rounds; ++rep) {
       const bool split_run = rep == args.repeat;
-      for (std::size_t k = 0; k <= buses.size(); ++k) {
-        if (split_run && k > 0) break;
-        Timing scratch;
-        Timing& t = split_run ? scratch : k == 0 ? plain : bused[k - 1];
-        agents::RunOptions o;
-        o.seed = args.seed;
-        o.duration_s = args.seconds;
-        o.threads = threads;
-        if (k > 0) o.observer = buses[k - 1].publisher.get();
-        o.profile = split_run;
-        try {
-          t.r = agents::run_scenario(s, o);
-        } catch (const std::exception& e) {
-          spdlog::error("{} robots: {}", n, e.what());
-          return kExitFailure;
-        }
-        if (!first_digest) first_digest = t.r.trajectory_digest;
-        same = same && t.r.trajectory_digest == *first_digest;
-        t.walls.push_back(t.r.run_wall_s);
-        t.cpus.push_back(t.r.run_cpu_s);
-        t.startups.push_back(t.r.wall_s - t.r.run_wall_s);
-        if (t.r.profile) {
-          // One row per count and thread count.
-          if (splits.empty() || splits.back().robots != n || splits.back().threads != threads)
-            splits.push_back({n, threads, 0.0, 0.0, {}});
-          Split& split = splits.back();
-          split.run_s += t.r.run_wall_s;
-          split.simulated_s += t.r.simulated_s;
-          const agents::RunProfile& p = *t.r.profile;
-          split.profile.sensing_s += p.sensing_s;
-          split.profile.behaviours_s += p.behaviours_s;
-          split.profile.integration_s += p.integration_s;
-          split.profile.collisions_s += p.collisions_s;
-          split.profile.monitor_s += p.monitor_s;
+      for (std::size_t ti = 0; ti < thread_rows; ++ti) {
+        for (std::size_t k = 0; k <= buses.size(); ++k) {
+          if (split_run && k > 0) break;
+          Timing scratch;
+          Timing& t = split_run ? scratch : k == 0 ? plain[ti] : bused[ti][k - 1];
+          agents::RunOptions o;
+          o.seed = args.seed;
+          o.duration_s = args.seconds;
+          o.threads = thread_counts.ids[ti];
+          if (k > 0) o.observer = buses[k - 1].publisher.get();
+          o.profile = split_run;
+          try {
+            t.r = agents::run_scenario(s, o);
+          } catch (const std::exception& e) {
+            spdlog::error("{} robots: {}", n, e.what());
+            return kExitFailure;
+          }
+          if (!first_digest) first_digest = t.r.trajectory_digest;
+          if (t.r.trajectory_digest != *first_digest) same[ti] = 0;
+          t.walls.push_back(t.r.run_wall_s);
+          t.cpus.push_back(t.r.run_cpu_s);
+          t.startups.push_back(t.r.wall_s - t.r.run_wall_s);
+          if (t.r.profile) {
+            Split& split = row_splits[ti];
+            split.robots = n;
+            split.threads = thread_counts.ids[ti];
+            split.run_s += t.r.run_wall_s;
+            split.simulated_s += t.r.simulated_s;
+            const agents::RunProfile& p = *t.r.profile;
+            split.profile.sensing_s += p.sensing_s;
+            split.profile.behaviours_s += p.behaviours_s;
+            split.profile.integration_s += p.integration_s;
+            split.profile.collisions_s += p.collisions_s;
+            split.profile.monitor_s += p.monitor_s;
+          }
         }
       }
     }
-    auto row = [&](Timing& t, const std::string& label) {
-      std::sort(t.walls.begin(), t.walls.end());
-      std::sort(t.cpus.begin(), t.cpus.end());
-      std::sort(t.startups.begin(), t.startups.end());
-      const double startup_s = t.startups[t.startups.size() / 2];
-      const double wall_s = std::max(1e-9, t.walls[t.walls.size() / 2]);
-      const double cpu_s = std::max(1e-9, t.cpus[t.cpus.size() / 2]);
-      if (ti == 0 && label.empty()) first_threads_wall_s = wall_s;
-      const agents::RunResult& r = t.r;
-      const double steps = n * r.simulated_s / 0.1;
-      std::printf("| %d%s | %d | %.1f x %.1f | %.1f | %.3f | %.3f | %.3f | %.1f | %.1f | %.1f | %.2f | %.2f | %.0f | %d | %.2g | %s |\n", n,
-                  label.c_str(), threads, s.map.field.width_m, s.map.field.height_m, r.simulated_s, startup_s, wall_s,
-                  cpu_s, 1000.0 * wall_s / r.simulated_s, r.simulated_s / wall_s, r.simulated_s / cpu_s, 1e6 * cpu_s / steps,
-                  first_threads_wall_s / wall_s, peak_rss_mb(), r.collisions, r.max_overlap_m, same ? "yes" : "NO");
-      return cpu_s;
-    };
-    const double plain_cpu = row(plain, "");
-    for (std::size_t k = 0; k < buses.size(); ++k) {
-      const double bused_cpu = row(bused[k], " (bus " + buses[k].url + ")");
-      buses[k].costs.push_back({n, 100.0 * (bused_cpu / plain_cpu - 1.0)});
-      buses[k].core_shares.push_back(100.0 * (bused_cpu - plain_cpu) / std::max(1e-9, bused[k].r.simulated_s));
+    double first_threads_wall_s = 0.0;
+    for (std::size_t ti = 0; ti < thread_rows; ++ti) {
+      const int threads = thread_counts.ids[ti];
+      auto row = [&](Timing& t, const std::string& label) {
+        std::sort(t.walls.begin(), t.walls.end());
+        std::sort(t.cpus.begin(), t.cpus.end());
+        std::sort(t.startups.begin(), t.startups.end());
+        const double startup_s = t.startups[t.startups.size() / 2];
+        const double wall_s = std::max(1e-9, t.walls[t.walls.size() / 2]);
+        const double cpu_s = std::max(1e-9, t.cpus[t.cpus.size() / 2]);
+        if (ti == 0 && label.empty()) first_threads_wall_s = wall_s;
+        const agents::RunResult& r = t.r;
+        const double steps = n * r.simulated_s / 0.1;
+        std::printf("| %d%s | %d | %.1f x %.1f | %.1f | %.3f | %.3f | %.3f | %.1f | %.1f | %.1f | %.2f | %.2f | %.0f | %d | %.2g | %s |\n", n,
+                    label.c_str(), threads, s.map.field.width_m, s.map.field.height_m, r.simulated_s, startup_s, wall_s,
+                    cpu_s, 1000.0 * wall_s / r.simulated_s, r.simulated_s / wall_s, r.simulated_s / cpu_s, 1e6 * cpu_s / steps,
+                    first_threads_wall_s / wall_s, peak_rss_mb(), r.collisions, r.max_overlap_m, same[ti] ? "yes" : "NO");
+        return cpu_s;
+      };
+      const double plain_cpu = row(plain[ti], "");
+      for (std::size_t k = 0; k < buses.size(); ++k) {
+        const double bused_cpu = row(bused[ti][k], " (bus " + buses[k].url + ")");
+        buses[k].costs.push_back({n, 100.0 * (bused_cpu / plain_cpu - 1.0)});
+        buses[k].core_shares.push_back(100.0 * (bused_cpu - plain_cpu) / std::max(1e-9, bused[ti][k].r.simulated_s));
+      }
+      if (!same[ti]) any_differs = true;
+      if (row_splits[ti].robots > 0) splits.push_back(row_splits[ti]);
     }
     std::fflush(stdout);
-    if (!same) any_differs = true;
-    }
   }
   if (!splits.empty()) print_splits(splits);
   if (any_differs) spdlog::error("runs of the same robot count gave different trajectories (the \"same\" column)");

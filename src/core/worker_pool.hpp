@@ -3,6 +3,7 @@
 // thread works too, so a pool of N threads starts N - 1.
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <cstddef>
 #include <exception>
@@ -46,13 +47,13 @@ class WorkerPool {
   std::mutex mutex_;
   std::condition_variable start_;
   std::condition_variable done_;
-  // The loop in progress (guarded by mutex_ while it is set up and torn down).
+  // The loop in progress: set by for_chunks before it bumps the generation.
   const std::function<void(std::size_t, std::size_t)>* body_ = nullptr;
   std::size_t count_ = 0;
   std::size_t chunks_ = 0;
-  unsigned long generation_ = 0;  // bumped for each loop; workers wait for a new one
-  std::size_t pending_ = 0;       // chunks not yet finished by workers
-  bool stopping_ = false;
+  std::atomic<unsigned long> generation_{0};  // bumped for each loop; workers wait for a new one
+  std::atomic<std::size_t> pending_{0};       // workers not yet done with the loop
+  std::atomic<bool> stopping_{false};
   std::vector<std::exception_ptr> errors_;  // per chunk
 };
 

@@ -88,17 +88,27 @@ void CollisionResolver::find_contacts_ahead(const CollisionScene& s) {
   near_static_.assign(n, 0);
   dirty_.assign(n, 0);
   const bool ordered = s.search_order.size() == n;
+  // Found in search order, written by position in it (each thread its own stretch of
+  // memory: written by slot, both threads wrote the same cache lines all the time), then
+  // scattered to the slots.
+  found_.resize(n);
   auto check = [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
       const std::size_t i = ordered ? s.search_order[k] : k;
-      near_robot_[i] = s.bodies[i].pushable && near_another_robot(s, i);
-      near_static_[i] = near_a_static(s, i);
+      found_[k] = static_cast<std::uint8_t>((s.bodies[i].pushable && near_another_robot(s, i) ? 1 : 0) |
+                                            (near_a_static(s, i) ? 2 : 0));
     }
   };
   if (workers_ && workers_->threads() > 1 && n > 1)
     workers_->for_chunks(n, check);
   else
     check(0, n);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (found_[k] == 0) continue;
+    const std::size_t i = ordered ? s.search_order[k] : k;
+    near_robot_[i] = found_[k] & 1;
+    near_static_[i] = (found_[k] >> 1) & 1;
+  }
 }
 
 // Whether the first pass's visit of robot i would find another robot within contact

@@ -125,6 +125,7 @@ class CollisionResolver {
   std::vector<std::uint8_t> near_robot_;   // at the pass's start: another robot within contact
   std::vector<std::uint8_t> near_static_;  // at the pass's start: a wall or obstacle within contact, or crossed
   std::vector<std::uint8_t> dirty_;        // near a robot moved in this pass
+  std::vector<std::uint8_t> found_;        // by position in the search order: 1 near a robot, 2 near a static
   core::WorkerPool* workers_ = nullptr;
 };
 

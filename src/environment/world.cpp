@@ -341,15 +341,17 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us) {
       m.begin_substep();
       m.translate(m.velocity_mps() * h_s);
     }
-    for (std::size_t i = 0; i < bodies_.size(); ++i) {
-      Body& b = bodies_[i];
-      b.previous_m = b.position_m;
-      if (!b.pushable) continue;
-      Motion& m = motion_[i];
-      const Vec2 d = m.local_step_m;
-      b.position_m = b.position_m + Vec2{m.heading.x * d.x - m.heading.y * d.y, m.heading.y * d.x + m.heading.x * d.y};
-      m.heading = {m.heading.x * m.cos_turn - m.heading.y * m.sin_turn, m.heading.y * m.cos_turn + m.heading.x * m.sin_turn};
-    }
+    for_robot_slots([&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        Body& b = bodies_[i];
+        b.previous_m = b.position_m;
+        if (!b.pushable) continue;
+        Motion& m = motion_[i];
+        const Vec2 d = m.local_step_m;
+        b.position_m = b.position_m + Vec2{m.heading.x * d.x - m.heading.y * d.y, m.heading.y * d.x + m.heading.x * d.y};
+        m.heading = {m.heading.x * m.cos_turn - m.heading.y * m.sin_turn, m.heading.y * m.cos_turn + m.heading.x * m.sin_turn};
+      }
+    });
     const Clock::time_point resolving = Clock::now();
     resolver_.resolve(cs, t_us_ + dt_us * (k + 1) / substeps);
     collisions_s += std::chrono::duration<double>(Clock::now() - resolving).count();
@@ -417,7 +419,7 @@ SensorReadings World::sense(int id, TimeUs t_us, NoiseRng& rng) const {
 void World::sense_into(int id, TimeUs t_us, SensorReadings& out) const {
   const std::size_t s = slot(id);
   if (ahead_valid_ && ahead_t_us_ == t_us) {
-    out = ahead_[s];
+    out = ahead_[ahead_position_[s]];
     return;
   }
   sense_slot(scene(), s, t_us, out);
@@ -428,6 +430,7 @@ void World::sense_ahead(TimeUs t_us) {
   ahead_.resize(robots_.size());
   const Scene sc = scene();
   const std::span<const std::uint32_t> order = sweep_order();
+  // Stored by position in the sweep (each thread writes its own stretch of memory).
   for_robot_slots([&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
       // The sweep goes by place, so each robot's own records are far from the last one's
@@ -437,9 +440,8 @@ void World::sense_ahead(TimeUs t_us) {
         __builtin_prefetch(&robots_[ahead]);
         __builtin_prefetch(&headings_[ahead]);
         __builtin_prefetch(&bodies_[ahead]);
-        __builtin_prefetch(&ahead_[ahead], 1);
       }
-      sense_slot(sc, order[k], t_us, ahead_[order[k]]);
+      sense_slot(sc, order[k], t_us, ahead_[k]);
     }
   });
   ahead_t_us_ = t_us;
@@ -461,7 +463,12 @@ void World::refresh_sweep_order() {
   }
   std::sort(sweep_keys_.begin(), sweep_keys_.end());
   sweep_order_.resize(n);
-  for (std::size_t k = 0; k < n; ++k) sweep_order_[k] = sweep_keys_[k].second;
+  ahead_position_.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    sweep_order_[k] = sweep_keys_[k].second;
+    ahead_position_[sweep_order_[k]] = static_cast<std::uint32_t>(k);
+  }
+  changed();  // the store is by position in the sweep
 }
 
 void World::sense_slot(const Scene& scene, std::size_t s, TimeUs t_us, SensorReadings& out) const {
@@ -492,26 +499,40 @@ WorldSnapshot World::snapshot() const {
 }
 
 double World::max_overlap_m() const {
+  std::mutex worst_mutex;
+  double worst_of_all = 0.0;
+  auto check = [&](std::size_t begin, std::size_t end) {
+    double worst = 0.0;
+    for (std::size_t i = begin; i < end; ++i) worst = std::max(worst, overlap_of(i));
+    std::lock_guard lock(worst_mutex);
+    worst_of_all = std::max(worst_of_all, worst);
+  };
+  if (workers_ && workers_->threads() > 1 && bodies_.size() > 1)
+    workers_->for_chunks(bodies_.size(), check);
+  else
+    check(0, bodies_.size());
+  return worst_of_all;
+}
+
+double World::overlap_of(std::size_t i) const {
   double worst = 0.0;
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    const Body& b = bodies_[i];
-    if (!b.pushable) continue;
-    grid_.for_each_in_box(box_around(b.position_m, b.radius_m + max_radius_m_), [&](int jj) {
-      const auto j = static_cast<std::size_t>(jj);
-      if (j == i) return;
-      const double gap = std::sqrt(distance_sq(b.position_m, bodies_[j].position_m)) - b.radius_m - bodies_[j].radius_m;
-      worst = std::max(worst, -gap);
-    });
-    statics_.for_each_in_box(box_around(b.position_m, b.radius_m), [&](const IndexedSegment& seg) {
-      worst = std::max(worst, -disc_segment_contact(b.position_m, b.radius_m, seg.a_m, seg.b_m).separation_m);
-    });
-    if (map_.obstacle_containing(b.position_m) >= 0) worst = std::max(worst, b.radius_m);
-    for (const MovingObstacle& m : movers_) {
-      const Contact c = m.shape() == MovingShape::Disc
-                            ? disc_disc_contact(b.position_m, b.radius_m, m.position_m(), m.bounding_radius_m())
-                            : disc_convex_polygon_contact(b.position_m, b.radius_m, m.world_vertices_m());
-      worst = std::max(worst, -c.separation_m);
-    }
+  const Body& b = bodies_[i];
+  if (!b.pushable) return worst;
+  grid_.for_each_in_box(box_around(b.position_m, b.radius_m + max_radius_m_), [&](int jj) {
+    const auto j = static_cast<std::size_t>(jj);
+    if (j == i) return;
+    const double gap = std::sqrt(distance_sq(b.position_m, bodies_[j].position_m)) - b.radius_m - bodies_[j].radius_m;
+    worst = std::max(worst, -gap);
+  });
+  statics_.for_each_in_box(box_around(b.position_m, b.radius_m), [&](const IndexedSegment& seg) {
+    worst = std::max(worst, -disc_segment_contact(b.position_m, b.radius_m, seg.a_m, seg.b_m).separation_m);
+  });
+  if (map_.obstacle_containing(b.position_m) >= 0) worst = std::max(worst, b.radius_m);
+  for (const MovingObstacle& m : movers_) {
+    const Contact c = m.shape() == MovingShape::Disc
+                          ? disc_disc_contact(b.position_m, b.radius_m, m.position_m(), m.bounding_radius_m())
+                          : disc_convex_polygon_contact(b.position_m, b.radius_m, m.world_vertices_m());
+    worst = std::max(worst, -c.separation_m);
   }
   return worst;
 }

@@ -158,7 +158,7 @@ class World {
 
   /// Largest overlap, metres, between a virtual robot and anything (another robot, a
   /// wall or static obstacle, a moving obstacle); 0 when none. A check for tests and
-  /// benchmarks: O(robots).
+  /// benchmarks: O(robots), on the workers when set.
   double max_overlap_m() const;
 
   /// The read-only view sensors use (valid until the world changes).
@@ -195,6 +195,7 @@ class World {
   // What can change a reading happened: sense_ahead's store is stale.
   void changed() { ahead_valid_ = false; }
   void refresh_sweep_order();
+  double overlap_of(std::size_t slot) const;
   // Slots in the order sweeps visit them (by place), refreshed when stale.
   std::span<const std::uint32_t> sweep_order() {
     if (sweep_order_.size() != robots_.size()) refresh_sweep_order();
@@ -224,7 +225,8 @@ class World {
   CollisionResolver resolver_;
   WorldStepTimes step_times_;
   core::WorkerPool* workers_ = nullptr;
-  std::vector<SensorReadings> ahead_;  // sense_ahead's readings, by slot
+  std::vector<SensorReadings> ahead_;  // sense_ahead's readings, by position in the sweep order
+  std::vector<std::uint32_t> ahead_position_;  // per slot: its position in the sweep order
   TimeUs ahead_t_us_ = 0;
   bool ahead_valid_ = false;
   long steps_ = 0;
