@@ -49,6 +49,9 @@ class CControllerAdapter final : public Controller {
   ControlOutput step(const ControlInput& input) override;
   /// Calls cleanup once (also done by the destructor if the run did not).
   void finish() override;
+  /// False: C static variables are shared by every robot running the same controller, so
+  /// C controllers step one at a time on the run's thread, whatever `--threads` says.
+  bool concurrent() const override { return false; }
   const RegisterMap& registers() const { return registers_; }
 
  private:

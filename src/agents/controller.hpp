@@ -88,6 +88,10 @@ class Controller {
   /// Whether it has reached its goal (a controller with a goal, e.g. going to a pose);
   /// a run with RunOptions::stop_when_done ends once every controller is done.
   virtual bool done() const { return false; }
+  /// Whether its step may run at the same time as other robots' controllers' steps (a
+  /// run on `--threads N`): it shares no mutable state with them. Asked once. Default
+  /// true; a controller that keeps state shared between robots must say false.
+  virtual bool concurrent() const { return true; }
 };
 
 }  // namespace rilbed::agents

@@ -7,7 +7,8 @@
  *
  * One process runs many robots with the same controller, so C static variables are
  * shared between them: keep per-robot state in the user registers (RILBED_REG_USER_0..),
- * which are the robot's own memory and start at 0. */
+ * which are the robot's own memory and start at 0. (C controllers are stepped one at a
+ * time even on `--threads N`, for the same reason.) */
 #ifndef RILBED_CONTROLLER_H
 #define RILBED_CONTROLLER_H
 

@@ -109,9 +109,11 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   void set_profile(bool on) { profiled_ = on; }
   /// Its sensing and behaviours times so far (set_profile); the rest of `RunProfile` is 0.
   const RunProfile& times() const { return times_; }
-  /// Concurrent (Coordinator::set_workers) when its controller runs here and its body is
-  /// concurrent: an agent touches its own state, its controller and its body only.
-  bool transitions_concurrent() const override { return !remote_ && body_.concurrent(); }
+  /// Concurrent (Coordinator::set_workers) when its controller runs here and says so, and
+  /// its body is concurrent: an agent touches its own state, its controller and its body.
+  bool transitions_concurrent() const override {
+    return !remote_ && body_.concurrent() && (!controller_ || controller_->concurrent());
+  }
 
  private:
   Body& body_;

@@ -389,11 +389,10 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
       record({e.t_us, "collision", party_code(e.first), party_code(e.second),
               to_string(e.first) + " touched " + to_string(e.second)});
     }
-    // Overlaps are checked once per simulated second: the check visits every robot's
-    // neighbours, as much as a tenth of a swarm's step when done every control step.
     if (t >= next_overlap_check_us_) {
       r.max_overlap_m = std::max(r.max_overlap_m, s_.world->max_overlap_m());
-      next_overlap_check_us_ = (t / 1'000'000 + 1) * 1'000'000;
+      const TimeUs every = s_.options->overlap_check_us;
+      next_overlap_check_us_ = every > 0 ? (t / every + 1) * every : t + 1;
     }
     read_agents(t);
     // Changes of health and behaviour, in agent order.

@@ -191,7 +191,12 @@ int run_batch(const agents::Scenario& scenario, const RunArgs& args, agents::Run
       }
     }
   };
-  const int jobs = std::clamp(args.jobs > 0 ? args.jobs : static_cast<int>(std::thread::hardware_concurrency()), 1, max_jobs);
+  // By default as many runs at once as the cores hold with each run's threads.
+  const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int jobs = std::clamp(args.jobs > 0 ? args.jobs : cores / std::max(1, args.threads), 1, max_jobs);
+  if (jobs * args.threads > cores)
+    spdlog::warn("{} runs at once on {} threads each is more threads than this machine's {} cores: they will wait on "
+                 "each other", jobs, args.threads, cores);
   std::vector<std::thread> threads;
   for (int j = 0; j < std::min(jobs, n); ++j) threads.emplace_back(worker);
   for (auto& t : threads) t.join();
@@ -587,7 +592,8 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--seeds", args->seeds, "Run a batch of N seeds (seed, seed+1, ...) and print its table")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--out", args->out, "Write the run folder here (a batch: one folder per seed and batch.json)");
-  cmd->add_option("--jobs", args->jobs, "Runs of a batch at once (default: one per core)")->check(CLI::PositiveNumber);
+  cmd->add_option("--jobs", args->jobs, "Runs of a batch at once (default: one per core, or per --threads cores)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--threads", args->threads,
                   "Threads that step each run's world and agents (the run folder is the same for any count; only the "
                   "speed differs)")

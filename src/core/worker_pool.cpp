@@ -28,7 +28,22 @@ inline void cpu_relax() {
 WorkerPool::WorkerPool(int threads) {
   if (threads < 1) throw std::invalid_argument("worker pool: threads must be >= 1, not " + std::to_string(threads));
   workers_.reserve(static_cast<std::size_t>(threads - 1));
-  for (int w = 0; w + 1 < threads; ++w) workers_.emplace_back([this, w] { work(static_cast<std::size_t>(w) + 1); });
+  try {
+    for (int w = 0; w + 1 < threads; ++w) workers_.emplace_back([this, w] { work(static_cast<std::size_t>(w) + 1); });
+  } catch (...) {
+    stop_workers();  // the threads started so far; the destructor will not run
+    throw;
+  }
+}
+
+void WorkerPool::stop_workers() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_.store(true);
+    generation_.fetch_add(1, std::memory_order_release);
+  }
+  start_.notify_all();
+  for (std::thread& t : workers_) t.join();
 }
 
 double WorkerPool::worker_cpu_seconds() const {
@@ -42,15 +57,7 @@ double WorkerPool::worker_cpu_seconds() const {
   return total_s;
 }
 
-WorkerPool::~WorkerPool() {
-  {
-    std::lock_guard lock(mutex_);
-    stopping_.store(true);
-    generation_.fetch_add(1, std::memory_order_release);
-  }
-  start_.notify_all();
-  for (std::thread& t : workers_) t.join();
-}
+WorkerPool::~WorkerPool() { stop_workers(); }
 
 void WorkerPool::run_chunk(std::size_t chunk) {
   const std::size_t begin = count_ * chunk / chunks_;

@@ -17,7 +17,9 @@ namespace rilbed::core {
 /// Runs `body(begin, end)` over a range split into one contiguous chunk per thread, and
 /// returns once every chunk is done. What each iteration computes must not depend on the
 /// chunk it falls in (results stay the same for any thread count); the pool gives no
-/// other guarantee of order. One loop at a time: for_chunks() belongs to one thread.
+/// other guarantee of order. One loop at a time: for_chunks() belongs to one thread, and
+/// a body must not call for_chunks() on the same pool. Idle threads poll for a few tens of
+/// microseconds before they sleep: give a pool no more threads than there are cores.
 class WorkerPool {
  public:
   /// `threads` >= 1 (1: no thread is started and loops run on the caller's thread).
@@ -41,6 +43,7 @@ class WorkerPool {
 
  private:
   void work(std::size_t worker);
+  void stop_workers();
   void run_chunk(std::size_t chunk);
 
   std::vector<std::thread> workers_;

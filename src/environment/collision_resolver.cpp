@@ -84,9 +84,11 @@ void CollisionResolver::resolve(CollisionScene& s, TimeUs t_us) {
 
 void CollisionResolver::find_contacts_ahead(const CollisionScene& s) {
   const std::size_t n = s.bodies.size();
-  near_robot_.assign(n, 0);
-  near_static_.assign(n, 0);
+  const std::uint8_t visit_all = config_.search_ahead ? 0 : 1;
+  near_robot_.assign(n, visit_all);
+  near_static_.assign(n, visit_all);
   dirty_.assign(n, 0);
+  if (visit_all) return;
   const bool ordered = s.search_order.size() == n;
   // Found in search order, written by position in it (each thread its own stretch of
   // memory: written by slot, both threads wrote the same cache lines all the time), then
@@ -162,7 +164,9 @@ bool CollisionResolver::robots_vs_robots(CollisionScene& s) {
       const auto j = static_cast<std::size_t>(jj);
       if (j == i) return;
       Body& bj = s.bodies[j];
-      // A pair of virtual robots both visited in this pass is handled by the lower slot.
+      // A pair of virtual robots both active in this pass is handled by the lower slot (in
+      // the first pass the lower one may have been skipped, which means it touched
+      // nothing then: the pair was apart).
       if (bj.pushable && j < i && (all_active_ || is_active_[j])) return;
       const Vec2 d = bi.position_m - bj.position_m;
       const double dist_sq = d.dot(d);

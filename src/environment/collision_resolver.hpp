@@ -47,6 +47,10 @@ struct CollisionConfig {
   double contact_margin_m = 1e-4;
   /// Overlaps up to this are left alone (floating-point slack). Metres.
   double tolerance_m = 1e-9;
+  /// Find the robots that may touch anything first (on the workers, when set) and visit
+  /// only those, and those a push brings near something, in the first pass; false visits
+  /// every robot. The same results either way (a test compares them); true is faster.
+  bool search_ahead = true;
 };
 
 /// What the resolver works on, by reference: the World's arrays.

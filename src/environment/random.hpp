@@ -1,6 +1,8 @@
 // Random numbers for the world's noise models. Written out instead of using the
-// standard library's engines and distributions so that one seed gives the same numbers
-// with every standard library: a recorded run replays identically on another machine.
+// standard library's engines and distributions, whose output the standard leaves to
+// each library: one seed gives the same bits from the generators everywhere, and the
+// same normals wherever the C library's exp and log round alike (glibc's do on every
+// CPU it runs on), so a recorded run replays identically on another machine.
 //
 // The world draws its noise from many short streams rather than one long one: each
 // robot's noise at each instant comes from a generator keyed by (run seed, robot id,

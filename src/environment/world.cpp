@@ -151,8 +151,9 @@ void World::add_robot(const RobotConfig& c) {
   state.wheel_base_m = c.wheel_base_m;
   state.noise = c.noise;
   state.sensors = c.sensors;
-  // Grow everything first (geometrically, so that adding n robots costs O(n)) so that a
-  // failed allocation leaves the parallel arrays in step.
+  // Grow the parallel arrays first (geometrically, so that adding n robots costs O(n)) so
+  // that a failed allocation leaves them in step. (The suite pool and the dense id table
+  // may still allocate after the pushes; the id map stays the authority for lookups.)
   const std::size_t s = robots_.size();
   if (s == robots_.capacity()) {
     const std::size_t want = std::max<std::size_t>(16, 2 * s);

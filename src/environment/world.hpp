@@ -51,7 +51,7 @@ struct WorldConfig {
   /// Every this many steps the world sorts its robots by where they are (tiles of the
   /// grid) into the order its sweeps visit them (sense_ahead, the collision search), so
   /// that a robot's neighbours were just visited and are still in cache; 0 sorts only
-  /// when robots are added or removed. Costs a sort of the robots each time.
+  /// when the number of robots changes. Costs a sort of the robots each time.
   int reorder_every_steps = 20;
 };
 
@@ -62,9 +62,10 @@ struct WorldStepTimes {
 };
 
 /// The world. Owns everything in it. Not thread-safe for changes: one thread adds,
-/// removes, sets and steps. The const members (sense, sense_all, snapshot, robot, ...)
-/// keep no scratch state, so several threads may call them at once between steps, each
-/// with its own random generator.
+/// removes, sets, steps and sweeps (sense_ahead). The const members (sense, sense_all,
+/// snapshot, robot, ...) keep no scratch state, so several threads may call them at once
+/// between steps; max_overlap_m is the exception when workers are set (it runs on them:
+/// call it from the stepping thread, outside any worker loop).
 class World {
  public:
   /// Builds the world around a validated static map. Throws std::invalid_argument for a

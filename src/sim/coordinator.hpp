@@ -56,7 +56,9 @@ struct StepReport {
 /// flat order) whose transitions_concurrent() is true has its transitions spread over
 /// the pool's threads; everything else stays on the running thread and in flat order.
 /// Since such models do not depend on each other's transitions, the run's results are
-/// the same for any number of threads.
+/// the same for any number of threads. (Not after a model error: the other threads'
+/// models of that step may have made their transitions, which on one thread they would
+/// not have; the run is over then, and what it left is not compared.)
 ///
 /// Threading: run_until(), step() and the registration calls belong to one thread;
 /// inject(), stop() and now_us() may be called from any thread. Listeners and

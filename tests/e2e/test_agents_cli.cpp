@@ -86,7 +86,7 @@ TEST(AgentsCli, RealRobotsWhoseAgentProcessDiesAreStoppedOverTheirLinks) {
       "echo \"timed out waiting for $2 in $1\" >&2; return 1; }\n";
   const int status = in_namespace(
       dir, wait_for + "\"$R\" agent --scenario " + s + " --ids 4-5 --lcm \"$URL\" > agent.txt 2>&1 &\nA=$!\n" +
-               "\"$R\" run " + s + " --realtime --seed 2 --duration 9 --no-place --out run --lcm \"$URL\" > run.txt 2>&1 &\n"
+               "\"$R\" run " + s + " --realtime --seed 2 --duration 12 --no-place --out run --lcm \"$URL\" > run.txt 2>&1 &\n"
                "RUN=$!\n"
                "wait_for run/trajectories.csv '^4\\.[0-9]*,4,'\n"
                "kill -9 $A\n"

@@ -403,3 +403,45 @@ TEST(World, TheSensorSweepGivesTheReadingsOfOneByOne) {
     EXPECT_EQ(*after.proximity, *fresh.back().proximity);
   }
 }
+
+// The collision resolver's first pass visits only robots found near something (or near
+// a robot pushed in the pass): the same as visiting them all, in a crowd that shoves.
+TEST(World, SearchingContactsAheadChangesNoCollision) {
+  for (const std::uint64_t seed : {3ULL, 17ULL, 2026ULL}) {
+    WorldConfig ahead, every;
+    ahead.noise_seed = every.noise_seed = seed;
+    every.collision.search_ahead = false;
+    World a(cluttered_field(), ahead), b(cluttered_field(), every);
+    std::mt19937_64 ra(seed), rb(seed);
+    populate(a, 220, ra, 0.065);
+    populate(b, 220, rb, 0.065);
+    MovingObstacleConfig disc;
+    disc.radius_m = 0.07;
+    disc.position_m = {0.75, 1.1};
+    disc.velocity_mps = {0.25, -0.2};
+    a.add_moving_obstacle(disc);
+    b.add_moving_obstacle(disc);
+    std::mt19937_64 commands(seed + 1);
+    int events = 0;
+    for (int step = 0; step < 200; ++step) {
+      if (step % 4 == 0) {
+        for (const RobotState& r : a.robots()) {
+          const int base = static_cast<int>(uniform01(commands) * 180) - 40;
+          const int left = base + static_cast<int>(uniform01(commands) * 40) - 20;
+          const int right = base + static_cast<int>(uniform01(commands) * 40) - 20;
+          a.set_wheel_speeds(r.id, left, right);
+          b.set_wheel_speeds(r.id, left, right);
+        }
+      }
+      const auto ea = a.step(kTick);
+      const std::vector<CollisionEvent> events_a(ea.begin(), ea.end());
+      const auto eb = b.step(kTick);
+      ASSERT_EQ(events_a.size(), eb.size()) << "seed " << seed << " step " << step;
+      for (std::size_t k = 0; k < eb.size(); ++k) ASSERT_TRUE(events_a[k] == eb[k]) << "seed " << seed << " step " << step;
+      events += static_cast<int>(eb.size());
+      for (std::size_t i = 0; i < a.robots().size(); ++i)
+        ASSERT_EQ(a.robots()[i].pose.position_m, b.robots()[i].pose.position_m) << "seed " << seed << " step " << step;
+    }
+    EXPECT_GT(events, 150) << "seed " << seed << ": crowded enough to shove";
+  }
+}
