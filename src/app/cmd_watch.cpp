@@ -82,16 +82,27 @@ class Watcher final : public agents::RunObserver {
     std::printf("%s\n", line.c_str());
     std::fflush(stdout);
     // A reset run starts over: the watcher stays for the run that follows.
-    if (s.state == "ended" && s.ended_by != "reset") ended_ = true;
+    if (s.state == "ended" && s.ended_by != "reset") {
+      ended_ = true;
+      unheard_end_.reset();
+    }
   }
 
   void on_summary(TimeUs, const nlohmann::json& summary) override {
     heard();
     const std::string ended_by = summary.value("ended_by", std::string("?"));
-    if (ended_ || ended_by == "reset") return;
-    // The run's last status was lost on the way, its summary was not.
-    std::printf("run ended (ended by %s; its last status was not heard)\n", ended_by.c_str());
+    if (ended_ || ended_by == "reset" || unheard_end_) return;
+    // The run's last status was lost on the way, or is still to come: the run sends the
+    // end's status and summary three times each, interleaved, so a later copy of the
+    // status may follow. Wait a moment for it before saying it was not heard.
+    unheard_end_ = UnheardEnd{ended_by, std::chrono::steady_clock::now() + kLateStatusWait};
+  }
+  /// Once the wait for a late ended status is over: says the run ended without it.
+  void check_unheard_end(std::chrono::steady_clock::time_point now) {
+    if (!unheard_end_ || now < unheard_end_->give_up) return;
+    std::printf("run ended (ended by %s; its last status was not heard)\n", unheard_end_->ended_by.c_str());
     std::fflush(stdout);
+    unheard_end_.reset();
     ended_ = true;
   }
 
@@ -133,6 +144,14 @@ class Watcher final : public agents::RunObserver {
   std::vector<std::string> robots_;
   std::optional<std::pair<TimeUs, std::string>> last_status_;  // time and state of the last shown
   bool ended_ = false;
+  // A summary came before any ended status: the end as the summary tells it, and when to
+  // stop waiting for a late copy of the status.
+  struct UnheardEnd {
+    std::string ended_by;
+    std::chrono::steady_clock::time_point give_up;
+  };
+  static constexpr std::chrono::milliseconds kLateStatusWait{500};
+  std::optional<UnheardEnd> unheard_end_;
   bool heard_anything_ = false;
   bool silent_reported_ = false;
   long bad_messages_ = 0;
@@ -172,6 +191,7 @@ int watch_command(const WatchArgs& args) {
     }
     const auto now = std::chrono::steady_clock::now();
     watcher.check_silence(now);
+    watcher.check_unheard_end(now);
     if (args.until_ended && watcher.ended()) break;
     if (args.for_s > 0.0 && now - start >= std::chrono::duration<double>(args.for_s)) break;
   }
