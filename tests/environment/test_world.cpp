@@ -296,6 +296,19 @@ TEST(World, LongRandomRunOf200RobotsNeverOverlaps) {
   RecordProperty("worst_overlap_m", std::to_string(worst));
 }
 
+// Gives the same random wheel commands to the robots of two worlds stepped side by side:
+// mostly forward and fast (a base speed in [-back, span - back), each wheel +-20), so that
+// they crowd and shove.
+void command_both(World& a, World& b, std::mt19937_64& commands, int span, int back) {
+  for (const RobotState& r : a.robots()) {
+    const int base = static_cast<int>(uniform01(commands) * span) - back;
+    const int left = base + static_cast<int>(uniform01(commands) * 40) - 20;
+    const int right = base + static_cast<int>(uniform01(commands) * 40) - 20;
+    a.set_wheel_speeds(r.id, left, right);
+    b.set_wheel_speeds(r.id, left, right);
+  }
+}
+
 // --threads: a crowded world stepped with its robots' motion and contact search spread
 // over worker threads moves exactly as on one thread, contacts and readings included.
 TEST(World, ThreadsChangeNothing) {
@@ -317,15 +330,7 @@ TEST(World, ThreadsChangeNothing) {
   std::vector<SensorReadings> readings_one, readings_three;
   int events = 0;
   for (int step = 0; step < 300; ++step) {
-    if (step % 5 == 0) {
-      for (const RobotState& r : one.robots()) {
-        const int base = static_cast<int>(uniform01(commands) * 160) - 30;
-        const int left = base + static_cast<int>(uniform01(commands) * 40) - 20;
-        const int right = base + static_cast<int>(uniform01(commands) * 40) - 20;
-        one.set_wheel_speeds(r.id, left, right);
-        three.set_wheel_speeds(r.id, left, right);
-      }
-    }
+    if (step % 5 == 0) command_both(one, three, commands, 160, 30);
     const auto e1 = one.step(kTick);
     const std::vector<CollisionEvent> events_one(e1.begin(), e1.end());
     const auto e3 = three.step(kTick);
@@ -424,15 +429,7 @@ TEST(World, SearchingContactsAheadChangesNoCollision) {
     std::mt19937_64 commands(seed + 1);
     int events = 0;
     for (int step = 0; step < 200; ++step) {
-      if (step % 4 == 0) {
-        for (const RobotState& r : a.robots()) {
-          const int base = static_cast<int>(uniform01(commands) * 180) - 40;
-          const int left = base + static_cast<int>(uniform01(commands) * 40) - 20;
-          const int right = base + static_cast<int>(uniform01(commands) * 40) - 20;
-          a.set_wheel_speeds(r.id, left, right);
-          b.set_wheel_speeds(r.id, left, right);
-        }
-      }
+      if (step % 4 == 0) command_both(a, b, commands, 180, 40);
       const auto ea = a.step(kTick);
       const std::vector<CollisionEvent> events_a(ea.begin(), ea.end());
       const auto eb = b.step(kTick);
