@@ -40,7 +40,7 @@ class VirtualBody final : public Body {
   // wheel speeds only, which nothing reads before the world's next step.
   bool concurrent() const override { return true; }
   environment::SensorReadings sense(TimeUs t_us) override { return world_.sense(id_, t_us); }
-  std::optional<Pose2> pose() const override { return world_.robot(id_).pose; }
+  std::optional<Pose2> pose() const override { return world_.pose(id_); }
   void drive(const WheelCommand& w) override {
     world_.set_wheel_speeds(id_, std::clamp(w.left, -kMaxWheelUnits, kMaxWheelUnits),
                             std::clamp(w.right, -kMaxWheelUnits, kMaxWheelUnits));

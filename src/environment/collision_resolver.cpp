@@ -89,28 +89,36 @@ void CollisionResolver::find_contacts_ahead(const CollisionScene& s) {
   near_static_.assign(n, visit_all);
   dirty_.assign(n, 0);
   if (visit_all) return;
-  const bool ordered = s.search_order.size() == n;
-  // Found in search order, written by position in it (each thread its own stretch of
-  // memory: written by slot, both threads wrote the same cache lines all the time), then
-  // scattered to the slots.
-  found_.resize(n);
+  // In slot order, which the World keeps by place: neighbours are still in cache, and
+  // each thread writes its own stretch of the flags.
   auto check = [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) {
-      const std::size_t i = ordered ? s.search_order[k] : k;
-      found_[k] = static_cast<std::uint8_t>((s.bodies[i].pushable && near_another_robot(s, i) ? 1 : 0) |
-                                            (near_a_static(s, i) ? 2 : 0));
+    for (std::size_t i = begin; i < end; ++i) {
+      near_robot_[i] = s.bodies[i].pushable && near_another_robot(s, i) ? 1 : 0;
+      near_static_[i] = near_a_static(s, i) ? 1 : 0;
     }
   };
   if (workers_ && workers_->threads() > 1 && n > 1)
     workers_->for_chunks(n, check);
   else
     check(0, n);
-  for (std::size_t k = 0; k < n; ++k) {
-    if (found_[k] == 0) continue;
-    const std::size_t i = ordered ? s.search_order[k] : k;
-    near_robot_[i] = found_[k] & 1;
-    near_static_[i] = (found_[k] >> 1) & 1;
+}
+
+template <class Visit>
+void CollisionResolver::for_each_by_id(const CollisionScene& s, Visit&& visit) const {
+  if (s.id_order.size() == s.bodies.size()) {
+    for (const std::uint32_t i : s.id_order) visit(static_cast<std::size_t>(i));
+  } else {
+    for (std::size_t i = 0; i < s.bodies.size(); ++i) visit(i);
   }
+}
+
+// The robots whose cells overlap `box`, by ascending id (valid until the next call).
+std::span<const std::uint32_t> CollisionResolver::robots_in_box_by_id(const CollisionScene& s, const Box& box) {
+  in_box_.clear();
+  s.grid.for_each_in_box(box, [&](int j) { in_box_.push_back(static_cast<std::uint32_t>(j)); });
+  if (in_box_.size() > 1)
+    std::sort(in_box_.begin(), in_box_.end(), [&](std::uint32_t a, std::uint32_t b) { return s.body_ids[a] < s.body_ids[b]; });
+  return in_box_;
 }
 
 // Whether the first pass's visit of robot i would find another robot within contact
@@ -160,25 +168,25 @@ bool CollisionResolver::robots_vs_robots(CollisionScene& s) {
     Body& bi = s.bodies[i];
     if (!bi.pushable) return;  // real robots start nothing; their virtual partners do
     const double reach = bi.radius_m + s.max_body_radius_m + margin;
-    s.grid.for_each_in_box(box_around(bi.position_m, reach), [&](int jj) {
+    for (const std::uint32_t jj : robots_in_box_by_id(s, box_around(bi.position_m, reach))) {
       const auto j = static_cast<std::size_t>(jj);
-      if (j == i) return;
+      if (j == i) continue;
       Body& bj = s.bodies[j];
-      // A pair of virtual robots both active in this pass is handled by the lower slot (in
-      // the first pass the lower one may have been skipped, which means it touched
-      // nothing then: the pair was apart).
-      if (bj.pushable && j < i && (all_active_ || is_active_[j])) return;
+      // A pair of virtual robots both active in this pass is handled by the lower id,
+      // visited first (in the first pass the lower one may have been skipped, which means
+      // it touched nothing then: the pair was apart).
+      if (bj.pushable && s.body_ids[j] < s.body_ids[i] && (all_active_ || is_active_[j])) continue;
       const Vec2 d = bi.position_m - bj.position_m;
       const double dist_sq = d.dot(d);
       const double sum = bi.radius_m + bj.radius_m;
-      if (dist_sq >= (sum + margin) * (sum + margin)) return;
+      if (dist_sq >= (sum + margin) * (sum + margin)) continue;
       if (bi.pushable && bj.pushable) {
         const int a = s.body_ids[i], b = s.body_ids[j];
         record({BodyKind::Robot, std::min(a, b)}, {BodyKind::Robot, std::max(a, b)});
       } else {
         record(robot_ref(s, i), robot_ref(s, j));
       }
-      if (dist_sq >= (sum - tol) * (sum - tol)) return;
+      if (dist_sq >= (sum - tol) * (sum - tol)) continue;
       const double dist = std::sqrt(dist_sq);
       Vec2 normal{1.0, 0.0};  // from j towards i
       if (dist > 1e-12) {
@@ -201,12 +209,13 @@ bool CollisionResolver::robots_vs_robots(CollisionScene& s) {
       mark_moved(i);
       if (all_active_) mark_near_dirty(s, i);
       corrected = true;
-    });
+    }
   };
   if (all_active_) {
     // Only those that something is near: a visit of any other finds nothing to do.
-    for (std::size_t i = 0; i < s.bodies.size(); ++i)
+    for_each_by_id(s, [&](std::size_t i) {
       if (near_robot_[i] || dirty_[i]) visit(i);
+    });
   } else {
     for (const int i : active_) visit(static_cast<std::size_t>(i));
   }
@@ -219,13 +228,13 @@ bool CollisionResolver::robots_vs_movers(CollisionScene& s) {
   for (std::size_t m = 0; m < s.movers.size(); ++m) {
     MovingObstacle& mover = s.movers[m];
     const double reach = mover.bounding_radius_m() + s.max_body_radius_m + margin;
-    s.grid.for_each_in_box(box_around(mover.position_m(), reach), [&](int jj) {
+    for (const std::uint32_t jj : robots_in_box_by_id(s, box_around(mover.position_m(), reach))) {
       const auto j = static_cast<std::size_t>(jj);
       Body& b = s.bodies[j];
       const Contact c = body_mover_contact(b, mover);
-      if (c.separation_m >= margin) return;
+      if (c.separation_m >= margin) continue;
       record(robot_ref(s, j), {BodyKind::MovingObstacle, static_cast<int>(m)});
-      if (c.separation_m >= -tol) return;
+      if (c.separation_m >= -tol) continue;
       const double depth = -c.separation_m;
       if (b.pushable) {
         b.position_m = b.position_m + c.normal * depth;
@@ -235,7 +244,7 @@ bool CollisionResolver::robots_vs_movers(CollisionScene& s) {
         mover.reflect_off(c.normal * -1.0);
       }
       corrected = true;
-    });
+    }
   }
   return corrected;
 }
@@ -269,8 +278,9 @@ bool CollisionResolver::robots_vs_statics(CollisionScene& s) {
   };
   if (all_active_) {
     // Only those near a static at the start, or moved since (by a push or a mover).
-    for (std::size_t i = 0; i < s.bodies.size(); ++i)
+    for_each_by_id(s, [&](std::size_t i) {
       if (near_static_[i] || moved_[i]) visit(i);
+    });
   } else {
     for (const int i : active_) visit(static_cast<std::size_t>(i));
   }
@@ -352,9 +362,8 @@ void CollisionResolver::fall_back(CollisionScene& s) {
   std::vector<int>& queue = moved_list_;  // free at this point; reused to avoid allocating
   queue.assign(active_.begin(), active_.end());
   auto enqueue_neighbours = [&](Vec2 p, double reach) {
-    s.grid.for_each_in_box(box_around(p, reach + s.max_body_radius_m), [&](int j) {
-      if (!reverted_[static_cast<std::size_t>(j)]) queue.push_back(j);
-    });
+    for (const std::uint32_t j : robots_in_box_by_id(s, box_around(p, reach + s.max_body_radius_m)))
+      if (!reverted_[j]) queue.push_back(static_cast<int>(j));
   };
   for (;;) {
     while (!queue.empty()) {

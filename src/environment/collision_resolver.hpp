@@ -61,9 +61,11 @@ struct CollisionScene {
   const SegmentIndex& statics;     ///< walls and obstacle edges
   std::span<MovingObstacle> movers;  ///< by index
   double max_body_radius_m = 0.0;
-  /// The order in which to search the robots for contacts (slots, each once; by place, so
-  /// that neighbours stay in cache), or empty for slot order. Results do not depend on it.
-  std::span<const std::uint32_t> search_order;
+  /// The slots by ascending robot id (each once), or empty when slots are in id order.
+  /// Overlaps are corrected robot after robot in this order, and a robot's neighbours in
+  /// id order too, so that the results depend on the ids alone, not on how the slots are
+  /// numbered (the World renumbers them by place).
+  std::span<const std::uint32_t> id_order;
 };
 
 /// Resolves overlaps and records contact episodes. Keeps scratch buffers between calls
@@ -109,6 +111,9 @@ class CollisionResolver {
   bool near_a_static(const CollisionScene& s, std::size_t i) const;
   void mark_near_dirty(const CollisionScene& s, std::size_t moved);
   bool mover_overlaps(const CollisionScene& s, std::size_t m) const;
+  template <class Visit>
+  void for_each_by_id(const CollisionScene& s, Visit&& visit) const;
+  std::span<const std::uint32_t> robots_in_box_by_id(const CollisionScene& s, const Box& box);
   void fall_back(CollisionScene& s);
 
   CollisionConfig config_;
@@ -129,7 +134,7 @@ class CollisionResolver {
   std::vector<std::uint8_t> near_robot_;   // at the pass's start: another robot within contact
   std::vector<std::uint8_t> near_static_;  // at the pass's start: a wall or obstacle within contact, or crossed
   std::vector<std::uint8_t> dirty_;        // near a robot moved in this pass
-  std::vector<std::uint8_t> found_;        // by position in the search order: 1 near a robot, 2 near a static
+  std::vector<std::uint32_t> in_box_;      // scratch of robots_in_box_by_id
   core::WorkerPool* workers_ = nullptr;
 };
 

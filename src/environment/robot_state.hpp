@@ -30,19 +30,22 @@ struct RobotConfig {
   SensorSuiteConfig sensors;            ///< virtual sensors (fed by the world for either kind)
 };
 
-/// The world's record of one robot. Values; the World owns them.
-struct RobotState {
+/// The world's record of one robot. Values; the World owns them. The fields an agent
+/// touches every control step (pose, wheel commands) share the first cache line, and
+/// each record starts a line of its own: agents on different threads never write the
+/// same line, and a step reads one line per robot from memory.
+struct alignas(64) RobotState {
   int id = 0;                          ///< as configured
   RobotKind kind = RobotKind::Virtual; ///< as configured
   Pose2 pose;                        ///< current pose, heading in [-pi, pi)
+  int left_speed_units = 0;          ///< commanded, pulses per 10 ms, in [-127, 127]
+  int right_speed_units = 0;
   TimeUs pose_t_us = 0;              ///< when pose was last set (step end or observation)
   /// Real robots: whether the camera has placed it at least once (until then `pose` is
   /// only where the scenario put it).
   bool observed = false;
   double radius_m = kKheperaRadius_m;        ///< body disc
   double wheel_base_m = kKheperaWheelBase_m;  ///< between the wheels
-  int left_speed_units = 0;          ///< commanded, pulses per 10 ms, in [-127, 127]
-  int right_speed_units = 0;
   /// Wheel travel counted by the encoders since the counters were last set, metres
   /// (kept in metres so that fractions of a pulse are not lost between steps).
   double left_wheel_travel_m = 0.0;

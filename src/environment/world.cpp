@@ -12,8 +12,8 @@ namespace rilbed::environment {
 namespace {
 
 constexpr double kDefaultCell_m = 0.1;
-// How many robots ahead the sensor sweep asks for a robot's records (World::sense_ahead).
-constexpr std::size_t kSweepPrefetch = 8;
+// How many robots ahead the sensor sweep asks for the record it will write (sense_ahead).
+constexpr std::size_t kStorePrefetch = 8;
 
 bool finite(Vec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); }
 
@@ -158,12 +158,15 @@ void World::add_robot(const RobotConfig& c) {
   if (s == robots_.capacity()) {
     const std::size_t want = std::max<std::size_t>(16, 2 * s);
     robots_.reserve(want), bodies_.reserve(want), ids_.reserve(want), suite_of_.reserve(want), motion_.reserve(want);
-    headings_.reserve(want);
+    headings_.reserve(want), added_order_.reserve(want), added_of_slot_.reserve(want), poses_.reserve(want);
     slot_of_.reserve(want);
   }
   robots_.push_back(std::move(state));
   bodies_.push_back({c.pose.position_m, c.pose.position_m, c.radius_m, c.kind == RobotKind::Virtual});
   ids_.push_back(c.id);
+  added_of_slot_.push_back(static_cast<std::uint32_t>(added_order_.size()));
+  added_order_.push_back(c.id);
+  poses_.push_back(robots_.back().pose);
   suite_of_.push_back(pooled_suite(c.sensors, std::move(suite)));
   motion_.emplace_back();
   slot_of_.emplace(c.id, s);
@@ -171,6 +174,7 @@ void World::add_robot(const RobotConfig& c) {
   headings_.push_back({std::cos(heading_rad), std::sin(heading_rad)});
   set_dense_slot(c.id, static_cast<std::int32_t>(s));
   grid_.push_back(c.pose.position_m);
+  renumber_due_ = true;
   changed();
   // The new radius only (a full refresh made adding n robots cost O(n^2): 7 s for 100,000).
   max_radius_m_ = s == 0 ? c.radius_m : std::max(max_radius_m_, c.radius_m);
@@ -179,11 +183,19 @@ void World::add_robot(const RobotConfig& c) {
 
 void World::remove_robot(int id) {
   const std::size_t s = slot(id);
+  // Its place in the added order goes to the last added (as its slot goes to the last slot).
+  const std::uint32_t place = added_of_slot_[s];
+  const int last_added = added_order_.back();
+  added_of_slot_[slot(last_added)] = place;
+  added_order_[place] = last_added;
+  poses_[place] = poses_.back();
+  added_order_.pop_back(), poses_.pop_back();
   const std::size_t last = robots_.size() - 1;
   if (s != last) {
     robots_[s] = std::move(robots_[last]);
     bodies_[s] = bodies_[last];
     ids_[s] = ids_[last];
+    added_of_slot_[s] = added_of_slot_[last];
     suite_of_[s] = suite_of_[last];
     motion_[s] = motion_[last];
     headings_[s] = headings_[last];
@@ -191,8 +203,10 @@ void World::remove_robot(int id) {
     set_dense_slot(ids_[s], static_cast<std::int32_t>(s));
   }
   robots_.pop_back(), bodies_.pop_back(), ids_.pop_back(), suite_of_.pop_back(), motion_.pop_back(), headings_.pop_back();
+  added_of_slot_.pop_back();
   slot_of_.erase(id);
   set_dense_slot(id, -1);
+  renumber_due_ = true;
   changed();
   grid_.rebuild(bodies_.size(), [&](std::size_t i) { return bodies_[i].position_m; });
   refresh_max_radius();
@@ -245,6 +259,7 @@ void World::set_observed_pose(int id, Pose2 pose, TimeUs t_us) {
   r.pose = {pose.position_m, wrap_rad_pi(pose.heading_rad)};
   r.pose_t_us = t_us;
   r.observed = true;
+  poses_[added_of_slot_[s]] = r.pose;
   headings_[s] = {std::cos(r.pose.heading_rad), std::sin(r.pose.heading_rad)};
   changed();
   bodies_[s].position_m = bodies_[s].previous_m = pose.position_m;
@@ -300,7 +315,8 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us) {
   if (dt_us < 0) throw std::invalid_argument("world: step dt_us must be >= 0");
   if (dt_us == 0) return {};
   changed();
-  if (config_.reorder_every_steps > 0 && ++steps_ % config_.reorder_every_steps == 0) sweep_order_.clear();
+  const bool reorder_due = config_.reorder_every_steps > 0 && ++steps_ % config_.reorder_every_steps == 0;
+  if (renumber_due_ || reorder_due) renumber_by_place();
   using Clock = std::chrono::steady_clock;
   const Clock::time_point started = Clock::now();
   double collisions_s = 0.0;
@@ -335,7 +351,7 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us) {
     }
   });
 
-  CollisionScene cs{bodies_, ids_, grid_, statics_, movers_, max_radius_m_, sweep_order()};
+  CollisionScene cs{bodies_, ids_, grid_, statics_, movers_, max_radius_m_, id_order_};
   resolver_.begin_step();
   for (int k = 0; k < substeps; ++k) {
     for (MovingObstacle& m : movers_) {
@@ -365,6 +381,7 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us) {
       if (r.kind != RobotKind::Virtual) continue;
       r.pose = {bodies_[i].position_m, wrap_rad_pi(motion_[i].end_heading_rad)};
       r.pose_t_us = t_us_;
+      poses_[added_of_slot_[i]] = r.pose;
       headings_[i] = {std::cos(r.pose.heading_rad), std::sin(r.pose.heading_rad)};
     }
   });
@@ -420,7 +437,7 @@ SensorReadings World::sense(int id, TimeUs t_us, NoiseRng& rng) const {
 void World::sense_into(int id, TimeUs t_us, SensorReadings& out) const {
   const std::size_t s = slot(id);
   if (ahead_valid_ && ahead_t_us_ == t_us) {
-    out = ahead_[ahead_position_[s]];
+    out = ahead_[added_of_slot_[s]].readings;
     return;
   }
   sense_slot(scene(), s, t_us, out);
@@ -428,48 +445,68 @@ void World::sense_into(int id, TimeUs t_us, SensorReadings& out) const {
 
 void World::sense_ahead(TimeUs t_us) {
   if (ahead_valid_ && ahead_t_us_ == t_us) return;
-  ahead_.resize(robots_.size());
+  ahead_.resize(robots_.size());  // by index in added_order_
   const Scene sc = scene();
-  const std::span<const std::uint32_t> order = sweep_order();
-  // Stored by position in the sweep (each thread writes its own stretch of memory).
+  // Slot order is by place (renumber_by_place): a robot's neighbours were just read, and
+  // each thread writes its own stretch of the store.
   for_robot_slots([&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) {
-      // The sweep goes by place, so each robot's own records are far from the last one's
-      // in memory: ask for them a few robots ahead (a hint; GCC and Clang on any CPU).
-      if (k + kSweepPrefetch < end) {
-        const std::uint32_t ahead = order[k + kSweepPrefetch];
-        __builtin_prefetch(&robots_[ahead]);
-        __builtin_prefetch(&headings_[ahead]);
-        __builtin_prefetch(&bodies_[ahead]);
-      }
-      sense_slot(sc, order[k], t_us, ahead_[k]);
+    for (std::size_t s = begin; s < end; ++s) {
+      // The store is in the agents' order, so each robot's record is far from the last
+      // one's: ask for it (for writing) a few robots ahead. A hint; GCC and Clang on any CPU.
+      if (s + kStorePrefetch < end) __builtin_prefetch(&ahead_[added_of_slot_[s + kStorePrefetch]], 1);
+      sense_slot(sc, s, t_us, ahead_[added_of_slot_[s]].readings);
     }
   });
   ahead_t_us_ = t_us;
   ahead_valid_ = true;
 }
 
-void World::refresh_sweep_order() {
+template <class T>
+void World::permute(std::vector<T>& items) {
+  std::vector<T> moved;
+  moved.reserve(items.size());
+  for (const std::uint32_t old : new_order_) moved.push_back(std::move(items[old]));
+  items.swap(moved);
+}
+
+void World::renumber_by_place() {
   const std::size_t n = robots_.size();
-  // Tiles of 8 x 8 cells, row by row; cells row by row within a tile.
+  // Tiles of 8 x 8 cells, row by row; cells row by row within a tile; by id within a
+  // cell (so that the order does not depend on the previous one).
   constexpr int kTile = 8;
   const GridGeometry& g = grid_geometry_;
   const std::uint64_t tiles_x = static_cast<std::uint64_t>(g.nx / kTile + 1);
-  sweep_keys_.resize(n);
+  struct Key {
+    std::uint64_t place;
+    int id;
+    std::uint32_t slot;
+  };
+  std::vector<Key> keys(n);
   for (std::size_t i = 0; i < n; ++i) {
     const int col = g.column(bodies_[i].position_m.x), row = g.row(bodies_[i].position_m.y);
     const std::uint64_t tile = static_cast<std::uint64_t>(row / kTile) * tiles_x + static_cast<std::uint64_t>(col / kTile);
-    sweep_keys_[i] = {(tile * kTile + static_cast<std::uint64_t>(row % kTile)) * kTile + static_cast<std::uint64_t>(col % kTile),
-                      static_cast<std::uint32_t>(i)};
+    keys[i] = {(tile * kTile + static_cast<std::uint64_t>(row % kTile)) * kTile + static_cast<std::uint64_t>(col % kTile),
+               ids_[i], static_cast<std::uint32_t>(i)};
   }
-  std::sort(sweep_keys_.begin(), sweep_keys_.end());
-  sweep_order_.resize(n);
-  ahead_position_.resize(n);
+  std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) { return a.place != b.place ? a.place < b.place : a.id < b.id; });
+  new_order_.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
-    sweep_order_[k] = sweep_keys_[k].second;
-    ahead_position_[sweep_order_[k]] = static_cast<std::uint32_t>(k);
+    new_order_[k] = keys[k].slot;
+    keys[k].slot = static_cast<std::uint32_t>(k);  // from now on: its new slot
   }
-  changed();  // the store is by position in the sweep
+  permute(robots_), permute(bodies_), permute(ids_), permute(suite_of_), permute(headings_), permute(added_of_slot_);
+  // motion_ is the step's scratch, filled after this.
+  for (std::size_t k = 0; k < n; ++k) {
+    slot_of_[ids_[k]] = k;
+    set_dense_slot(ids_[k], static_cast<std::int32_t>(k));
+  }
+  grid_.rebuild(n, [&](std::size_t i) { return bodies_[i].position_m; });
+  // The collision resolver's order: by id, whatever the slots.
+  std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) { return a.id < b.id; });
+  id_order_.resize(n);
+  for (std::size_t k = 0; k < n; ++k) id_order_[k] = keys[k].slot;
+  renumber_due_ = false;
+  changed();
 }
 
 void World::sense_slot(const Scene& scene, std::size_t s, TimeUs t_us, SensorReadings& out) const {
@@ -490,8 +527,10 @@ WorldSnapshot World::snapshot() const {
   WorldSnapshot snap;
   snap.t_us = t_us_;
   snap.robots.reserve(robots_.size());
-  for (const RobotState& r : robots_)
+  for (const int id : added_order_) {
+    const RobotState& r = robot(id);
     snap.robots.push_back({r.id, r.kind, r.pose, r.radius_m, r.left_speed_units, r.right_speed_units});
+  }
   for (const MovingObstacle& m : movers_)
     snap.moving_obstacles.push_back({m.shape(), m.position_m(), m.velocity_mps(), m.bounding_radius_m(), m.world_vertices_m()});
   const auto events = resolver_.events();

@@ -48,10 +48,11 @@ struct WorldConfig {
   /// instant is drawn from its own stream keyed by (seed, robot id, time), so results do
   /// not depend on the order in which robots sense or on threads.
   std::uint64_t noise_seed = 0;
-  /// Every this many steps the world sorts its robots by where they are (tiles of the
-  /// grid) into the order its sweeps visit them (sense_ahead, the collision search), so
-  /// that a robot's neighbours were just visited and are still in cache; 0 sorts only
-  /// when the number of robots changes. Costs a sort of the robots each time.
+  /// Every this many steps the world renumbers its robots' slots by where they are
+  /// (tiles of the grid), so that every per-robot loop (sensing, motion, the contact
+  /// search) walks memory in order and finds a robot's neighbours just visited, still in
+  /// cache; 0 renumbers only when robots are added or removed. Results do not depend on
+  /// it. Costs a sort and a move of every robot's records each time.
   int reorder_every_steps = 20;
 };
 
@@ -92,8 +93,16 @@ class World {
   /// The robot with this id. Throws std::invalid_argument for an unknown id. The
   /// reference stays valid until a robot is added or removed.
   const RobotState& robot(int id) const;
-  /// All robots, in the order they were added (removal moves the last into the gap).
+  /// All robots, in slot order: by place, renumbered as they move (see
+  /// WorldConfig::reorder_every_steps), the same for the same calls. For a stable order
+  /// use ids_in_added_order() or sort by id.
   std::span<const RobotState> robots() const { return robots_; }
+  /// The robots' ids in the order they were added (removal moves the last into the gap).
+  std::span<const int> ids_in_added_order() const { return added_order_; }
+  /// Robot `id`'s current pose, as robot(id).pose. Throws std::invalid_argument for an
+  /// unknown id. Kept in the order robots were added, apart from the slots that move by
+  /// place: agents that ask in id order read memory in order.
+  Pose2 pose(int id) const { return poses_[added_of_slot_[slot(id)]]; }
 
   /// Sets a robot's wheel commands, pulses per 10 ms, clamped to [-127, 127] as the
   /// Khepera firmware does. Used by the next step (virtual robots); kept for display for
@@ -148,13 +157,14 @@ class World {
   /// elements' buffers are reused).
   void sense_all(TimeUs t_us, std::vector<SensorReadings>& out) const;
   /// Reads every robot's sensors at t_us into the world's own store, robot after robot
-  /// in memory order (on the workers when set), so that sense(id, t_us) and
+  /// in slot order, i.e. by place (on the workers when set), so that sense(id, t_us) and
   /// sense_into(id, t_us) return the stored reading until the world next changes. The
   /// same readings as computed one by one (each robot's noise has its own stream): a
   /// sweep only keeps neighbours in cache and spreads the work.
   void sense_ahead(TimeUs t_us);
 
-  /// A copy of the moving state, with the last step's events.
+  /// A copy of the moving state (robots in the order they were added), with the last
+  /// step's events.
   WorldSnapshot snapshot() const;
 
   /// Largest overlap, metres, between a virtual robot and anything (another robot, a
@@ -195,13 +205,10 @@ class World {
   double start_wheels(std::size_t begin, std::size_t end, double dt_s);
   // What can change a reading happened: sense_ahead's store is stale.
   void changed() { ahead_valid_ = false; }
-  void refresh_sweep_order();
+  void renumber_by_place();
+  template <class T>
+  void permute(std::vector<T>& items);
   double overlap_of(std::size_t slot) const;
-  // Slots in the order sweeps visit them (by place), refreshed when stale.
-  std::span<const std::uint32_t> sweep_order() {
-    if (sweep_order_.size() != robots_.size()) refresh_sweep_order();
-    return sweep_order_;
-  }
 
   WorldConfig config_;
   StaticMap map_;
@@ -226,13 +233,21 @@ class World {
   CollisionResolver resolver_;
   WorldStepTimes step_times_;
   core::WorkerPool* workers_ = nullptr;
-  std::vector<SensorReadings> ahead_;  // sense_ahead's readings, by position in the sweep order
-  std::vector<std::uint32_t> ahead_position_;  // per slot: its position in the sweep order
+  // sense_ahead's readings in the order robots were added (what agents read in id order),
+  // each on cache lines of its own (threads of the sweep write them in any order).
+  struct alignas(64) StoredReadings {
+    SensorReadings readings;
+  };
+  std::vector<StoredReadings> ahead_;
+  std::vector<std::uint32_t> added_of_slot_;  // per slot: its robot's index in added_order_
+  std::vector<Pose2> poses_;                  // each robot's pose, by index in added_order_
   TimeUs ahead_t_us_ = 0;
   bool ahead_valid_ = false;
   long steps_ = 0;
-  std::vector<std::uint32_t> sweep_order_;  // empty or stale: rebuilt by sweep_order()
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> sweep_keys_;  // scratch
+  bool renumber_due_ = true;              // robots were added or removed since the last renumbering
+  std::vector<int> added_order_;          // ids in the order added (removal moves the last into the gap)
+  std::vector<std::uint32_t> id_order_;   // slots by ascending robot id (the collision resolver's order)
+  std::vector<std::uint32_t> new_order_;  // scratch of renumber_by_place: old slot of each new slot
   TimeUs t_us_ = 0;
 };
 

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
 
 #include "environment/random.hpp"
@@ -441,4 +442,101 @@ TEST(World, SearchingContactsAheadChangesNoCollision) {
     }
     EXPECT_GT(events, 150) << "seed " << seed << ": crowded enough to shove";
   }
+}
+
+// The world renumbers its slots by place as robots move (WorldConfig::reorder_every_steps):
+// a crowd that shoves moves, collides and senses exactly alike however often that
+// happens, compared robot by robot through their ids (the slots differ).
+TEST(World, RenumberingTheSlotsChangesNothing) {
+  for (const std::uint64_t seed : {11ULL, 4242ULL}) {
+    std::vector<std::unique_ptr<World>> worlds;
+    for (const int every : {1, 0, 7}) {
+      WorldConfig config;
+      config.noise_seed = seed;
+      config.reorder_every_steps = every;
+      worlds.push_back(std::make_unique<World>(cluttered_field(), config));
+      std::mt19937_64 placement(seed);
+      populate(*worlds.back(), 220, placement, 0.065);
+      MovingObstacleConfig disc;
+      disc.radius_m = 0.07;
+      disc.position_m = {0.75, 1.1};
+      disc.velocity_mps = {0.25, -0.2};
+      worlds.back()->add_moving_obstacle(disc);
+    }
+    const std::vector<int> ids(worlds[0]->ids_in_added_order().begin(), worlds[0]->ids_in_added_order().end());
+    std::mt19937_64 commands(seed + 1);
+    int events = 0;
+    bool slots_differed = false;
+    for (int step = 0; step < 200; ++step) {
+      if (step % 4 == 0) {
+        for (const int id : ids) {
+          const int base = static_cast<int>(uniform01(commands) * 180) - 40;
+          const int left = base + static_cast<int>(uniform01(commands) * 40) - 20;
+          const int right = base + static_cast<int>(uniform01(commands) * 40) - 20;
+          for (auto& w : worlds) w->set_wheel_speeds(id, left, right);
+        }
+      }
+      std::vector<std::vector<CollisionEvent>> stepped;
+      for (auto& w : worlds) {
+        const auto e = w->step(kTick);
+        stepped.emplace_back(e.begin(), e.end());
+        w->sense_ahead(w->time_us());
+      }
+      for (std::size_t k = 1; k < worlds.size(); ++k) {
+        ASSERT_EQ(stepped[0].size(), stepped[k].size()) << "seed " << seed << " step " << step;
+        for (std::size_t e = 0; e < stepped[0].size(); ++e) ASSERT_TRUE(stepped[0][e] == stepped[k][e]);
+        for (std::size_t i = 0; i < ids.size(); ++i)
+          slots_differed |= worlds[0]->robots()[i].id != worlds[k]->robots()[i].id;
+        for (const int id : ids) {
+          ASSERT_EQ(worlds[0]->robot(id).pose.position_m, worlds[k]->robot(id).pose.position_m)
+              << "seed " << seed << " step " << step << " robot " << id;
+          ASSERT_EQ(worlds[0]->robot(id).pose.heading_rad, worlds[k]->robot(id).pose.heading_rad);
+          ASSERT_EQ(worlds[k]->pose(id).position_m, worlds[k]->robot(id).pose.position_m);
+          ASSERT_EQ(*worlds[0]->sense(id, worlds[0]->time_us()).proximity,
+                    *worlds[k]->sense(id, worlds[k]->time_us()).proximity);
+        }
+      }
+      events += static_cast<int>(stepped[0].size());
+    }
+    EXPECT_TRUE(slots_differed) << "the renumbering periods should give different slots";
+    EXPECT_GT(events, 150) << "seed " << seed << ": crowded enough to shove";
+  }
+}
+
+// Renumbering by place moves robots between slots; lookups by id, the added order, the
+// snapshot's order, the stored readings and removal all follow.
+TEST(World, RobotsKeepTheirIdsPosesAndAddedOrderWhileTheirSlotsMove) {
+  World world(empty_field(2, 2));
+  // Added right to left, so that the order by place differs from the added one.
+  for (int id = 1; id <= 6; ++id) world.add_robot(quiet_robot(id, 1.9 - 0.3 * id, 0.2 + 0.25 * id, 0.1 * id));
+  world.set_wheel_speeds(4, 20, 30);
+  world.step(kTick);
+  const std::vector<int> added(world.ids_in_added_order().begin(), world.ids_in_added_order().end());
+  EXPECT_EQ(added, (std::vector<int>{1, 2, 3, 4, 5, 6}));
+  bool renumbered = false;
+  for (std::size_t s = 0; s < world.robots().size(); ++s) renumbered |= world.robots()[s].id != static_cast<int>(s) + 1;
+  EXPECT_TRUE(renumbered) << "slots should follow the place, not the order of adding";
+  const WorldSnapshot snap = world.snapshot();
+  for (std::size_t k = 0; k < snap.robots.size(); ++k) {
+    EXPECT_EQ(snap.robots[k].id, static_cast<int>(k) + 1);
+    EXPECT_EQ(snap.robots[k].pose.position_m, world.robot(snap.robots[k].id).pose.position_m);
+  }
+  EXPECT_EQ(snap.robots[3].left_speed_units, 20);
+  EXPECT_NE(world.pose(4).position_m, (Vec2{1.9 - 1.2, 1.2}));  // it drove
+  world.sense_ahead(world.time_us());
+  for (int id = 1; id <= 6; ++id) {
+    EXPECT_EQ(world.pose(id).position_m, world.robot(id).pose.position_m);
+    EXPECT_EQ(world.sense(id, world.time_us()).odometry.has_value(), true);
+  }
+  world.remove_robot(2);
+  const std::vector<int> after(world.ids_in_added_order().begin(), world.ids_in_added_order().end());
+  EXPECT_EQ(after, (std::vector<int>{1, 6, 3, 4, 5}));  // the last added takes the gap
+  for (const int id : after) EXPECT_EQ(world.pose(id).position_m, world.robot(id).pose.position_m);
+  world.step(kTick);
+  world.sense_ahead(world.time_us());
+  for (const int id : after) {
+    EXPECT_EQ(world.pose(id).position_m, world.robot(id).pose.position_m);
+    EXPECT_EQ(world.sense(id, world.time_us()).odometry->left_pulses, world.robot(id).odometer().left_pulses);
+  }
+  EXPECT_FALSE(world.has_robot(2));
 }
