@@ -40,9 +40,8 @@ class SegmentIndex {
     const int c0 = grid_.column(box.lo_m.x), c1 = grid_.column(box.hi_m.x);
     const int r0 = grid_.row(box.lo_m.y), r1 = grid_.row(box.hi_m.y);
     for (int r = r0; r <= r1; ++r) {
-      const int base = r * grid_.nx;
       for (int c = c0; c <= c1; ++c) {
-        const int cell = base + c;
+        const int cell = grid_.cell(c, r);
         if (!occupied(cell)) continue;
         for (std::uint32_t k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) f(segments_[ids_[k]]);
       }

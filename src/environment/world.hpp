@@ -34,7 +34,8 @@ struct WorldConfig {
   /// query but more cells to visit; far from a Khepera's scale, set it to about the
   /// largest robot diameter plus the longest proximity range.
   double cell_size_m = 0.0;
-  /// Upper bound on the cell count; cells grow beyond cell_size_m on huge fields.
+  /// Upper bound on the cell count; cells grow beyond cell_size_m on huge fields. (The
+  /// grids' per-cell arrays pad the cells to whole blocks of 8 x 8.)
   std::size_t max_grid_cells = std::size_t{1} << 22;
   /// Largest distance a body may travel in one substep, metres; 0 means the smallest
   /// robot radius, which keeps two robots from passing through each other. Smaller is
@@ -224,7 +225,7 @@ class World {
   std::vector<SensorSuite> suite_pool_;          // the distinct suites
   std::vector<SensorSuiteConfig> suite_configs_; // their configurations
   std::vector<Motion> motion_;
-  std::vector<Vec2> headings_;  // unit vector of each robot's heading (cos, sin), kept with the pose
+  std::vector<Vec2> headings_;  // (cos, sin) of each robot's heading: computed when placed or seen, rotated by each step with the pose (equal to a few ulps)
   std::unordered_map<int, std::size_t> slot_of_;
   std::vector<std::int32_t> dense_slot_;  // slot by id for small ids, -1 for none
   double max_radius_m_ = 0.0;

@@ -27,8 +27,30 @@ TEST(GridGeometry, ClampsPointsOutsideIntoBorderCells) {
   EXPECT_EQ(g.row(0.25), 2);
   // Too many cells for the cap: cells grow.
   const GridGeometry big = GridGeometry::covering({{0, 0}, {100, 100}}, 0.01, 10000);
-  EXPECT_LE(big.cell_count(), 10201u);
+  EXPECT_LE(big.nx * big.ny, 10201);
   EXPECT_GE(big.cell_m, 1.0 - 1e-9);
+  // Indices pad the cells to whole blocks of 8 x 8, no more.
+  EXPECT_LT(big.cell_count(), static_cast<std::size_t>((big.nx + 8) * (big.ny + 8)));
+}
+
+TEST(GridGeometry, EveryCellHasItsOwnIndexAndNeighboursShareBlocks) {
+  for (const double width_m : {0.3, 1.0, 2.37, 17.0}) {
+    const GridGeometry g = GridGeometry::covering({{0, 0}, {width_m, 0.61 * width_m}}, 0.1, 1 << 20);
+    std::vector<int> seen(g.cell_count(), 0);
+    for (int r = 0; r < g.ny; ++r) {
+      for (int c = 0; c < g.nx; ++c) {
+        const int cell = g.cell(c, r);
+        ASSERT_GE(cell, 0);
+        ASSERT_LT(static_cast<std::size_t>(cell), g.cell_count());
+        ASSERT_EQ(seen[static_cast<std::size_t>(cell)]++, 0) << "cell (" << c << ", " << r << ") shares an index";
+        ASSERT_EQ(g.cell_of({g.origin_m.x + (c + 0.5) * g.cell_m, g.origin_m.y + (r + 0.5) * g.cell_m}), cell);
+      }
+    }
+    if (g.nx >= 8 && g.ny >= 8) {
+      // The 8 x 8 cells of a block are 64 consecutive indices.
+      EXPECT_EQ(g.cell(7, 7) - g.cell(0, 0), 63);
+    }
+  }
 }
 
 TEST(SpatialGrid, BoxQueriesFindEveryItemInTheBoxAfterMovesAndRebuilds) {

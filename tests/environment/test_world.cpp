@@ -540,3 +540,31 @@ TEST(World, RobotsKeepTheirIdsPosesAndAddedOrderWhileTheirSlotsMove) {
   }
   EXPECT_FALSE(world.has_robot(2));
 }
+
+// A step turns each robot's sensing direction by rotating it, not by recomputing it from
+// the heading: after hours of turning in every way, a robot still senses as one placed
+// afresh at its pose (same readings, to the unit).
+TEST(World, ARobotThatTurnedForHoursSensesAsOnePlacedAtItsPose) {
+  World turning(empty_field(0.5, 0.5));
+  turning.add_robot(quiet_robot(1, 0.25, 0.25, 0.3));
+  turning.add_robot(quiet_robot(2, 0.25, 0.33, -1.0));  // a neighbour in view
+  std::mt19937_64 rng(19);
+  for (int step = 0; step < 40'000; ++step) {
+    if (step % 10 == 0) {
+      const int turn = static_cast<int>(uniform01(rng) * 60) - 30;
+      turning.set_wheel_speeds(1, -turn, turn);  // on the spot, either way
+    }
+    turning.step(kTick);
+  }
+  const Pose2 end = turning.robot(1).pose;
+  EXPECT_NEAR(end.position_m.x, 0.25, 1e-9);
+  World fresh(empty_field(0.5, 0.5));
+  fresh.add_robot(quiet_robot(1, end.position_m.x, end.position_m.y, end.heading_rad));
+  fresh.add_robot(quiet_robot(2, 0.25, 0.33, -1.0));
+  const SensorReadings seen = turning.sense(1, turning.time_us());
+  const SensorReadings placed = fresh.sense(1, fresh.time_us());
+  EXPECT_EQ(*seen.proximity, *placed.proximity);
+  int lit = 0;
+  for (const int v : *seen.proximity) lit += v > 0 ? 1 : 0;
+  EXPECT_GT(lit, 0) << "the neighbour should be in view of some sensor";
+}
