@@ -56,7 +56,7 @@ void CollisionResolver::resolve(CollisionScene& s, TimeUs t_us) {
   moved_.assign(n, 0);
   active_.clear();
   all_active_ = true;
-  s.grid.rebuild(n, [&](std::size_t i) { return s.bodies[i].position_m; });
+  s.grid.refresh(n, [&](std::size_t i) { return s.bodies[i].position_m; });
   find_contacts_ahead(s);
 
   for (int pass = 0; pass < config_.max_passes; ++pass) {

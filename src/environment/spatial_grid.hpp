@@ -36,6 +36,23 @@ class SpatialGrid {
     resize_items(count);
     for (std::size_t i = 0; i < count; ++i) link(static_cast<std::int32_t>(i), geometry_.cell_of(positions_of(i)));
   }
+  /// Brings items 0..count-1 to positions_of(i) after they moved: only the items whose
+  /// cell changed are relinked (a step moves few robots out of their cell), the rest cost
+  /// a cell computation each. Rebuilds when count differs from size(). The order of items
+  /// within a cell then depends on the history of moves: callers must not depend on it.
+  template <class PositionOf>
+  void refresh(std::size_t count, PositionOf&& positions_of) {
+    if (count != cell_of_.size()) {
+      rebuild(count, positions_of);
+      return;
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+      const int cell = geometry_.cell_of(positions_of(i));
+      if (cell == cell_of_[i]) continue;
+      unlink(static_cast<std::int32_t>(i));
+      link(static_cast<std::int32_t>(i), cell);
+    }
+  }
   /// Adds item size() at p.
   void push_back(Vec2 p);
   /// Moves item `item` to p (O(length of its old cell's list)).

@@ -315,10 +315,10 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us) {
   if (dt_us < 0) throw std::invalid_argument("world: step dt_us must be >= 0");
   if (dt_us == 0) return {};
   changed();
-  const bool reorder_due = config_.reorder_every_steps > 0 && ++steps_ % config_.reorder_every_steps == 0;
-  if (renumber_due_ || reorder_due) renumber_by_place();
   using Clock = std::chrono::steady_clock;
   const Clock::time_point started = Clock::now();
+  const bool reorder_due = config_.reorder_every_steps > 0 && ++steps_ % config_.reorder_every_steps == 0;
+  if (renumber_due_ || reorder_due) renumber_by_place();
   double collisions_s = 0.0;
   const double dt_s = us_to_seconds(dt_us);
 
@@ -467,11 +467,14 @@ void World::sense_ahead(TimeUs t_us) {
 }
 
 template <class T>
-void World::permute(std::vector<T>& items) {
-  std::vector<T> moved;
-  moved.reserve(items.size());
-  for (const std::uint32_t old : new_order_) moved.push_back(std::move(items[old]));
-  items.swap(moved);
+void World::permute(std::vector<T>& items, std::vector<T>& scratch) {
+  // Into a kept buffer (no allocation, no page faults after the first time), each thread
+  // writing its own stretch of new slots.
+  scratch.resize(items.size());
+  for_robot_slots([&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) scratch[k] = std::move(items[new_order_[k]]);
+  });
+  items.swap(scratch);
 }
 
 void World::renumber_by_place() {
@@ -479,22 +482,20 @@ void World::renumber_by_place() {
   // By cell, in the grid's numbering (blocks of 8 x 8 cells, row by row), and by id
   // within a cell (so that the order does not depend on the previous one).
   const GridGeometry& g = grid_geometry_;
-  struct Key {
-    std::uint64_t place;
-    int id;
-    std::uint32_t slot;
-  };
-  std::vector<Key> keys(n);
+  std::vector<RenumberKey>& keys = renumber_keys_;
+  keys.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     keys[i] = {static_cast<std::uint64_t>(g.cell_of(bodies_[i].position_m)), ids_[i], static_cast<std::uint32_t>(i)};
   }
-  std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) { return a.place != b.place ? a.place < b.place : a.id < b.id; });
+  std::sort(keys.begin(), keys.end(),
+            [](const RenumberKey& a, const RenumberKey& b) { return a.place != b.place ? a.place < b.place : a.id < b.id; });
   new_order_.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
     new_order_[k] = keys[k].slot;
     keys[k].slot = static_cast<std::uint32_t>(k);  // from now on: its new slot
   }
-  permute(robots_), permute(bodies_), permute(ids_), permute(suite_of_), permute(headings_), permute(added_of_slot_);
+  permute(robots_, robots_scratch_), permute(bodies_, bodies_scratch_), permute(ids_, ints_scratch_);
+  permute(suite_of_, slots_scratch_), permute(added_of_slot_, slots_scratch_), permute(headings_, headings_scratch_);
   // motion_ is the step's scratch, filled after this.
   for (std::size_t k = 0; k < n; ++k) {
     slot_of_[ids_[k]] = k;
@@ -502,7 +503,7 @@ void World::renumber_by_place() {
   }
   grid_.rebuild(n, [&](std::size_t i) { return bodies_[i].position_m; });
   // The collision resolver's order: by id, whatever the slots.
-  std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) { return a.id < b.id; });
+  std::sort(keys.begin(), keys.end(), [](const RenumberKey& a, const RenumberKey& b) { return a.id < b.id; });
   id_order_.resize(n);
   for (std::size_t k = 0; k < n; ++k) id_order_[k] = keys[k].slot;
   renumber_due_ = false;

@@ -59,7 +59,7 @@ struct WorldConfig {
 
 /// Wall time the world's steps took, summed since it was built, seconds.
 struct WorldStepTimes {
-  double integration_s = 0.0;  ///< wheel speeds, arcs, moving bodies
+  double integration_s = 0.0;  ///< wheel speeds, arcs, moving bodies, renumbering the slots by place
   double collisions_s = 0.0;   ///< CollisionResolver, every substep
 };
 
@@ -208,7 +208,7 @@ class World {
   void changed() { ahead_valid_ = false; }
   void renumber_by_place();
   template <class T>
-  void permute(std::vector<T>& items);
+  void permute(std::vector<T>& items, std::vector<T>& scratch);
   double overlap_of(std::size_t slot) const;
 
   WorldConfig config_;
@@ -249,6 +249,18 @@ class World {
   std::vector<int> added_order_;          // ids in the order added (removal moves the last into the gap)
   std::vector<std::uint32_t> id_order_;   // slots by ascending robot id (the collision resolver's order)
   std::vector<std::uint32_t> new_order_;  // scratch of renumber_by_place: old slot of each new slot
+  struct RenumberKey {
+    std::uint64_t place;  // grid cell
+    int id;
+    std::uint32_t slot;
+  };
+  std::vector<RenumberKey> renumber_keys_;  // scratch of renumber_by_place
+  // Kept buffers of renumber_by_place's moves (the previous arrays, moved from).
+  std::vector<RobotState> robots_scratch_;
+  std::vector<Body> bodies_scratch_;
+  std::vector<int> ints_scratch_;
+  std::vector<std::uint32_t> slots_scratch_;
+  std::vector<Vec2> headings_scratch_;
   TimeUs t_us_ = 0;
 };
 

@@ -86,6 +86,18 @@ TEST(SpatialGrid, BoxQueriesFindEveryItemInTheBoxAfterMovesAndRebuilds) {
   grid.rebuild(points);
   EXPECT_EQ(grid.size(), points.size());
   check();
+  // A step's small moves (most stay in their cell), then a refresh; then a big shuffle.
+  for (Vec2& p : points) p = p + Vec2{0.03 * (uniform01(rng) - 0.5), 0.03 * (uniform01(rng) - 0.5)};
+  grid.refresh(points.size(), [&](std::size_t i) { return points[i]; });
+  check();
+  for (Vec2& p : points) p = random_point(rng, -0.5, 2.5);
+  grid.refresh(points.size(), [&](std::size_t i) { return points[i]; });
+  check();
+  // A different count rebuilds.
+  points.resize(300);
+  grid.refresh(points.size(), [&](std::size_t i) { return points[i]; });
+  EXPECT_EQ(grid.size(), points.size());
+  check();
 }
 
 TEST(SegmentIndex, NearQueriesTrackLookupsAndSightLinesMatchBruteForce) {
