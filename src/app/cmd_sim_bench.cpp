@@ -54,13 +54,14 @@ agents::Scenario bench_scenario(int robots, const BenchArgs& args) {
 // routing, the world model's own bookkeeping, and the clock reads themselves).
 template <class Split>
 void print_splits(const std::vector<Split>& splits) {
-  std::printf("\nWhere the time goes (one more run of each row above, timed in parts with steady_clock, a few reads "
-              "per robot and step, which make it 3-8 %% slower; `--no-split` leaves it out): wall ms per simulated "
+  std::printf("\nWhere the time goes (one more run of each row above, timed in parts with steady_clock, three reads "
+              "per robot and step, which make that run slower: by how much, against the median of the untimed runs, is "
+              "the last column; `--no-split` leaves it out): wall ms per simulated "
               "second, and the share of that run. With "
               "more than one thread, sensing and behaviours run on all threads at once: their columns are the time "
               "summed over the threads, divided by the thread count.\n\n"
-              "| robots | threads | sensing | behaviours | integration | collisions | recording | DEVS kernel and the rest |\n"
-              "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+              "| robots | threads | sensing | behaviours | integration | collisions | recording | DEVS kernel and the rest | timed run slower by |\n"
+              "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
   for (const Split& s : splits) {
     agents::RunProfile p = s.profile;
     p.sensing_s /= s.threads;
@@ -71,7 +72,7 @@ void print_splits(const std::vector<Split>& splits) {
     for (const double part_s : parts) {
       std::printf(" %.1f (%.0f %%) |", 1000.0 * part_s / s.simulated_s, 100.0 * part_s / std::max(1e-9, s.run_s));
     }
-    std::printf("\n");
+    std::printf(" %+.0f %% |\n", 100.0 * (s.run_s / s.simulated_s / std::max(1e-12, s.plain_wall_per_simulated_s) - 1.0));
   }
 }
 
@@ -109,6 +110,7 @@ int bench_command(const BenchArgs& args) {
     int robots = 0;
     int threads = 1;
     double run_s = 0.0, simulated_s = 0.0;
+    double plain_wall_per_simulated_s = 0.0;  // the untimed runs' median
     agents::RunProfile profile;
   };
   std::vector<Split> splits;
@@ -214,6 +216,7 @@ int bench_command(const BenchArgs& args) {
         return cpu_s;
       };
       const double plain_cpu = row(plain[ti], "");
+      row_splits[ti].plain_wall_per_simulated_s = plain[ti].walls[plain[ti].walls.size() / 2] / plain[ti].r.simulated_s;
       for (std::size_t k = 0; k < buses.size(); ++k) {
         const double bused_cpu = row(bused[ti][k], " (bus " + buses[k].url + ")");
         buses[k].costs.push_back({n, 100.0 * (bused_cpu / plain_cpu - 1.0)});

@@ -181,6 +181,8 @@ TEST(SimBenchCli, PrintsItsTable) {
   for (int i = 1; i <= 6; ++i) total += std::stoi(m[i]);
   EXPECT_NEAR(total, 100, 4) << out;  // each share rounded
   EXPECT_GT(std::stoi(m[1]), 0) << "sensing took no time: " << out;
+  // And how much slower the timed run was than the untimed ones.
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(\| 100 \| 2 \|[^\n]* %\) \| [+-]\d+ % \|\n)"))) << out;
   // --no-split leaves the timers and their table out.
   const CommandResult plain = run_rilbed("sim-bench --robots 50 --seconds 1 --repeat 1 --no-split");
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
