@@ -114,6 +114,7 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   bool transitions_concurrent() const override {
     return !remote_ && body_.concurrent() && (!controller_ || controller_->concurrent());
   }
+  void prefetch() const override;
 
  private:
   Body& body_;

@@ -47,6 +47,13 @@ class Atomic : public Component {
   /// first. Default false (always run on the coordinator's thread, in flat order). Asked
   /// once, when the coordinator is built: the answer must not change.
   virtual bool transitions_concurrent() const { return false; }
+  /// A hint, called a few models ahead of this one's transition in a step where many
+  /// models transition: ask the CPU for (__builtin_prefetch) the memory the transition
+  /// will touch first, so that it arrives while the models before it run. Must not
+  /// change anything and must cost next to nothing. Default: nothing. (A swarm's agents
+  /// each sit on their own page of memory, where the CPU's own prefetcher does not
+  /// follow: the first touch of each was a cache miss that stalled the step.)
+  virtual void prefetch() const {}
 };
 
 /// An atomic model whose whole state is one value of type State, so that tests,

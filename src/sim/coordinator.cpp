@@ -248,6 +248,7 @@ void Coordinator::transitions(TimeUs t_us, bool bulk) {
     if (workers_ && workers_->threads() > 1)
       while (end < n && slots_[active_[end]].concurrent) ++end;
     if (end - k < 2) {
+      if (bulk && k + kPrefetchAhead < n) slots_[active_[k + kPrefetchAhead]].model->prefetch();
       transition(active_[k], t_us);  // flat order, this thread
       settle(k, t_us, next_time(active_[k], t_us), bulk);
       ++k;
@@ -259,6 +260,7 @@ void Coordinator::transitions(TimeUs t_us, bool bulk) {
     const std::size_t first = k;
     workers_->for_chunks(end - first, [&](std::size_t b, std::size_t e) {
       for (std::size_t j = first + b; j < first + e; ++j) {
+        if (j + kPrefetchAhead < first + e) slots_[active_[j + kPrefetchAhead]].model->prefetch();
         transition(active_[j], t_us);
         next_times_[j] = next_time(active_[j], t_us);
         if (bulk) settle(j, t_us, next_times_[j], true);

@@ -136,6 +136,8 @@ class Coordinator {
   static constexpr std::size_t kNotAtomic = static_cast<std::size_t>(-1);
   // A step is "bulk" when at least 1/kBulkShare of the atomics take part (see do_step).
   static constexpr std::size_t kBulkShare = 8;
+  // In bulk steps, how many models ahead of the one transitioning Atomic::prefetch() is called.
+  static constexpr std::size_t kPrefetchAhead = 4;
   struct Destination {
     PortBase* port;
     std::size_t atomic;  // flat index of the owner, or kNotAtomic for a root output

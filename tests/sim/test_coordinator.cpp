@@ -478,3 +478,59 @@ TEST(Coordinator, AConcurrentModelsErrorNamesTheFirstFailingModelInFlatOrder) {
     EXPECT_NE(std::string(e.what()).find("tick 3"), std::string::npos) << e.what();
   }
 }
+
+namespace {
+// Counts the prefetch hints it was given, and whether each came before its transition
+// of the same instant.
+class Hinted final : public AtomicModel<int> {
+ public:
+  Hinted(std::string id, TimeUs period_us) : AtomicModel<int>(std::move(id), 0), period_us_(period_us) {}
+  TimeUs time_advance() const override { return period_us_; }
+  void internal_transition() override {
+    if (hinted_at_ == state_) ++hinted_before_;
+    ++state_;
+  }
+  void external_transition(TimeUs) override {}
+  void output() override {}
+  bool transitions_concurrent() const override { return true; }
+  void prefetch() const override {
+    ++hints_;
+    hinted_at_ = state_;
+  }
+  int hints() const { return hints_; }
+  int hinted_before() const { return hinted_before_; }
+
+ private:
+  TimeUs period_us_;
+  mutable int hints_ = 0;
+  mutable int hinted_at_ = -1;
+  int hinted_before_ = 0;
+};
+}  // namespace
+
+// In a step where many models transition, the coordinator asks each a few models ahead
+// to prefetch (a hint): all but the first few of each thread's chunk, before their
+// transition; a model that steps alone is never asked. Results do not change.
+TEST(Coordinator, ModelsAheadAreAskedToPrefetchInBulkSteps) {
+  for (const int threads : {1, 2}) {
+    auto top = std::make_shared<Coupled>("top");
+    std::vector<Hinted*> crowd;
+    for (int i = 0; i < 40; ++i) crowd.push_back(&top->emplace<Hinted>("h" + std::to_string(i), 10 * kMs));
+    Hinted& loner = top->emplace<Hinted>("loner", 7 * kMs);  // steps at its own instants (and with the crowd at 70 ms)
+    FastClock clock;
+    Coordinator coordinator(top, clock);
+    rilbed::core::WorkerPool pool(threads);
+    coordinator.set_workers(&pool);
+    coordinator.run_until(1000 * kMs);
+    int hints = 0, before = 0;
+    for (const Hinted* h : crowd) {
+      EXPECT_EQ(h->state(), 100);
+      hints += h->hints();
+      before += h->hinted_before();
+    }
+    EXPECT_GE(hints, 100 * (40 - 4 * threads - 1)) << "on " << threads << " threads";
+    EXPECT_EQ(before, hints) << "every hint should come before the model's transition";
+    EXPECT_EQ(loner.state(), 142);
+    EXPECT_LE(loner.hints(), 14) << "asked only in the steps it shares with the crowd";
+  }
+}
