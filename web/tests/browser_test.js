@@ -45,6 +45,7 @@ const COLOUR_TOLERANCE = 40;     // per channel: antialiasing and the camera ima
 const ROBOT_RADIUS_M = 0.0275;   // a Khepera
 const DRIVEN = 4;                // the robot the page drives
 const DRIVEN_POSE = [0.25, 0.6, 0]; // x_m, y_m, theta_deg: room ahead of it (the field is 1.5 m wide)
+const TRAIL_ROBOT = 8;            // a standing virtual robot driven out and back for the trails
 const STILL_M = 0.003;           // two readings 0.5 s apart closer than this: standing
 const MOVED_M = 0.02;            // a clear move
 const STOP_WITHIN_S = 5;         // a stop is seen about 1 s after the key (0.5 s of it the two readings)
@@ -356,9 +357,21 @@ async function main(state) {
       pause: document.getElementById('pause').disabled, start: document.getElementById('start').disabled };
   });
   check(!(await banner()).pause, 'the Pause button is disabled in a running real-time run');
-  // Enough trail behind the convoy for the zoom check while paused (a loaded machine, or
-  // the ASan build, runs the convoy slowly: up to 150 s).
-  await poll('the convoy to leave 40 trail points (for the zoom check)', () => page.evaluate(() => {
+  // Enough trail for the zoom check while paused. The convoy forms within seconds and then
+  // stands, so a page that connected late (a loaded machine) saw little of its motion:
+  // a robot that stands anyway is driven out and back by hand too. (A loaded machine, or
+  // the ASan build, runs slowly: up to 150 s.)
+  await page.selectOption('#drive-robot', String(TRAIL_ROBOT));
+  await page.click('#drive-take');
+  for (const key of ['ArrowUp', 'ArrowDown']) {
+    await page.keyboard.down(key);
+    const from = await poseOf(page, TRAIL_ROBOT);
+    await poll(`robot ${TRAIL_ROBOT} to move 10 cm while ${key} is held (for the trails)`, async () =>
+      dist(await poseOf(page, TRAIL_ROBOT), from) > 0.1, { ms: 60000 });
+    await page.keyboard.up(key);
+  }
+  await page.click('#drive-release');
+  await poll('the robots to leave 40 trail points (for the zoom check)', () => page.evaluate(() => {
     let k = 0;
     for (const t of window.rilbed.run.trails.values()) k += t.length;
     return k >= 40 && k;
