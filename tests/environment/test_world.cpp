@@ -37,6 +37,16 @@ StaticMapConfig cluttered_field() {
 }
 
 // Places up to `count` virtual robots on free lattice points of the world.
+// A disc-shaped moving obstacle starting at (0.75, 1.1) in cluttered_field(), drifting
+// through the crowd at `velocity_mps`.
+MovingObstacleConfig drifting_disc(double radius_m, Vec2 velocity_mps) {
+  MovingObstacleConfig disc;
+  disc.radius_m = radius_m;
+  disc.position_m = {0.75, 1.1};
+  disc.velocity_mps = velocity_mps;
+  return disc;
+}
+
 void populate(World& world, int count, std::mt19937_64& rng, double spacing = 0.075) {
   const FieldConfig& f = world.map().field();
   int id = 0;
@@ -266,10 +276,7 @@ TEST(World, RealRobotsGetVirtualSensorsButNoVirtualOdometry) {
 
 TEST(World, LongRandomRunOf200RobotsNeverOverlaps) {
   World world(cluttered_field());
-  MovingObstacleConfig disc;
-  disc.radius_m = 0.06;
-  disc.position_m = {0.75, 1.1};
-  disc.velocity_mps = {0.23, -0.17};
+  const MovingObstacleConfig disc = drifting_disc(0.06, {0.23, -0.17});
   std::mt19937_64 rng(2024);
   world.add_moving_obstacle(disc);
   populate(world, 200, rng);
@@ -321,10 +328,7 @@ TEST(World, ThreadsChangeNothing) {
   std::mt19937_64 rng_one(31), rng_three(31);
   populate(one, 200, rng_one);
   populate(three, 200, rng_three);
-  MovingObstacleConfig disc;
-  disc.radius_m = 0.06;
-  disc.position_m = {0.75, 1.1};
-  disc.velocity_mps = {0.23, -0.17};
+  const MovingObstacleConfig disc = drifting_disc(0.06, {0.23, -0.17});
   one.add_moving_obstacle(disc);
   three.add_moving_obstacle(disc);
   std::mt19937_64 commands(5);
@@ -421,10 +425,7 @@ TEST(World, SearchingContactsAheadChangesNoCollision) {
     std::mt19937_64 ra(seed), rb(seed);
     populate(a, 220, ra, 0.065);
     populate(b, 220, rb, 0.065);
-    MovingObstacleConfig disc;
-    disc.radius_m = 0.07;
-    disc.position_m = {0.75, 1.1};
-    disc.velocity_mps = {0.25, -0.2};
+    const MovingObstacleConfig disc = drifting_disc(0.07, {0.25, -0.2});
     a.add_moving_obstacle(disc);
     b.add_moving_obstacle(disc);
     std::mt19937_64 commands(seed + 1);
@@ -457,10 +458,7 @@ TEST(World, RenumberingTheSlotsChangesNothing) {
       worlds.push_back(std::make_unique<World>(cluttered_field(), config));
       std::mt19937_64 placement(seed);
       populate(*worlds.back(), 220, placement, 0.065);
-      MovingObstacleConfig disc;
-      disc.radius_m = 0.07;
-      disc.position_m = {0.75, 1.1};
-      disc.velocity_mps = {0.25, -0.2};
+      const MovingObstacleConfig disc = drifting_disc(0.07, {0.25, -0.2});
       worlds.back()->add_moving_obstacle(disc);
     }
     const std::vector<int> ids(worlds[0]->ids_in_added_order().begin(), worlds[0]->ids_in_added_order().end());
