@@ -39,6 +39,9 @@ class Body {
   /// concurrent bodies' (each body from one thread): they read shared state only, and
   /// write only this robot's. Default false.
   virtual bool concurrent() const { return false; }
+  /// A hint, no effect on results: ask the CPU for the memory the next sense(), pose()
+  /// and drive() will touch (called a few agents ahead in a swarm's step). Default: nothing.
+  virtual void prefetch() const {}
 };
 
 }  // namespace rilbed::agents

@@ -24,13 +24,16 @@ AgentModel::AgentModel(Body& body, std::unique_ptr<Controller> controller, TimeU
 
 TimeUs AgentModel::time_advance() const { return state_.sigma_us; }
 
-void AgentModel::prefetch() const {
-  // Its own state (the lines a step reads and writes) and its body's and controller's
-  // first line (a hint; GCC and Clang on any CPU).
-  const char* self = reinterpret_cast<const char*>(this);
-  for (std::size_t offset = 0; offset < sizeof(*this); offset += 64) __builtin_prefetch(self + offset, 1);
-  __builtin_prefetch(&body_);
-  if (controller_) __builtin_prefetch(controller_.get());
+void AgentModel::prefetch(int round) const {
+  // Round 0: its body's and controller's first line (its own lines were asked for
+  // earlier, prefetch_bytes); round 1: what the body will touch in the world. Hints;
+  // GCC and Clang on any CPU.
+  if (round == 0) {
+    __builtin_prefetch(&body_);
+    if (controller_) __builtin_prefetch(controller_.get());
+  } else {
+    body_.prefetch();
+  }
 }
 
 void AgentModel::internal_transition() {

@@ -114,7 +114,8 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   bool transitions_concurrent() const override {
     return !remote_ && body_.concurrent() && (!controller_ || controller_->concurrent());
   }
-  void prefetch() const override;
+  void prefetch(int round) const override;
+  std::size_t prefetch_bytes() const override { return sizeof(*this); }
 
  private:
   Body& body_;

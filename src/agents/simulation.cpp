@@ -40,6 +40,7 @@ class VirtualBody final : public Body {
   // Sensing reads the world (const, per-robot noise streams); driving writes this robot's
   // wheel speeds only, which nothing reads before the world's next step.
   bool concurrent() const override { return true; }
+  void prefetch() const override { world_.prefetch(id_); }
   environment::SensorReadings sense(TimeUs t_us) override { return world_.sense(id_, t_us); }
   std::optional<Pose2> pose() const override { return world_.pose(id_); }
   void drive(const WheelCommand& w) override {

@@ -1,6 +1,7 @@
 // Atomic DEVS models (Parallel DEVS): explicit state, time advance, transitions, output.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <utility>
 
@@ -47,13 +48,20 @@ class Atomic : public Component {
   /// first. Default false (always run on the coordinator's thread, in flat order). Asked
   /// once, when the coordinator is built: the answer must not change.
   virtual bool transitions_concurrent() const { return false; }
-  /// A hint, called a few models ahead of this one's transition in a step where many
-  /// models transition: ask the CPU for (__builtin_prefetch) the memory the transition
-  /// will touch first, so that it arrives while the models before it run. Must not
-  /// change anything and must cost next to nothing. Default: nothing. (A swarm's agents
-  /// each sit on their own page of memory, where the CPU's own prefetcher does not
-  /// follow: the first touch of each was a cache miss that stalled the step.)
-  virtual void prefetch() const {}
+  /// A hint, in a step where many models transition: ask the CPU for
+  /// (__builtin_prefetch) the memory the transition will touch, so that it arrives while
+  /// the models before it run. Called twice before the transition: `round` 0 some models
+  /// ahead (the model's own lines have been asked for already, see prefetch_bytes: ask for
+  /// what its pointers point to), then `round` 1 nearer (what was asked for in round 0 has
+  /// arrived: ask for what that points to). Must not change anything and must cost next
+  /// to nothing. Default: nothing. (A swarm's agents each sit on their own page of
+  /// memory, where the CPU's own prefetcher does not follow: the first touch of each
+  /// was a cache miss that stalled the step, and so was reading a cold model to ask it.)
+  virtual void prefetch([[maybe_unused]] int round) const {}
+  /// How many bytes from its own address (`this`) the coordinator asks the CPU for, by
+  /// address alone, before prefetch(0). Asked once, when the coordinator is built.
+  /// Default 0 (nothing).
+  virtual std::size_t prefetch_bytes() const { return 0; }
 };
 
 /// An atomic model whose whole state is one value of type State, so that tests,

@@ -82,6 +82,7 @@ Coordinator::Coordinator(std::shared_ptr<Component> root, Clock& clock)
   for (Atomic* atomic : atomics_) {
     Slot slot{atomic, {}};
     slot.concurrent = atomic->transitions_concurrent();
+    slot.prefetch_bytes = atomic->prefetch_bytes();
     for (const auto& port : atomic->outputs()) slot.outputs.push_back(resolve(*port));
     slots_.push_back(std::move(slot));
   }
@@ -239,6 +240,20 @@ void Coordinator::settle(std::size_t k, TimeUs t_us, TimeUs next_us, bool bulk) 
   transitioned_[k] = &model;
 }
 
+void Coordinator::prefetch_ahead(std::size_t k, std::size_t end) const {
+  // In stages, each far enough ahead for the last to have arrived: the model's own lines
+  // by address alone (the models of a swarm are cold, and reading one to ask it
+  // stalls); then the model, reading its own pointers (now in cache); then again, for
+  // what those pointed to.
+  if (k + 3 * kPrefetchAhead < end) {
+    const Slot& far = slots_[active_[k + 3 * kPrefetchAhead]];
+    const char* bytes = reinterpret_cast<const char*>(far.model);
+    for (std::size_t offset = 0; offset < far.prefetch_bytes; offset += 64) __builtin_prefetch(bytes + offset, 1);
+  }
+  if (k + 2 * kPrefetchAhead < end) slots_[active_[k + 2 * kPrefetchAhead]].model->prefetch(0);
+  if (k + kPrefetchAhead < end) slots_[active_[k + kPrefetchAhead]].model->prefetch(1);
+}
+
 void Coordinator::transitions(TimeUs t_us, bool bulk) {
   const std::size_t n = active_.size();
   transitioned_.resize(n);
@@ -248,7 +263,7 @@ void Coordinator::transitions(TimeUs t_us, bool bulk) {
     if (workers_ && workers_->threads() > 1)
       while (end < n && slots_[active_[end]].concurrent) ++end;
     if (end - k < 2) {
-      if (bulk && k + kPrefetchAhead < n) slots_[active_[k + kPrefetchAhead]].model->prefetch();
+      if (bulk) prefetch_ahead(k, n);
       transition(active_[k], t_us);  // flat order, this thread
       settle(k, t_us, next_time(active_[k], t_us), bulk);
       ++k;
@@ -260,7 +275,7 @@ void Coordinator::transitions(TimeUs t_us, bool bulk) {
     const std::size_t first = k;
     workers_->for_chunks(end - first, [&](std::size_t b, std::size_t e) {
       for (std::size_t j = first + b; j < first + e; ++j) {
-        if (j + kPrefetchAhead < first + e) slots_[active_[j + kPrefetchAhead]].model->prefetch();
+        if (bulk) prefetch_ahead(j, first + e);
         transition(active_[j], t_us);
         next_times_[j] = next_time(active_[j], t_us);
         if (bulk) settle(j, t_us, next_times_[j], true);

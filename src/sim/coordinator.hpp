@@ -136,7 +136,8 @@ class Coordinator {
   static constexpr std::size_t kNotAtomic = static_cast<std::size_t>(-1);
   // A step is "bulk" when at least 1/kBulkShare of the atomics take part (see do_step).
   static constexpr std::size_t kBulkShare = 8;
-  // In bulk steps, how many models ahead of the one transitioning Atomic::prefetch() is called.
+  // In bulk steps, how many models ahead of the one transitioning Atomic::prefetch(1) is
+  // called; prefetch(0) twice as far, the model's own bytes three times as far.
   static constexpr std::size_t kPrefetchAhead = 4;
   struct Destination {
     PortBase* port;
@@ -153,6 +154,7 @@ class Coordinator {
     bool imminent = false;
     bool influenced = false;
     bool concurrent = false;  // model->transitions_concurrent(), asked once
+    std::size_t prefetch_bytes = 0;  // model->prefetch_bytes(), asked once
   };
   struct OutputListener {
     PortBase* port;
@@ -167,6 +169,9 @@ class Coordinator {
   void transition(std::size_t index, TimeUs t_us);
   void transitions(TimeUs t_us, bool bulk);
   void settle(std::size_t k, TimeUs t_us, TimeUs next_us, bool bulk);
+  // In a bulk step, before transitioning active_[k] (whose run of models ends at `end`):
+  // the hints for the models 1, 2 and 3 times kPrefetchAhead ahead.
+  void prefetch_ahead(std::size_t k, std::size_t end) const;
   void route(const Route& route);
   void deliver_injections();
   TimeUs next_time(std::size_t index, TimeUs t_us) const;

@@ -493,24 +493,35 @@ class Hinted final : public AtomicModel<int> {
   void external_transition(TimeUs) override {}
   void output() override {}
   bool transitions_concurrent() const override { return true; }
-  void prefetch() const override {
+  void prefetch(int round) const override {
+    if (round == 0) {
+      round0_at_ = state_;
+      return;
+    }
     ++hints_;
+    if (round0_at_ == state_) ++paired_;
     hinted_at_ = state_;
   }
+  std::size_t prefetch_bytes() const override { return sizeof(*this); }
+  // Round 1 hints that came after a round 0 hint of the same instant.
+  int paired() const { return paired_; }
   int hints() const { return hints_; }
   int hinted_before() const { return hinted_before_; }
 
  private:
   TimeUs period_us_;
   mutable int hints_ = 0;
+  mutable int round0_at_ = -1;
+  mutable int paired_ = 0;
   mutable int hinted_at_ = -1;
   int hinted_before_ = 0;
 };
 }  // namespace
 
 // In a step where many models transition, the coordinator asks each a few models ahead
-// to prefetch (a hint): all but the first few of each thread's chunk, before their
-// transition; a model that steps alone is never asked. Results do not change.
+// to prefetch (a hint), in two rounds (0 then 1): all but the first few of each
+// thread's chunk, before their transition; a model that steps alone is never asked.
+// Results do not change.
 TEST(Coordinator, ModelsAheadAreAskedToPrefetchInBulkSteps) {
   for (const int threads : {1, 2}) {
     auto top = std::make_shared<Coupled>("top");
@@ -522,14 +533,16 @@ TEST(Coordinator, ModelsAheadAreAskedToPrefetchInBulkSteps) {
     rilbed::core::WorkerPool pool(threads);
     coordinator.set_workers(&pool);
     coordinator.run_until(1000 * kMs);
-    int hints = 0, before = 0;
+    int hints = 0, before = 0, paired = 0;
     for (const Hinted* h : crowd) {
       EXPECT_EQ(h->state(), 100);
       hints += h->hints();
       before += h->hinted_before();
+      paired += h->paired();
     }
     EXPECT_GE(hints, 100 * (40 - 4 * threads - 1)) << "on " << threads << " threads";
     EXPECT_EQ(before, hints) << "every hint should come before the model's transition";
+    EXPECT_GE(paired, 100 * (40 - 8 * threads - 1)) << "round 0 should come before round 1 (" << threads << " threads)";
     EXPECT_EQ(loner.state(), 142);
     EXPECT_LE(loner.hints(), 14) << "asked only in the steps it shares with the crowd";
   }
