@@ -79,8 +79,8 @@ World::World(StaticMapConfig map, WorldConfig config)
 std::size_t World::slot(int id) const {
   // Small ids (the usual 1..N) through the dense table: every agent looks its robot up
   // several times a step, and a hash lookup was a cache miss each at 10,000 robots.
-  if (id >= 0 && static_cast<std::size_t>(id) < dense_slot_.size()) {
-    const std::int32_t s = dense_slot_[static_cast<std::size_t>(id)];
+  if (id >= 0 && static_cast<std::size_t>(id) < by_id_.size()) {
+    const std::int32_t s = by_id_[static_cast<std::size_t>(id)].slot;
     if (s >= 0) return static_cast<std::size_t>(s);
   }
   const auto it = slot_of_.find(id);
@@ -173,6 +173,7 @@ void World::add_robot(const RobotConfig& c) {
   const double heading_rad = robots_.back().pose.heading_rad;
   headings_.push_back({std::cos(heading_rad), std::sin(heading_rad)});
   set_dense_slot(c.id, static_cast<std::int32_t>(s));
+  set_dense_added(c.id, added_of_slot_.back());
   grid_.push_back(c.pose.position_m);
   renumber_due_ = true;
   changed();
@@ -187,6 +188,7 @@ void World::remove_robot(int id) {
   const std::uint32_t place = added_of_slot_[s];
   const int last_added = added_order_.back();
   added_of_slot_[slot(last_added)] = place;
+  set_dense_added(last_added, place);
   added_order_[place] = last_added;
   poses_[place] = poses_.back();
   added_order_.pop_back(), poses_.pop_back();
@@ -226,13 +228,25 @@ std::uint32_t World::pooled_suite(const SensorSuiteConfig& config, SensorSuite&&
 void World::set_dense_slot(int id, std::int32_t s) {
   if (id < 0) return;
   const auto i = static_cast<std::size_t>(id);
-  if (i >= dense_slot_.size()) {
+  if (i >= by_id_.size()) {
     // Only ids within a few times the robot count get a dense entry (memory stays
     // proportional to the robots); others go through the hash map alone.
     if (s < 0 || i >= 4 * robots_.size() + 4096) return;
-    dense_slot_.resize(std::max(i + 1, 2 * dense_slot_.size()), -1);
+    by_id_.resize(std::max(i + 1, 2 * by_id_.size()));
   }
-  dense_slot_[i] = s;
+  by_id_[i].slot = s;
+}
+
+void World::set_dense_added(int id, std::uint32_t added) {
+  if (id >= 0 && static_cast<std::size_t>(id) < by_id_.size()) by_id_[static_cast<std::size_t>(id)].added = added;
+}
+
+std::size_t World::added_index(int id) const {
+  if (id >= 0 && static_cast<std::size_t>(id) < by_id_.size()) {
+    const IdEntry& e = by_id_[static_cast<std::size_t>(id)];
+    if (e.slot >= 0) return e.added;
+  }
+  return added_of_slot_[slot(id)];
 }
 
 void World::refresh_max_radius() {
@@ -245,14 +259,11 @@ void World::refresh_max_radius() {
 }
 
 void World::prefetch(int id) const {
-  if (id < 0 || static_cast<std::size_t>(id) >= dense_slot_.size()) return;
-  const std::int32_t s = dense_slot_[static_cast<std::size_t>(id)];
-  if (s < 0) return;
-  const std::size_t slot = static_cast<std::size_t>(s);
-  __builtin_prefetch(&robots_[slot].left_speed_units, 1);  // a hint; GCC and Clang on any CPU
-  const std::size_t added = added_of_slot_[slot];
-  if (added < ahead_.size()) __builtin_prefetch(&ahead_[added]);
-  __builtin_prefetch(&poses_[added]);
+  // Its readings and pose are in id order, which the agents follow (the CPU's own
+  // prefetcher sees that): only its row, for the wheel command. A hint; GCC and Clang.
+  if (id < 0 || static_cast<std::size_t>(id) >= by_id_.size()) return;
+  const std::int32_t s = by_id_[static_cast<std::size_t>(id)].slot;
+  if (s >= 0) __builtin_prefetch(&robots_[static_cast<std::size_t>(s)].left_speed_units, 1);
 }
 
 void World::set_wheel_speeds(int id, int left_units, int right_units) {
@@ -451,12 +462,11 @@ SensorReadings World::sense(int id, TimeUs t_us, NoiseRng& rng) const {
 }
 
 void World::sense_into(int id, TimeUs t_us, SensorReadings& out) const {
-  const std::size_t s = slot(id);
   if (ahead_valid_ && ahead_t_us_ == t_us) {
-    out = ahead_[added_of_slot_[s]].readings;
+    out = ahead_[added_index(id)].readings;
     return;
   }
-  sense_slot(scene(), s, t_us, out);
+  sense_slot(scene(), slot(id), t_us, out);
 }
 
 void World::sense_ahead(TimeUs t_us) {
