@@ -10,7 +10,7 @@ namespace rilbed::agents {
 AgentModel::AgentModel(Body& body, std::unique_ptr<Controller> controller, TimeUs period_us, TimeUs first_step_us,
                        bool commanded, AgentExchange* remote)
     : sim::AtomicModel<AgentState>("agent" + std::to_string(body.id()), AgentState{}),
-      body_(body),
+      body_(&body),
       controller_(std::move(controller)),
       period_us_(period_us),
       remote_(remote && remote->serves(body.id()) ? remote : nullptr),
@@ -29,10 +29,10 @@ void AgentModel::prefetch(int round) const {
   // earlier, prefetch_bytes); round 1: what the body will touch in the world. Hints;
   // GCC and Clang on any CPU.
   if (round == 0) {
-    __builtin_prefetch(&body_);
+    __builtin_prefetch(body_);
     if (controller_) __builtin_prefetch(controller_.get());
   } else {
-    body_.prefetch();
+    body_->prefetch();
   }
 }
 
@@ -42,10 +42,10 @@ void AgentModel::internal_transition() {
     // The hand drive is over: the controller (or the coordinator's next command) takes over.
     state_.manual.reset();
     state_.last = {};
-    body_.stop();
+    body_->stop();
   }
   if (state_.manual) {
-    body_.drive(state_.manual->wheels);
+    body_->drive(state_.manual->wheels);
     state_.last.wheels = state_.manual->wheels;
     state_.last.behaviour = "console";
   } else if (controller_ && !state_.commanded) {
@@ -66,9 +66,9 @@ void AgentModel::step() {
   const Clock::time_point start = profiled_ ? Clock::now() : Clock::time_point{};
   ControlInput input;
   input.t_us = state_.t_us;
-  input.robot_id = body_.id();
-  input.sensors = body_.sense(state_.t_us);
-  input.pose = body_.pose();
+  input.robot_id = body_->id();
+  input.sensors = body_->sense(state_.t_us);
+  input.pose = body_->pose();
   if (state_.team) input.team = *state_.team;
   const Clock::time_point sensed = profiled_ ? Clock::now() : Clock::time_point{};
   if (remote_) {
@@ -76,7 +76,7 @@ void AgentModel::step() {
     remote_->submit(input);
   } else {
     state_.last = controller_->step(input);
-    body_.drive(state_.last.wheels);
+    body_->drive(state_.last.wheels);
   }
   state_.sensors = std::move(input.sensors);  // kept for the run's observer
   if (profiled_) {
@@ -89,7 +89,7 @@ void AgentModel::complete(const RemoteOutput& answer) {
   if (!remote_ || state_.commanded || state_.manual) return;
   state_.last = answer.output;
   remote_done_ = answer.done;
-  body_.drive(state_.last.wheels);
+  body_->drive(state_.last.wheels);
 }
 
 void AgentModel::external_transition(TimeUs elapsed_us) {
@@ -99,18 +99,18 @@ void AgentModel::external_transition(TimeUs elapsed_us) {
   for (const ConsoleOrder& order : console_in_.messages()) apply(order);
   if (state_.manual) return;  // driven by hand: commands wait
   for (const AgentCommand& c : command_in_.messages()) {
-    if (c.id != body_.id()) continue;
+    if (c.id != body_->id()) continue;
     state_.last = c.output;
-    body_.drive(c.output.wheels);
+    body_->drive(c.output.wheels);
   }
 }
 
 void AgentModel::apply(const ConsoleOrder& order) {
   switch (order.kind) {
     case ConsoleOrder::Kind::kDrive:
-      if (order.robot_id != body_.id()) return;
+      if (order.robot_id != body_->id()) return;
       state_.manual = ManualDrive{order.wheels, order.until_us};
-      body_.drive(order.wheels);  // now, not at the next step
+      body_->drive(order.wheels);  // now, not at the next step
       state_.last.wheels = order.wheels;
       state_.last.behaviour = "console";
       // A stepping agent keeps its step times (the drive ends at a step); one that waits
@@ -134,7 +134,7 @@ void AgentModel::apply(const ConsoleOrder& order) {
 void AgentModel::finish() {
   // A remote controller finishes in its own process (AgentExchange::end).
   if (controller_ && !remote_) controller_->finish();
-  body_.stop();
+  body_->stop();
   state_.last.wheels = {};
 }
 

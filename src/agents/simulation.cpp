@@ -400,15 +400,16 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     r.trajectory_digest += step_digest_;
     // Changes of health and behaviour, in agent order.
     for (const std::size_t i : changed_) {
-      const AgentModel& a = *s_.agents[i];
-      const std::string_view behaviour = a.behaviour(), health = a.body().health();
+      // As read_agents read them (the agents themselves are cold again by now).
+      const int id = reads_[i].id;
+      const std::string_view behaviour = reads_[i].behaviour, health = reads_[i].health;
       if (health != last_health_[i]) {
-        record({t, "health", a.body().id(), 0, std::string(last_health_[i]) + " -> " + std::string(health)});
+        record({t, "health", id, 0, std::string(last_health_[i]) + " -> " + std::string(health)});
         last_health_[i] = health;
       }
       if (behaviour != last_behaviour_[i]) {
         if (!last_behaviour_[i].empty()) {
-          record({t, "behaviour", a.body().id(), 0,
+          record({t, "behaviour", id, 0,
                                   std::string(last_behaviour_[i]) + " -> " + std::string(behaviour)});
         }
         last_behaviour_[i] = behaviour;
@@ -444,7 +445,11 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     std::optional<TrajectorySample> sample;  // none for a real robot with no pose
     std::uint64_t digest = 0;                // of the sample's time, id, position and heading, bit for bit
     bool changed = false;                    // its health or behaviour changed
+    std::string_view behaviour, health;      // as read (static strings)
+    int id = 0;                              // its robot's
   };
+  // How many agents ahead read_agents asks for an agent's body (and twice that for the agent).
+  static constexpr std::size_t kReadAhead = 8;
   // Reads every agent (on the workers when they may), and sums the samples' digests and
   // lists the agents whose health or behaviour changed (in agent order) as it goes: the
   // run's thread then has no pass over every agent left (at 10,000 robots it held the
@@ -458,18 +463,24 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
       std::uint64_t digest = 0;  // a sum: the same whatever thread made each term
       std::vector<std::size_t> changed;
       for (std::size_t i = begin; i < end; ++i) {
+        // A swarm's agents are far apart in memory: ask for them ahead (two rounds).
+        if (i + 2 * kReadAhead < end) s_.agents[i + 2 * kReadAhead]->prefetch_view(0);
+        if (i + kReadAhead < end) s_.agents[i + kReadAhead]->prefetch_view(1);
         const AgentModel& a = *s_.agents[i];
         AgentRead& out = reads_[i];
         const auto pose = a.body().pose();
-        const std::string_view behaviour = a.behaviour();
-        out.changed = a.body().health() != last_health_[i] || behaviour != last_behaviour_[i];
+        const std::string_view behaviour = a.behaviour(), health = a.body().health();
+        out.changed = health != last_health_[i] || behaviour != last_behaviour_[i];
+        out.behaviour = behaviour;
+        out.health = health;
+        out.id = a.body().id();
         if (out.changed) changed.push_back(i);
         out.sample.reset();
         out.digest = 0;
         if (!pose) continue;
-        out.sample = TrajectorySample{t, a.body().id(), *pose, behaviour};
+        out.sample = TrajectorySample{t, out.id, *pose, behaviour};
         std::uint64_t h = 0x6a09e667f3bcc909ULL;
-        for (const std::uint64_t word : {static_cast<std::uint64_t>(t), static_cast<std::uint64_t>(a.body().id()),
+        for (const std::uint64_t word : {static_cast<std::uint64_t>(t), static_cast<std::uint64_t>(out.id),
                                          std::bit_cast<std::uint64_t>(pose->position_m.x),
                                          std::bit_cast<std::uint64_t>(pose->position_m.y),
                                          std::bit_cast<std::uint64_t>(pose->heading_rad)})
