@@ -51,6 +51,8 @@ class SensorSuite {
   const RangeFinders& range_finders() const { return range_finders_; }
   /// The track sensor elements (possibly none), with their footprints.
   const std::vector<TrackSensor>& track_sensors() const { return track_sensors_; }
+  /// Whether its readings may fill any of SensorReadings' lists (ranges, beacons, track).
+  bool has_lists() const { return range_finders_.size() > 0 || beacon_finder_ || !track_sensors_.empty(); }
 
  private:
   std::optional<ProximitySensor> proximity_;

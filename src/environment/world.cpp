@@ -463,24 +463,54 @@ SensorReadings World::sense(int id, TimeUs t_us, NoiseRng& rng) const {
 
 void World::sense_into(int id, TimeUs t_us, SensorReadings& out) const {
   if (ahead_valid_ && ahead_t_us_ == t_us) {
-    out = ahead_[added_index(id)].readings;
+    const std::size_t added = added_index(id);
+    const StoredReadings& stored = ahead_[added];
+    out.t_us = stored.t_us;
+    if (stored.has_proximity) out.proximity = stored.proximity;
+    else out.proximity.reset();
+    if (stored.has_odometry) out.odometry = stored.odometry;
+    else out.odometry.reset();
+    if (stored.has_lists) {
+      const StoredLists& lists = ahead_lists_[added];
+      out.ranges = lists.ranges, out.beacons = lists.beacons, out.track = lists.track;
+    } else {
+      out.ranges.clear(), out.beacons.clear(), out.track.clear();
+    }
     return;
   }
   sense_slot(scene(), slot(id), t_us, out);
 }
 
+void World::store_readings(std::size_t added, SensorReadings& readings) {
+  StoredReadings& stored = ahead_[added];
+  stored.t_us = readings.t_us;
+  stored.has_proximity = readings.proximity.has_value();
+  if (stored.has_proximity) stored.proximity = *readings.proximity;
+  stored.has_odometry = readings.odometry.has_value();
+  if (stored.has_odometry) stored.odometry = *readings.odometry;
+  stored.has_lists = !readings.ranges.empty() || !readings.beacons.empty() || !readings.track.empty();
+  if (stored.has_lists) {
+    // Swapped, not copied: the record's old lists become the scratch's, capacity kept.
+    StoredLists& lists = ahead_lists_[added];
+    lists.ranges.swap(readings.ranges), lists.beacons.swap(readings.beacons), lists.track.swap(readings.track);
+  }
+}
+
 void World::sense_ahead(TimeUs t_us) {
   if (ahead_valid_ && ahead_t_us_ == t_us) return;
   ahead_.resize(robots_.size());  // by index in added_order_
+  const bool lists = std::any_of(suite_pool_.begin(), suite_pool_.end(), [](const SensorSuite& x) { return x.has_lists(); });
+  ahead_lists_.resize(lists ? robots_.size() : 0);
   const Scene sc = scene();
-  // Slot order is by place (renumber_by_place): a robot's neighbours were just read, and
-  // each thread writes its own stretch of the store.
+  // Slot order is by place (renumber_by_place): a robot's neighbours were just read.
   for_robot_slots([&](std::size_t begin, std::size_t end) {
+    SensorReadings readings;  // this thread's, reused (its lists keep their capacity)
     for (std::size_t s = begin; s < end; ++s) {
       // The store is in the agents' order, so each robot's record is far from the last
       // one's: ask for it (for writing) a few robots ahead. A hint; GCC and Clang on any CPU.
       if (s + kStorePrefetch < end) __builtin_prefetch(&ahead_[added_of_slot_[s + kStorePrefetch]], 1);
-      sense_slot(sc, s, t_us, ahead_[added_of_slot_[s]].readings);
+      sense_slot(sc, s, t_us, readings);
+      store_readings(added_of_slot_[s], readings);
     }
   });
   ahead_t_us_ = t_us;

@@ -414,6 +414,95 @@ TEST(World, TheSensorSweepGivesTheReadingsOfOneByOne) {
   }
 }
 
+namespace {
+// Every field of two readings, lists included.
+void expect_same_readings(const SensorReadings& a, const SensorReadings& b, const std::string& where) {
+  EXPECT_EQ(a.t_us, b.t_us) << where;
+  EXPECT_EQ(a.proximity, b.proximity) << where;
+  ASSERT_EQ(a.odometry.has_value(), b.odometry.has_value()) << where;
+  if (a.odometry) {
+    EXPECT_EQ(a.odometry->left_pulses, b.odometry->left_pulses) << where;
+    EXPECT_EQ(a.odometry->right_pulses, b.odometry->right_pulses) << where;
+  }
+  ASSERT_EQ(a.ranges.size(), b.ranges.size()) << where;
+  for (std::size_t k = 0; k < a.ranges.size(); ++k) {
+    EXPECT_EQ(a.ranges[k].hit, b.ranges[k].hit) << where;
+    EXPECT_EQ(a.ranges[k].distance_m, b.ranges[k].distance_m) << where;
+  }
+  ASSERT_EQ(a.beacons.size(), b.beacons.size()) << where;
+  for (std::size_t k = 0; k < a.beacons.size(); ++k) {
+    EXPECT_EQ(a.beacons[k].id, b.beacons[k].id) << where;
+    EXPECT_EQ(a.beacons[k].bearing_rad, b.beacons[k].bearing_rad) << where;
+  }
+  EXPECT_EQ(a.track, b.track) << where;
+}
+}  // namespace
+
+// The sweep's store keeps every kind of reading: robots without an IR ring or odometer,
+// with range finders, a beacon finder or track sensors, among plain Kheperas, read from
+// the store exactly what they read one by one (the store packs the IR ring and odometry
+// and keeps the lists apart).
+TEST(World, TheSensorSweepKeepsEveryKindOfReading) {
+  StaticMapConfig map = cluttered_field();
+  map.beacons.push_back({4, {0.2, 1.0}, 0.0, 2.0 * kPi, 1.5});
+  map.beacons.push_back({6, {1.3, 0.2}, 0.0, 2.0 * kPi, 1.5});
+  map.tracks.push_back({{{0.1, 0.6}, {1.4, 0.6}}, 0.03, false, "tape"});
+  for (const int threads : {1, 2}) {
+    WorldConfig config;
+    config.noise_seed = 31;
+    World world(map, config);
+    core::WorkerPool pool(threads);
+    world.set_workers(&pool);
+    std::mt19937_64 rng(8);
+    int id = 0;
+    for (double y = 0.1; y < 1.1; y += 0.12) {
+      for (double x = 0.1; x < 1.4; x += 0.12) {
+        RobotConfig c;
+        c.id = id;
+        c.pose = {{x, y}, 2 * kPi * uniform01(rng)};
+        switch (id % 5) {
+          case 1:  // one ahead, one behind
+            c.sensors.range_finders.push_back({});
+            c.sensors.range_finders.push_back({});
+            c.sensors.range_finders[1].mount_angle_rad = kPi;
+            break;
+          case 2: c.sensors.beacon_finder = BeaconFinderConfig{}; break;
+          case 3: c.sensors.track_sensors.push_back({}); break;
+          case 4: c.sensors.proximity.reset(), c.sensors.odometer = false; break;
+          default: break;
+        }
+        try {
+          world.add_robot(c);
+          ++id;
+        } catch (const std::invalid_argument&) {
+        }
+      }
+    }
+    ASSERT_GT(id, 40);
+    for (const RobotState& r : world.robots()) world.set_wheel_speeds(r.id, 40, 30);
+    std::vector<SensorReadings> fresh;
+    int beacons_seen = 0, track_seen = 0, ranges_hit = 0;
+    for (int step = 0; step < 6; ++step) {
+      world.step(kTick);
+      const TimeUs t = world.time_us();
+      world.sense_all(t, fresh);
+      world.sense_ahead(t);
+      for (std::size_t i = 0; i < fresh.size(); ++i) {
+        const int robot = world.robots()[i].id;
+        const SensorReadings stored = world.sense(robot, t);
+        expect_same_readings(stored, fresh[i], "robot " + std::to_string(robot) + " at step " + std::to_string(step));
+        beacons_seen += static_cast<int>(stored.beacons.size());
+        for (const int v : stored.track) track_seen += v > 0;
+        for (const RangeReading& range : stored.ranges) ranges_hit += range.hit;
+      }
+    }
+    // The lists were there to keep (else the test would prove little).
+    EXPECT_GT(beacons_seen, 0);
+    EXPECT_GT(track_seen, 0);
+    EXPECT_GT(ranges_hit, 0);
+  }
+}
+
 // The collision resolver's first pass visits only robots found near something (or near
 // a robot pushed in the pass): the same as visiting them all, in a crowd that shoves.
 TEST(World, SearchingContactsAheadChangesNoCollision) {
