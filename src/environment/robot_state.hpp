@@ -30,16 +30,21 @@ struct RobotConfig {
   SensorSuiteConfig sensors;            ///< virtual sensors (fed by the world for either kind)
 };
 
-/// The world's record of one robot. Values; the World owns them. The fields an agent
-/// touches every control step (pose, wheel commands) share the first cache line, and
-/// each record starts a line of its own: agents on different threads never write the
-/// same line, and a step reads one line per robot from memory.
+/// A robot's wheel commands, pulses per 10 ms (1 unit = 8 mm/s), in [-127, 127].
+struct WheelUnits {
+  int left = 0;
+  int right = 0;
+  bool operator==(const WheelUnits&) const = default;
+};
+
+/// The world's record of one robot. Values; the World owns them. The fields a step
+/// touches (pose, wheel travel, noise) share the first two cache lines, and each record
+/// starts a line of its own: threads never write the same line. The wheel commands are
+/// kept apart (World::wheel_speeds), in the agents' order, since agents write them.
 struct alignas(64) RobotState {
   int id = 0;                          ///< as configured
   RobotKind kind = RobotKind::Virtual; ///< as configured
   Pose2 pose;                        ///< current pose, heading in [-pi, pi)
-  int left_speed_units = 0;          ///< commanded, pulses per 10 ms, in [-127, 127]
-  int right_speed_units = 0;
   TimeUs pose_t_us = 0;              ///< when pose was last set (step end or observation)
   /// Real robots: whether the camera has placed it at least once (until then `pose` is
   /// only where the scenario put it).

@@ -159,6 +159,7 @@ void World::add_robot(const RobotConfig& c) {
     const std::size_t want = std::max<std::size_t>(16, 2 * s);
     robots_.reserve(want), bodies_.reserve(want), ids_.reserve(want), suite_of_.reserve(want), motion_.reserve(want);
     headings_.reserve(want), added_order_.reserve(want), added_of_slot_.reserve(want), poses_.reserve(want);
+    commands_.reserve(want);
     slot_of_.reserve(want);
   }
   robots_.push_back(std::move(state));
@@ -167,6 +168,7 @@ void World::add_robot(const RobotConfig& c) {
   added_of_slot_.push_back(static_cast<std::uint32_t>(added_order_.size()));
   added_order_.push_back(c.id);
   poses_.push_back(robots_.back().pose);
+  commands_.emplace_back();
   suite_of_.push_back(pooled_suite(c.sensors, std::move(suite)));
   motion_.emplace_back();
   slot_of_.emplace(c.id, s);
@@ -191,7 +193,8 @@ void World::remove_robot(int id) {
   set_dense_added(last_added, place);
   added_order_[place] = last_added;
   poses_[place] = poses_.back();
-  added_order_.pop_back(), poses_.pop_back();
+  commands_[place] = commands_.back();
+  added_order_.pop_back(), poses_.pop_back(), commands_.pop_back();
   const std::size_t last = robots_.size() - 1;
   if (s != last) {
     robots_[s] = std::move(robots_[last]);
@@ -259,17 +262,13 @@ void World::refresh_max_radius() {
 }
 
 void World::prefetch(int id) const {
-  // Its readings and pose are in id order, which the agents follow (the CPU's own
-  // prefetcher sees that): only its row, for the wheel command. A hint; GCC and Clang.
-  if (id < 0 || static_cast<std::size_t>(id) >= by_id_.size()) return;
-  const std::int32_t s = by_id_[static_cast<std::size_t>(id)].slot;
-  if (s >= 0) __builtin_prefetch(&robots_[static_cast<std::size_t>(s)].left_speed_units, 1);
+  // Its readings, pose and wheel commands are in id order, which the agents follow (the
+  // CPU's own prefetcher sees that): the id table's entry is all there is to ask for.
+  if (id >= 0 && static_cast<std::size_t>(id) < by_id_.size()) __builtin_prefetch(&by_id_[static_cast<std::size_t>(id)]);
 }
 
 void World::set_wheel_speeds(int id, int left_units, int right_units) {
-  RobotState& r = robots_[slot(id)];
-  r.left_speed_units = clamp_speed_units(left_units);
-  r.right_speed_units = clamp_speed_units(right_units);
+  commands_[added_index(id)] = {clamp_speed_units(left_units), clamp_speed_units(right_units)};
 }
 
 void World::set_observed_pose(int id, Pose2 pose, TimeUs t_us) {
@@ -422,8 +421,10 @@ double World::start_wheels(std::size_t begin, std::size_t end, double dt_s) {
   for (std::size_t i = begin; i < end; ++i) {
     RobotState& r = robots_[i];
     if (r.kind != RobotKind::Virtual) continue;
-    const double left_cmd = speed_units_to_mps(r.left_speed_units);
-    const double right_cmd = speed_units_to_mps(r.right_speed_units);
+    // In added order: a read from a table of 8 bytes a robot (cached), where the agents wrote.
+    const WheelUnits command = commands_[added_of_slot_[i]];
+    const double left_cmd = speed_units_to_mps(command.left);
+    const double right_cmd = speed_units_to_mps(command.right);
     double left_gain = 1.0 + r.noise.left_bias, right_gain = 1.0 + r.noise.right_bias;
     if (r.noise.slip_sd > 0.0) {
       NoiseRng rng = NoiseRng::keyed(config_.noise_seed, r.id, t_us_, NoisePurpose::kWheels);
@@ -579,9 +580,9 @@ WorldSnapshot World::snapshot() const {
   WorldSnapshot snap;
   snap.t_us = t_us_;
   snap.robots.reserve(robots_.size());
-  for (const int id : added_order_) {
-    const RobotState& r = robot(id);
-    snap.robots.push_back({r.id, r.kind, r.pose, r.radius_m, r.left_speed_units, r.right_speed_units});
+  for (std::size_t k = 0; k < added_order_.size(); ++k) {
+    const RobotState& r = robot(added_order_[k]);
+    snap.robots.push_back({r.id, r.kind, r.pose, r.radius_m, commands_[k].left, commands_[k].right});
   }
   for (const MovingObstacle& m : movers_)
     snap.moving_obstacles.push_back({m.shape(), m.position_m(), m.velocity_mps(), m.bounding_radius_m(), m.world_vertices_m()});

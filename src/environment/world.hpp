@@ -105,15 +105,19 @@ class World {
   /// place: agents that ask in id order read memory in order.
   Pose2 pose(int id) const { return poses_[added_index(id)]; }
   /// A hint, no effect on results: asks the CPU for what an agent's step will touch of
-  /// robot `id` (its stored readings and pose, and for writing its wheel commands), so
-  /// that it arrives while the agents before it step. At 100,000 robots the wheel write
-  /// lands anywhere in the robots' table, and each was a cache miss. Unknown ids: nothing.
+  /// robot `id` (its stored readings, pose and wheel commands), so that it arrives while
+  /// the agents before it step. Unknown ids: nothing.
   void prefetch(int id) const;
 
   /// Sets a robot's wheel commands, pulses per 10 ms, clamped to [-127, 127] as the
   /// Khepera firmware does. Used by the next step (virtual robots); kept for display for
-  /// real ones.
+  /// real ones. Throws std::invalid_argument for an unknown id.
   void set_wheel_speeds(int id, int left_units, int right_units);
+  /// Robot `id`'s wheel commands as last set (clamped). Kept in the order robots were
+  /// added, like pose(): agents that drive in id order write memory in order (in the
+  /// robots' table, by place, each write was a cache miss at 100,000 robots). Throws
+  /// std::invalid_argument for an unknown id.
+  WheelUnits wheel_speeds(int id) const { return commands_[added_index(id)]; }
   /// Sets a real robot's pose as observed (by the camera) at t_us. Throws
   /// std::invalid_argument for a virtual robot or a non-finite pose.
   void set_observed_pose(int id, Pose2 pose, TimeUs t_us);
@@ -278,6 +282,7 @@ class World {
   std::vector<StoredLists> ahead_lists_;  // by added index; empty unless a suite has lists
   std::vector<std::uint32_t> added_of_slot_;  // per slot: its robot's index in added_order_
   std::vector<Pose2> poses_;                  // each robot's pose, by index in added_order_
+  std::vector<WheelUnits> commands_;          // each robot's wheel commands, by index in added_order_
   TimeUs ahead_t_us_ = 0;
   bool ahead_valid_ = false;
   long steps_ = 0;

@@ -79,8 +79,9 @@ TEST(Kinematics, SpeedsAreClampedLikeTheFirmware) {
   World world(empty_field(2, 2));
   world.add_robot(quiet_robot(1, 1.0, 1.0, 0.0));
   world.set_wheel_speeds(1, 500, -500);
-  EXPECT_EQ(world.robot(1).left_speed_units, 127);
-  EXPECT_EQ(world.robot(1).right_speed_units, -127);
+  EXPECT_EQ(world.wheel_speeds(1), (WheelUnits{127, -127}));
+  world.set_wheel_speeds(1, -128, 126);
+  EXPECT_EQ(world.wheel_speeds(1), (WheelUnits{-127, 126}));
 }
 
 TEST(Kinematics, SystematicBiasCurvesAStraightCommand) {

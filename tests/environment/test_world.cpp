@@ -597,6 +597,7 @@ TEST(World, RobotsKeepTheirIdsPosesAndAddedOrderWhileTheirSlotsMove) {
   // Added right to left, so that the order by place differs from the added one.
   for (int id = 1; id <= 6; ++id) world.add_robot(quiet_robot(id, 1.9 - 0.3 * id, 0.2 + 0.25 * id, 0.1 * id));
   world.set_wheel_speeds(4, 20, 30);
+  world.set_wheel_speeds(6, -15, 25);
   world.step(kTick);
   const std::vector<int> added(world.ids_in_added_order().begin(), world.ids_in_added_order().end());
   EXPECT_EQ(added, (std::vector<int>{1, 2, 3, 4, 5, 6}));
@@ -626,6 +627,13 @@ TEST(World, RobotsKeepTheirIdsPosesAndAddedOrderWhileTheirSlotsMove) {
     EXPECT_EQ(world.sense(id, world.time_us()).odometry->left_pulses, world.robot(id).odometer().left_pulses);
   }
   EXPECT_FALSE(world.has_robot(2));
+  // The wheel commands stay with their robots (robot 6 took robot 2's place in the order).
+  EXPECT_EQ(world.wheel_speeds(4), (WheelUnits{20, 30}));
+  EXPECT_EQ(world.wheel_speeds(6), (WheelUnits{-15, 25}));
+  EXPECT_EQ(world.wheel_speeds(1), (WheelUnits{0, 0}));
+  EXPECT_EQ(world.snapshot().robots[1].right_speed_units, 25);
+  EXPECT_THROW(world.wheel_speeds(2), std::invalid_argument);
+  EXPECT_THROW(world.set_wheel_speeds(2, 1, 1), std::invalid_argument);
 }
 
 // A step turns each robot's sensing direction by rotating it, not by recomputing it from
