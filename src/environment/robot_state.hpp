@@ -37,9 +37,9 @@ struct WheelUnits {
   bool operator==(const WheelUnits&) const = default;
 };
 
-/// The world's record of one robot. Values; the World owns them. The fields a step
-/// touches (pose, wheel travel, noise) share the first two cache lines, and each record
-/// starts a line of its own: threads never write the same line. The wheel commands are
+/// The world's record of one robot. Values; the World owns them. A record is two cache
+/// lines, all of it read by a step, and starts a line of its own: threads never write
+/// the same line. The wheel commands are
 /// kept apart (World::wheel_speeds), in the agents' order, since agents write them.
 struct alignas(64) RobotState {
   int id = 0;                          ///< as configured
@@ -56,11 +56,13 @@ struct alignas(64) RobotState {
   double left_wheel_travel_m = 0.0;
   double right_wheel_travel_m = 0.0;
   WheelNoiseConfig noise;     ///< as configured
-  SensorSuiteConfig sensors;  ///< as configured
+  // (Its sensors' configuration is World::sensor_config(id): kept out of this record,
+  // which every step reads four times, so that a record is two cache lines, not five.)
 
   /// The wheel counters, as the Khepera's `H` command would report them: whole pulses of
   /// 0.08 mm, rounded towards minus infinity.
   OdometryReading odometer() const;
 };
+static_assert(sizeof(RobotState) == 128, "two cache lines a robot (see above)");
 
 }  // namespace rilbed::environment

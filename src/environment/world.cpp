@@ -150,7 +150,6 @@ void World::add_robot(const RobotConfig& c) {
   state.radius_m = c.radius_m;
   state.wheel_base_m = c.wheel_base_m;
   state.noise = c.noise;
-  state.sensors = c.sensors;
   // Grow the parallel arrays first (geometrically, so that adding n robots costs O(n)) so
   // that a failed allocation leaves them in step. (The suite pool and the dense id table
   // may still allocate after the pushes; the id map stays the authority for lookups.)

@@ -118,6 +118,9 @@ class World {
   /// robots' table, by place, each write was a cache miss at 100,000 robots). Throws
   /// std::invalid_argument for an unknown id.
   WheelUnits wheel_speeds(int id) const { return commands_[added_index(id)]; }
+  /// Robot `id`'s sensors as configured (RobotConfig::sensors). Throws
+  /// std::invalid_argument for an unknown id.
+  const SensorSuiteConfig& sensor_config(int id) const { return suite_configs_[suite_of_[slot(id)]]; }
   /// Sets a real robot's pose as observed (by the camera) at t_us. Throws
   /// std::invalid_argument for a virtual robot or a non-finite pose.
   void set_observed_pose(int id, Pose2 pose, TimeUs t_us);

@@ -473,6 +473,7 @@ TEST(World, TheSensorSweepKeepsEveryKindOfReading) {
         }
         try {
           world.add_robot(c);
+          EXPECT_EQ(world.sensor_config(c.id), c.sensors);
           ++id;
         } catch (const std::invalid_argument&) {
         }
