@@ -272,6 +272,8 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
         formation_(std::max<int>(1, static_cast<int>(s_.convoy_ids.size()))) {
     last_behaviour_.assign(s_.agents.size(), {});
     last_health_.assign(s_.agents.size(), "ok");
+    // The samples in one list only for those who read them (a swarm's benchmark has none).
+    listed_ = s_.recorder || s_.options->keep_in_memory || !s_.convoy_ids.empty();
     all_concurrent_ = std::all_of(s_.agents.begin(), s_.agents.end(),
                                   [](const AgentModel* a) { return a->transitions_concurrent(); });
   }
@@ -399,28 +401,24 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     read_agents(t);
     r.trajectory_digest += step_digest_;
     // Changes of health and behaviour, in agent order.
-    for (const std::size_t i : changed_) {
-      // As read_agents read them (the agents themselves are cold again by now).
-      const int id = reads_[i].id;
-      const std::string_view behaviour = reads_[i].behaviour, health = reads_[i].health;
-      if (health != last_health_[i]) {
-        record({t, "health", id, 0, std::string(last_health_[i]) + " -> " + std::string(health)});
-        last_health_[i] = health;
+    for (const AgentChange& change : changed_) {
+      const std::size_t i = change.agent;
+      if (change.health != last_health_[i]) {
+        record({t, "health", change.id, 0, std::string(last_health_[i]) + " -> " + std::string(change.health)});
+        last_health_[i] = change.health;
       }
-      if (behaviour != last_behaviour_[i]) {
+      if (change.behaviour != last_behaviour_[i]) {
         if (!last_behaviour_[i].empty()) {
-          record({t, "behaviour", id, 0,
-                                  std::string(last_behaviour_[i]) + " -> " + std::string(behaviour)});
+          record({t, "behaviour", change.id, 0,
+                  std::string(last_behaviour_[i]) + " -> " + std::string(change.behaviour)});
         }
-        last_behaviour_[i] = behaviour;
+        last_behaviour_[i] = change.behaviour;
       }
     }
-    // The samples in one list only for those who read them (a swarm's benchmark has none).
-    const bool listed = s_.recorder || s_.options->keep_in_memory || !s_.convoy_ids.empty();
     samples_.clear();
-    if (listed) {
-      for (const AgentRead& read : reads_)
-        if (read.sample) samples_.push_back(*read.sample);
+    if (listed_) {
+      for (const std::optional<TrajectorySample>& sample : read_samples_)
+        if (sample) samples_.push_back(*sample);
     }
     if (s_.recorder) s_.recorder->add_samples(samples_);
     if (s_.options->keep_in_memory) r.trajectory.insert(r.trajectory.end(), samples_.begin(), samples_.end());
@@ -440,52 +438,45 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     }
   }
 
-  // What the monitor reads of each agent at a step, read on the workers when there are.
-  struct AgentRead {
-    std::optional<TrajectorySample> sample;  // none for a real robot with no pose
-    std::uint64_t digest = 0;                // of the sample's time, id, position and heading, bit for bit
-    bool changed = false;                    // its health or behaviour changed
-    std::string_view behaviour, health;      // as read (static strings)
-    int id = 0;                              // its robot's
+  // An agent whose health or behaviour changed, as read_agents read it (static strings).
+  struct AgentChange {
+    std::size_t agent = 0;  // index in s_.agents
+    int id = 0;             // its robot's
+    std::string_view behaviour, health;
   };
   // How many agents ahead read_agents asks for an agent's body (and twice that for the agent).
   static constexpr std::size_t kReadAhead = 8;
   // Reads every agent (on the workers when they may), and sums the samples' digests and
   // lists the agents whose health or behaviour changed (in agent order) as it goes: the
   // run's thread then has no pass over every agent left (at 10,000 robots it held the
-  // other threads up).
+  // other threads up). The samples themselves are kept only when listed_ (a swarm's
+  // benchmark keeps none: at 100,000 robots writing them was 7 MB a step).
   void read_agents(TimeUs t) {
-    reads_.resize(s_.agents.size());
+    read_samples_.resize(listed_ ? s_.agents.size() : 0);
     std::mutex merge_mutex;
     step_digest_ = 0;
     changed_.clear();
     auto read = [&](std::size_t begin, std::size_t end) {
       std::uint64_t digest = 0;  // a sum: the same whatever thread made each term
-      std::vector<std::size_t> changed;
+      std::vector<AgentChange> changed;
       for (std::size_t i = begin; i < end; ++i) {
         // A swarm's agents are far apart in memory: ask for them ahead (two rounds).
         if (i + 2 * kReadAhead < end) s_.agents[i + 2 * kReadAhead]->prefetch_view(0);
         if (i + kReadAhead < end) s_.agents[i + kReadAhead]->prefetch_view(1);
         const AgentModel& a = *s_.agents[i];
-        AgentRead& out = reads_[i];
         const auto pose = a.body().pose();
+        const int id = a.body().id();
         const std::string_view behaviour = a.behaviour(), health = a.body().health();
-        out.changed = health != last_health_[i] || behaviour != last_behaviour_[i];
-        out.behaviour = behaviour;
-        out.health = health;
-        out.id = a.body().id();
-        if (out.changed) changed.push_back(i);
-        out.sample.reset();
-        out.digest = 0;
-        if (!pose) continue;
-        out.sample = TrajectorySample{t, out.id, *pose, behaviour};
-        std::uint64_t h = 0x6a09e667f3bcc909ULL;
-        for (const std::uint64_t word : {static_cast<std::uint64_t>(t), static_cast<std::uint64_t>(out.id),
+        if (health != last_health_[i] || behaviour != last_behaviour_[i]) changed.push_back({i, id, behaviour, health});
+        if (listed_) read_samples_[i].reset();
+        if (!pose) continue;  // a real robot with no pose: no sample
+        if (listed_) read_samples_[i] = TrajectorySample{t, id, *pose, behaviour};
+        std::uint64_t h = 0x6a09e667f3bcc909ULL;  // of the time, id, position and heading, bit for bit
+        for (const std::uint64_t word : {static_cast<std::uint64_t>(t), static_cast<std::uint64_t>(id),
                                          std::bit_cast<std::uint64_t>(pose->position_m.x),
                                          std::bit_cast<std::uint64_t>(pose->position_m.y),
                                          std::bit_cast<std::uint64_t>(pose->heading_rad)})
           h = environment::mix64(h ^ word) + 0x9e3779b97f4a7c15ULL;
-        out.digest = h;
         digest += h;
       }
       std::lock_guard lock(merge_mutex);
@@ -499,7 +490,8 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     } else {
       read(0, s_.agents.size());
     }
-    std::sort(changed_.begin(), changed_.end());  // chunks merge in any order
+    // Chunks merge in any order.
+    std::sort(changed_.begin(), changed_.end(), [](const AgentChange& x, const AgentChange& y) { return x.agent < y.agent; });
   }
 
   void check_formation(TimeUs t) {
@@ -556,10 +548,11 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   TimeUs t_us_ = 0;
   TimeUs next_report_us_ = 0;
   TimeUs next_overlap_check_us_ = 0;
-  std::vector<AgentRead> reads_;
-  std::uint64_t step_digest_ = 0;     // read_agents: the sum of this step's sample digests
-  std::vector<std::size_t> changed_;  // read_agents: agents whose health or behaviour changed, in order
+  std::vector<std::optional<TrajectorySample>> read_samples_;  // read_agents, when listed_: per agent
+  std::uint64_t step_digest_ = 0;       // read_agents: the sum of this step's sample digests
+  std::vector<AgentChange> changed_;    // read_agents: agents whose health or behaviour changed, in order
   bool all_concurrent_ = false;
+  bool listed_ = false;  // the samples are recorded, kept or watched by the formation monitor
   std::vector<PoseReport> reports_;
   std::vector<WheelReport> wheel_reports_;
   std::vector<SensorReport> sensor_reports_;
