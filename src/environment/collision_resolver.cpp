@@ -43,7 +43,11 @@ void CollisionResolver::begin_step() { contacts_.clear(); }
 
 void CollisionResolver::record(BodyRef a, BodyRef b) { contacts_.push_back({a, b, now_us_}); }
 
-void CollisionResolver::mark_moved(std::size_t body) {
+void CollisionResolver::mark_moved(CollisionScene& s, std::size_t body) {
+  // Its cell at once, not after the pass: a later visit in the same pass then finds it
+  // where it is, so that what a pass finds depends on the bodies alone, never on where
+  // the grid's cell boundaries fall (WorldConfig::cell_size_m).
+  s.grid.move(body, s.bodies[body].position_m);
   if (moved_[body]) return;
   moved_[body] = 1;
   moved_list_.push_back(static_cast<int>(body));
@@ -67,7 +71,6 @@ void CollisionResolver::resolve(CollisionScene& s, TimeUs t_us) {
     corrected |= robots_vs_robots(s);
     corrected |= robots_vs_movers(s);
     corrected |= robots_vs_statics(s);
-    for (const int i : moved_list_) s.grid.move(static_cast<std::size_t>(i), s.bodies[static_cast<std::size_t>(i)].position_m);
     if (!corrected) return;
     // Only the bodies moved in this pass can be in new overlaps with each other, with
     // unmoved bodies or with statics; pairs of unmoved bodies were checked already.
@@ -115,7 +118,12 @@ void CollisionResolver::for_each_by_id(const CollisionScene& s, Visit&& visit) c
 // The robots whose cells overlap `box`, by ascending id (valid until the next call).
 std::span<const std::uint32_t> CollisionResolver::robots_in_box_by_id(const CollisionScene& s, const Box& box) {
   in_box_.clear();
-  s.grid.for_each_in_box(box, [&](int j) { in_box_.push_back(static_cast<std::uint32_t>(j)); });
+  // Those whose centre is in the box, not every robot of its cells: the list must not
+  // depend on the cell size, since a visit moves the robot it visits between the list's
+  // entries.
+  s.grid.for_each_in_box(box, [&](int j) {
+    if (contains(box, s.bodies[static_cast<std::size_t>(j)].position_m)) in_box_.push_back(static_cast<std::uint32_t>(j));
+  });
   if (in_box_.size() > 1)
     std::sort(in_box_.begin(), in_box_.end(), [&](std::uint32_t a, std::uint32_t b) { return s.body_ids[a] < s.body_ids[b]; });
   return in_box_;
@@ -157,8 +165,10 @@ bool CollisionResolver::near_a_static(const CollisionScene& s, std::size_t i) co
 void CollisionResolver::mark_near_dirty(const CollisionScene& s, std::size_t moved) {
   const Body& b = s.bodies[moved];
   dirty_[moved] = 1;
-  s.grid.for_each_in_box(box_around(b.position_m, b.radius_m + s.max_body_radius_m + config_.contact_margin_m),
-                         [&](int j) { dirty_[static_cast<std::size_t>(j)] = 1; });
+  const Box box = box_around(b.position_m, b.radius_m + s.max_body_radius_m + config_.contact_margin_m);
+  s.grid.for_each_in_box(box, [&](int j) {
+    if (contains(box, s.bodies[static_cast<std::size_t>(j)].position_m)) dirty_[static_cast<std::size_t>(j)] = 1;
+  });
 }
 
 bool CollisionResolver::robots_vs_robots(CollisionScene& s) {
@@ -201,12 +211,12 @@ bool CollisionResolver::robots_vs_robots(CollisionScene& s) {
       if (bj.pushable) {
         bi.position_m = bi.position_m + normal * (0.5 * overlap);
         bj.position_m = bj.position_m - normal * (0.5 * overlap);
-        mark_moved(j);
+        mark_moved(s, j);
         if (all_active_) mark_near_dirty(s, j);
       } else {
         bi.position_m = bi.position_m + normal * overlap;
       }
-      mark_moved(i);
+      mark_moved(s, i);
       if (all_active_) mark_near_dirty(s, i);
       corrected = true;
     }
@@ -238,7 +248,7 @@ bool CollisionResolver::robots_vs_movers(CollisionScene& s) {
       const double depth = -c.separation_m;
       if (b.pushable) {
         b.position_m = b.position_m + c.normal * depth;
-        mark_moved(j);
+        mark_moved(s, j);
       } else {
         mover.translate(c.normal * -depth);
         mover.reflect_off(c.normal * -1.0);
@@ -255,7 +265,10 @@ bool CollisionResolver::robots_vs_statics(CollisionScene& s) {
   auto visit = [&](std::size_t i) {
     Body& b = s.bodies[i];
     const Box box = path_box(b.pushable ? b.previous_m : b.position_m, b.position_m, b.radius_m + margin);
-    s.statics.for_each_in_box(box, [&](const IndexedSegment& seg) {
+    // Each segment once, by index: a push off one changes what the next one sees.
+    s.statics.segments_in_box(box, in_segments_);
+    for (const std::uint32_t k : in_segments_) {
+      const IndexedSegment& seg = s.statics.segments()[k];
       if (b.pushable && path_crosses_segment(b.previous_m, b.position_m, seg.a_m, seg.b_m)) {
         // The centre went through the segment (a fast robot, or a push): put it back on
         // the side it came from, touching.
@@ -263,18 +276,18 @@ bool CollisionResolver::robots_vs_statics(CollisionScene& s) {
         const double signed_dist = (b.position_m - seg.a_m).dot(n);
         b.position_m = b.position_m + n * (b.radius_m - signed_dist);
         record(robot_ref(s, i), seg.owner);
-        mark_moved(i);
+        mark_moved(s, i);
         corrected = true;
-        return;
+        continue;
       }
       const Contact c = disc_segment_contact(b.position_m, b.radius_m, seg.a_m, seg.b_m);
-      if (c.separation_m >= margin) return;
+      if (c.separation_m >= margin) continue;
       record(robot_ref(s, i), seg.owner);
-      if (!b.pushable || c.separation_m >= -tol) return;
+      if (!b.pushable || c.separation_m >= -tol) continue;
       b.position_m = b.position_m + c.normal * -c.separation_m;
-      mark_moved(i);
+      mark_moved(s, i);
       corrected = true;
-    });
+    }
   };
   if (all_active_) {
     // Only those near a static at the start, or moved since (by a push or a mover).
@@ -294,7 +307,9 @@ bool CollisionResolver::movers_vs_statics(CollisionScene& s) {
     MovingObstacle& mover = s.movers[m];
     const BodyRef self{BodyKind::MovingObstacle, static_cast<int>(m)};
     const Box box = path_box(mover.previous_m(), mover.position_m(), mover.bounding_radius_m() + margin);
-    s.statics.for_each_in_box(box, [&](const IndexedSegment& seg) {
+    s.statics.segments_in_box(box, in_segments_);  // each once, by index (see robots_vs_statics)
+    for (const std::uint32_t k : in_segments_) {
+      const IndexedSegment& seg = s.statics.segments()[k];
       if (path_crosses_segment(mover.previous_m(), mover.position_m(), seg.a_m, seg.b_m)) {
         // Went through: mirror the reference point back across the segment's line.
         const Vec2 n = normal_towards(seg.a_m, seg.b_m, mover.previous_m());
@@ -303,18 +318,18 @@ bool CollisionResolver::movers_vs_statics(CollisionScene& s) {
         mover.reflect_off(n);
         record(self, seg.owner);
         corrected = true;
-        return;
+        continue;
       }
       const Contact c = mover_segment_contact(mover, seg.a_m, seg.b_m);
-      if (c.separation_m >= margin) return;
+      if (c.separation_m >= margin) continue;
       record(self, seg.owner);
-      if (c.separation_m >= -tol) return;
+      if (c.separation_m >= -tol) continue;
       const double depth = -c.separation_m;
       // An elastic bounce: the overshoot into the wall is mirrored out of it.
       const bool bounced = mover.reflect_off(c.normal);
       mover.translate(c.normal * (bounced ? 2.0 * depth : depth));
       corrected = true;
-    });
+    }
   }
   return corrected;
 }

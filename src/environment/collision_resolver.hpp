@@ -104,7 +104,7 @@ class CollisionResolver {
   bool robots_vs_movers(CollisionScene& s);
   bool robots_vs_statics(CollisionScene& s);
   bool movers_vs_statics(CollisionScene& s);
-  void mark_moved(std::size_t body);
+  void mark_moved(CollisionScene& s, std::size_t body);
   bool body_overlaps(const CollisionScene& s, std::size_t i) const;
   void find_contacts_ahead(const CollisionScene& s);
   bool near_another_robot(const CollisionScene& s, std::size_t i) const;
@@ -135,6 +135,7 @@ class CollisionResolver {
   std::vector<std::uint8_t> near_static_;  // at the pass's start: a wall or obstacle within contact, or crossed
   std::vector<std::uint8_t> dirty_;        // near a robot moved in this pass
   std::vector<std::uint32_t> in_box_;      // scratch of robots_in_box_by_id
+  std::vector<std::uint32_t> in_segments_;  // scratch: segments_in_box
   core::WorkerPool* workers_ = nullptr;
 };
 

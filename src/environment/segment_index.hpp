@@ -48,6 +48,13 @@ class SegmentIndex {
     }
   }
 
+  /// Fills `out` with the index (in segments()) of every segment whose bounding box,
+  /// widened by its half width, overlaps `box`: each once, in ascending order. The same
+  /// list whatever the grid's cell size, unlike for_each_in_box's visits, for callers
+  /// whose visit of one segment changes what the next one sees (a robot pushed off one
+  /// wall of a corner, then off the other).
+  void segments_in_box(const Box& box, std::vector<std::uint32_t>& out) const;
+
   /// Calls f for the segments listed in the cell holding p: every segment within its
   /// half width of p is among them (used for "is this point on a track").
   template <class F>

@@ -19,6 +19,16 @@ struct Box {
   Vec2 hi_m;  ///< upper-right corner
 };
 
+/// Whether p lies in `box` (borders included).
+inline bool contains(const Box& box, Vec2 p) {
+  return p.x >= box.lo_m.x && p.x <= box.hi_m.x && p.y >= box.lo_m.y && p.y <= box.hi_m.y;
+}
+
+/// Whether two boxes share any point (borders included).
+inline bool overlap(const Box& a, const Box& b) {
+  return a.lo_m.x <= b.hi_m.x && b.lo_m.x <= a.hi_m.x && a.lo_m.y <= b.hi_m.y && b.lo_m.y <= a.hi_m.y;
+}
+
 /// The square box of half side `half_m` around p.
 inline Box box_around(Vec2 p, double half_m) { return {{p.x - half_m, p.y - half_m}, {p.x + half_m, p.y + half_m}}; }
 

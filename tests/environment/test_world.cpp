@@ -537,14 +537,20 @@ TEST(World, SearchingContactsAheadChangesNoCollision) {
 
 // The world renumbers its slots by place as robots move (WorldConfig::reorder_every_steps):
 // a crowd that shoves moves, collides and senses exactly alike however often that
-// happens, compared robot by robot through their ids (the slots differ).
-TEST(World, RenumberingTheSlotsChangesNothing) {
+// happens, and whatever the grid's cell size, compared robot by robot through their ids
+// (the slots differ).
+TEST(World, NeitherRenumberingTheSlotsNorTheCellSizeChangesAnything) {
+  struct Setting {
+    int reorder_every_steps;
+    double cell_size_m;  // 0: the default
+  };
   for (const std::uint64_t seed : {11ULL, 4242ULL}) {
     std::vector<std::unique_ptr<World>> worlds;
-    for (const int every : {1, 0, 7}) {
+    for (const Setting setting : {Setting{1, 0.0}, Setting{0, 0.0}, Setting{7, 0.0}, Setting{20, 0.1}, Setting{20, 0.45}}) {
       WorldConfig config;
       config.noise_seed = seed;
-      config.reorder_every_steps = every;
+      config.reorder_every_steps = setting.reorder_every_steps;
+      config.cell_size_m = setting.cell_size_m;
       worlds.push_back(std::make_unique<World>(cluttered_field(), config));
       std::mt19937_64 placement(seed);
       populate(*worlds.back(), 220, placement, 0.065);
@@ -572,7 +578,7 @@ TEST(World, RenumberingTheSlotsChangesNothing) {
       }
       for (std::size_t k = 1; k < worlds.size(); ++k) {
         ASSERT_EQ(stepped[0].size(), stepped[k].size()) << "seed " << seed << " step " << step;
-        for (std::size_t e = 0; e < stepped[0].size(); ++e) ASSERT_TRUE(stepped[0][e] == stepped[k][e]);
+        for (std::size_t e = 0; e < stepped[0].size(); ++e) ASSERT_TRUE(stepped[0][e] == stepped[k][e]) << "world " << k << " step " << step << " event " << e;
         for (std::size_t i = 0; i < ids.size(); ++i)
           slots_differed |= worlds[0]->robots()[i].id != worlds[k]->robots()[i].id;
         for (const int id : ids) {
@@ -595,8 +601,9 @@ TEST(World, RenumberingTheSlotsChangesNothing) {
 // snapshot's order, the stored readings and removal all follow.
 TEST(World, RobotsKeepTheirIdsPosesAndAddedOrderWhileTheirSlotsMove) {
   World world(empty_field(2, 2));
-  // Added right to left, so that the order by place differs from the added one.
-  for (int id = 1; id <= 6; ++id) world.add_robot(quiet_robot(id, 1.9 - 0.3 * id, 0.2 + 0.25 * id, 0.1 * id));
+  // Added right to left and top to bottom, so that the order by place (grid cells by
+  // rows) differs from the added one.
+  for (int id = 1; id <= 6; ++id) world.add_robot(quiet_robot(id, 1.9 - 0.3 * id, 1.8 - 0.25 * id, 0.1 * id));
   world.set_wheel_speeds(4, 20, 30);
   world.set_wheel_speeds(6, -15, 25);
   world.step(kTick);
@@ -611,7 +618,7 @@ TEST(World, RobotsKeepTheirIdsPosesAndAddedOrderWhileTheirSlotsMove) {
     EXPECT_EQ(snap.robots[k].pose.position_m, world.robot(snap.robots[k].id).pose.position_m);
   }
   EXPECT_EQ(snap.robots[3].left_speed_units, 20);
-  EXPECT_NE(world.pose(4).position_m, (Vec2{1.9 - 1.2, 1.2}));  // it drove
+  EXPECT_NE(world.pose(4).position_m, (Vec2{1.9 - 1.2, 1.8 - 1.0}));  // it drove
   world.sense_ahead(world.time_us());
   for (int id = 1; id <= 6; ++id) {
     EXPECT_EQ(world.pose(id).position_m, world.robot(id).pose.position_m);
