@@ -25,12 +25,18 @@ AgentModel::AgentModel(Body& body, std::unique_ptr<Controller> controller, TimeU
 TimeUs AgentModel::time_advance() const { return state_.sigma_us; }
 
 void AgentModel::prefetch(int round) const {
-  // Round 0: its body's and controller's first line (its own lines were asked for
+  // Round 0: its body's and controller's first lines (its own lines were asked for
   // earlier, prefetch_bytes); round 1: what the body will touch in the world. Hints;
   // GCC and Clang on any CPU.
   if (round == 0) {
     __builtin_prefetch(body_);
-    if (controller_) __builtin_prefetch(controller_.get());
+    if (controller_) {
+      // Two lines: a controller is its vtable pointer and a configuration of a few
+      // numbers at least (a wander controller is 72 bytes), rarely aligned to a line.
+      const char* controller = reinterpret_cast<const char*>(controller_.get());
+      __builtin_prefetch(controller);
+      __builtin_prefetch(controller + 64);
+    }
   } else {
     body_->prefetch();
   }

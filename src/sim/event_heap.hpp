@@ -61,17 +61,24 @@ class EventHeap {
 
   /// Appends to `items` every item whose time is `t_us`, in no particular order.
   /// Only the subtrees whose root is due are visited (heap order).
-  void collect_at(TimeUs t_us, std::vector<std::size_t>& items) {
-    if (heap_.empty() || times_us_[heap_[0]] != t_us) return;
+  /// Stops early, returning false, once more than `limit` items are listed (some of the
+  /// due items are then listed, in no useful order): a caller that handles many due items
+  /// another way (collect_all_at) need not walk them all through the heap. True when all
+  /// due items were listed.
+  bool collect_at(TimeUs t_us, std::vector<std::size_t>& items, std::size_t limit = static_cast<std::size_t>(-1)) {
+    if (heap_.empty() || times_us_[heap_[0]] != t_us) return true;
+    const std::size_t first = items.size();
     stack_.clear();
     stack_.push_back(0);
     while (!stack_.empty()) {
       const std::size_t pos = stack_.back();
       stack_.pop_back();
       items.push_back(heap_[pos]);
+      if (items.size() - first > limit) return false;
       for (std::size_t child = 2 * pos + 1; child <= 2 * pos + 2 && child < heap_.size(); ++child)
         if (times_us_[heap_[child]] == t_us) stack_.push_back(child);
     }
+    return true;
   }
 
  private:

@@ -59,3 +59,29 @@ TEST(EventHeap, MatchesBruteForceUnderRandomUpdates) {
     }
   }
 }
+
+// With a limit, collecting says whether every due item was listed: exactly when there are
+// no more than the limit, and then it lists them all.
+TEST(EventHeap, CollectingStopsPastItsLimit) {
+  std::mt19937 random(77);
+  for (int round = 0; round < 200; ++round) {
+    const std::size_t n = 1 + random() % 300;
+    std::vector<TimeUs> times(n);
+    for (auto& t : times) t = static_cast<TimeUs>(random() % 3);
+    EventHeap heap;
+    heap.assign(times);
+    const TimeUs earliest = heap.top_time_us();
+    const auto due_count = static_cast<std::size_t>(std::count(times.begin(), times.end(), earliest));
+    const std::size_t limit = random() % (n + 1);
+    std::vector<std::size_t> due{12345};  // appended to, never cleared
+    const bool complete = heap.collect_at(earliest, due, limit);
+    EXPECT_EQ(complete, due_count <= limit) << "round " << round;
+    EXPECT_EQ(due.front(), 12345u);
+    if (complete) {
+      EXPECT_EQ(due.size() - 1, due_count);
+    } else {
+      EXPECT_EQ(due.size() - 1, limit + 1) << "it should stop at once past the limit";
+    }
+    for (std::size_t k = 1; k < due.size(); ++k) EXPECT_EQ(times[due[k]], earliest);
+  }
+}
