@@ -206,7 +206,9 @@ class World {
   std::string label(int id) const { return "robot " + std::to_string(id); }
   void check_placement_free(const std::string& what, Vec2 position_m, double radius_m, int exclude_slot) const;
   void refresh_max_radius();
-  void set_dense_slot(int id, std::int32_t s);
+  // Sets robot `id`'s slot in the dense table (-1: none); false when the id has no
+  // entry there (too large, or negative), and the hash map must hold its slot.
+  bool set_dense_slot(int id, std::int32_t s);
   // Records robot `id`'s index in added_order_ in the dense table (if it has an entry).
   void set_dense_added(int id, std::uint32_t added);
   // Robot `id`'s index in added_order_ (throws like slot()).
@@ -244,6 +246,9 @@ class World {
   std::vector<SensorSuiteConfig> suite_configs_; // their configurations
   std::vector<Motion> motion_;
   std::vector<Vec2> headings_;  // (cos, sin) of each robot's heading: computed when placed or seen, rotated by each step with the pose (equal to a few ulps)
+  // Every robot's id (has_robot); its slot, which slot() reads only for ids without a
+  // dense entry in by_id_, is kept current for those only (renumbering does not touch the
+  // others' entries).
   std::unordered_map<int, std::size_t> slot_of_;
   // Per small id: its slot (-1 for none) and its index in added_order_. An agent reads
   // both each step in id order: one sequential table, where added_of_slot_[slot] was a

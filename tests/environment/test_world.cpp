@@ -671,3 +671,41 @@ TEST(World, ARobotThatTurnedForHoursSensesAsOnePlacedAtItsPose) {
   for (const int v : *seen.proximity) lit += v > 0 ? 1 : 0;
   EXPECT_GT(lit, 0) << "the neighbour should be in view of some sensor";
 }
+
+// Ids far beyond the robot count live in the world's hash map, small ones in its dense
+// table: both are found after renumbering moves every slot, and after removals.
+TEST(World, SmallAndHugeIdsAreFoundWhileSlotsMove) {
+  WorldConfig config;
+  config.reorder_every_steps = 1;
+  World world(empty_field(3, 3), config);
+  const std::vector<int> ids = {3, 2'000'000'000, 7, 123'456'789, 1, 50'000};
+  for (std::size_t k = 0; k < ids.size(); ++k)
+    world.add_robot(quiet_robot(ids[k], 2.8 - 0.45 * static_cast<double>(k), 0.3 + 0.4 * static_cast<double>(k), 0.0));
+  for (const int id : ids) world.set_wheel_speeds(id, 30 + id % 7, 30);
+  auto check = [&](const std::vector<int>& present) {
+    for (const int id : present) {
+      ASSERT_TRUE(world.has_robot(id)) << id;
+      EXPECT_EQ(world.robot(id).id, id);
+      EXPECT_EQ(world.pose(id).position_m, world.robot(id).pose.position_m) << id;
+      EXPECT_EQ(world.wheel_speeds(id).left, 30 + id % 7) << id;
+    }
+  };
+  for (int step = 0; step < 5; ++step) {
+    world.step(kTick);
+    check(ids);
+  }
+  world.remove_robot(7);
+  world.remove_robot(2'000'000'000);
+  const std::vector<int> left = {3, 123'456'789, 1, 50'000};
+  for (int step = 0; step < 5; ++step) {
+    world.step(kTick);
+    check(left);
+  }
+  EXPECT_FALSE(world.has_robot(7));
+  EXPECT_FALSE(world.has_robot(2'000'000'000));
+  EXPECT_THROW(world.robot(2'000'000'000), std::invalid_argument);
+  world.add_robot(quiet_robot(2'000'000'000, 1.5, 2.8, 0.0));  // the id may come back
+  world.set_wheel_speeds(2'000'000'000, 30 + 2'000'000'000 % 7, 30);
+  world.step(kTick);
+  check({3, 123'456'789, 1, 50'000, 2'000'000'000});
+}
