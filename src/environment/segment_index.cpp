@@ -89,22 +89,13 @@ bool SegmentIndex::blocks_sight(Vec2 from, Vec2 to) const {
 
 void SegmentIndex::segments_in_box(const Box& box, std::vector<std::uint32_t>& out) const {
   out.clear();
-  if (segments_.empty()) return;
-  const int c0 = grid_.column(box.lo_m.x), c1 = grid_.column(box.hi_m.x);
-  const int r0 = grid_.row(box.lo_m.y), r1 = grid_.row(box.hi_m.y);
-  for (int r = r0; r <= r1; ++r) {
-    for (int c = c0; c <= c1; ++c) {
-      const int cell = grid_.cell(c, r);
-      if (!occupied(cell)) continue;
-      for (std::uint32_t k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) {
-        const IndexedSegment& seg = segments_[ids_[k]];
-        const double w = seg.half_width_m;
-        const Box bounds{{std::min(seg.a_m.x, seg.b_m.x) - w, std::min(seg.a_m.y, seg.b_m.y) - w},
-                         {std::max(seg.a_m.x, seg.b_m.x) + w, std::max(seg.a_m.y, seg.b_m.y) + w}};
-        if (overlap(bounds, box)) out.push_back(ids_[k]);
-      }
-    }
-  }
+  for_each_listed_in_box(box, [&](std::uint32_t index) {
+    const IndexedSegment& seg = segments_[index];
+    const double w = seg.half_width_m;
+    const Box bounds{{std::min(seg.a_m.x, seg.b_m.x) - w, std::min(seg.a_m.y, seg.b_m.y) - w},
+                     {std::max(seg.a_m.x, seg.b_m.x) + w, std::max(seg.a_m.y, seg.b_m.y) + w}};
+    if (overlap(bounds, box)) out.push_back(index);
+  });
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
 }

@@ -36,16 +36,7 @@ class SegmentIndex {
   /// little time and no correctness).
   template <class F>
   void for_each_in_box(const Box& box, F&& f) const {
-    if (segments_.empty()) return;
-    const int c0 = grid_.column(box.lo_m.x), c1 = grid_.column(box.hi_m.x);
-    const int r0 = grid_.row(box.lo_m.y), r1 = grid_.row(box.hi_m.y);
-    for (int r = r0; r <= r1; ++r) {
-      for (int c = c0; c <= c1; ++c) {
-        const int cell = grid_.cell(c, r);
-        if (!occupied(cell)) continue;
-        for (std::uint32_t k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) f(segments_[ids_[k]]);
-      }
-    }
+    for_each_listed_in_box(box, [&](std::uint32_t index) { f(segments_[index]); });
   }
 
   /// Fills `out` with the index (in segments()) of every segment whose bounding box,
@@ -75,6 +66,22 @@ class SegmentIndex {
   const GridGeometry& grid() const { return grid_; }
 
  private:
+  // Calls f(index in segments_) for every listing of a segment in a cell overlapping
+  // `box` (a segment once per such cell).
+  template <class F>
+  void for_each_listed_in_box(const Box& box, F&& f) const {
+    if (segments_.empty()) return;
+    const int c0 = grid_.column(box.lo_m.x), c1 = grid_.column(box.hi_m.x);
+    const int r0 = grid_.row(box.lo_m.y), r1 = grid_.row(box.hi_m.y);
+    for (int r = r0; r <= r1; ++r) {
+      for (int c = c0; c <= c1; ++c) {
+        const int cell = grid_.cell(c, r);
+        if (!occupied(cell)) continue;
+        for (std::uint32_t k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) f(ids_[k]);
+      }
+    }
+  }
+
   // Calls f(cell) for each cell the segment [a, b], widened by `margin`, may touch.
   template <class F>
   void for_each_cell_along(Vec2 a, Vec2 b, double margin, F&& f) const;
