@@ -266,8 +266,8 @@ void World::refresh_max_radius() {
 }
 
 void World::prefetch(int id) const {
-  // Its readings, pose and wheel commands are in id order, which the agents follow (the
-  // CPU's own prefetcher sees that): the id table's entry is all there is to ask for.
+  // Its readings, pose and wheel commands are in the agents' order (the CPU's own
+  // prefetcher follows that): the id table's entry, found by id, is what to ask for.
   if (id >= 0 && static_cast<std::size_t>(id) < by_id_.size()) __builtin_prefetch(&by_id_[static_cast<std::size_t>(id)]);
 }
 

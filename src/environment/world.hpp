@@ -106,9 +106,10 @@ class World {
   /// unknown id. Kept in the order robots were added, apart from the slots that move by
   /// place: agents that ask in id order read memory in order.
   Pose2 pose(int id) const { return poses_[added_index(id)]; }
-  /// A hint, no effect on results: asks the CPU for what an agent's step will touch of
-  /// robot `id` (its stored readings, pose and wheel commands), so that it arrives while
-  /// the agents before it step. Unknown ids: nothing.
+  /// A hint, no effect on results, for an agent's step a few agents ahead: asks the CPU
+  /// for robot `id`'s entry in the id table, through which the step finds the robot's
+  /// stored readings, pose and wheel commands. (Those are in the agents' order, which the
+  /// CPU's own prefetcher follows; the ids need not be.) Unknown ids: nothing.
   void prefetch(int id) const;
 
   /// Sets a robot's wheel commands, pulses per 10 ms, clamped to [-127, 127] as the
