@@ -56,16 +56,21 @@ void expect_forms_and_stops(const std::string& name, int real_robots) {
 TEST(MixedRun, ConvoyMixedFormsAndStopsItsRealRobots) { expect_forms_and_stops("convoy_mixed", 2); }
 TEST(MixedRun, ConvoyRealFormsAndStopsItsRealRobots) { expect_forms_and_stops("convoy_real", 4); }
 
-// Interrupted by `signal` 3 s into a real-time run: every real robot ends stopped.
+// Interrupted by `signal` while a real-time run goes (once it printed the status of its
+// first simulated second, not after a fixed time: a loaded machine may still be starting
+// it then): every real robot ends stopped.
 void expect_signal_stops_every_robot(const std::string& signal) {
   const fs::path dir = scratch_dir("mixed_" + signal);
   const std::string out = (dir / "out.txt").string();
   const fs::path script = dir / "interrupt.sh";
-  std::ofstream(script) << "'" << RILBED_BINARY << "' run " << shipped_scenario_arg("convoy_mixed") << " --realtime --duration 30 >'"
-                        << out << "' 2>&1 &\npid=$!\nsleep 3\nkill -" << signal << " $pid\nwait $pid\n";
+  std::ofstream(script) << "'" << RILBED_BINARY << "' run " << shipped_scenario_arg("convoy_mixed")
+                        << " --realtime --duration 60 >'" << out << "' 2>&1 &\npid=$!\n"
+                        << "i=0\nuntil grep -q '^t=[1-9]' '" << out << "' || [ $i -ge 1200 ]; do sleep 0.1; i=$((i+1)); done\n"
+                        << "kill -" << signal << " $pid\nwait $pid\n";
   const int status = std::system(("/bin/sh '" + script.string() + "'").c_str());
   EXPECT_TRUE(WIFEXITED(status));
   const std::string printed = read_file(out);
+  EXPECT_NE(printed.find("\nt=1"), std::string::npos) << "the run should have been going when interrupted: " << printed;
   EXPECT_NE(printed.find("ended by interrupt"), std::string::npos) << printed;
   EXPECT_NE(printed.find("robot 4 (emulated): last speed 0 0"), std::string::npos) << printed;
   EXPECT_NE(printed.find("robot 5 (emulated): last speed 0 0"), std::string::npos) << printed;
