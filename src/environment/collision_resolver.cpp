@@ -115,12 +115,11 @@ void CollisionResolver::for_each_by_id(const CollisionScene& s, Visit&& visit) c
   }
 }
 
-// The robots whose cells overlap `box`, by ascending id (valid until the next call).
+// The robots whose centre is in `box`, by ascending id (valid until the next call). Not
+// every robot of the box's cells: the list must not depend on the cell size, since a
+// visit moves the robot it visits between the list's entries.
 std::span<const std::uint32_t> CollisionResolver::robots_in_box_by_id(const CollisionScene& s, const Box& box) {
   in_box_.clear();
-  // Those whose centre is in the box, not every robot of its cells: the list must not
-  // depend on the cell size, since a visit moves the robot it visits between the list's
-  // entries.
   s.grid.for_each_in_box(box, [&](int j) {
     if (contains(box, s.bodies[static_cast<std::size_t>(j)].position_m)) in_box_.push_back(static_cast<std::uint32_t>(j));
   });
