@@ -84,7 +84,7 @@ void AgentModel::step() {
     state_.last = controller_->step(input);
     body_->drive(state_.last.wheels);
   }
-  state_.sensors = std::move(input.sensors);  // kept for the run's observer
+  if (keep_sensors_) sensors_ = std::move(input.sensors);  // for the run's observer
   if (profiled_) {
     times_.sensing_s += std::chrono::duration<double>(sensed - start).count();
     times_.behaviours_s += std::chrono::duration<double>(Clock::now() - sensed).count();

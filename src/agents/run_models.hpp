@@ -57,7 +57,6 @@ struct AgentState {
   TimeUs sigma_us = 0;             ///< time left to the next control step
   std::shared_ptr<const std::vector<TeamMessage>> team;  ///< the latest broadcast, as received (shared, not copied)
   ControlOutput last;              ///< the last command applied to the body
-  environment::SensorReadings sensors;  ///< what its controller read at the last step
   bool commanded = false;          ///< it obeys the "command" input (central mode), its controller idle
   std::optional<ManualDrive> manual;  ///< driven by hand (its controller and commands set aside) until then
 };
@@ -100,9 +99,12 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   /// The active behaviour (a static string), "idle" before the first step.
   std::string_view behaviour() const { return state_.last.behaviour; }
   const WheelCommand& wheels() const { return state_.last.wheels; }
-  /// What its controller read at its last step (empty before the first, and for a
-  /// commanded agent, which reads nothing).
-  const environment::SensorReadings& sensors() const { return state_.sensors; }
+  /// What its controller read at its last step (empty before the first, for a
+  /// commanded agent, which reads nothing, and when not kept: set_keep_sensors).
+  const environment::SensorReadings& sensors() const { return sensors_; }
+  /// Whether sensors() keeps each step's readings (the default): a run whose observer
+  /// may ask for them keeps them; a swarm's benchmark, with none, spares the copy.
+  void set_keep_sensors(bool on) { keep_sensors_ = on; }
   /// Tells the controller the run ended (Controller::finish) and stops the body.
   void finish();
   /// Times its sensing and its controller's steps (times()), or not.
@@ -126,23 +128,31 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
       __builtin_prefetch(body_);
     }
   }
-  std::size_t prefetch_bytes() const override { return sizeof(*this); }
+  /// The lines a step touches: those up to keep_sensors_ (see the members' order).
+  std::size_t prefetch_bytes() const override {
+    return static_cast<std::size_t>(reinterpret_cast<const char*>(&keep_sensors_ + 1) - reinterpret_cast<const char*>(this));
+  }
 
  private:
-  Body* body_;  // never null (a pointer, so that prefetch_view can name its line)
-  bool profiled_ = false;
-  RunProfile times_;  // its own (agents may step on several threads at once)
-  std::unique_ptr<Controller> controller_;
-  TimeUs period_us_;
-  AgentExchange* remote_ = nullptr;  // serves this robot, or null
-  bool remote_done_ = false;         // the remote controller's done() at its last answer
   void apply(const ConsoleOrder& order);
   // Its own step: sense, decide (controller or hand), drive.
   void step();
 
+  // What every step touches first, together after the state (a swarm's agents are cold
+  // at each step: the fewer lines, the fewer waits on memory); what it rarely touches
+  // after, from the ports on (prefetch_bytes).
+  Body* body_;  // never null (a pointer, so that prefetch_view can name its line)
+  std::unique_ptr<Controller> controller_;
+  TimeUs period_us_;
+  AgentExchange* remote_ = nullptr;  // serves this robot, or null
+  bool profiled_ = false;
+  bool remote_done_ = false;         // the remote controller's done() at its last answer
+  bool keep_sensors_ = true;
   sim::Port<TeamBroadcast>& team_in_;
   sim::Port<AgentCommand>& command_in_;
   sim::Port<ConsoleOrder>& console_in_;
+  RunProfile times_;  // its own (agents may step on several threads at once)
+  environment::SensorReadings sensors_;  // what its controller read at its last step, when kept
 };
 
 /// Broadcasts every agent's pose and behaviour to the team every period.

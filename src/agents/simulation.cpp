@@ -905,6 +905,9 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
     agents.push_back(&root->emplace<AgentModel>(*bodies[i], std::move(controller), scenario.control_period_us, 0, commanded,
                                                 options.remote_agents));
   }
+  // The readings each step are kept for an observer only (the GUI and the bus report them).
+  if (!options.observer)
+    for (AgentModel* a : agents) a->set_keep_sensors(false);
   RunProfile profile;
   if (options.profile) {
     for (AgentModel* a : agents) a->set_profile(true);

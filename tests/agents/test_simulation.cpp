@@ -167,6 +167,29 @@ TEST(Simulation, BeaconHomersReachTheBeacon) {
   EXPECT_GE(arrived, 3) << "robots within 0.35 m of beacon 2 at the end";
 }
 
+// An observer gets every robot's readings at every step (the run keeps them for it; a
+// run without one does not), each stamped with the step's instant.
+TEST(Simulation, AnObserverGetsEachStepsSensorReadings) {
+  struct Readings final : RunObserver {
+    int steps = 0, reports = 0, with_proximity = 0;
+    void on_sensors(TimeUs t_us, std::span<const SensorReport> sensors) override {
+      ++steps;
+      for (const SensorReport& r : sensors) {
+        ++reports;
+        if (r.readings->proximity && r.readings->t_us == t_us) ++with_proximity;
+      }
+    }
+  } readings;
+  const Scenario s = shipped("wander");
+  RunOptions o;
+  o.duration_s = 2.0;
+  o.observer = &readings;
+  run_scenario(s, o);
+  EXPECT_GE(readings.steps, 19);
+  EXPECT_EQ(readings.reports, readings.steps * static_cast<int>(s.robots.size()));
+  EXPECT_EQ(readings.with_proximity, readings.reports);  // each the step's own reading
+}
+
 TEST(Simulation, StatusLineOncePerSimulatedSecond) {
   // Control periods that divide a second and ones that do not: one status line per
   // simulated second, never the same time twice, each within a control period of its
