@@ -51,6 +51,7 @@ void CollisionResolver::mark_moved(CollisionScene& s, std::size_t body) {
   if (moved_[body]) return;
   moved_[body] = 1;
   moved_list_.push_back(static_cast<int>(body));
+  pushed_.push_back(static_cast<int>(body));
 }
 
 void CollisionResolver::resolve(CollisionScene& s, TimeUs t_us) {
@@ -58,6 +59,7 @@ void CollisionResolver::resolve(CollisionScene& s, TimeUs t_us) {
   const std::size_t n = s.bodies.size();
   is_active_.assign(n, 0);
   moved_.assign(n, 0);
+  pushed_.clear();
   active_.clear();
   all_active_ = true;
   s.grid.refresh(n, [&](std::size_t i) { return s.bodies[i].position_m; });
@@ -387,6 +389,7 @@ void CollisionResolver::fall_back(CollisionScene& s) {
       if (!b.pushable || reverted_[i] || !body_overlaps(s, i)) continue;
       b.position_m = b.previous_m;
       s.grid.move(i, b.position_m);
+      pushed_.push_back(static_cast<int>(i));
       reverted_[i] = 1;
       enqueue_neighbours(b.position_m, b.radius_m);
     }

@@ -90,6 +90,10 @@ class CollisionResolver {
   void set_workers(core::WorkerPool* pool) { workers_ = pool; }
   /// The events of the last ended step.
   std::span<const CollisionEvent> events() const { return events_; }
+  /// The bodies (indices into the scene's) whose positions the last resolve() changed,
+  /// some maybe more than once: those whose step-end pose a caller set before it must set
+  /// again.
+  std::span<const int> pushed() const { return pushed_; }
 
  private:
   struct ContactRecord {
@@ -125,6 +129,7 @@ class CollisionResolver {
   // Active-set bookkeeping: bodies to visit in this pass, bodies moved in this pass.
   std::vector<int> active_;
   std::vector<int> moved_list_;
+  std::vector<int> pushed_;  // see pushed()
   std::vector<std::uint8_t> is_active_;
   std::vector<std::uint8_t> moved_;
   std::vector<std::uint8_t> reverted_;

@@ -362,61 +362,50 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us) {
   constexpr double kMaxSubsteps = 100000.0;
   const int substeps = static_cast<int>(std::clamp(std::ceil(max_travel_m / substep_limit_m()), 1.0, kMaxSubsteps));
   const double h_s = dt_s / substeps;
-  for_robot_slots([&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      const RobotState& r = robots_[i];
-      if (r.kind != RobotKind::Virtual) continue;
-      Motion& m = motion_[i];
-      const ArcStep arc = diff_drive_arc(m.local_step_m.x, m.local_step_m.y, r.wheel_base_m, h_s);
-      m.local_step_m = arc.local_displacement_m;
-      m.cos_turn = arc.cos_heading_change;
-      m.sin_turn = arc.sin_heading_change;
-      m.heading = headings_[i];  // cos and sin of r.pose.heading_rad
-      m.end_heading_rad = r.pose.heading_rad + arc.heading_change_rad * substeps;
-    }
-  });
+  if (substeps > 1) {
+    // start_wheels made each robot's arc for one substep: shorter ones, from the speeds.
+    for_robot_slots([&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const RobotState& r = robots_[i];
+        if (r.kind == RobotKind::Virtual) set_arc(i, motion_[i].wheels_mps, r.wheel_base_m, h_s, substeps);
+      }
+    });
+  }
 
   CollisionScene cs{bodies_, ids_, grid_, statics_, movers_, max_radius_m_, id_order_};
   resolver_.begin_step();
+  const TimeUs end_t_us = t_us_ + dt_us;
   for (int k = 0; k < substeps; ++k) {
     for (MovingObstacle& m : movers_) {
       m.begin_substep();
       m.translate(m.velocity_mps() * h_s);
     }
+    const bool last = k + 1 == substeps;
     for_robot_slots([&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         Body& b = bodies_[i];
         b.previous_m = b.position_m;
-        if (!b.pushable) continue;
+        if (!b.pushable) continue;  // a real robot: only the camera moves it
         Motion& m = motion_[i];
         const Vec2 d = m.local_step_m;
         b.position_m = b.position_m + Vec2{m.heading.x * d.x - m.heading.y * d.y, m.heading.y * d.x + m.heading.x * d.y};
         m.heading = {m.heading.x * m.cos_turn - m.heading.y * m.sin_turn, m.heading.y * m.cos_turn + m.heading.x * m.sin_turn};
+        // The step's end pose at once, while the records are in cache (a pass of its own
+        // read them from memory again at 100,000 robots); the few robots the collisions
+        // below push are set again after them.
+        if (last) finish_move(i, end, end_t_us);
       }
     });
     const Clock::time_point resolving = Clock::now();
     resolver_.resolve(cs, t_us_ + dt_us * (k + 1) / substeps);
     collisions_s += std::chrono::duration<double>(Clock::now() - resolving).count();
   }
-
-  t_us_ += dt_us;
-  for_robot_slots([&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      RobotState& r = robots_[i];
-      if (r.kind != RobotKind::Virtual) continue;
-      r.pose = {bodies_[i].position_m, wrap_rad_pi(motion_[i].end_heading_rad)};
-      r.pose_t_us = t_us_;
-      // poses_ is in added order, far from this slot's: ask for the one a few robots on.
-      if (i + kStorePrefetch < end) __builtin_prefetch(&poses_[added_of_slot_[i + kStorePrefetch]], 1);
-      poses_[added_of_slot_[i]] = r.pose;
-      // The substeps rotated the heading vector as far as the heading turned: no sine
-      // and cosine per robot (they were a twentieth of a step). One Newton step on 1/|h|
-      // keeps it of unit length (rotations are exact to a few ulps; this stops the drift).
-      const Vec2 h = motion_[i].heading;
-      const double rescale = 1.5 - 0.5 * (h.x * h.x + h.y * h.y);
-      headings_[i] = {h.x * rescale, h.y * rescale};
-    }
-  });
+  for (const int pushed : resolver_.pushed()) {
+    const auto i = static_cast<std::size_t>(pushed);
+    robots_[i].pose.position_m = bodies_[i].position_m;
+    poses_[added_of_slot_[i]].position_m = bodies_[i].position_m;
+  }
+  t_us_ = end_t_us;
   step_times_.collisions_s += collisions_s;
   step_times_.integration_s += std::chrono::duration<double>(Clock::now() - started).count() - collisions_s;
   return resolver_.end_step();
@@ -448,10 +437,38 @@ double World::start_wheels(std::size_t begin, std::size_t end, double dt_s) {
       r.right_wheel_travel_m += right_cmd * dt_s;
     }
     max_travel_m = std::max(max_travel_m, std::abs(0.5 * (left_mps + right_mps)) * dt_s);
-    // Stash the speeds in the motion record; the substep arc needs the substep count.
-    motion_[i].local_step_m = {left_mps, right_mps};
+    // The arc for the whole step as one substep (the usual case), here while the robot's
+    // records are in cache: a pass of its own read them from memory again. step()
+    // redoes it, from the speeds kept, when the step needs substeps.
+    motion_[i].wheels_mps = {left_mps, right_mps};
+    set_arc(i, motion_[i].wheels_mps, r.wheel_base_m, dt_s, 1);
   }
   return max_travel_m;
+}
+
+void World::set_arc(std::size_t i, Vec2 wheels_mps, double wheel_base_m, double h_s, int substeps) {
+  Motion& m = motion_[i];
+  const ArcStep arc = diff_drive_arc(wheels_mps.x, wheels_mps.y, wheel_base_m, h_s);
+  m.local_step_m = arc.local_displacement_m;
+  m.cos_turn = arc.cos_heading_change;
+  m.sin_turn = arc.sin_heading_change;
+  m.heading = headings_[i];  // cos and sin of robots_[i].pose.heading_rad
+  m.end_heading_rad = robots_[i].pose.heading_rad + arc.heading_change_rad * substeps;
+}
+
+void World::finish_move(std::size_t i, std::size_t end, TimeUs end_t_us) {
+  RobotState& r = robots_[i];
+  r.pose = {bodies_[i].position_m, wrap_rad_pi(motion_[i].end_heading_rad)};
+  r.pose_t_us = end_t_us;
+  // poses_ is in added order, far from this slot's: ask for the one a few robots on.
+  if (i + kStorePrefetch < end) __builtin_prefetch(&poses_[added_of_slot_[i + kStorePrefetch]], 1);
+  poses_[added_of_slot_[i]] = r.pose;
+  // The substeps rotated the heading vector as far as the heading turned: no sine and
+  // cosine per robot (they were a twentieth of a step). One Newton step on 1/|h| keeps it
+  // of unit length (rotations are exact to a few ulps; this stops the drift).
+  const Vec2 h = motion_[i].heading;
+  const double rescale = 1.5 - 0.5 * (h.x * h.x + h.y * h.y);
+  headings_[i] = {h.x * rescale, h.y * rescale};
 }
 
 SensorReadings World::sense(int id, TimeUs t_us) const {

@@ -196,6 +196,7 @@ class World {
   // the rotation per substep (exact arc, applied by rotating a unit heading vector, so
   // that a substep costs no trigonometry).
   struct Motion {
+    Vec2 wheels_mps;  // left (x) and right (y) ground speeds over the step
     Vec2 local_step_m;
     double cos_turn = 1.0, sin_turn = 0.0;
     Vec2 heading;  // unit, current substep
@@ -225,6 +226,11 @@ class World {
       body(0, robots_.size());
   }
   double start_wheels(std::size_t begin, std::size_t end, double dt_s);
+  // Sets motion_[i] for substeps of h_s seconds each, from the wheels' ground speeds.
+  void set_arc(std::size_t i, Vec2 wheels_mps, double wheel_base_m, double h_s, int substeps);
+  // The end of virtual robot i's move in a step ending at end_t_us: its pose (and poses_)
+  // and its heading vector, renormalised. `end`: the end of the caller's run of slots.
+  void finish_move(std::size_t i, std::size_t end, TimeUs end_t_us);
   // What can change a reading happened: sense_ahead's store is stale.
   void changed() { ahead_valid_ = false; }
   void renumber_by_place();
