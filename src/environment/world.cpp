@@ -402,6 +402,7 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us) {
   }
   for (const int pushed : resolver_.pushed()) {
     const auto i = static_cast<std::size_t>(pushed);
+    if (robots_[i].kind != RobotKind::Virtual) continue;  // (the resolver pushes none: they are not pushable)
     robots_[i].pose.position_m = bodies_[i].position_m;
     poses_[added_of_slot_[i]].position_m = bodies_[i].position_m;
   }
