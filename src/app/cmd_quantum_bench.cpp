@@ -151,8 +151,8 @@ int quantum_bench_command(const QuantumBenchArgs& args) {
     grid.emplace_back(1000, 8);
     quanta_of[1000] = std::max(50, args.quanta / 5);
   } else {
-    const IdListResult robots = parse_id_list(args.robots, 1, 100'000);
-    const IdListResult processes = parse_id_list(args.processes, 1, 64);
+    const IdListResult robots = parse_id_list(args.robots, 1, 100'000, "list");
+    const IdListResult processes = parse_id_list(args.processes, 1, 64, "list");
     if (!robots.ok() || !processes.ok()) {
       spdlog::error("quantum-bench: {}", !robots.ok() ? "--robots: " + robots.error : "--processes: " + processes.error);
       return kExitUsage;

@@ -77,12 +77,12 @@ void print_splits(const std::vector<Split>& splits) {
 }
 
 int bench_command(const BenchArgs& args) {
-  const auto counts = parse_id_list(args.robots, 1, 1'000'000);
+  const auto counts = parse_id_list(args.robots, 1, 1'000'000, "list");
   if (!counts.ok()) {
     spdlog::error("--robots: {}", counts.error);
     return kExitUsage;
   }
-  const auto thread_counts = parse_id_list(args.threads, 1, 256);
+  const auto thread_counts = parse_id_list(args.threads, 1, 256, "list");
   if (!thread_counts.ok()) {
     spdlog::error("--threads: {}", thread_counts.error);
     return kExitUsage;

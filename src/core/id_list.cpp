@@ -23,10 +23,10 @@ std::optional<int> parse_int(std::string_view s) {
 
 }  // namespace
 
-IdListResult parse_id_list(std::string_view text, int min_id, int max_id) {
+IdListResult parse_id_list(std::string_view text, int min_id, int max_id, std::string_view what) {
   IdListResult result;
   if (trim(text).empty()) {
-    result.error = "empty ID list";
+    result.error = "empty " + std::string(what);
     return result;
   }
   std::size_t start = 0;
@@ -38,11 +38,11 @@ IdListResult parse_id_list(std::string_view text, int min_id, int max_id) {
     std::optional<int> lo = parse_int(dash == std::string_view::npos ? item : item.substr(0, dash));
     std::optional<int> hi = dash == std::string_view::npos ? lo : parse_int(item.substr(dash + 1));
     if (!lo || !hi || *lo > *hi) {
-      result.error = "bad ID list item '" + std::string(item) + "' (expected N or A-B with A<=B)";
+      result.error = "bad " + std::string(what) + " item '" + std::string(item) + "' (expected N or A-B with A<=B)";
       return result;
     }
     if (*lo < min_id || *hi > max_id) {
-      result.error = "ID list item '" + std::string(item) + "' is outside " +
+      result.error = std::string(what) + " item '" + std::string(item) + "' is outside " +
                      std::to_string(min_id) + ".." + std::to_string(max_id);
       return result;
     }

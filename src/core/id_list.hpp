@@ -17,8 +17,9 @@ struct IdListResult {
 };
 
 /// Parses a comma-separated list of IDs and inclusive ranges ("1-8", "2,4,9-12").
-/// Every ID must lie in [min_id, max_id]. Whitespace around items is ignored.
-IdListResult parse_id_list(std::string_view text, int min_id, int max_id);
+/// Every ID must lie in [min_id, max_id]. Whitespace around items is ignored. `what`
+/// names the list in errors ("ID list"; a list of counts says "list").
+IdListResult parse_id_list(std::string_view text, int min_id, int max_id, std::string_view what = "ID list");
 
 /// IDs as people read them: "4, 5, 7" (in the order given; empty for none).
 std::string id_list_text(const std::vector<int>& ids);

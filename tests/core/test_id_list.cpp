@@ -32,6 +32,13 @@ TEST(IdList, RejectsGarbage) {
   EXPECT_FALSE(parse_id_list("1-", 1, 8).ok());
 }
 
+TEST(IdList, ErrorsNameTheListAsTheCallerCallsIt) {
+  EXPECT_EQ(parse_id_list("x", 1, 8).error, "bad ID list item 'x' (expected N or A-B with A<=B)");
+  EXPECT_EQ(parse_id_list("1000,2", 1, 100, "list").error, "list item '1000' is outside 1..100");
+  EXPECT_EQ(parse_id_list("2,abc", 1, 100, "list").error, "bad list item 'abc' (expected N or A-B with A<=B)");
+  EXPECT_EQ(parse_id_list(" ", 1, 8, "list").error, "empty list");
+}
+
 TEST(IdList, RangesTextIsShortAndReadsBackTheSameIds) {
   EXPECT_EQ(id_ranges_text({}), "");
   EXPECT_EQ(id_ranges_text({5}), "5");
