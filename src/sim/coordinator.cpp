@@ -84,6 +84,7 @@ Coordinator::Coordinator(std::shared_ptr<Component> root, Clock& clock)
     slot.concurrent = atomic->transitions_concurrent();
     slot.prefetch_bytes = atomic->prefetch_bytes();
     for (const auto& port : atomic->outputs()) slot.outputs.push_back(resolve(*port));
+    marks_.push_back(slot.outputs.empty() ? 0 : kHasOutputs);
     slots_.push_back(std::move(slot));
   }
   for (const auto& port : root_->inputs())
@@ -184,10 +185,10 @@ void Coordinator::route(const Route& route) {
   for (const Destination& destination : route.destinations) {
     destination.port->append_from(*route.source);
     if (destination.atomic == kNotAtomic) continue;
-    Slot& slot = slots_[destination.atomic];
-    if (slot.influenced) continue;
-    slot.influenced = true;
-    if (!slot.imminent) active_.push_back(destination.atomic);  // imminent ones are listed
+    std::uint8_t& marks = marks_[destination.atomic];
+    if (marks & kInfluenced) continue;
+    marks |= kInfluenced;
+    if (!(marks & kImminent)) active_.push_back(destination.atomic);  // imminent ones are listed
   }
 }
 
@@ -203,9 +204,9 @@ void Coordinator::deliver_injections() {
     if (root_input.source->empty()) continue;
     if (root_is_atomic_) {
       // The root's input is the atomic's own input: nothing to copy, nothing to clear.
-      Slot& slot = slots_[0];
-      if (!slot.influenced && !slot.imminent) active_.push_back(0);
-      slot.influenced = true;
+      std::uint8_t& marks = marks_[0];
+      if (!(marks & (kInfluenced | kImminent))) active_.push_back(0);
+      marks |= kInfluenced;
     } else {
       route(root_input);
       root_input.source->clear();
@@ -217,9 +218,10 @@ void Coordinator::transition(std::size_t index, TimeUs t_us) {
   Slot& slot = slots_[index];
   Atomic& model = *slot.model;
   const TimeUs elapsed_us = t_us - slot.last_t_us;
-  if (slot.imminent && slot.influenced)
+  const std::uint8_t marks = marks_[index];
+  if ((marks & kImminent) && (marks & kInfluenced))
     guarded(model, "confluent_transition", t_us, [&] { model.confluent_transition(elapsed_us); });
-  else if (slot.imminent)
+  else if (marks & kImminent)
     guarded(model, "internal_transition", t_us, [&] { model.internal_transition(); });
   else
     guarded(model, "external_transition", t_us, [&] { model.external_transition(elapsed_us); });
@@ -229,9 +231,9 @@ void Coordinator::settle(std::size_t k, TimeUs t_us, TimeUs next_us, bool bulk) 
   const std::size_t index = active_[k];
   Slot& slot = slots_[index];
   Atomic& model = *slot.model;
-  if (slot.influenced)
+  if (marks_[index] & kInfluenced)
     for (const auto& input : model.inputs()) input->clear();
-  slot.imminent = slot.influenced = false;
+  marks_[index] &= kHasOutputs;
   slot.last_t_us = t_us;
   if (bulk)
     schedule_.set_time_unordered(index, next_us);  // distinct items: safe from several threads
@@ -305,21 +307,26 @@ void Coordinator::do_step(TimeUs t_us) {
   const std::size_t imminent_count = active_.size();
 
   // Parallel DEVS: every imminent output is collected before any transition.
+  emitting_.clear();
   for (std::size_t i = 0; i < imminent_count; ++i) {
-    Slot& slot = slots_[active_[i]];
-    slot.imminent = true;
+    std::uint8_t& marks = marks_[active_[i]];
+    marks |= kImminent;
     // A model without output ports has nothing to output (output() must not change its
     // state): not calling it spares a swarm's agents a visit each.
-    if (!slot.outputs.empty()) guarded(*slot.model, "output", t_us, [&] { slot.model->output(); });
+    if (marks & kHasOutputs) emitting_.push_back(active_[i]);
   }
-  for (std::size_t i = 0; i < imminent_count; ++i)
-    for (const Route& output : slots_[active_[i]].outputs) route(output);
+  for (const std::size_t index : emitting_) {
+    Atomic& model = *slots_[index].model;
+    guarded(model, "output", t_us, [&] { model.output(); });
+  }
+  for (const std::size_t index : emitting_)
+    for (const Route& output : slots_[index].outputs) route(output);
   if (has_injections_.load(std::memory_order_acquire)) deliver_injections();
 
   for (const OutputListener& listener : output_listeners_)
     if (!listener.port->empty()) listener.call(t_us);
-  for (std::size_t i = 0; i < imminent_count; ++i)
-    for (const Route& output : slots_[active_[i]].outputs) output.source->clear();
+  for (const std::size_t index : emitting_)
+    for (const Route& output : slots_[index].outputs) output.source->clear();
   for (const auto& port : root_->outputs()) port->clear();
 
   // Influenced atomics were appended after the imminent ones: restore flat order (the
