@@ -46,7 +46,18 @@ class SpatialGrid {
       rebuild(count, positions_of);
       return;
     }
+    // The cells a move touches are far apart in a large grid (a cache miss each at
+    // 100,000 robots): a robot's old and new cells' heads are asked for a few robots ahead.
+    constexpr std::size_t kAhead = 16;
     for (std::size_t i = 0; i < count; ++i) {
+      if (i + kAhead < count) {
+        const int ahead = geometry_.cell_of(positions_of(i + kAhead));
+        const int was = cell_of_[i + kAhead];
+        if (ahead != was) {
+          __builtin_prefetch(&head_[static_cast<std::size_t>(was)], 1);
+          __builtin_prefetch(&head_[static_cast<std::size_t>(ahead)], 1);
+        }
+      }
       const int cell = geometry_.cell_of(positions_of(i));
       if (cell == cell_of_[i]) continue;
       unlink(static_cast<std::int32_t>(i));
