@@ -196,7 +196,6 @@ class World {
   // the rotation per substep (exact arc, applied by rotating a unit heading vector, so
   // that a substep costs no trigonometry).
   struct Motion {
-    Vec2 wheels_mps;  // left (x) and right (y) ground speeds over the step
     Vec2 local_step_m;
     double cos_turn = 1.0, sin_turn = 0.0;
     Vec2 heading;  // unit, current substep
@@ -225,12 +224,21 @@ class World {
     else
       body(0, robots_.size());
   }
+  // Each virtual robot's wheel speeds for a step of dt_s (step_wheels_mps_) and odometer;
+  // returns the longest distance one of them travels.
   double start_wheels(std::size_t begin, std::size_t end, double dt_s);
   // Sets motion_[i] for substeps of h_s seconds each, from the wheels' ground speeds.
   void set_arc(std::size_t i, Vec2 wheels_mps, double wheel_base_m, double h_s, int substeps);
-  // The end of virtual robot i's move in a step ending at end_t_us: its pose (and poses_)
-  // and its heading vector, renormalised. `end`: the end of the caller's run of slots.
-  void finish_move(std::size_t i, std::size_t end, TimeUs end_t_us);
+  // One of several substeps of a step (motion_ set by set_arc) for slots [begin, end);
+  // `last`: the step's last, which sets the end poses (finish_move).
+  void move_substep(std::size_t begin, std::size_t end, bool last, TimeUs end_t_us);
+  // A step of dt_s taken as one substep (the usual case): each robot's arc, move and end
+  // pose in one pass over slots [begin, end), with no Motion stored and read again.
+  void move_whole_step(std::size_t begin, std::size_t end, double dt_s, TimeUs end_t_us);
+  // The end of virtual robot i's move in a step ending at end_t_us: its pose (and poses_),
+  // heading end_heading_rad, and its heading vector `heading`, renormalised. `end`: the end
+  // of the caller's run of slots.
+  void finish_move(std::size_t i, std::size_t end, TimeUs end_t_us, Vec2 heading, double end_heading_rad);
   // What can change a reading happened: sense_ahead's store is stale.
   void changed() { ahead_valid_ = false; }
   void renumber_by_place();
@@ -251,7 +259,8 @@ class World {
   std::vector<std::uint32_t> suite_of_;          // per slot: its suite in suite_pool_
   std::vector<SensorSuite> suite_pool_;          // the distinct suites
   std::vector<SensorSuiteConfig> suite_configs_; // their configurations
-  std::vector<Motion> motion_;
+  std::vector<Motion> motion_;  // a step's substeps (only when it has more than one)
+  std::vector<Vec2> step_wheels_mps_;  // per slot: left (x) and right (y) ground speeds over the step
   std::vector<Vec2> headings_;  // (cos, sin) of each robot's heading: computed when placed or seen, rotated by each step with the pose (equal to a few ulps)
   // Every robot's id (has_robot); its slot, which slot() reads only for ids without a
   // dense entry in by_id_, is kept current for those only (renumbering does not touch the
