@@ -106,6 +106,8 @@ class World {
   /// unknown id. Kept in the order robots were added, apart from the slots that move by
   /// place: agents that ask in id order read memory in order.
   Pose2 pose(int id) const { return poses_[added_index(id)]; }
+  /// Every robot's pose(), by index in ids_in_added_order() (valid until the world changes).
+  std::span<const Pose2> poses_in_added_order() const { return poses_; }
   /// A hint, no effect on results, for an agent's step a few agents ahead: asks the CPU
   /// for robot `id`'s entry in the id table, through which the step finds the robot's
   /// stored readings, pose and wheel commands. (Those are in the agents' order, which the

@@ -190,6 +190,28 @@ TEST(Simulation, AnObserverGetsEachStepsSensorReadings) {
   EXPECT_EQ(readings.with_proximity, readings.reports);  // each the step's own reading
 }
 
+TEST(Simulation, TheDigestIsTheSameWhetherTheSamplesAreKeptOrNot) {
+  // With nobody taking samples or events the monitor sums the digest from the world's
+  // tables; keeping the samples in memory makes it read every agent's body. The same
+  // terms must give the same sum, on one thread and on two.
+  const int robots = 300;
+  const Scenario s = wandering_scenario(robots, 3.0);
+  for (const int threads : {1, 2}) {
+    RunOptions plain;
+    plain.duration_s = 3.0;
+    plain.seed = 11;
+    plain.threads = threads;
+    RunOptions kept = plain;
+    kept.keep_in_memory = true;
+    const RunResult from_world = run_scenario(s, plain);
+    const RunResult from_agents = run_scenario(s, kept);
+    EXPECT_TRUE(from_world.trajectory.empty());
+    ASSERT_EQ(from_agents.trajectory.size(), static_cast<std::size_t>(robots) * 30) << threads << " threads";
+    EXPECT_NE(from_world.trajectory_digest, 0u);
+    EXPECT_EQ(from_world.trajectory_digest, from_agents.trajectory_digest) << threads << " threads";
+  }
+}
+
 TEST(Simulation, StatusLineOncePerSimulatedSecond) {
   // Control periods that divide a second and ones that do not: one status line per
   // simulated second, never the same time twice, each within a control period of its
