@@ -97,7 +97,9 @@ void CollisionResolver::find_contacts_ahead(const CollisionScene& s) {
   // In slot order, which the World keeps by place: neighbours are still in cache, and
   // each thread writes its own stretch of the flags.
   auto check = [&](std::size_t begin, std::size_t end) {
+    constexpr std::size_t kAhead = 8;
     for (std::size_t i = begin; i < end; ++i) {
+      if (i + kAhead < end) s.grid.prefetch_around(i + kAhead);
       near_robot_[i] = s.bodies[i].pushable && near_another_robot(s, i) ? 1 : 0;
       near_static_[i] = near_a_static(s, i) ? 1 : 0;
     }

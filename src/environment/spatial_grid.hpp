@@ -3,6 +3,7 @@
 // linearly in the number of robots.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -63,6 +64,18 @@ class SpatialGrid {
       unlink(static_cast<std::int32_t>(i));
       link(static_cast<std::int32_t>(i), cell);
     }
+  }
+  /// A hint, for a pass over the items in order that queries around each: asks for the
+  /// list heads of item `item`'s cell and of the cells above and below it (in its 8 x 8
+  /// block, so a line each). In a large grid they are cold (the heads of 100,000 robots'
+  /// cells are 1.5 MB, most of them empty cells).
+  void prefetch_around(std::size_t item) const {
+    const int cell = cell_of_[item];
+    const int last = static_cast<int>(head_.size()) - 1;
+    const int block_row = GridGeometry::kBlock;
+    __builtin_prefetch(&head_[static_cast<std::size_t>(std::max(cell - block_row, 0))]);
+    __builtin_prefetch(&head_[static_cast<std::size_t>(cell)]);
+    __builtin_prefetch(&head_[static_cast<std::size_t>(std::min(cell + block_row, last))]);
   }
   /// Adds item size() at p.
   void push_back(Vec2 p);

@@ -563,7 +563,10 @@ void World::sense_ahead(TimeUs t_us) {
     for (std::size_t s = begin; s < end; ++s) {
       // The store is in the agents' order, so each robot's record is far from the last
       // one's: ask for it (for writing) a few robots ahead. A hint; GCC and Clang on any CPU.
-      if (s + kStorePrefetch < end) __builtin_prefetch(&ahead_[added_of_slot_[s + kStorePrefetch]], 1);
+      if (s + kStorePrefetch < end) {
+        __builtin_prefetch(&ahead_[added_of_slot_[s + kStorePrefetch]], 1);
+        grid_.prefetch_around(s + kStorePrefetch);
+      }
       sense_slot(sc, s, t_us, readings);
       store_readings(added_of_slot_[s], readings);
     }
