@@ -130,7 +130,8 @@ TEST(RunGui, ServesItsOwnRunAndADrivenRobotStopsWhenItsKeysStopAndItsDriverGoes)
   const std::string codes = read_file(dir / "codes.txt");
   const std::string printed = read_file(dir / "run.txt") + read_file(dir / "run.err");
   for (const char* line : {"drive 0", "exit 0", "run 0"}) {
-    EXPECT_NE(codes.find(line), std::string::npos) << line << "\n" << codes << printed << read_file(dir / "drive.txt");
+    EXPECT_NE(codes.find(line), std::string::npos) << line << "\n" << codes << printed << read_file(dir / "exit.txt")
+                                                   << read_file(dir / "drive.txt");
   }
   const std::string events = read_file(dir / "run" / "events.csv");
   const std::size_t driven = events.find("robot 4 driven 40 40 for ");
