@@ -5,6 +5,7 @@
 
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/post.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
@@ -43,6 +44,9 @@ bool same_secret(std::string_view a, std::string_view b) {
 }
 
 namespace {
+
+// How long a stopping server waits for its clients to answer its close frame.
+constexpr std::chrono::milliseconds kCloseWait{500};
 
 std::string_view sv(beast::string_view v) { return {v.data(), v.size()}; }
 
@@ -129,6 +133,9 @@ struct WebServer::Impl {
   // The last message of each latched channel (the server's thread only).
   std::map<std::uint32_t, std::pair<std::uint64_t, std::shared_ptr<const std::string>>> latest;
   std::atomic<std::size_t> client_count{0};
+  // Shutting down: the clients were sent a close frame; the timer ends the wait for them.
+  bool stopping = false;                 // the server's thread only
+  asio::steady_timer stop_timer{io};
   // The parameters' current values, by name (the server's thread only).
   std::map<std::string, nlohmann::json> parameters;
 
@@ -216,6 +223,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     ws_.read_message_max(server_.config.max_message_bytes);
     ws_.async_accept(request, [self = shared_from_this()](beast::error_code ec) {
       if (ec) return self->close();
+      self->accepted_ = true;
       self->send_text(foxglove::server_info(self->server_.config.name, self->server_.capabilities(), {"json"},
                                             self->server_.config.session_id));
       const auto channels = self->server_.channels_now();
@@ -240,6 +248,21 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     queue_.push_back(std::move(o));
     server_.count(&WebServerCounters::messages_sent);
     write();
+  }
+
+  // The server stops: what is queued is dropped (the run flushed its end before), and
+  // once the message being written, if any, is out, the client gets a close frame (1001,
+  // going away) and the connection closes when the client answers it. So a client sees a
+  // clean close, not a lost connection. One still in its handshake is closed at once.
+  void go_away() {
+    if (closed_ || going_away_) return;
+    going_away_ = true;
+    if (!accepted_) return close();
+    while (queue_.size() > (writing_ ? 1u : 0u)) {
+      queued_bytes_ -= queue_.back().bytes;
+      queue_.pop_back();
+    }
+    if (!writing_) send_close();
   }
 
   void close() {
@@ -291,8 +314,13 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     }
   }
 
+  void send_close() {
+    ws_.async_close(websocket::close_reason(websocket::close_code::going_away, "the server stops"),
+                    [self = shared_from_this()](beast::error_code) { self->close(); });
+  }
+
   void write() {
-    if (writing_ || queue_.empty() || closed_) return;
+    if (writing_ || queue_.empty() || closed_ || going_away_) return;
     writing_ = true;
     Out& o = queue_.front();
     auto done = [self = shared_from_this()](beast::error_code ec, std::size_t) {
@@ -300,6 +328,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
       if (ec) return self->close();
       self->queued_bytes_ -= self->queue_.front().bytes;
       self->queue_.pop_front();
+      if (self->going_away_) return self->send_close();  // (a close is a write: after this one)
       self->write();
     };
     if (o.binary) {
@@ -457,6 +486,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   std::size_t queued_bytes_ = 0;
   bool writing_ = false;
   bool closed_ = false;
+  bool accepted_ = false;    // the WebSocket handshake is done
+  bool going_away_ = false;  // the server stops (go_away)
   std::chrono::steady_clock::time_point last_drop_status_{};
 };
 
@@ -560,6 +591,7 @@ void WebServer::Impl::remove(const std::shared_ptr<WsSession>& s) {
   client_count = sessions.size();
   for (const std::uint32_t channel : s->subscribed_channels()) count_subscriber(channel, -1);
   if (handlers.on_client_gone) handlers.on_client_gone(s->name());
+  if (stopping && sessions.empty()) stop_timer.cancel();  // every client answered the close
 }
 
 WebServer::WebServer(WebServerConfig config, Handlers handlers) : impl_(std::make_shared<Impl>()) {
@@ -592,8 +624,15 @@ WebServer::~WebServer() {
   asio::post(m.io, [&m] {
     beast::error_code ignored;
     m.acceptor.close(ignored);
-    for (const auto& s : std::vector<std::shared_ptr<WsSession>>(m.sessions.begin(), m.sessions.end())) s->close();
-    m.io.stop();
+    m.stopping = true;
+    for (const auto& s : std::vector<std::shared_ptr<WsSession>>(m.sessions.begin(), m.sessions.end())) s->go_away();
+    if (m.sessions.empty()) return m.io.stop();
+    // Clients that do not answer the close frame (one that never reads) are cut off.
+    m.stop_timer.expires_after(kCloseWait);
+    m.stop_timer.async_wait([&m](beast::error_code) {
+      for (const auto& s : std::vector<std::shared_ptr<WsSession>>(m.sessions.begin(), m.sessions.end())) s->close();
+      m.io.stop();
+    });
   });
   if (m.thread.joinable()) m.thread.join();
   m.sessions.clear();

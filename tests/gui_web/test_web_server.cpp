@@ -163,6 +163,40 @@ TEST(WebServer, GreetsSubscribesAndSendsData) {
   }
 }
 
+TEST(WebServer, AStoppingServerSaysGoingAwayToItsClients) {
+  // A client connected when the server goes (a run that ended) gets a close frame with
+  // 1001, going away, not a connection cut mid-stream; one that never reads is cut off
+  // after a short wait, and holds up nobody.
+  auto server = std::make_unique<WebServer>(config(), WebServer::Handlers{});
+  Client client, silent;
+  ASSERT_EQ(client.connect(server->port(), "/ws?token=" + kToken), 101);
+  ASSERT_EQ(silent.connect(server->port(), "/ws?token=" + kToken), 101);
+  EXPECT_EQ(client.next_json()["op"], "serverInfo");
+  EXPECT_EQ(client.next_json()["op"], "advertise");
+  std::thread reader([&] {
+    beast::error_code ec;
+    for (;;) {
+      client.buffer.consume(client.buffer.size());
+      client.ws.read(client.buffer, ec);
+      if (ec) break;
+    }
+    EXPECT_EQ(ec, websocket::error::closed) << ec.message();
+    EXPECT_EQ(client.ws.reason().code, websocket::close_code::going_away);
+  });
+  server.reset();
+  reader.join();
+  // The silent one was sent the close frame too, behind what it had not read (its answer
+  // to it then finds the connection cut: the server waited for it no longer).
+  beast::error_code ec;
+  int read = 0;
+  for (; read < 10 && !ec; ++read) {
+    silent.buffer.consume(silent.buffer.size());
+    silent.ws.read(silent.buffer, ec);
+  }
+  EXPECT_EQ(read, 3) << ec.message();  // serverInfo, advertise, then the close frame
+  EXPECT_EQ(silent.ws.reason().code, websocket::close_code::going_away) << ec.message();
+}
+
 TEST(WebServer, ClientMessagesReachTheOwnerAndBadOnesGetAStatus) {
   std::mutex mutex;
   std::vector<std::string> heard;
