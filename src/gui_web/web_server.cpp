@@ -224,6 +224,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     ws_.async_accept(request, [self = shared_from_this()](beast::error_code ec) {
       if (ec) return self->close();
       self->accepted_ = true;
+      if (self->going_away_) return self->send_close();  // the server began to stop meanwhile
       self->send_text(foxglove::server_info(self->server_.config.name, self->server_.capabilities(), {"json"},
                                             self->server_.config.session_id));
       const auto channels = self->server_.channels_now();
@@ -253,11 +254,12 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   // The server stops: what is queued is dropped (the run flushed its end before), and
   // once the message being written, if any, is out, the client gets a close frame (1001,
   // going away) and the connection closes when the client answers it. So a client sees a
-  // clean close, not a lost connection. One still in its handshake is closed at once.
+  // clean close, not a lost connection. One still in its handshake gets the close frame
+  // when the handshake is done.
   void go_away() {
     if (closed_ || going_away_) return;
     going_away_ = true;
-    if (!accepted_) return close();
+    if (!accepted_) return;
     while (queue_.size() > (writing_ ? 1u : 0u)) {
       queued_bytes_ -= queue_.back().bytes;
       queue_.pop_back();

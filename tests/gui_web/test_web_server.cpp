@@ -186,14 +186,15 @@ TEST(WebServer, AStoppingServerSaysGoingAwayToItsClients) {
   server.reset();
   reader.join();
   // The silent one was sent the close frame too, behind what it had not read (its answer
-  // to it then finds the connection cut: the server waited for it no longer).
+  // to it then finds the connection cut: the server waited for it no longer). (Its
+  // greeting may not have been sent: the server may have stopped before its handshake's
+  // end was handled.)
   beast::error_code ec;
-  int read = 0;
-  for (; read < 10 && !ec; ++read) {
+  for (int i = 0; i < 10 && !ec; ++i) {
     silent.buffer.consume(silent.buffer.size());
     silent.ws.read(silent.buffer, ec);
   }
-  EXPECT_EQ(read, 3) << ec.message();  // serverInfo, advertise, then the close frame
+  EXPECT_TRUE(ec);
   EXPECT_EQ(silent.ws.reason().code, websocket::close_code::going_away) << ec.message();
 }
 
