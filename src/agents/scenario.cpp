@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "agents/builtin_controllers.hpp"
 #include "core/id_list.hpp"
 #include "environment/shapes.hpp"
 
@@ -209,7 +210,7 @@ environment::SensorSuiteConfig read_sensors(const Reader& r) {
   return s;
 }
 
-std::vector<RobotSpec> read_robots(const Reader& top) {
+std::vector<RobotSpec> read_robots(const Reader& top, const ControllerRegistry& controllers) {
   const YAML::Node list = top.get("robots");
   if (!list || !list.IsSequence() || list.size() == 0) top.fail_key("robots", "must be a non-empty list of robots");
   std::vector<RobotSpec> robots;
@@ -256,12 +257,23 @@ std::vector<RobotSpec> read_robots(const Reader& top) {
       }
     }
     base.controller.name = r.text("controller", "convoy");
+    const ControllerEntry* controller = controllers.find(base.controller.name);
+    if (!controller) {
+      r.fail_key("controller", "unknown controller '" + base.controller.name + "' (known: " + controllers.names_text() +
+                                   "; `rilbed controllers` lists them)");
+    }
     if (r.has("params")) {
       const Reader p = r.child("params");
       for (const auto& kv : r.get("params")) {
         const std::string key = kv.first.as<std::string>();
         base.controller.params[key] = p.number(key, 0.0);
       }
+      if (const auto problem = check_params(*controller, base.controller.params)) {
+        if (problem->key.empty()) r.fail_key("params", problem->problem);
+        p.fail_key(problem->key, problem->problem);
+      }
+    } else if (const auto problem = check_params(*controller, {})) {
+      r.fail_key("controller", problem->problem);
     }
     if (r.has("noise")) {
       const Reader n = r.child("noise");
@@ -272,6 +284,10 @@ std::vector<RobotSpec> read_robots(const Reader& top) {
       base.noise.odometer_counts_slip = n.boolean("odometer_counts_slip", true);
     }
     if (r.has("sensors")) base.sensors = read_sensors(r.child("sensors"));
+    if (const auto sensor = missing_sensor(*controller, base.sensors)) {
+      r.fail_key(r.has("sensors") ? "sensors" : "controller",
+                 base.controller.name + " needs `sensors: " + *sensor + ":` (see scenarios/README.md)");
+    }
     if (r.has("link")) {
       if (base.kind != environment::RobotKind::Real) r.fail_key("link", "only a robot of kind real has a link");
       const Reader l = r.child("link");
@@ -328,7 +344,7 @@ std::vector<RobotSpec> read_robots(const Reader& top) {
   return robots;
 }
 
-Scenario read_scenario(const YAML::Node& root, const std::string& source) {
+Scenario read_scenario(const YAML::Node& root, const std::string& source, const ControllerRegistry& controllers) {
   Scenario s;
   const Reader top(root, source, "");
   top.allow({"name", "description", "mode", "field", "timing", "duration_s", "convoy", "obstacles", "tracks", "beacons",
@@ -416,7 +432,7 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source) {
     c.name = m.text("name", "");
     s.moving_obstacles.push_back(c);
   });
-  s.robots = read_robots(top);
+  s.robots = read_robots(top, controllers);
   if (top.has("camera")) {
     const Reader c = top.child("camera");
     c.allow({"emulate", "device", "file", "calibration", "fps", "marker_diameter_m", "family", "vision"});
@@ -517,7 +533,9 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source) {
 
 }  // namespace
 
-Scenario parse_scenario(const std::string& yaml_text, const std::string& source_name) {
+Scenario parse_scenario(const std::string& yaml_text, const std::string& source_name,
+                        std::shared_ptr<const ControllerRegistry> controllers) {
+  if (!controllers) controllers = default_controllers();
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
@@ -526,18 +544,20 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source_
   }
   if (!root || root.IsNull()) throw ScenarioError(source_name + ": the scenario is empty");
   try {
-    return read_scenario(root, source_name);
+    Scenario scenario = read_scenario(root, source_name, *controllers);
+    scenario.controllers = std::move(controllers);
+    return scenario;
   } catch (const YAML::Exception& e) {
     throw ScenarioError(source_name + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
 }
 
-Scenario load_scenario(const std::filesystem::path& path) {
+Scenario load_scenario(const std::filesystem::path& path, std::shared_ptr<const ControllerRegistry> controllers) {
   std::ifstream in(path);
   if (!in) throw ScenarioError(path.string() + ": cannot open the scenario file");
   std::stringstream text;
   text << in.rdbuf();
-  Scenario s = parse_scenario(text.str(), path.string());
+  Scenario s = parse_scenario(text.str(), path.string(), std::move(controllers));
   s.source = path;
   return s;
 }
@@ -655,6 +675,7 @@ Scenario wandering_scenario(int robots, double seconds, double physics_step_ms, 
   Scenario s;
   s.name = "wander-" + std::to_string(robots);
   s.source = "(benchmark)";
+  s.controllers = default_controllers();
   const double area_m2 = robots / density_per_m2;
   s.map.field.width_m = std::sqrt(area_m2 * 1.25);
   s.map.field.height_m = area_m2 / s.map.field.width_m;

@@ -6,12 +6,14 @@
 
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 #include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "agents/controller_registry.hpp"
 #include "agents/convoy.hpp"
 #include "core/geometry.hpp"
 #include "core/time.hpp"
@@ -75,10 +77,10 @@ struct CameraSpec {
 
 /// A robot's controller and its knobs.
 struct ControllerSpec {
-  /// "convoy", "wander", "track_follow", "beacon_homing", "c:<name>" (a built-in C
-  /// controller) or "none" (stands still).
+  /// An entry of the scenario's controller registry (`rilbed controllers` lists them):
+  /// "convoy", "wander", ..., "none" (stands still).
   std::string name = "convoy";
-  std::map<std::string, double> params;  ///< controller-specific numbers, checked by the run
+  std::map<std::string, double> params;  ///< the entry's parameters, checked against it
 };
 
 /// One robot of a scenario.
@@ -144,15 +146,21 @@ struct Scenario {
   double geofence_margin_m = 0.0;
   std::vector<RobotSpec> robots;    ///< sorted by ID
   std::optional<AgentsSpec> agents; ///< controllers in other processes (the `agents:` block)
+  /// The controllers its robots were checked against when it was read; the run makes
+  /// them from it. Never null for a scenario read by load_scenario() or parse_scenario().
+  std::shared_ptr<const ControllerRegistry> controllers;
 };
 
 /// The IDs of the scenario's real robots, in ID order.
 std::vector<int> real_robot_ids(const Scenario& scenario);
 
-/// Reads and checks a scenario file. Throws ScenarioError.
-Scenario load_scenario(const std::filesystem::path& path);
-/// Parses scenario text (`source_name` is used in messages). Throws ScenarioError.
-Scenario parse_scenario(const std::string& yaml_text, const std::string& source_name);
+/// Reads and checks a scenario file, its robots' controllers and their `params` against
+/// `controllers` (null: rilbed's own, default_controllers()). Throws ScenarioError.
+Scenario load_scenario(const std::filesystem::path& path, std::shared_ptr<const ControllerRegistry> controllers = {});
+/// Parses scenario text (`source_name` is used in messages), as load_scenario() does.
+/// Throws ScenarioError.
+Scenario parse_scenario(const std::string& yaml_text, const std::string& source_name,
+                        std::shared_ptr<const ControllerRegistry> controllers = {});
 
 /// The benchmarks' scenario (sim-bench, bench_gui): `robots` wandering Kheperas with their
 /// eight IR sensors and 2 % wheel slip in a field of `density_per_m2` (the lab's convoy is 8

@@ -13,8 +13,7 @@
 #include <set>
 #include <sstream>
 
-#include "agents/basic_controllers.hpp"
-#include "agents/c_controller.hpp"
+#include "agents/builtin_controllers.hpp"
 #include "agents/convoy.hpp"
 #include "agents/run_control.hpp"
 #include "agents/run_models.hpp"
@@ -775,12 +774,6 @@ WorldReport world_report(const Scenario& scenario, const std::vector<int>& real_
   return w;
 }
 
-double param(const RobotSpec& spec, const std::string& key, double fallback, std::set<std::string>& used) {
-  used.insert(key);
-  const auto it = spec.controller.params.find(key);
-  return it == spec.controller.params.end() ? fallback : it->second;
-}
-
 }  // namespace
 
 nlohmann::json RunResult::summary() const {
@@ -805,58 +798,27 @@ nlohmann::json RunResult::summary() const {
 }
 
 std::unique_ptr<Controller> make_controller(const Scenario& scenario, const RobotSpec& spec) {
-  const std::string& name = spec.controller.name;
   const std::string where = scenario.source.string() + ":" + std::to_string(spec.line) + ": robot " + std::to_string(spec.id);
-  std::set<std::string> used;
-  std::unique_ptr<Controller> controller;
-  if (name == "convoy") {
-    // Its own controller in either mode: in central mode it idles until the console
-    // switches the run to distributed.
-    controller = std::make_unique<ConvoyController>(spec.id, scenario.convoy);
-  } else if (name == "wander") {
-    WanderConfig c;
-    c.speed_mps = param(spec, "speed_mps", c.speed_mps, used);
-    controller = std::make_unique<WanderController>(c);
-  } else if (name == "track_follow") {
-    TrackFollowConfig c;
-    c.speed_mps = param(spec, "speed_mps", c.speed_mps, used);
-    if (!spec.sensors.track_sensors.empty()) c.max_value = spec.sensors.track_sensors.front().max_value;
-    c.max_value = static_cast<int>(param(spec, "max_value", c.max_value, used));
-    if (spec.sensors.track_sensors.empty()) throw ScenarioError(where + ": track_follow needs `sensors: track:` elements");
-    controller = std::make_unique<TrackFollowController>(c);
-  } else if (name == "beacon_homing") {
-    BeaconHomingConfig c;
-    if (spec.controller.params.contains("beacon_id")) c.beacon_id = static_cast<int>(param(spec, "beacon_id", 0, used));
-    c.speed_mps = param(spec, "speed_mps", c.speed_mps, used);
-    if (!spec.sensors.beacon_finder) throw ScenarioError(where + ": beacon_homing needs `sensors: beacon_finder:`");
-    controller = std::make_unique<BeaconHomingController>(c);
-  } else if (name == "goto") {
-    GoToPoseConfig c;
-    c.target = Pose2{{param(spec, "x_m", 0.0, used), param(spec, "y_m", 0.0, used)},
-                     deg_to_rad(param(spec, "theta_deg", 0.0, used))};
-    if (!spec.controller.params.contains("x_m") || !spec.controller.params.contains("y_m")) {
-      throw ScenarioError(where + ": goto needs params x_m and y_m (and theta_deg)");
-    }
-    c.speed_mps = param(spec, "speed_mps", c.speed_mps, used);
-    c.position_tolerance_m = param(spec, "tolerance_m", c.position_tolerance_m, used);
-    c.heading_tolerance_rad = deg_to_rad(param(spec, "tolerance_deg", rad_to_deg(c.heading_tolerance_rad), used));
-    controller = std::make_unique<GoToPoseController>(c);
-  } else if (name.rfind("c:", 0) == 0) {
-    const rilbed_c_controller* c = find_c_controller(name.substr(2));
-    if (!c) {
-      std::string known;
-      for (const auto& n : c_controller_names()) known += " c:" + n;
-      throw ScenarioError(where + ": unknown C controller '" + name + "' (built in:" + known + ")");
-    }
-    controller = std::make_unique<CControllerAdapter>(*c);
-  } else if (name != "none") {
-    throw ScenarioError(where + ": unknown controller '" + name +
-                        "' (convoy, wander, track_follow, beacon_homing, goto, c:<name>, none)");
+  const std::shared_ptr<const ControllerRegistry> registry =
+      scenario.controllers ? scenario.controllers : default_controllers();
+  const ControllerEntry* entry = registry->find(spec.controller.name);
+  if (!entry) {
+    throw ScenarioError(where + ": unknown controller '" + spec.controller.name + "' (known: " + registry->names_text() +
+                        ")");
   }
-  for (const auto& [key, value] : spec.controller.params) {
-    if (!used.contains(key)) throw ScenarioError(where + ": controller " + name + " has no parameter '" + key + "'");
+  // A scenario read from a file was checked already; one built in code is checked here.
+  if (const auto problem = check_params(*entry, spec.controller.params)) {
+    throw ScenarioError(where + ": " + (problem->key.empty() ? "" : "params." + problem->key + ": ") + problem->problem);
   }
-  return controller;
+  if (const auto sensor = missing_sensor(*entry, spec.sensors)) {
+    throw ScenarioError(where + ": " + entry->name + " needs `sensors: " + *sensor + ":`");
+  }
+  const ControllerParams params(entry->params, spec.controller.params);
+  try {
+    return entry->make(ControllerContext{spec.id, params, spec.sensors, scenario.convoy});
+  } catch (const std::invalid_argument& e) {
+    throw ScenarioError(where + ": controller " + entry->name + ": " + e.what());
+  }
 }
 
 std::vector<Pose2> start_poses(const Scenario& scenario, std::uint64_t seed) {

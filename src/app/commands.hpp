@@ -19,6 +19,8 @@ void add_synth_command(CLI::App& app);
 void add_score_command(CLI::App& app);
 /// `rilbed run`: runs a scenario once or over a batch of seeds.
 void add_run_command(CLI::App& app);
+/// `rilbed controllers [--json]`: the controllers a scenario can name, with their parameters.
+void add_controllers_command(CLI::App& app);
 /// `rilbed sim-bench`: times the simulation with many virtual robots.
 void add_sim_bench_command(CLI::App& app);
 /// `rilbed compare`: the difference of two run folders (sim-to-real comparison).

@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
   rilbed::app::add_synth_command(app);
   rilbed::app::add_score_command(app);
   rilbed::app::add_run_command(app);
+  rilbed::app::add_controllers_command(app);
   rilbed::app::add_sim_bench_command(app);
   rilbed::app::add_compare_command(app);
   rilbed::app::add_loop_bench_command(app);

@@ -5,6 +5,7 @@
 #include <cctype>
 #include <filesystem>
 
+#include "agents/builtin_controllers.hpp"
 #include "links/lcm_console.hpp"
 
 namespace rilbed::app {
@@ -37,6 +38,9 @@ std::unique_ptr<gui_web::GuiService> start_panel(const PanelOptions& o, std::str
   config.session_id = config.token.substr(0, 8);
   if (std::filesystem::is_directory(o.web_root)) config.web_root = o.web_root;
   config.allowed_origins = o.allowed_origins;
+  // The editor's lists and forms of controllers: the registry scenarios are checked against.
+  config.documents["/controllers.json"] = {"application/json",
+                                            agents::controllers_json(*agents::default_controllers()).dump()};
   if (o.bind != "127.0.0.1") {
     spdlog::warn("gui: serving on {}: anyone who can reach it and has the URL's token can watch and steer the run", o.bind);
   }

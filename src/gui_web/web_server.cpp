@@ -540,6 +540,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   std::string cookie_name() const { return "rilbed_token_" + std::to_string(server_.port); }
 
   void serve_file(const http::request<http::string_body>& req, const std::string& path) {
+    if (const auto doc = server_.config.documents.find(path); doc != server_.config.documents.end()) {
+      return respond(req, http::status::ok, doc->second.content_type, doc->second.body);
+    }
     if (server_.config.web_root.empty() || path.find("..") != std::string::npos || path.empty() || path[0] != '/') {
       return respond(req, http::status::not_found, "text/plain", "not found\n");
     }

@@ -22,12 +22,20 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <map>
 #include <string_view>
 #include <vector>
 
 #include "gui_web/foxglove_protocol.hpp"
 
 namespace rilbed::gui_web {
+
+/// A document the server keeps in memory and serves at its path beside the page's files
+/// (the controllers' JSON, which the page's editor builds its lists from).
+struct ServedDocument {
+  std::string content_type;  ///< e.g. "application/json"
+  std::string body;
+};
 
 /// How the server listens and what it allows; each knob says what it costs.
 struct WebServerConfig {
@@ -40,6 +48,9 @@ struct WebServerConfig {
   std::size_t max_queued_bytes = 8u << 20; ///< per client; more memory lets a slow client lag longer
   std::size_t max_message_bytes = 1u << 20;  ///< largest message a client may send; larger closes its socket (1009)
   std::vector<std::string> allowed_origins;  ///< Origins allowed besides the server's own, e.g. "https://app.foxglove.dev"
+  /// Documents served at their paths ("/controllers.json"), under the same token as the
+  /// page's files, even without a web root; their memory is held while the server runs.
+  std::map<std::string, ServedDocument> documents;
 };
 
 /// What the server counted (all clients together).

@@ -22,6 +22,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "agents/builtin_controllers.hpp"
 #include "gui_web/web_server.hpp"
 #include "ws_test_client.hpp"
 
@@ -70,6 +71,30 @@ TEST(WebServer, TheTokenOpensEverythingAndNothingOpensWithoutIt) {
   taken.bind_address = "127.0.0.2";  // another address, same port: fine; the same address is not
   taken.bind_address = "127.0.0.1";
   EXPECT_THROW(WebServer(taken, {}), std::runtime_error);
+}
+
+TEST(WebServer, ServesTheDocumentsItIsGivenUnderTheToken) {
+  // The controllers' JSON of a registry that has one controller more than rilbed's own:
+  // what the page's editor reads is the registry the server was given.
+  agents::ControllerRegistry registry = agents::builtin_controllers();
+  agents::ControllerEntry extra;
+  extra.name = "lab_spinner";
+  extra.summary = "a lab's own";
+  extra.params = {{"turn_radps", "rad/s", 1.0, false, 0.0, 5.0, false, "how fast it turns"}};
+  extra.make = [](const agents::ControllerContext&) { return std::unique_ptr<agents::Controller>(); };
+  registry.add(extra);
+  WebServerConfig c = config();
+  c.documents["/controllers.json"] = {"application/json", agents::controllers_json(registry).dump()};
+  WebServer server(c, {});  // no web root: the documents alone
+  const auto [status, body] = get(server.port(), "/controllers.json?token=" + kToken);
+  ASSERT_EQ(status, 200);
+  const json served = json::parse(body);
+  ASSERT_EQ(served.size(), registry.entries().size());
+  EXPECT_EQ(served.back()["name"], "lab_spinner");
+  EXPECT_EQ(served.back()["params"][0]["unit"], "rad/s");
+  EXPECT_EQ(served.back()["params"][0]["max"], 5.0);
+  EXPECT_EQ(get(server.port(), "/controllers.json").first, 401);
+  EXPECT_EQ(get(server.port(), "/index.html?token=" + kToken).first, 404);
 }
 
 TEST(WebServer, ThePagesLoadSetsACookieThatOpensItsFilesButNotTheWebSocket) {
