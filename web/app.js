@@ -3,6 +3,8 @@
 // keeps no state the run does not send, so any number of tabs show the same run.
 import { prepareCanvas } from './canvas.js';
 import { FoxgloveClient } from './foxglove.js';
+import { wrapRadPi } from './angles.js';
+import { makeProjection } from './projection.js';
 
 const params = new URLSearchParams(location.search);
 const token = params.get('token') || '';
@@ -168,7 +170,7 @@ function distanceAhead(r, robots) {
     if (o.id === r.id) continue;
     const dx = o.x_m - r.x_m, dy = o.y_m - r.y_m;
     const d = Math.hypot(dx, dy);
-    const off = Math.abs(wrap(Math.atan2(dy, dx) - r.theta_rad));
+    const off = Math.abs(wrapRadPi(Math.atan2(dy, dx) - r.theta_rad));
     if (off <= Math.PI / 3 && (best === null || d < best)) best = d;
   }
   return best;
@@ -288,7 +290,6 @@ const fmt = (x) => {
   const t = v.toPrecision(3);
   return t.includes('.') ? t.replace(/0+$/, '').replace(/\.$/, '') : t;
 };
-const wrap = (a) => Math.atan2(Math.sin(a), Math.cos(a));
 
 // ------------------------------------------------------------------ console
 function command(name, ...args) {
@@ -656,39 +657,9 @@ canvas.addEventListener('pointerup', () => { drag = null; });
 // Where field point (x, y) metres lands on the canvas: through the camera's homography when
 // the camera image is shown, else a fit of the field; then zoom and pan (`vw`: the view's
 // zoom, panX, panY; the current view unless another is given, e.g. the trail layer's).
-function makeProjection(width, height, vw = view) {
-  const useCamera = overlays.camera && run.image && run.calibration;
-  let base;
-  if (useCamera) {
-    const H = run.calibration.field_to_image;
-    const s = Math.min(width / run.calibration.width_px, height / run.calibration.height_px);
-    const ox = (width - s * run.calibration.width_px) / 2, oy = (height - s * run.calibration.height_px) / 2;
-    base = { s, ox, oy, camera: true,
-      toPx: (x, y) => { const w = H[6] * x + H[7] * y + H[8]; return [(H[0] * x + H[1] * y + H[2]) / w, (H[3] * x + H[4] * y + H[5]) / w]; } };
-  } else {
-    const fw = run.world?.width_m || 1, fh = run.world?.height_m || 1;
-    const margin = 16;
-    const s = Math.min((width - 2 * margin) / fw, (height - 2 * margin) / fh);
-    const ox = (width - s * fw) / 2, oy = (height + s * fh) / 2;
-    base = { s, ox, oy, camera: false, toPx: (x, y) => [x, -y] }; // y up on the field
-  }
-  const z = vw.zoom;
-  const project = (x, y) => {
-    const [u, v] = base.toPx(x, y);
-    return [vw.panX + z * (base.ox + base.s * u), vw.panY + z * (base.oy + base.s * v)];
-  };
-  // Metres to pixels near a point (for radii): the projection's local scale.
-  const scaleAt = (x, y) => {
-    const [a, b] = project(x, y), [c, d] = project(x + 0.01, y);
-    return Math.hypot(c - a, d - b) / 0.01;
-  };
-  // Without the camera the projection is u = ax * x + bx, v = ay * y + by: the loops over
-  // thousands of points (trails) use that, allocating nothing.
-  const affine = base.camera ? null
-    : { ax: z * base.s, bx: vw.panX + z * base.ox, ay: -z * base.s, by: vw.panY + z * base.oy };
-  // Whether canvas point (u, v) is within `margin` pixels of the canvas (else not drawn).
-  const onCanvas = (u, v, margin) => u > -margin && v > -margin && u < width + margin && v < height + margin;
-  return { project, scaleAt, base, z, affine, onCanvas, width, height };
+function projection(width, height, vw = view) {
+  const calibration = overlays.camera && run.image && run.calibration ? run.calibration : null;
+  return makeProjection(width, height, vw, { field: run.world, calibration });
 }
 
 let drawPending = false;
@@ -703,7 +674,7 @@ function draw(now) {
   drawPending = false;
   const t0 = performance.now();
   const [, w, h] = prepareCanvas(canvas);
-  const P = makeProjection(w, h);
+  const P = projection(w, h);
   window.rilbed.project = P.project; // field metres -> canvas CSS pixels, as drawn now (for tests)
   if (P.base.camera) {
     ctx.save();
@@ -811,7 +782,7 @@ function drawTrails(P) {
     clearTimeout(L.restTimer);
     L.restTimer = setTimeout(requestDraw, VIEW_REST_MS + 10);
   }
-  const LP = follow ? makeProjection(P.width, P.height, L.view) : P;
+  const LP = follow ? projection(P.width, P.height, L.view) : P;
   const A = LP.affine;
   // The layer onto the canvas, moved from its view to the current one: zoom and pan map
   // canvas pixels affinely (camera or not), u' = pan' + (z' / z) (u - pan).

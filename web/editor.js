@@ -1,10 +1,11 @@
-// rilbed's scenario editor (issue 17): place, move, rotate and delete robots, obstacles,
-// tracks and beacons on a canvas of the field, and save the scenario YAML that
-// `rilbed run` reads (scenarios/README.md is the contract).
+// rilbed's scenario editor: place, move, rotate and delete robots, obstacles, tracks and
+// beacons on a canvas of the field, and save the scenario YAML that `rilbed run` reads
+// (scenarios/README.md is the contract). The controllers, their parameters and the sensors
+// they need come from the server's registry (controllers.json), never from a list here.
 //
 // The editor edits the parsed YAML object itself (`ed.doc`), never a model of its own:
-// whatever it does not show (camera, safety, sensors, controller params, a real robot's
-// link, moving obstacles, `ids: 4-5` ranges...) is saved as it was loaded. A robot of an
+// whatever it does not show (camera, safety, sensors, a real robot's link, moving
+// obstacles, `ids: 4-5` ranges...) is saved as it was loaded. A robot of an
 // `ids:` group with a random pose sits in the tray under the field; dragging it onto the
 // field takes it out of its group as an entry of its own with that pose.
 //
@@ -13,25 +14,33 @@
 // current poses into the scenario being edited.
 import { load, dump, visit, COLLECTION_STYLE, VISIT_SKIP } from './node_modules/js-yaml/dist/js-yaml.mjs';
 import { prepareCanvas } from './canvas.js';
+import { degToRad, headingDeg, radToDeg } from './angles.js';
+import { centroid, distToSegment, pointInPolygon } from './geometry.js';
+import { formatIds, parseIds } from './ids.js';
+import { editorLayout, toField, toPx } from './projection.js';
+import { loadRegistry, numberText, paramDescription } from './controller_registry.js';
+import {
+  DEFAULT_CONTROLLER, DEFAULT_FIELD, ROBOT_RADIUS_M, controllerOf, entryIds, isNum, isPoint, isPose, listOf,
+  obstaclePoints, robotHasSensor, robotItems as robotItemsOf, scenarioField, trackPoints,
+} from './scenario.js';
+import { findProblems as scenarioProblems } from './scenario_checks.js';
 
 const $ = (id) => document.getElementById(id);
 
-const ROBOT_RADIUS_M = 0.0275; // a Khepera
-const CONTROLLERS = ['convoy', 'wander', 'track_follow', 'beacon_homing', 'none'];
-// The params each controller takes (src/agents/simulation.cpp make_controller): a
-// controller given one it does not take stops the run, so a change of controller drops them.
-const CONTROLLER_PARAMS = {
-  convoy: [], none: [], wander: ['speed_mps'], track_follow: ['speed_mps', 'max_value'],
-  beacon_homing: ['beacon_id', 'speed_mps'],
-  goto: ['x_m', 'y_m', 'theta_deg', 'speed_mps', 'tolerance_m', 'tolerance_deg'],
+// What the editor adds to a robot's `sensors:` when its new controller requires a sensor it
+// lacks (keyed by sensor, as the registry's required_sensors name them): track elements
+// three across its front, as in scenarios/track_following.yaml; an all-round beacon finder;
+// one ultrasonic finder ahead; the IR ring and odometer turned back on.
+const DEFAULT_SENSORS = {
+  track: [0.012, 0, -0.012].map((y) => ({
+    mount_x_m: 0.02, mount_y_m: y, height_mm: 8, inclination_deg: 0, cone_angle_deg: 30, precision: 16,
+    coverage_percent: 15, max_value: 255, error_level_percent: 5,
+  })),
+  beacon_finder: { field_of_view_deg: 360 },
+  range_finders: [{ mount_deg: 0, opening_deg: 30, max_range_m: 1.0 }],
+  proximity: true,
+  odometer: true,
 };
-// A track_follow robot needs track sensor elements: three across its front, as in
-// scenarios/track_following.yaml.
-const DEFAULT_TRACK_SENSORS = [0.012, 0, -0.012].map((y) => ({
-  mount_x_m: 0.02, mount_y_m: y, height_mm: 8, inclination_deg: 0, cone_angle_deg: 30, precision: 16,
-  coverage_percent: 15, max_value: 255, error_level_percent: 5,
-}));
-const DEFAULT_FIELD = { width_m: 1.5, height_m: 1.2 };
 const TRAY_HEIGHT_PX = 46;
 const MARGIN_PX = 22;
 const HANDLE_PX = 7;
@@ -50,51 +59,21 @@ const ed = {
   yaml: '',
 };
 
+// The controllers a robot can have: the server's registry (controllers.json), which the
+// scenario parser checks against too. The editor has no list of its own: until the
+// registry has come there is no controller to choose, and if it fails to come the page says
+// so and the robots' controllers go unchecked.
+const controllers = { registry: null, error: null, loaded: false };
+
 const canvas = $('editor-canvas');
 const ctx = canvas.getContext('2d');
 
-// ------------------------------------------------------------------ numbers and ids
+// ------------------------------------------------------------------ numbers
 const round3 = (v) => { const r = Math.round(v * 1000) / 1000; return r === 0 ? 0 : r; };
-const round1 = (v) => { const r = Math.round(v * 10) / 10; return r === 0 ? 0 : r; };
-const wrapDeg = (d) => { let a = ((d + 180) % 360 + 360) % 360 - 180; if (a === -180) a = 180; return round1(a); };
-const deg = (rad) => (rad * 180) / Math.PI;
-const rad = (d) => (d * Math.PI) / 180;
-const isNum = (v) => typeof v === 'number' && Number.isFinite(v);
-const isPoint = (p) => Array.isArray(p) && p.length === 2 && isNum(p[0]) && isNum(p[1]);
-const isPose = (p) => Array.isArray(p) && p.length === 3 && p.every(isNum);
 const snapOn = () => $('editor-snap').checked;
 const snap = (v) => (snapOn() ? Math.round(v * 100) / 100 : round3(v));
 const clone = (v) => (v === undefined ? undefined : JSON.parse(JSON.stringify(v)));
 
-// `ids:` as rilbed reads it (src/core/id_list.hpp): "1-8", "2,4,9-12", or a number.
-function parseIds(v) {
-  if (Number.isInteger(v)) return [v];
-  if (typeof v !== 'string') return null;
-  const out = new Set();
-  for (const part of v.split(',')) {
-    const m = /^\s*(\d+)\s*(?:-\s*(\d+)\s*)?$/.exec(part);
-    if (!m) return null;
-    const a = Number(m[1]), b = m[2] === undefined ? a : Number(m[2]);
-    if (b < a || b - a > 100000) return null;
-    for (let k = a; k <= b; ++k) out.add(k);
-  }
-  return [...out].sort((a, b) => a - b);
-}
-function formatIds(ids) {
-  const s = [...ids].sort((a, b) => a - b), parts = [];
-  for (let i = 0; i < s.length;) {
-    let j = i;
-    while (j + 1 < s.length && s[j + 1] === s[j] + 1) ++j;
-    parts.push(j > i ? `${s[i]}-${s[j]}` : `${s[i]}`);
-    i = j + 1;
-  }
-  return parts.join(',');
-}
-function entryIds(e) {
-  if (!e || typeof e !== 'object') return [];
-  if (e.id !== undefined) return Number.isInteger(e.id) ? [e.id] : [];
-  return parseIds(e.ids) || [];
-}
 // A copy of `obj` with key `from` replaced by `to` (value `value`) in the same place.
 function renameKey(obj, from, to, value) {
   const out = {};
@@ -106,32 +85,15 @@ function renameKey(obj, from, to, value) {
 }
 
 // ------------------------------------------------------------------ the scenario's items
-const list = (key) => (Array.isArray(ed.doc?.[key]) ? ed.doc[key] : []);
-const field = () => {
-  const f = ed.doc?.field && typeof ed.doc.field === 'object' ? ed.doc.field : {};
-  return { w: isNum(f.width_m) && f.width_m > 0 ? f.width_m : DEFAULT_FIELD.width_m,
-    h: isNum(f.height_m) && f.height_m > 0 ? f.height_m : DEFAULT_FIELD.height_m, walls: f.walls !== false };
-};
+const list = (key) => listOf(ed.doc, key);
+const field = () => scenarioField(ed.doc);
 function ensureList(key) {
   if (!Array.isArray(ed.doc[key])) ed.doc[key] = [];
   return ed.doc[key];
 }
 
 // Every robot: placed ones (one id, a pose) and the tray's (random poses).
-function robotItems() {
-  const out = [];
-  list('robots').forEach((e, index) => {
-    const ids = entryIds(e);
-    if (ids.length === 1 && isPose(e.pose)) {
-      out.push({ index, id: ids[0], placed: true, x: e.pose[0], y: e.pose[1], th: e.pose[2], e });
-    } else {
-      for (const id of ids) out.push({ index, id, placed: false, e });
-    }
-  });
-  return out;
-}
-const obstaclePoints = (o) => (Array.isArray(o?.polygon) ? o.polygon.filter(isPoint) : []);
-const trackPoints = (t) => (Array.isArray(t?.points) ? t.points.filter(isPoint) : []);
+const robotItems = () => robotItemsOf(ed.doc);
 const nextRobotId = () => Math.max(0, ...robotItems().map((r) => r.id)) + 1;
 const nextBeaconId = () => Math.max(0, ...list('beacons').map((b) => (Number.isInteger(b?.id) ? b.id : 0))) + 1;
 function uniqueName(key, stem) {
@@ -238,7 +200,7 @@ function updateButtons() {
 }
 
 // ------------------------------------------------------------------ edits
-function setPose(e, pose) { e.pose = [round3(pose[0]), round3(pose[1]), wrapDeg(pose[2])]; }
+function setPose(e, pose) { e.pose = [round3(pose[0]), round3(pose[1]), headingDeg(pose[2])]; }
 
 // Gives robot `id` of entry `index` a pose; an `ids:` group gives the robot up to an entry
 // of its own right after it. Returns the robot's entry index.
@@ -266,18 +228,34 @@ function removeRobot(index, id) {
   if (!rest.length) robots.splice(index, 1);
   else robots[index] = rest.length === 1 ? renameKey(robots[index], 'ids', 'id', rest[0]) : renameKey(robots[index], 'ids', 'ids', formatIds(rest));
 }
+// A controller given a parameter it does not take stops the run, so a change of controller
+// drops them; a sensor the new controller requires is added with its defaults.
 function setController(e, name) {
   e.controller = name;
-  const allowed = CONTROLLER_PARAMS[name];
-  if (e.params && typeof e.params === 'object') {
-    for (const k of Object.keys(e.params)) if (!allowed || !allowed.includes(k)) delete e.params[k];
-    if (!Object.keys(e.params).length) delete e.params;
+  const c = controllers.registry?.find(name);
+  dropParamsNotTaken(e, c);
+  addRequiredSensors(e, c);
+}
+function dropParamsNotTaken(e, c) {
+  if (!e.params || typeof e.params !== 'object') return;
+  for (const k of Object.keys(e.params)) if (!c?.params.some((p) => p.name === k)) delete e.params[k];
+  if (!Object.keys(e.params).length) delete e.params;
+}
+function addRequiredSensors(e, c) {
+  const missing = (c?.required_sensors ?? []).filter((s) => !robotHasSensor(e.sensors, s) && s in DEFAULT_SENSORS);
+  if (!missing.length) return;
+  if (!e.sensors || typeof e.sensors !== 'object') e.sensors = {};
+  for (const s of missing) e.sensors[s] = clone(DEFAULT_SENSORS[s]);
+}
+// Parameter `name` of entry e set to `value`, or removed (null: its default applies).
+function setParam(e, name, value) {
+  if (value === null) {
+    if (e.params && typeof e.params === 'object') delete e.params[name];
+    if (e.params && !Object.keys(e.params).length) delete e.params;
+    return;
   }
-  if (name === 'track_follow' || name === 'beacon_homing') {
-    if (!e.sensors || typeof e.sensors !== 'object') e.sensors = {};
-    if (name === 'track_follow' && !Array.isArray(e.sensors.track)) e.sensors.track = clone(DEFAULT_TRACK_SENSORS);
-    if (name === 'beacon_homing' && !e.sensors.beacon_finder) e.sensors.beacon_finder = { field_of_view_deg: 360 };
-  }
+  if (!e.params || typeof e.params !== 'object' || Array.isArray(e.params)) putKey(e, 'params', {}, ['controller', 'pose', 'link', 'kind', 'id', 'ids']);
+  e.params[name] = value;
 }
 const stashedLinks = new WeakMap(); // an entry made virtual keeps its link here, should it be made real again
 // Sets obj[key] in place, placed after the first of `after` that obj has (else before
@@ -312,7 +290,8 @@ function newRobot(x, y) {
   if ($('editor-new-kind').value === 'real') e.kind = 'real';
   e.pose = null;
   setPose(e, [x, y, Number($('editor-new-robot-theta').value) || 0]);
-  setController(e, $('editor-new-controller').value);
+  const controller = $('editor-new-controller').value;
+  if (controller) setController(e, controller); // (none to choose when the list did not load: the scenario's default)
   const robots = ensureList('robots');
   robots.push(e);
   if (e.kind === 'real') setKind(robots.length - 1, 'real');
@@ -325,7 +304,7 @@ function newBeacon(x, y) {
   const id = Number.isInteger(idWanted) && !taken.has(idWanted) && $('editor-new-beacon-id').value !== '' ? idWanted : nextBeaconId();
   const num = (inputId, fallback) => { const v = Number($(inputId).value); return isNum(v) && $(inputId).value !== '' ? v : fallback; };
   const b = {
-    id, position: [snap(x), snap(y)], facing_deg: wrapDeg(num('editor-new-beacon-facing', 0)),
+    id, position: [snap(x), snap(y)], facing_deg: headingDeg(num('editor-new-beacon-facing', 0)),
     aperture_deg: num('editor-new-beacon-aperture', 360), range_m: num('editor-new-beacon-range', 2),
   };
   ensureList('beacons').push(b);
@@ -397,16 +376,15 @@ function rotateSelection(from, byDeg) {
     const e = ed.doc.robots[s.index];
     if (isPose(e.pose)) setPose(e, [e.pose[0], e.pose[1], from + byDeg]);
   } else if (s.type === 'beacon') {
-    ed.doc.beacons[s.index].facing_deg = wrapDeg(from + byDeg);
+    ed.doc.beacons[s.index].facing_deg = headingDeg(from + byDeg);
   } else {
     const item = list(`${s.type}s`)[s.index];
     const key = s.type === 'obstacle' ? 'polygon' : 'points';
     const [cx, cy] = centroid(from);
-    const c = Math.cos(rad(byDeg)), sn = Math.sin(rad(byDeg));
+    const c = Math.cos(degToRad(byDeg)), sn = Math.sin(degToRad(byDeg));
     item[key] = from.map(([x, y]) => [round3(cx + c * (x - cx) - sn * (y - cy)), round3(cy + sn * (x - cx) + c * (y - cy))]);
   }
 }
-const centroid = (pts) => [pts.reduce((a, p) => a + p[0], 0) / pts.length, pts.reduce((a, p) => a + p[1], 0) / pts.length];
 function rotationOf(s) {
   if (s.type === 'robot') return ed.doc.robots[s.index].pose[2];
   if (s.type === 'beacon') return isNum(ed.doc.beacons[s.index].facing_deg) ? ed.doc.beacons[s.index].facing_deg : 0;
@@ -446,8 +424,8 @@ function startFromRun() {
     const e = { id: r.id };
     if (r.real) { e.kind = 'real'; e.link = { emulate: true }; }
     const p = poses.get(r.id);
-    e.pose = p ? [round3(p.x_m), round3(p.y_m), wrapDeg(deg(p.theta_rad))] : 'random';
-    e.controller = 'convoy';
+    e.pose = p ? [round3(p.x_m), round3(p.y_m), headingDeg(radToDeg(p.theta_rad))] : 'random';
+    e.controller = DEFAULT_CONTROLLER;
     return e;
   });
   if (doc.robots.some((r) => r.kind === 'real')) doc.camera = { emulate: true };
@@ -507,7 +485,7 @@ function posesFromRun() {
   const F = field();
   const ids = new Set(robotItems().map((r) => r.id));
   const taken = run.poses.robots.filter((p) => ids.has(p.id));
-  const poses = taken.map((p) => [round3(p.x_m), round3(p.y_m), wrapDeg(deg(p.theta_rad))]);
+  const poses = taken.map((p) => [round3(p.x_m), round3(p.y_m), headingDeg(radToDeg(p.theta_rad))]);
   // (Robots of the scenario the run does not have keep their places, and are kept clear of.)
   const others = robotItems().filter((r) => r.placed && !taken.some((p) => p.id === r.id)).map((r) => [r.x, r.y, r.th]);
   const nudged = nudgeApart([...poses, ...others], F.walls, F.w, F.h, list('obstacles').map(obstaclePoints));
@@ -564,53 +542,8 @@ function newScenario() {
 // ------------------------------------------------------------------ problems
 // What rilbed run would refuse, as far as the editor can tell (the run has the last word).
 function findProblems() {
-  const out = [];
-  const F = field();
-  const robots = robotItems();
-  if (!robots.length) out.push('robots: rilbed run needs at least one robot.');
-  const seen = new Set();
-  for (const r of robots) {
-    if (seen.has(r.id)) out.push(`robot ${r.id} is defined twice.`);
-    seen.add(r.id);
-  }
-  list('robots').forEach((e, i) => {
-    if (!entryIds(e).length) out.push(`robots[${i}]: no valid id or ids.`);
-    if (e.kind === 'real' && !e.link) out.push(`robots[${i}]: a real robot needs a link.`);
-    if (e.controller === 'track_follow' && !Array.isArray(e.sensors?.track)) out.push(`robots[${i}]: track_follow needs sensors: track.`);
-    if (e.controller === 'beacon_homing' && !e.sensors?.beacon_finder) out.push(`robots[${i}]: beacon_homing needs sensors: beacon_finder.`);
-  });
-  if (list('robots').some((e) => e.kind === 'real') && !ed.doc.camera) out.push('camera: real robots need a camera.');
-  const convoy = robots.filter((r) => (r.e.controller ?? 'convoy') === 'convoy').map((r) => r.id).sort((a, b) => a - b);
-  if (convoy.some((id, k) => id !== k + 1)) out.push(`convoy robots must be numbered 1..N; they are ${formatIds(convoy)}.`);
-  const placed = robots.filter((r) => r.placed);
-  for (const r of placed) {
-    if (F.walls && (r.x < ROBOT_RADIUS_M || r.y < ROBOT_RADIUS_M || r.x > F.w - ROBOT_RADIUS_M || r.y > F.h - ROBOT_RADIUS_M)) {
-      out.push(`robot ${r.id} overlaps a wall.`);
-    }
-    list('obstacles').forEach((o, i) => {
-      const pts = obstaclePoints(o);
-      if (pointInPolygon([r.x, r.y], pts)) out.push(`robot ${r.id} is inside obstacle ${i + 1}${o.name ? ` (${o.name})` : ''}.`);
-      else if (pts.some((p, k) => distToSegment([r.x, r.y], p, pts[(k + 1) % pts.length]) < ROBOT_RADIUS_M)) {
-        out.push(`robot ${r.id} overlaps obstacle ${i + 1}${o.name ? ` (${o.name})` : ''}.`);
-      }
-    });
-  }
-  for (let i = 0; i < placed.length; ++i) {
-    for (let j = i + 1; j < placed.length; ++j) {
-      if (Math.hypot(placed[i].x - placed[j].x, placed[i].y - placed[j].y) < 2 * ROBOT_RADIUS_M) {
-        out.push(`robots ${placed[i].id} and ${placed[j].id} overlap.`);
-      }
-    }
-  }
-  list('obstacles').forEach((o, i) => { if (obstaclePoints(o).length < 3) out.push(`obstacle ${i + 1} needs at least 3 points.`); });
-  list('tracks').forEach((t, i) => { if (trackPoints(t).length < 2) out.push(`track ${i + 1} needs at least 2 points.`); });
-  const beaconIds = new Set();
-  list('beacons').forEach((b, i) => {
-    if (beaconIds.has(b.id)) out.push(`beacon ${b.id} is defined twice.`);
-    beaconIds.add(b.id);
-    if (b.aperture_deg !== undefined && !(b.aperture_deg > 0 && b.aperture_deg <= 360)) out.push(`beacon ${i + 1}: aperture_deg must be in (0, 360].`);
-    if (b.range_m !== undefined && !(b.range_m > 0)) out.push(`beacon ${i + 1}: range_m must be above 0.`);
-  });
+  const out = scenarioProblems(ed.doc, controllers.registry);
+  if (controllers.error) out.unshift('controllers, their parameters and sensors are not checked: the list of controllers did not load.');
   return out;
 }
 function showProblems() {
@@ -619,28 +552,7 @@ function showProblems() {
 }
 
 // ------------------------------------------------------------------ geometry
-function layout() {
-  const w = canvas.clientWidth, h = canvas.clientHeight;
-  const F = field();
-  const s = Math.max(1e-6, Math.min((w - 2 * MARGIN_PX) / F.w, (h - TRAY_HEIGHT_PX - 2 * MARGIN_PX) / F.h));
-  const ox = (w - s * F.w) / 2, oy = MARGIN_PX + s * F.h;
-  return { w, h, s, ox, oy, trayTop: h - TRAY_HEIGHT_PX };
-}
-const toPx = (L, x, y) => [L.ox + L.s * x, L.oy - L.s * y];
-const toField = (L, u, v) => [(u - L.ox) / L.s, (L.oy - v) / L.s];
-function pointInPolygon([x, y], pts) {
-  let inside = false;
-  for (let i = 0, j = pts.length - 1; i < pts.length; j = i++) {
-    const [xi, yi] = pts[i], [xj, yj] = pts[j];
-    if ((yi > y) !== (yj > y) && x < ((xj - xi) * (y - yi)) / (yj - yi) + xi) inside = !inside;
-  }
-  return inside;
-}
-function distToSegment([px, py], [ax, ay], [bx, by]) {
-  const dx = bx - ax, dy = by - ay, l2 = dx * dx + dy * dy;
-  const t = l2 ? Math.max(0, Math.min(1, ((px - ax) * dx + (py - ay) * dy) / l2)) : 0;
-  return Math.hypot(px - ax - t * dx, py - ay - t * dy);
-}
+const layout = () => editorLayout(canvas.clientWidth, canvas.clientHeight, field(), { margin: MARGIN_PX, trayHeight: TRAY_HEIGHT_PX });
 function trayPosition(L, k) { return [MARGIN_PX + 100 + k * 30, L.trayTop + TRAY_HEIGHT_PX / 2]; }
 function trayRobots() { return robotItems().filter((r) => !r.placed); }
 // Where the selection's rotation handle is on the canvas, or null.
@@ -650,13 +562,13 @@ function rotateHandle(L, s = ed.sel) {
     const e = ed.doc.robots[s.index];
     if (!e || !isPose(e.pose) || entryIds(e).length !== 1) return null;
     const [u, v] = toPx(L, e.pose[0], e.pose[1]);
-    const d = Math.max(6, ROBOT_RADIUS_M * L.s) + 16, a = rad(e.pose[2]);
+    const d = Math.max(6, ROBOT_RADIUS_M * L.s) + 16, a = degToRad(e.pose[2]);
     return [u + d * Math.cos(a), v - d * Math.sin(a)];
   }
   if (s.type === 'beacon') {
     const b = ed.doc.beacons[s.index];
     if (!b || !isPoint(b.position)) return null;
-    const [u, v] = toPx(L, ...b.position), a = rad(isNum(b.facing_deg) ? b.facing_deg : 0);
+    const [u, v] = toPx(L, ...b.position), a = degToRad(isNum(b.facing_deg) ? b.facing_deg : 0);
     return [u + 24 * Math.cos(a), v - 24 * Math.sin(a)];
   }
   const pts = s.type === 'obstacle' ? obstaclePoints(ed.doc.obstacles[s.index]) : trackPoints(ed.doc.tracks[s.index]);
@@ -784,8 +696,8 @@ function draw() {
   list('beacons').forEach((b, i) => {
     if (!isPoint(b?.position)) return;
     const [u, v] = P(...b.position);
-    const facing = rad(isNum(b.facing_deg) ? b.facing_deg : 0);
-    const ap = rad(isNum(b.aperture_deg) ? Math.min(360, b.aperture_deg) : 360);
+    const facing = degToRad(isNum(b.facing_deg) ? b.facing_deg : 0);
+    const ap = degToRad(isNum(b.aperture_deg) ? Math.min(360, b.aperture_deg) : 360);
     const wedge = (r) => {
       ctx.beginPath();
       if (ap >= 2 * Math.PI - 1e-9) { ctx.arc(u, v, r, 0, 2 * Math.PI); return; }
@@ -862,12 +774,12 @@ function drawRobot(r, u, v, radius, isSelected, inTray = false) {
     ctx.beginPath(); ctx.arc(u, v, radius, 0, 2 * Math.PI); ctx.fill(); ctx.stroke();
   }
   if (!inTray) {
-    const a = rad(r.th);
+    const a = degToRad(r.th);
     ctx.beginPath(); ctx.moveTo(u, v); ctx.lineTo(u + radius * 1.2 * Math.cos(a), v - radius * 1.2 * Math.sin(a)); ctx.stroke();
   }
   ctx.fillStyle = '#111'; ctx.font = '11px system-ui';
   if (inTray) { ctx.textAlign = 'center'; ctx.fillText(String(r.id), u, v + 4); ctx.textAlign = 'start'; }
-  else ctx.fillText(`${r.id}${r.e?.controller && r.e.controller !== 'convoy' ? ` ${r.e.controller}` : ''}`, u + radius + 3, v - radius - 1);
+  else ctx.fillText(`${r.id}${r.e?.controller && r.e.controller !== DEFAULT_CONTROLLER ? ` ${r.e.controller}` : ''}`, u + radius + 3, v - radius - 1);
 }
 
 // ------------------------------------------------------------------ pointer and keys
@@ -935,7 +847,7 @@ canvas.addEventListener('pointermove', (e) => {
   if (d.mode === 'aim') {
     if (Math.hypot(u - d.start[0], v - d.start[1]) < 6 && !d.moved) return;
     d.moved = true;
-    const a = wrapDeg(deg(Math.atan2(-(v - d.start[1]), u - d.start[0])));
+    const a = headingDeg(radToDeg(Math.atan2(-(v - d.start[1]), u - d.start[0])));
     if (ed.sel.type === 'robot') { const p = ed.doc.robots[ed.sel.index].pose; setPose(ed.doc.robots[ed.sel.index], [p[0], p[1], a]); }
     else ed.doc.beacons[ed.sel.index].facing_deg = a;
   } else if (d.mode === 'rotate') {
@@ -995,7 +907,7 @@ function handleAngle(L, u, v, s) {
   if (s.type === 'robot') c = toPx(L, ...ed.doc.robots[s.index].pose.slice(0, 2));
   else if (s.type === 'beacon') c = toPx(L, ...ed.doc.beacons[s.index].position);
   else c = toPx(L, ...centroid(selectedPoints(s)));
-  return deg(Math.atan2(-(v - c[1]), u - c[0]));
+  return radToDeg(Math.atan2(-(v - c[1]), u - c[0]));
 }
 function positionOf(s) {
   if (s.type === 'robot') return ed.doc.robots[s.index].pose;
@@ -1083,9 +995,27 @@ for (const r of document.querySelectorAll('input[name="editor-tool"]')) {
 }
 
 // ------------------------------------------------------------------ the property form
-// Each row: [label, get, set, {type, options, step}]; a change is one undo step.
+// Each row: {label, get, set, type, options, step, ...}; a change is one undo step.
 let formRows = [];
 function numberField(label, get, set, step = 0.001, extra = {}) { return { label, get, set, type: 'number', step, ...extra }; }
+// The robot's controller: one of the registry's (and the entry's own if rilbed does not
+// know it, flagged in the problems); none to choose while the list has not loaded.
+function controllerRow(e) {
+  const current = () => controllerOf(e());
+  const names = controllers.registry?.names ?? [];
+  const options = names.includes(current()) ? names : [...names, current()];
+  const titles = Object.fromEntries(options.map((n) => [n, controllers.registry?.find(n)?.summary ?? 'not a controller rilbed knows']));
+  return { label: 'controller', type: 'select', options, titles, disabled: !controllers.registry, get: current, set: (v) => setController(e(), v) };
+}
+// One parameter of the robot's controller: a number input with its unit, its default as
+// the placeholder and its range; emptied, the parameter is left out (its default applies).
+function paramRow(e, p) {
+  return numberField(p.name, () => e().params?.[p.name], (v) => setParam(e(), p.name, v), p.integer ? 1 : 'any', {
+    name: `param_${p.name}`, unit: p.unit, title: paramDescription(p), emptyIsNull: true,
+    min: p.min ?? undefined, max: p.max ?? undefined,
+    placeholder: p.required ? 'required' : p.default !== null ? numberText(p.default) : '',
+  });
+}
 function formFor(s) {
   const rows = [];
   if (!s) {
@@ -1103,20 +1033,20 @@ function formFor(s) {
       }, 1, { min: 1 }));
     }
     rows.push({ label: 'kind', type: 'select', options: ['virtual', 'real'], get: () => (e().kind === 'real' ? 'real' : 'virtual'), set: (v) => setKind(s.index, v) });
-    const controllers = [...CONTROLLERS];
-    const current = () => e().controller ?? 'convoy';
-    if (!controllers.includes(current())) controllers.push(current());
-    rows.push({ label: 'controller', type: 'select', options: controllers, get: current, set: (v) => setController(e(), v) });
+    rows.push(controllerRow(e));
     if (isPose(e().pose) && !group) {
       rows.push(numberField('x_m', () => e().pose[0], (v) => setPose(e(), [v, e().pose[1], e().pose[2]])));
       rows.push(numberField('y_m', () => e().pose[1], (v) => setPose(e(), [e().pose[0], v, e().pose[2]])));
       rows.push(numberField('theta_deg', () => e().pose[2], (v) => setPose(e(), [e().pose[0], e().pose[1], v]), 1));
     }
-    const kept = Object.keys(e()).filter((k) => !['id', 'ids', 'kind', 'controller', 'pose'].includes(k));
+    const entry = controllers.registry?.find(controllerOf(e()));
+    if (entry?.params.length) rows.push({ type: 'heading', label: `parameters of ${entry.name}` }, ...entry.params.map((p) => paramRow(e, p)));
+    const shown = ['id', 'ids', 'kind', 'controller', 'pose', ...(entry ? ['params'] : [])];
+    const kept = Object.keys(e()).filter((k) => !shown.includes(k));
     return {
       title: `Robot ${s.id}${group ? ` (of group ${e().ids})` : ''}`, rows,
       note: `${isPose(e().pose) && !group ? '' : 'Random pose: drag it from the tray onto the field to place it' +
-        `${group ? ' (it then leaves its group)' : ''}. `}${group ? 'kind and controller apply to the whole group. ' : ''}` +
+        `${group ? ' (it then leaves its group)' : ''}. `}${group ? 'kind, controller and parameters apply to the whole group. ' : ''}` +
         `${kept.length ? `Kept as loaded: ${kept.join(', ')}.` : ''}`,
       actions: isPose(e().pose) && !group ? [['random pose', () => { e().pose = 'random'; s.tray = true; }]] : [],
     };
@@ -1126,7 +1056,7 @@ function formFor(s) {
     rows.push(numberField('id', () => b().id, (v) => { if (Number.isInteger(v)) b().id = v; }, 1));
     rows.push(numberField('x_m', () => b().position[0], (v) => { b().position = [round3(v), b().position[1]]; }));
     rows.push(numberField('y_m', () => b().position[1], (v) => { b().position = [b().position[0], round3(v)]; }));
-    rows.push(numberField('facing_deg', () => b().facing_deg ?? 0, (v) => { b().facing_deg = wrapDeg(v); }, 1));
+    rows.push(numberField('facing_deg', () => b().facing_deg ?? 0, (v) => { b().facing_deg = headingDeg(v); }, 1));
     rows.push(numberField('aperture_deg', () => b().aperture_deg ?? 360, (v) => { if (v > 0 && v <= 360) b().aperture_deg = v; }, 1, { min: 1, max: 360 }));
     rows.push(numberField('range_m', () => b().range_m ?? 2, (v) => { if (v > 0) b().range_m = v; }, 0.01, { min: 0.01 }));
     return { title: `Beacon ${b().id}`, rows };
@@ -1154,57 +1084,7 @@ function renderForm() {
   h.textContent = spec.title;
   form.append(h);
   formRows = [];
-  for (const row of spec.rows) {
-    const label = document.createElement('label');
-    label.className = 'editor-row';
-    const span = document.createElement('span');
-    span.textContent = row.label;
-    label.append(span);
-    const inputs = [];
-    const apply = (value) => { checkpoint(); row.set(value); changed(true); };
-    if (row.type === 'select') {
-      const sel = document.createElement('select');
-      for (const o of row.options) sel.append(new Option(o, o));
-      sel.addEventListener('change', () => apply(sel.value));
-      inputs.push(sel);
-    } else if (row.type === 'checkbox') {
-      const box = document.createElement('input');
-      box.type = 'checkbox';
-      box.addEventListener('change', () => apply(box.checked));
-      inputs.push(box);
-    } else if (row.type === 'pair') {
-      for (let k = 0; k < 2; ++k) {
-        const input = document.createElement('input');
-        input.type = 'number'; input.step = '0.001';
-        input.addEventListener('change', () => {
-          const v = Number(input.value);
-          if (input.value === '' || !isNum(v)) return;
-          const p = [...row.get()];
-          p[k] = round3(v);
-          apply(p);
-        });
-        inputs.push(input);
-      }
-    } else {
-      const input = document.createElement('input');
-      input.type = row.type;
-      if (row.step) input.step = String(row.step);
-      if (row.min !== undefined) input.min = String(row.min);
-      if (row.max !== undefined) input.max = String(row.max);
-      input.addEventListener('change', () => {
-        if (row.type === 'number') {
-          const v = Number(input.value);
-          if (input.value === '' || !isNum(v)) { refreshForm(); return; }
-          apply(v);
-        } else apply(input.value);
-      });
-      inputs.push(input);
-    }
-    inputs.forEach((i, k) => { i.name = `${row.label}${inputs.length > 1 ? ['_x', '_y'][k] : ''}`.replace(/\W+/g, '_'); });
-    label.append(...inputs);
-    form.append(label);
-    formRows.push({ row, inputs });
-  }
+  for (const row of spec.rows) form.append(row.type === 'heading' ? formHeading(row.label) : formRow(row));
   for (const [text, act] of spec.actions || []) {
     const b = document.createElement('button');
     b.type = 'button'; b.textContent = text;
@@ -1219,6 +1099,78 @@ function renderForm() {
   }
   refreshForm();
   updateButtons();
+}
+function formHeading(text) {
+  const h = document.createElement('h4');
+  h.textContent = text;
+  return h;
+}
+// A row of the form: its label, its input(s) and, for a number with a unit, the unit.
+function formRow(row) {
+  const label = document.createElement('label');
+  label.className = 'editor-row';
+  if (row.title) label.title = row.title;
+  const span = document.createElement('span');
+  span.textContent = row.label;
+  label.append(span);
+  const apply = (value) => { checkpoint(); row.set(value); changed(true); };
+  const inputs = row.type === 'select' ? [selectInput(row, apply)] : row.type === 'checkbox' ? [checkboxInput(apply)]
+    : row.type === 'pair' ? [0, 1].map((k) => pairInput(row, k, apply)) : [plainInput(row, apply)];
+  inputs.forEach((i, k) => { i.name = row.name ?? `${row.label}${inputs.length > 1 ? ['_x', '_y'][k] : ''}`.replace(/\W+/g, '_'); });
+  label.append(...inputs);
+  if (row.unit !== undefined) {
+    const unit = document.createElement('span');
+    unit.className = 'editor-unit muted small';
+    unit.textContent = row.unit || '(no unit)';
+    label.append(unit);
+  }
+  formRows.push({ row, inputs });
+  return label;
+}
+function selectInput(row, apply) {
+  const sel = document.createElement('select');
+  for (const o of row.options) {
+    const option = new Option(o, o);
+    if (row.titles?.[o]) option.title = row.titles[o];
+    sel.append(option);
+  }
+  sel.disabled = !!row.disabled;
+  sel.addEventListener('change', () => apply(sel.value));
+  return sel;
+}
+function checkboxInput(apply) {
+  const box = document.createElement('input');
+  box.type = 'checkbox';
+  box.addEventListener('change', () => apply(box.checked));
+  return box;
+}
+function pairInput(row, k, apply) {
+  const input = document.createElement('input');
+  input.type = 'number'; input.step = '0.001';
+  input.addEventListener('change', () => {
+    const v = Number(input.value);
+    if (input.value === '' || !isNum(v)) return;
+    const p = [...row.get()];
+    p[k] = round3(v);
+    apply(p);
+  });
+  return input;
+}
+function plainInput(row, apply) {
+  const input = document.createElement('input');
+  input.type = row.type;
+  if (row.step) input.step = String(row.step);
+  if (row.min !== undefined) input.min = String(row.min);
+  if (row.max !== undefined) input.max = String(row.max);
+  if (row.placeholder) input.placeholder = row.placeholder;
+  input.addEventListener('change', () => {
+    if (row.type !== 'number') { apply(input.value); return; }
+    const v = Number(input.value);
+    if (input.value === '' && row.emptyIsNull && !input.validity.badInput) apply(null);
+    else if (input.value === '' || !isNum(v)) refreshForm();
+    else apply(v);
+  });
+  return input;
 }
 function refreshForm() {
   if (ed.sel && !selectionExists()) { renderForm(); return; }
@@ -1269,9 +1221,35 @@ for (const [id, io] of Object.entries(scenarioInputs)) {
 }
 
 // ------------------------------------------------------------------ the panel's buttons
-for (const id of ['editor-new-controller']) {
-  for (const c of CONTROLLERS) $(id).append(new Option(c, c));
+// ------------------------------------------------------------------ the controllers
+async function loadControllers() {
+  try {
+    controllers.registry = await loadRegistry();
+  } catch (e) {
+    controllers.error = e.message;
+  }
+  controllers.loaded = true;
+  showControllersState();
+  fillNewRobotControllers();
+  changed(true); // the form, its parameters and the problems, now with the registry
 }
+function showControllersState() {
+  const p = $('editor-controllers');
+  p.hidden = controllers.loaded && !controllers.error;
+  p.classList.toggle('editor-bad', !!controllers.error);
+  p.textContent = controllers.error
+    ? `The list of controllers did not load (${controllers.error}): no controller can be chosen, and the robots' ` +
+      'controllers, parameters and sensors are not checked. Reload the page to try again.'
+    : 'Loading the list of controllers…';
+}
+function fillNewRobotControllers() {
+  const select = $('editor-new-controller');
+  const entries = controllers.registry?.entries ?? [];
+  select.replaceChildren(...entries.map((c) => { const o = new Option(c.name, c.name); o.title = c.summary; return o; }));
+  if (entries.some((c) => c.name === DEFAULT_CONTROLLER)) select.value = DEFAULT_CONTROLLER;
+  select.disabled = !entries.length;
+}
+
 $('editor-from-run').addEventListener('click', startFromRun);
 $('editor-poses-from-run').addEventListener('click', posesFromRun);
 $('editor-new').addEventListener('click', newScenario);
@@ -1295,6 +1273,9 @@ new ResizeObserver(requestDraw).observe(canvas);
 
 newScenario();
 status('');
+showControllersState();
+fillNewRobotControllers();
+loadControllers();
 
 // For tests and the curious: the editor's document and its canvas geometry.
 window.rilbedEditor = {
@@ -1309,4 +1290,6 @@ window.rilbedEditor = {
   trayPosition: (id) => { const k = trayRobots().findIndex((r) => r.id === id); return k < 0 ? null : trayPosition(layout(), k); },
   rotateHandle: () => rotateHandle(layout()),
   problems: findProblems,
+  // The registry's names as the editor has them, and why it has none if it failed.
+  get controllers() { return { loaded: controllers.loaded, names: controllers.registry?.names ?? [], error: controllers.error }; },
 };

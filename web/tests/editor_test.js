@@ -1,5 +1,5 @@
 #!/usr/bin/env node
-// The web panel's scenario editor (issue 17, web/editor.js) in a real browser: Debian's
+// The web panel's scenario editor (web/editor.js) in a real browser: Debian's
 // Chromium, driven by playwright-core, against `rilbed run --gui`.
 //
 //   node web/tests/editor_test.js RILBED [ARTEFACT_DIR]
@@ -19,9 +19,18 @@
 //   4. each scenarios/*.yaml loaded through the file input and saved unchanged parses
 //      (js-yaml) to an object deep-equal to the original's, and `RILBED run` accepts it
 //      (--fast --duration 1, plus --all-virtual when it has real robots);
-// and that the page logged no console error and threw nothing. A screenshot of the
-// editor goes to $RILBED_ARTIFACTS, else ARTEFACT_DIR (CTest passes BUILD/web-artifacts),
-// else a temp folder; its path is printed. Every wait polls with a deadline; on any
+//   5. a group split by dragging one of its robots out of the tray; 6. "Poses from run";
+//   7. the controllers are the server's registry: controllers.json is what `RILBED
+//      controllers --json` prints, the new robot's and a robot's controller choices are
+//      exactly its names, a robot's form has an input per parameter with the registry's
+//      unit, default, range and summary; an out-of-range speed_mps is flagged, a change of
+//      controller keeps the params it takes, adds the sensors it requires and asks for its
+//      required params; with controllers.json failing (503) the editor says so and offers
+//      no controller;
+// and that the page logged no console error and threw nothing. Screenshots of the
+// editor (editor.png, editor-params.png, editor-no-registry.png) go to $RILBED_ARTIFACTS,
+// else ARTEFACT_DIR (CTest passes BUILD/web-artifacts), else a temp folder; their paths
+// are printed. Every wait polls with a deadline; on any
 // failure it says what it was waiting for, shows the end of rilbed's output, kills
 // rilbed and the browser and exits 1. CTest runs it as web_editor (label e2e); `./run
 // test` installs its npm packages (web/tests and web/: the page's js-yaml) and Chromium.
@@ -389,8 +398,165 @@ async function main(state) {
     ok(`"Poses from run" on convoy_sim.yaml: robots 1-8 each at the run's pose, kind, noise and sensors kept; rilbed run accepts it`);
   }
 
+  // 7. The controllers: the registry's, in the lists, the forms and the checks.
+  const registry = cliRegistry(binary);
+  await checkControllerLists(page, until, registry);
+  await checkParameterForm(state, page, until, registry);
+  await checkRegistryFailure(state, context, url);
+
   check(state.pageErrors.length === 0, `the page logged errors:\n${state.pageErrors.join('\n')}`);
   ok('the page logged no console error and threw nothing');
+}
+
+// ---------------------------------------------------------------- the controller registry
+// What `RILBED controllers --json` prints: the registry the server serves at controllers.json.
+function cliRegistry(binary) {
+  const r = spawnSync(binary, ['controllers', '--json'], { encoding: 'utf8', timeout: 60000 });
+  check(r.status === 0, `rilbed controllers --json ended with ${r.error ? r.error.message : r.signal || `exit code ${r.status}`}: ${r.stderr}`);
+  const list = JSON.parse(r.stdout);
+  check(Array.isArray(list) && list.length > 0, `rilbed controllers --json printed no list: ${r.stdout.slice(0, 300)}`);
+  return list;
+}
+
+const optionValues = (page, selector) => page.$$eval(`${selector} option`, (os) => os.map((o) => o.value));
+
+// The page's controllers.json is the command's registry, and the editor's choices (the new
+// robot's and a robot's form) are exactly its names, in its order.
+async function checkControllerLists(page, until, registry) {
+  const names = registry.map((c) => c.name);
+  const served = await page.evaluate(() => fetch('controllers.json').then((r) => r.json()));
+  try {
+    assert.deepStrictEqual(served, registry);
+  } catch (e) {
+    fail(`the page's controllers.json is not what rilbed controllers --json prints:\n${e.message.slice(0, 2000)}`);
+  }
+  const editor = await until('the editor to have the list of controllers', () => window.rilbedEditor.controllers.loaded && window.rilbedEditor.controllers);
+  check(editor.error === null, `the editor says the list of controllers did not load: ${editor.error}`);
+  check(await page.isHidden('#editor-controllers'), 'the editor still shows a note about the list of controllers although it loaded');
+  const newRobot = await optionValues(page, '#editor-new-controller');
+  check(JSON.stringify(newRobot) === JSON.stringify(names), `the new robot's controllers are ${newRobot}, not the registry's ${names}`);
+  await loadScenario(page, until, 'wander.yaml');
+  await selectTrayRobot(page, until, 1);
+  const form = await optionValues(page, '#editor-form select[name=controller]');
+  check(JSON.stringify(form) === JSON.stringify(names), `robot 1's controller choices are ${form}, not the registry's ${names}`);
+  check(await page.inputValue('#editor-form select[name=controller]') === 'wander', 'robot 1 of wander.yaml does not show controller wander');
+  ok(`controllers.json is rilbed controllers --json; the editor offers exactly its controllers (${names.join(', ')}) for a new robot and in a robot's form`);
+}
+
+async function loadScenario(page, until, name) {
+  const loadsBefore = await page.evaluate(() => window.rilbedEditor.loads);
+  await page.setInputFiles('#editor-file', path.join(SCENARIOS, name));
+  await until(`the editor to load ${name}`, ([n, f]) => window.rilbedEditor.loads > n && window.rilbedEditor.loadedName === f, [loadsBefore, name]);
+}
+
+// Clicks robot `id` in the tray (a robot with a random pose) and waits for it to be selected.
+async function selectTrayRobot(page, until, id) {
+  const canvas = page.locator('#editor-canvas');
+  await canvas.evaluate((el) => el.scrollIntoView({ block: 'center' }));
+  const at = await page.evaluate((k) => window.rilbedEditor.trayPosition(k), id);
+  check(at, `robot ${id} is not in the tray`);
+  const b = await canvas.boundingBox();
+  await page.mouse.click(b.x + at[0], b.y + at[1]);
+  await until(`robot ${id} to be selected`, (k) => window.rilbedEditor.selection?.id === k, id);
+}
+
+const problemsShown = (page) => page.$$eval('#editor-problems li', (lis) => lis.map((li) => li.textContent));
+
+// Types `value` into parameter `name`'s input of the form, as a person does (then Tab).
+async function typeParam(page, name, value) {
+  const input = page.locator(`#editor-form input[name=param_${name}]`);
+  await input.fill(String(value));
+  await input.press('Tab');
+}
+
+// Robot 1 of wander.yaml (selected): a number input per parameter of wander with its unit,
+// default, range and summary from the registry; a speed out of range flagged, one in range
+// saved in params, an emptied one gone; another controller keeps the params it takes, adds
+// a sensor it requires and asks for its required params; `none` drops them all.
+async function checkParameterForm(state, page, until, registry) {
+  const wander = registry.find((c) => c.name === 'wander');
+  const speed = wander && wander.params.find((p) => p.name === 'speed_mps');
+  check(speed, 'the registry has no wander with a speed_mps parameter');
+  const shown = await page.$$eval('#editor-form input[name^=param_]', (inputs) => inputs.map((i) => ({
+    name: i.name, placeholder: i.placeholder, min: i.min, max: i.max, title: i.closest('label').title,
+    unit: i.closest('label').querySelector('.editor-unit')?.textContent,
+  })));
+  check(JSON.stringify(shown.map((i) => i.name)) === JSON.stringify(wander.params.map((p) => `param_${p.name}`)),
+    `robot 1's parameter inputs are ${shown.map((i) => i.name)}, not wander's ${wander.params.map((p) => p.name)}`);
+  const s = shown[0];
+  check(s.unit === speed.unit && s.placeholder === String(speed.default) && s.min === String(speed.min) && s.max === String(speed.max) &&
+    s.title.includes(speed.summary), `the speed_mps input shows ${JSON.stringify(s)}, not the registry's ${JSON.stringify(speed)}`);
+  ok(`robot 1 (wander): a speed_mps input in ${s.unit}, placeholder ${s.placeholder}, min ${s.min}, max ${s.max}, "${speed.summary}" on hover`);
+  const shot = path.join(state.artifacts, 'editor-params.png');
+  await page.locator('#editor').screenshot({ path: shot });
+  ok(`screenshot of a robot's parameters: ${shot}`);
+
+  const tooFast = speed.max + 4;
+  const flagged = `robots[0]: params.speed_mps must be ${speed.min} to ${speed.max} (${speed.unit}), not ${tooFast}.`;
+  await typeParam(page, 'speed_mps', tooFast);
+  await until(`the problems to flag speed_mps ${tooFast}`, (text) => window.rilbedEditor.problems().includes(text), flagged);
+  check((await problemsShown(page)).includes(flagged), `the page's problems do not show "${flagged}": ${await problemsShown(page)}`);
+  await typeParam(page, 'speed_mps', 0.08);
+  await until('speed_mps 0.08 to be saved in params and its problem to go', (text) => {
+    const e = window.rilbedEditor.doc.robots[0];
+    return e.params?.speed_mps === 0.08 && !window.rilbedEditor.problems().includes(text);
+  }, flagged);
+  check(/params: \{speed_mps: 0\.08\}/.test(await page.inputValue('#editor-yaml')), 'the YAML shown does not hold params: {speed_mps: 0.08}');
+  ok(`speed_mps ${tooFast} flagged as "${flagged}"; 0.08 accepted and saved as params: {speed_mps: 0.08}`);
+
+  await checkControllerChange(page, until, registry);
+  await typeParam(page, 'speed_mps', '');
+  await until('an emptied speed_mps to leave params', () => window.rilbedEditor.doc.robots[0].params === undefined);
+  ok('speed_mps emptied: robot 1\'s params are gone (the default applies)');
+}
+
+const setRobotController = (page, name) => page.selectOption('#editor-form select[name=controller]', name);
+
+async function checkControllerChange(page, until, registry) {
+  const takes = (name, param) => registry.find((c) => c.name === name)?.params.some((p) => p.name === param);
+  check(takes('track_follow', 'speed_mps') && takes('goto', 'speed_mps'), 'the registry\'s track_follow or goto takes no speed_mps');
+  await setRobotController(page, 'track_follow');
+  await until('track_follow to keep speed_mps and get track sensors', () => {
+    const e = window.rilbedEditor.doc.robots[0];
+    return e.controller === 'track_follow' && e.params?.speed_mps === 0.08 && Array.isArray(e.sensors?.track) && e.sensors.track.length > 0;
+  });
+  const goto = registry.find((c) => c.name === 'goto');
+  const required = goto.params.filter((p) => p.required).map((p) => `robots[0]: controller goto needs parameter '${p.name}' (${p.summary}).`);
+  check(required.length > 0, 'the registry\'s goto requires no parameter');
+  await setRobotController(page, 'goto');
+  await until('goto\'s required parameters to be asked for', (want) => want.every((t) => window.rilbedEditor.problems().includes(t)), required);
+  await setRobotController(page, 'none');
+  await until('none to drop every parameter', () => window.rilbedEditor.doc.robots[0].controller === 'none' && window.rilbedEditor.doc.robots[0].params === undefined);
+  check(await page.$$eval('#editor-form input[name^=param_]', (inputs) => inputs.length) === 0, 'robot 1 with controller none still shows parameter inputs');
+  await setRobotController(page, 'wander');
+  await typeParam(page, 'speed_mps', 0.08);
+  await until('wander with speed_mps 0.08 again', () => window.rilbedEditor.doc.robots[0].params?.speed_mps === 0.08);
+  ok(`controller changes: track_follow keeps speed_mps and gets track sensors; goto asks for ${goto.params.filter((p) => p.required).map((p) => p.name)}; none drops every parameter`);
+}
+
+// A page whose controllers.json fails: the editor says so, in red, and offers no
+// controller (no list of its own to fall back on).
+async function checkRegistryFailure(state, context, url) {
+  const page = await context.newPage();
+  await page.route('**/controllers.json*', (route) => route.fulfill({ status: 503, contentType: 'text/plain', body: 'unavailable\n' }));
+  await page.goto(url);
+  await page.waitForFunction(() => window.rilbedEditor?.controllers.loaded, null, { timeout: DEADLINE_MS, polling: 50 })
+    .catch((e) => fail(`the editor did not finish asking for controllers.json (${e.message.split('\n')[0]})`));
+  if (!(await page.evaluate(() => document.getElementById('editor-panel').open))) await page.click('#editor-panel > summary');
+  const seen = await page.evaluate(() => ({
+    editor: window.rilbedEditor.controllers, note: document.getElementById('editor-controllers').textContent,
+    visible: !document.getElementById('editor-controllers').hidden, colour: getComputedStyle(document.getElementById('editor-controllers')).color,
+    options: document.querySelectorAll('#editor-new-controller option').length, problems: window.rilbedEditor.problems(),
+  }));
+  check(seen.visible && /did not load/.test(seen.note) && /503/.test(seen.note) && seen.editor.error,
+    `with controllers.json failing the editor says ${JSON.stringify(seen.note)} (shown: ${seen.visible})`);
+  check(seen.options === 0 && seen.editor.names.length === 0, `with controllers.json failing the editor still offers ${seen.options} controllers`);
+  check(seen.problems.some((p) => /not checked/.test(p)), `with controllers.json failing the problems do not say the controllers go unchecked: ${seen.problems}`);
+  await page.locator('#editor-controllers').scrollIntoViewIfNeeded();
+  const shot = path.join(state.artifacts, 'editor-no-registry.png');
+  await page.locator('#editor').screenshot({ path: shot });
+  await page.close();
+  ok(`controllers.json answering 503: the editor says "${seen.note}" and offers no controller (screenshot ${shot})`);
 }
 
 run(main, {
