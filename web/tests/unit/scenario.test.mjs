@@ -1,0 +1,51 @@
+// Reading a scenario object (web/scenario.js) as rilbed run reads it.
+import test from 'node:test';
+import assert from 'node:assert/strict';
+import { controllerOf, entryIds, robotHasSensor, robotItems, scenarioField } from '../../scenario.js';
+
+test('the field: its size, the defaults for what is missing or not above 0, its walls', () => {
+  assert.deepEqual(scenarioField({ field: { width_m: 2, height_m: 1, walls: false } }), { w: 2, h: 1, walls: false });
+  assert.deepEqual(scenarioField({ field: { width_m: -1 } }), { w: 1.5, h: 1.2, walls: true });
+  assert.deepEqual(scenarioField({}), { w: 1.5, h: 1.2, walls: true });
+});
+
+test('an entry\'s IDs: id, or ids as a list text or a number; none when invalid', () => {
+  assert.deepEqual(entryIds({ id: 3 }), [3]);
+  assert.deepEqual(entryIds({ ids: '1-3,7' }), [1, 2, 3, 7]);
+  assert.deepEqual(entryIds({ ids: 4 }), [4]);
+  assert.deepEqual(entryIds({ id: 'x' }), []);
+  assert.deepEqual(entryIds({ ids: '3-1' }), []);
+  assert.deepEqual(entryIds(null), []);
+});
+
+test('robotItems: a placed robot per single entry with a pose, a tray robot per ID otherwise', () => {
+  const doc = { robots: [{ id: 1, pose: [0.2, 0.3, 90] }, { ids: '2-3', pose: 'random' }, { id: 4 }] };
+  const items = robotItems(doc).map(({ index, id, placed, x, y, th }) => ({ index, id, placed, x, y, th }));
+  assert.deepEqual(items, [
+    { index: 0, id: 1, placed: true, x: 0.2, y: 0.3, th: 90 },
+    { index: 1, id: 2, placed: false, x: undefined, y: undefined, th: undefined },
+    { index: 1, id: 3, placed: false, x: undefined, y: undefined, th: undefined },
+    { index: 2, id: 4, placed: false, x: undefined, y: undefined, th: undefined },
+  ]);
+  assert.deepEqual(robotItems({ robots: 'none' }), []);
+});
+
+test('a robot without controller: runs the scenario default', () => {
+  assert.equal(controllerOf({}), 'convoy');
+  assert.equal(controllerOf({ controller: 'wander' }), 'wander');
+});
+
+test('robotHasSensor as robot_has_sensor: defaults on, lists need an element, the pose always', () => {
+  assert.equal(robotHasSensor(undefined, 'proximity'), true);
+  assert.equal(robotHasSensor({ proximity: false }, 'proximity'), false);
+  assert.equal(robotHasSensor({ proximity: { range_m: 0.05 } }, 'proximity'), true);
+  assert.equal(robotHasSensor({}, 'odometer'), true);
+  assert.equal(robotHasSensor({ odometer: false }, 'odometer'), false);
+  assert.equal(robotHasSensor({ odometer: false, proximity: false }, 'pose'), true);
+  assert.equal(robotHasSensor({}, 'track'), false);
+  assert.equal(robotHasSensor({ track: [] }, 'track'), false);
+  assert.equal(robotHasSensor({ track: [{ height_mm: 8 }] }, 'track'), true);
+  assert.equal(robotHasSensor({ range_finders: [{}] }, 'range_finders'), true);
+  assert.equal(robotHasSensor({}, 'beacon_finder'), false);
+  assert.equal(robotHasSensor({ beacon_finder: { field_of_view_deg: 360 } }, 'beacon_finder'), true);
+});

@@ -1,0 +1,111 @@
+// The scenario checks (web/scenario_checks.js): what rilbed run would refuse, the robots'
+// controllers, parameters and sensors checked against the registry alone.
+import test from 'node:test';
+import assert from 'node:assert/strict';
+import { parseRegistry } from '../../controller_registry.js';
+import { controllerProblems, findProblems, paramsProblems } from '../../scenario_checks.js';
+import { REGISTRY_JSON } from './registry_fixture.mjs';
+
+const registry = parseRegistry(JSON.parse(JSON.stringify(REGISTRY_JSON)));
+const sweeper = registry.find('sweeper');
+const sweeperSensors = { range_finders: [{ mount_deg: 0 }], track: [{ height_mm: 8 }] };
+const scenario = (robots, more = {}) => ({ field: { width_m: 1.5, height_m: 1.2 }, robots, ...more });
+
+test('a good scenario has no problem', () => {
+  const doc = scenario([
+    { ids: '1-2', pose: 'random' },
+    { id: 3, pose: [0.5, 0.5, 0], controller: 'wander', params: { speed_mps: 0.2 } },
+    { id: 4, pose: [0.8, 0.5, 0], controller: 'sweeper', params: { lanes: 3 }, sensors: sweeperSensors },
+  ]);
+  assert.deepEqual(findProblems(doc, registry), []);
+});
+
+test('a controller the registry does not have is unknown, named with those it has', () => {
+  assert.deepEqual(controllerProblems({ controller: 'track_follow' }, registry),
+    ["unknown controller 'track_follow' (rilbed knows convoy, wander, sweeper)"]);
+  const doc = scenario([{ id: 1, pose: 'random', controller: 'beacon_homing' }]);
+  assert.deepEqual(findProblems(doc, registry), ["robots[0]: unknown controller 'beacon_homing' (rilbed knows convoy, wander, sweeper)."]);
+});
+
+test('a parameter the controller does not take', () => {
+  assert.deepEqual(paramsProblems(registry.find('wander'), { speed_mps: 0.1, lanes: 2 }),
+    ["controller wander has no parameter 'lanes' (it takes speed_mps)"]);
+  assert.deepEqual(paramsProblems(registry.find('convoy'), { speed_mps: 0.1 }),
+    ["controller convoy has no parameter 'speed_mps' (it takes none)"]);
+});
+
+test('values out of range, not whole, not numbers', () => {
+  const wander = registry.find('wander');
+  assert.deepEqual(paramsProblems(wander, { speed_mps: 5 }), ['params.speed_mps must be 0 to 1.016 (m/s), not 5']);
+  assert.deepEqual(paramsProblems(wander, { speed_mps: -0.01 }), ['params.speed_mps must be 0 to 1.016 (m/s), not -0.01']);
+  assert.deepEqual(paramsProblems(wander, { speed_mps: 1.016 }), []);
+  assert.deepEqual(paramsProblems(wander, { speed_mps: 'fast' }), ['params.speed_mps must be a number, not "fast"']);
+  assert.deepEqual(paramsProblems(sweeper, { lanes: 2.5 }), ['params.lanes must be a whole number, not 2.5']);
+  assert.deepEqual(paramsProblems(sweeper, { lanes: 21 }), ['params.lanes must be 1 to 20, not 21']);
+  assert.deepEqual(paramsProblems(sweeper, { lanes: 2, gap_m: 0.001 }), ['params.gap_m must be at least 0.01 (m), not 0.001']);
+  assert.deepEqual(paramsProblems(sweeper, { lanes: 2, gap_m: 50, bias: -1e9 }), []);
+  assert.deepEqual(paramsProblems(wander, [0.1]), ['params must be a mapping of names to numbers ({speed_mps: 0.08})']);
+});
+
+test('a required parameter missing', () => {
+  assert.deepEqual(paramsProblems(sweeper, {}), ["controller sweeper needs parameter 'lanes' (how many lanes)"]);
+  assert.deepEqual(paramsProblems(sweeper, undefined), ["controller sweeper needs parameter 'lanes' (how many lanes)"]);
+});
+
+test('a required sensor missing, each named', () => {
+  assert.deepEqual(controllerProblems({ controller: 'sweeper', params: { lanes: 1 } }, registry),
+    ['sweeper needs sensors: range_finders', 'sweeper needs sensors: track']);
+  assert.deepEqual(controllerProblems({ controller: 'sweeper', params: { lanes: 1 }, sensors: { track: [{}], range_finders: [] } }, registry),
+    ['sweeper needs sensors: range_finders']);
+});
+
+test('every problem of an entry is prefixed with the entry', () => {
+  const doc = scenario([{ id: 1, pose: 'random' }, { ids: '2-3', controller: 'wander', params: { speed_mps: 2 } }]);
+  assert.deepEqual(findProblems(doc, registry), ['robots[1]: params.speed_mps must be 0 to 1.016 (m/s), not 2.']);
+});
+
+test('without a registry the controllers go unchecked, the rest is still checked', () => {
+  const doc = scenario([{ id: 1, pose: 'random', controller: 'nonsense', params: { x: 'y' } }, { id: 1, pose: 'random' }]);
+  assert.deepEqual(findProblems(doc, null), ['robot 1 is defined twice.']);
+});
+
+test('robots: at least one, IDs valid and once, a real one with a link and a camera', () => {
+  assert.deepEqual(findProblems(scenario([]), registry), ['robots: rilbed run needs at least one robot.']);
+  assert.deepEqual(findProblems(scenario([{ ids: '0-2' }, { id: 1 }]), registry), ['robots[0]: no valid id or ids.']);
+  assert.deepEqual(findProblems(scenario([{ id: 1, kind: 'real' }]), registry),
+    ['robots[0]: a real robot needs a link.', 'camera: real robots need a camera.']);
+  assert.deepEqual(findProblems(scenario([{ id: 1, kind: 'real', link: { emulate: true } }], { camera: { emulate: true } }), registry), []);
+});
+
+test('convoy robots numbered 1..N', () => {
+  const doc = scenario([{ ids: '1-2' }, { id: 4 }, { id: 3, controller: 'wander' }]);
+  assert.deepEqual(findProblems(doc, registry), ['convoy robots must be numbered 1..N; they are 1-2,4.']);
+});
+
+test('placed robots against the walls, the obstacles and each other', () => {
+  const obstacles = [{ name: 'box', polygon: [[0.4, 0.4], [0.6, 0.4], [0.6, 0.6], [0.4, 0.6]] }];
+  const doc = scenario([
+    { id: 1, pose: [0.01, 0.5, 0] },
+    { id: 2, pose: [0.5, 0.5, 0] },
+    { id: 3, pose: [0.62, 0.5, 0] },
+    { id: 4, pose: [1.0, 1.0, 0] },
+    { id: 5, pose: [1.04, 1.0, 0] },
+  ], { obstacles });
+  assert.deepEqual(findProblems(doc, registry), [
+    'robot 1 overlaps a wall.', 'robot 2 is inside obstacle 1 (box).', 'robot 3 overlaps obstacle 1 (box).', 'robots 4 and 5 overlap.',
+  ]);
+  const open = scenario([{ id: 1, pose: [0.01, 0.5, 0] }], { field: { width_m: 1.5, height_m: 1.2, walls: false } });
+  assert.deepEqual(findProblems(open, registry), []);
+});
+
+test('obstacles, tracks and beacons', () => {
+  const doc = scenario([{ id: 1 }], {
+    obstacles: [{ polygon: [[0, 0], [1, 0]] }],
+    tracks: [{ points: [[0, 0]] }],
+    beacons: [{ id: 1, aperture_deg: 400 }, { id: 1, range_m: 0 }],
+  });
+  assert.deepEqual(findProblems(doc, registry), [
+    'obstacle 1 needs at least 3 points.', 'track 1 needs at least 2 points.', 'beacon 1: aperture_deg must be in (0, 360].',
+    'beacon 1 is defined twice.', 'beacon 2: range_m must be above 0.',
+  ]);
+});
