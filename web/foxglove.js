@@ -14,17 +14,27 @@
 //   await client.getParameters([]);           // [{name, value}, ...] (no names: all)
 //   await client.setParameters([{name: 'vision.contrast', value: 1.5}]); // the values after it (refused: unchanged)
 //   client.subscribeParameterUpdates(['vision.contrast']); // onParameterValues whenever they change
+//
+// A client is one connection: its subscription ids count from 0 and its client channel ids
+// from 1, as the protocol leaves them to the client. `createSocket(url, protocols)` makes
+// the connection (the browser's WebSocket unless a test gives a stand-in).
 
 export const SUBPROTOCOL = 'foxglove.websocket.v1';
+const OPEN = 1; // WebSocket.OPEN (not a global in Node, where the tests run)
+const MESSAGE_DATA = 0x01; // the binary opcode of a message on a channel (both ways)
+const MESSAGE_HEADER_BYTES = 13; // from the server: opcode, subscription id (u32), receive time (u64 ns), little-endian
+const CLIENT_HEADER_BYTES = 5; // from a client: opcode, client channel id (u32)
+
+const browserSocket = (url, protocols) => new WebSocket(url, protocols);
 
 export class FoxgloveClient {
-  constructor(url) {
+  constructor(url, { createSocket = browserSocket } = {}) {
     this.channelsByTopic = new Map();
     this.channelsById = new Map();
     this.wantedTopics = new Set();
     this.subscriptions = new Map(); // subscription id -> topic
     this.subscribedTopics = new Map(); // topic -> subscription id
-    this.nextSubscriptionId = 1;
+    this.nextSubscriptionId = 0;
     this.clientChannels = new Map(); // topic -> client channel id
     this.nextClientChannelId = 1;
     this.serverInfo = null;
@@ -39,7 +49,7 @@ export class FoxgloveClient {
     this.onClose = () => {};
     this.onServerInfo = () => {};
     this.onParameterValues = () => {};
-    this.ws = new WebSocket(url, [SUBPROTOCOL]);
+    this.ws = createSocket(url, [SUBPROTOCOL]);
     this.ws.binaryType = 'arraybuffer';
     this.ws.onopen = () => this.onOpen();
     this.ws.onclose = (event) => {
@@ -51,7 +61,7 @@ export class FoxgloveClient {
     this.ws.onmessage = (event) => this.receive(event.data);
   }
 
-  get open() { return this.ws.readyState === WebSocket.OPEN; }
+  get open() { return this.ws.readyState === OPEN; }
 
   // Whether the server's serverInfo lists this capability ('parameters', ...).
   can(capability) { return !!this.serverInfo?.capabilities?.includes(capability); }
@@ -61,14 +71,14 @@ export class FoxgloveClient {
   receive(data) {
     if (typeof data === 'string') return this.receiveText(data);
     const view = new DataView(data);
-    if (view.byteLength < 13 || view.getUint8(0) !== 1) return; // only Message Data is used
+    if (view.byteLength < MESSAGE_HEADER_BYTES || view.getUint8(0) !== MESSAGE_DATA) return; // only Message Data is used
     const subscriptionId = view.getUint32(1, true);
     const tNs = view.getBigUint64(5, true);
     const topic = this.subscriptions.get(subscriptionId);
     if (topic === undefined) return; // unsubscribed meanwhile
     let message;
     try {
-      message = JSON.parse(this.decoder.decode(new Uint8Array(data, 13)));
+      message = JSON.parse(this.decoder.decode(new Uint8Array(data, MESSAGE_HEADER_BYTES)));
     } catch (e) {
       this.onStatus(2, `${topic}: a message that is not JSON (${e.message})`);
       return;
@@ -190,10 +200,10 @@ export class FoxgloveClient {
       this.ws.send(JSON.stringify({ op: 'advertise', channels: [{ id, topic, encoding: 'json', schemaName }] }));
     }
     const payload = this.encoder.encode(JSON.stringify(message));
-    const frame = new Uint8Array(5 + payload.length);
-    frame[0] = 1;
+    const frame = new Uint8Array(CLIENT_HEADER_BYTES + payload.length);
+    frame[0] = MESSAGE_DATA;
     new DataView(frame.buffer).setUint32(1, id, true);
-    frame.set(payload, 5);
+    frame.set(payload, CLIENT_HEADER_BYTES);
     this.ws.send(frame);
     return true;
   }
