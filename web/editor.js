@@ -148,7 +148,7 @@ function scenarioText() {
   try {
     text = toYaml(ed.doc);
     if (!sameValue(load(text), JSON.parse(JSON.stringify(ed.doc)))) text = dump(ed.doc, { lineWidth: -1, noRefs: true });
-  } catch (e) {
+  } catch {
     text = dump(ed.doc, { lineWidth: -1, noRefs: true });
   }
   return ed.header + text;
@@ -637,7 +637,7 @@ function requestDraw() {
 }
 function draw() {
   if (!ed.doc || !canvas.clientWidth) return;
-  const [, w, h] = prepareCanvas(canvas);
+  const [, w] = prepareCanvas(canvas);
   const L = layout(), F = field();
   const P = (x, y) => toPx(L, x, y);
   const path = (pts, close) => {

@@ -510,7 +510,7 @@ async function main(state) {
   mixed.child.exitExpected = true;
   const dialogsBefore = state.dialogs.length;
   await page.click('#exit');
-  const ended = await poll('the banner to say that the run has ended', async () => {
+  await poll('the banner to say that the run has ended', async () => {
     const b = await banner();
     return !b.hidden && b.kind === 'ended' && /The run has ended/.test(b.text) && b;
   }, { describe: async () => JSON.stringify(await banner()) });

@@ -107,7 +107,7 @@ function requirePackages() {
   try {
     return { playwright: require('playwright-core'), WebSocketServer: require('ws').WebSocketServer };
   } catch (e) {
-    throw new Error(`${missing} (${e.message})`);
+    throw new Error(`${missing} (${e.message})`, { cause: e });
   }
 }
 
@@ -419,7 +419,7 @@ class StandInServer {
     // without a camera has none of them: getParameters answers an empty list).
     text({ op: 'serverInfo', name: 'rilbed', capabilities: ['clientPublish', 'parameters', 'parametersSubscribe'],
       supportedEncodings: ['json'], metadata: {}, sessionId: this.token.slice(0, 8) });
-    text({ op: 'advertise', channels: this.channels.map(({ latched, ...c }) => c) });
+    text({ op: 'advertise', channels: this.channels.map(({ latched: _latched, ...c }) => c) });
     s.status = status;
     ws.on('close', () => this.sessions.delete(s));
     ws.on('message', (data, isBinary) => {
@@ -635,7 +635,7 @@ async function main() {
   const rows = [];
   const loadBefore = os.loadavg();
   const pageErrors = [];
-  let screenshot = null, gpu = null, version = "?";
+  let screenshot = null, gpu = null, version;
   const extraShots = [];
   const cleanup = [];
   try {

@@ -366,7 +366,7 @@ async function main(state) {
     got[1].pose = [0.3, 0.3, got[1].pose[2]];
     try {
       assert.deepStrictEqual(got, want);
-    } catch (e) {
+    } catch {
       fail(`convoy_mixed.yaml with robot 4 placed and 8 deleted: robots ${JSON.stringify(got)}, expected ${JSON.stringify(want)}`);
     }
     runAccepts(binary, out.file, ['--fast', '--duration', '1', '--all-virtual'], path.join(state.tmp, 'run-split'));
@@ -390,7 +390,7 @@ async function main(state) {
       check(id === k + 1 && Array.isArray(pose) && pose.length === 3, `robot entry ${k}: ${JSON.stringify(r)}`);
       try {
         assert.deepStrictEqual(others, rest);
-      } catch (e) {
+      } catch {
         fail(`robot ${id} after "Poses from run" is ${JSON.stringify(r)}: its other keys are not ${JSON.stringify(rest)}`);
       }
     });
