@@ -1,8 +1,8 @@
-// ESLint over the web panel (CTest's web_lint): the page's ES modules in web/ with the
-// browser's globals, the Node tests in web/tests/ with Node's. The packages live in
-// web/tests/node_modules, so this file lives beside them and names web/ as the base path
-// of its patterns; it runs from any folder:
-//   node web/tests/node_modules/eslint/bin/eslint.js --config web/tests/eslint.config.js web/
+// ESLint over the web panel (web/tests/lint.js, CTest's web_lint): the page's ES modules
+// in web/ with the browser's globals, the Node tests in web/tests/ with Node's. The
+// packages live in web/tests/node_modules, so this file lives beside them; its patterns
+// are relative to web/, where lint.js runs eslint (by hand: from web/,
+// `node tests/node_modules/eslint/bin/eslint.js --config tests/eslint.config.js .`).
 'use strict';
 
 const path = require('node:path');

@@ -66,3 +66,30 @@ else()
     COMMAND sh -c "echo 'web_editor: no node on the PATH when CMake ran: run ./run test (it installs Node, the npm packages and Chromium)'; exit 1")
 endif()
 set_tests_properties(web_editor PROPERTIES LABELS e2e TIMEOUT 300 ENVIRONMENT "${RILBED_TEST_ENV}")
+
+# The page's pure helpers in Node (web/tests/unit/*.test.mjs, node's test runner): the
+# projection, ID lists, angles, geometry, the scenario checks against a controller registry
+# fixture, the Foxglove client against a stand-in WebSocket (label web). They need Node
+# alone: no npm package, no build, no browser. node --test runs in that folder and finds
+# its *.test.mjs there itself, since a folder given as an argument is searched by Node 20
+# but taken for a test file by Node 22 and later.
+if(NODE_EXECUTABLE)
+  add_test(NAME web_unit COMMAND ${NODE_EXECUTABLE} --test WORKING_DIRECTORY ${CMAKE_SOURCE_DIR}/web/tests/unit)
+else()
+  add_test(NAME web_unit
+    COMMAND sh -c "echo 'web_unit: no node on the PATH when CMake ran: run ./run test (it installs Node)'; exit 1")
+endif()
+set_tests_properties(web_unit PROPERTIES LABELS web TIMEOUT 120 ENVIRONMENT "${RILBED_TEST_ENV}")
+
+# ESLint over the web panel's JavaScript (web/tests/lint.js with web/tests/eslint.config.js:
+# eslint's recommended rules and a few that catch bugs, over web/*.js and web/tests/)
+# (label web). eslint and its packages are in web/tests/node_modules (./run installs
+# them); without them, or without Node, the test fails and says so rather than being
+# skipped.
+if(NODE_EXECUTABLE)
+  add_test(NAME web_lint COMMAND ${NODE_EXECUTABLE} ${CMAKE_SOURCE_DIR}/web/tests/lint.js)
+else()
+  add_test(NAME web_lint
+    COMMAND sh -c "echo 'web_lint: no node on the PATH when CMake ran: run ./run test (it installs Node and the npm packages)'; exit 1")
+endif()
+set_tests_properties(web_lint PROPERTIES LABELS web TIMEOUT 120 ENVIRONMENT "${RILBED_TEST_ENV}")
