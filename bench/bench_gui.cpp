@@ -64,9 +64,9 @@ using bench::first_line;
 
 const std::string kToken = "bench";
 // What rilbed's page subscribes to (web/app.js).
-const std::set<std::string> kPageTopics = {"/rilbed/world",  "/rilbed/status",  "/rilbed/poses",         "/rilbed/sensors",
-                                           "/rilbed/detections", "/rilbed/events", "/rilbed/summary",
-                                           "/rilbed/console_reply", "/rilbed/camera", "/rilbed/camera_calibration"};
+const std::set<std::string> kPageTopics = {
+    "/rilbed/world",  "/rilbed/status",  "/rilbed/poses",         "/rilbed/sensors", "/rilbed/detections",
+    "/rilbed/events", "/rilbed/summary", "/rilbed/console_reply", "/rilbed/camera",  "/rilbed/camera_calibration"};
 
 // One viewer: connects, subscribes to the page's topics, counts what comes. Async on the
 // viewers' shared io_context.
@@ -133,17 +133,18 @@ class Viewer : public std::enable_shared_from_this<Viewer> {
 double process_cpu_s() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 // One configuration's measurements over the repeats.
 struct Measured {
-  std::vector<double> latency_ms;          // every step of every repeat
-  std::vector<double> poses_per_s;         // every viewer of every repeat
+  std::vector<double> latency_ms;   // every step of every repeat
+  std::vector<double> poses_per_s;  // every viewer of every repeat
   std::vector<double> messages_per_s;
   std::vector<double> bytes_per_s;
   std::uint64_t dropped = 0;
-  std::vector<double> cpu_per_wall;        // per repeat
+  std::vector<double> cpu_per_wall;  // per repeat
 };
 
 // One run with `viewers` viewers (nullopt: no panel at all).
@@ -163,8 +164,9 @@ void run_once(const agents::Scenario& scenario, std::optional<int> viewers, doub
     config.port = 0;
     config.token = kToken;
     config.session_id = "bench";
-    gui = std::make_unique<gui_web::GuiService>(
-        config, [](const gui_web::ConsoleRequest&) { return gui_web::ConsoleAnswer{false, "a benchmark takes no commands"}; });
+    gui = std::make_unique<gui_web::GuiService>(config, [](const gui_web::ConsoleRequest&) {
+      return gui_web::ConsoleAnswer{false, "a benchmark takes no commands"};
+    });
     publisher.add_local_subscriber(*gui);
     for (int k = 0; k < *viewers; ++k) {
       clients.push_back(std::make_shared<Viewer>(io));
@@ -176,7 +178,8 @@ void run_once(const agents::Scenario& scenario, std::optional<int> viewers, doub
     });
     // Every viewer has subscribed (the server counts the connections; give the subscribe
     // messages a moment to be read: at worst the first message or two is missed).
-    while (gui->server().clients() < static_cast<std::size_t>(*viewers)) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    while (gui->server().clients() < static_cast<std::size_t>(*viewers))
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
   }
   agents::RunOptions o;
@@ -230,18 +233,22 @@ int main(int argc, char** argv) {
   std::printf("# rilbed web panel benchmark\n\n");
   std::printf("- CPU: %s; `nproc`: %d; load average at start: %s\n", cpu_model().c_str(), bench::usable_cpus(),
               first_line("/proc/loadavg").c_str());
-  std::printf("- build type: %s; sources: %s\n", env_or("RILBED_BENCH_BUILD_TYPE", "unknown (run through tools/bench.sh)").c_str(),
+  std::printf("- build type: %s; sources: %s\n",
+              env_or("RILBED_BENCH_BUILD_TYPE", "unknown (run through tools/bench.sh)").c_str(),
               env_or("RILBED_BENCH_SOURCE", "unknown (run through tools/bench.sh)").c_str());
-  std::printf("- the run: %d wandering Kheperas with 8 IR sensors (sim-bench's scenario, field %.2f x %.2f m), control "
-              "period 100 ms, real time at factor 1, %.0f s per run, %d runs per configuration taking turns; published "
-              "on memq:// as `rilbed run --gui` publishes, the panel's GuiService a local subscriber of the bytes\n",
-              robots, scenario.map.field.width_m, scenario.map.field.height_m, seconds, repeat);
-  std::printf("- viewers: Beast WebSocket clients on one thread of this process, over loopback, each subscribed to the "
-              "page's %zu topics (world, status, poses, sensors, detections, events, summary, console replies; this run "
-              "has no camera), reading as fast as they can\n",
-              kPageTopics.size());
-  std::printf("- loop latency: how far behind the wall clock each control step finished, its reports handed on "
-              "(summary.json's loop_latency_ms); p50 and p99 over every step of every run of the configuration\n\n");
+  std::printf(
+      "- the run: %d wandering Kheperas with 8 IR sensors (sim-bench's scenario, field %.2f x %.2f m), control "
+      "period 100 ms, real time at factor 1, %.0f s per run, %d runs per configuration taking turns; published "
+      "on memq:// as `rilbed run --gui` publishes, the panel's GuiService a local subscriber of the bytes\n",
+      robots, scenario.map.field.width_m, scenario.map.field.height_m, seconds, repeat);
+  std::printf(
+      "- viewers: Beast WebSocket clients on one thread of this process, over loopback, each subscribed to the "
+      "page's %zu topics (world, status, poses, sensors, detections, events, summary, console replies; this run "
+      "has no camera), reading as fast as they can\n",
+      kPageTopics.size());
+  std::printf(
+      "- loop latency: how far behind the wall clock each control step finished, its reports handed on "
+      "(summary.json's loop_latency_ms); p50 and p99 over every step of every run of the configuration\n\n");
   std::fflush(stdout);
 
   std::map<int, Measured> measured;  // -1: no panel
@@ -251,8 +258,9 @@ int main(int argc, char** argv) {
     }
   }
 
-  std::printf("| viewers | poses msgs/s per viewer (slowest, median) | all msgs/s per viewer (median) | KB/s per viewer "
-              "(median) | msgs dropped | loop latency p50 ms | p99 ms | max ms | steps | process CPU s per wall s |\n");
+  std::printf(
+      "| viewers | poses msgs/s per viewer (slowest, median) | all msgs/s per viewer (median) | KB/s per viewer "
+      "(median) | msgs dropped | loop latency p50 ms | p99 ms | max ms | steps | process CPU s per wall s |\n");
   std::printf("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
   for (const auto& c : configs) {
     const Measured& m = measured[c.value_or(-1)];
@@ -265,19 +273,21 @@ int main(int argc, char** argv) {
       std::snprintf(kb, sizeof kb, "%.1f", percentile(m.bytes_per_s, 0.5) / 1000.0);
     }
     std::printf("| %s | %s | %s | %s | %llu | %.3f | %.3f | %.3f | %zu | %.2f |\n", name.c_str(), delivered, all, kb,
-                static_cast<unsigned long long>(m.dropped), percentile(m.latency_ms, 0.5), percentile(m.latency_ms, 0.99),
-                max_of(m.latency_ms), m.latency_ms.size(), percentile(m.cpu_per_wall, 0.5));
+                static_cast<unsigned long long>(m.dropped), percentile(m.latency_ms, 0.5),
+                percentile(m.latency_ms, 0.99), max_of(m.latency_ms), m.latency_ms.size(),
+                percentile(m.cpu_per_wall, 0.5));
   }
   // The goal: 10 viewers within 5 % of none.
   if (measured.contains(0) && measured.contains(10)) {
     const Measured& none = measured[0];
     const Measured& ten = measured[10];
     const auto change = [](double a, double b) { return a > 0.0 ? 100.0 * (b - a) / a : 0.0; };
-    std::printf("\nLoop latency with 10 viewers against none (goal: within 5 %%): p50 %+.1f %% (%.3f -> %.3f ms), "
-                "p99 %+.1f %% (%.3f -> %.3f ms).\n",
-                change(percentile(none.latency_ms, 0.5), percentile(ten.latency_ms, 0.5)), percentile(none.latency_ms, 0.5),
-                percentile(ten.latency_ms, 0.5), change(percentile(none.latency_ms, 0.99), percentile(ten.latency_ms, 0.99)),
-                percentile(none.latency_ms, 0.99), percentile(ten.latency_ms, 0.99));
+    std::printf(
+        "\nLoop latency with 10 viewers against none (goal: within 5 %%): p50 %+.1f %% (%.3f -> %.3f ms), "
+        "p99 %+.1f %% (%.3f -> %.3f ms).\n",
+        change(percentile(none.latency_ms, 0.5), percentile(ten.latency_ms, 0.5)), percentile(none.latency_ms, 0.5),
+        percentile(ten.latency_ms, 0.5), change(percentile(none.latency_ms, 0.99), percentile(ten.latency_ms, 0.99)),
+        percentile(none.latency_ms, 0.99), percentile(ten.latency_ms, 0.99));
   }
   return 0;
 }

@@ -26,7 +26,6 @@
 #include <apriltag/tag36h11.h>
 #include <sched.h>
 
-
 #include <opencv2/aruco.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/core/ocl.hpp>
@@ -40,8 +39,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <filesystem>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <numeric>
@@ -59,12 +58,12 @@ using rilbed::bench::Clock;
 using rilbed::bench::cpu_model;
 using rilbed::bench::env_or;
 using rilbed::bench::first_line;
-using rilbed::bench::usable_cpus;
 using rilbed::bench::measure_timer_overhead;
 using rilbed::bench::ms_since;
 using rilbed::bench::net_ms;
 using rilbed::bench::thread_cpu_ms;
 using rilbed::bench::TimerOverhead;
+using rilbed::bench::usable_cpus;
 constexpr double kPi = 3.14159265358979323846;
 // Printed grey levels (as the synthetic camera and render_marker_topdown use).
 constexpr double kWhite = 240.0, kBlack = 28.0, kFloorGrey = 185.0;
@@ -124,14 +123,14 @@ Options parse_options(int argc, char** argv) {
 // marker's own frame, x forward, y to the left, in units of the outer radius (disc) or
 // half side (square, including its white quiet zone); -1 outside the printed marker.
 struct Pattern {
-  enum class Shape { Disc, Square };
-  Shape shape = Shape::Disc;
-  const rv::MarkerFamily* family = nullptr;  // Disc
-  int cells_n = 0;                           // Square: cells per side, quiet zone included
+  enum class Shape { kDisc, kSquare };
+  Shape shape = Shape::kDisc;
+  const rv::MarkerFamily* family = nullptr;      // Disc
+  int cells_n = 0;                               // Square: cells per side, quiet zone included
   std::vector<std::vector<std::uint8_t>> cells;  // Square: per ID, row-major, row 0 at the top
 
   double colour(int id, double mx, double my) const {
-    if (shape == Shape::Disc) {
+    if (shape == Shape::kDisc) {
       const double r = std::hypot(mx, my);
       if (r > 1.0) return -1.0;
       return family->colour_at(id, r, std::atan2(my, mx) * 180.0 / kPi);
@@ -142,12 +141,12 @@ struct Pattern {
     return cells[id][row * cells_n + col];
   }
   // Farthest printed point from the centre, in the units above.
-  double reach() const { return shape == Shape::Disc ? 1.0 : std::sqrt(2.0); }
+  double reach() const { return shape == Shape::kDisc ? 1.0 : std::sqrt(2.0); }
 };
 
 Pattern disc_pattern(const rv::MarkerFamily& family) {
   Pattern p;
-  p.shape = Pattern::Shape::Disc;
+  p.shape = Pattern::Shape::kDisc;
   p.family = &family;
   return p;
 }
@@ -156,7 +155,7 @@ Pattern disc_pattern(const rv::MarkerFamily& family) {
 // (the quiet zone), an 8-cell black border, 6 x 6 data bits.
 Pattern apriltag_pattern(apriltag_family_t* family, int count) {
   Pattern p;
-  p.shape = Pattern::Shape::Square;
+  p.shape = Pattern::Shape::kSquare;
   for (int id = 0; id < count; ++id) {
     image_u8_t* im = apriltag_to_image(family, id);
     p.cells_n = im->width;
@@ -176,7 +175,7 @@ Pattern apriltag_pattern(apriltag_family_t* family, int count) {
 // zone around it, 8 x 8 cells in all.
 Pattern aruco_pattern(const cv::Ptr<cv::aruco::Dictionary>& dict, int count) {
   Pattern p;
-  p.shape = Pattern::Shape::Square;
+  p.shape = Pattern::Shape::kSquare;
   for (int id = 0; id < count; ++id) {
     cv::Mat m, padded;
     dict->drawMarker(id, dict->markerSize + 2, m, 1);
@@ -267,8 +266,8 @@ void draw_marker(cv::Mat& img, const cv::Mat& floor, const Pattern& p, const Pla
 }
 
 // Lighting, blur, sensor noise, 8-bit quantisation and JPEG (MJPG) of one frame.
-cv::Mat render_frame(const Floor& floor, const Pattern& p, const std::vector<Placed>& markers, double size_px,
-                     int ss, const Imaging& im, cv::RNG& rng) {
+cv::Mat render_frame(const Floor& floor, const Pattern& p, const std::vector<Placed>& markers, double size_px, int ss,
+                     const Imaging& im, cv::RNG& rng) {
   cv::Mat img = floor.reflectance.clone();
   for (const Placed& m : markers) draw_marker(img, floor.reflectance, p, m, size_px, ss);
   img = img.mul(floor.gain);
@@ -291,8 +290,8 @@ cv::Mat render_frame(const Floor& floor, const Pattern& p, const std::vector<Pla
 // Random non-overlapping positions and headings for `count` markers (without IDs),
 // then `frames` frames in which each marker moves 1..4 px and turns up to 4 degrees per
 // frame, bouncing off the frame's margins and off each other.
-std::vector<std::vector<Placed>> make_motion(int count, int frames, double size_px, double min_gap_sizes,
-                                             cv::RNG& rng, bool move) {
+std::vector<std::vector<Placed>> make_motion(int count, int frames, double size_px, double min_gap_sizes, cv::RNG& rng,
+                                             bool move) {
   const double margin = size_px * 0.75 + 6.0, min_dist = size_px * min_gap_sizes;
   auto inside = [&](double u, double v) {
     return u > margin && v > margin && u < kFrameSize.width - 1 - margin && v < kFrameSize.height - 1 - margin;
@@ -476,7 +475,6 @@ struct Row {
 constexpr int kTimerIntervals = 20001;  // empty intervals that measure the timer's cost
 TimerOverhead g_timer_overhead;         // set once in main, before any timing
 
-
 using DetectFn = std::function<std::vector<Det>(const cv::Mat&)>;
 
 // Each row is timed in kRounds rounds, the detectors of a table taking turns (rilbed,
@@ -517,8 +515,8 @@ Row score_full_frame(const std::string& name, const std::string& markers, const 
 
 void time_full_frame(Row& row, const std::vector<Frame>& frames, const DetectFn& detect, const Share& share) {
   const auto start = Clock::now();
-  for (int passes = 0; passes < share.min_passes ||
-                       (passes < share.max_passes && ms_since(start) < share.budget_s * 1000.0);
+  for (int passes = 0;
+       passes < share.min_passes || (passes < share.max_passes && ms_since(start) < share.budget_s * 1000.0);
        ++passes) {
     for (const Frame& f : frames) {
       evict(f.grey);
@@ -562,8 +560,8 @@ Row score_tracked(const std::string& name, const std::string& markers, const std
 
 void time_tracked(Row& row, const std::vector<Frame>& frames, rv::MarkerTracker& tracker, const Share& share) {
   const auto start = Clock::now();
-  for (int passes = 0; passes < share.min_passes ||
-                       (passes < share.max_passes && ms_since(start) < share.budget_s * 1000.0);
+  for (int passes = 0;
+       passes < share.min_passes || (passes < share.max_passes && ms_since(start) < share.budget_s * 1000.0);
        ++passes) {
     tracker.reset();
     g_sink = g_sink + tracker.process(frames[0].grey).size();
@@ -599,8 +597,7 @@ void print_table1(const std::vector<Row>& rows) {
   for (const Row& r : rows) {
     std::string det = r.detector;
     if (r.full_searches >= 0) {
-      det += " (full search in " + std::to_string(r.full_searches) + "/" + std::to_string(r.scored_frames) +
-             " frames)";
+      det += " (full search in " + std::to_string(r.full_searches) + "/" + std::to_string(r.scored_frames) + " frames)";
     }
     // The peers report corners, not a heading: only rilbed's rows have one.
     const bool has_heading = r.detector.rfind("rilbed", 0) == 0;
@@ -643,10 +640,12 @@ int main(int argc, char** argv) {
               "not defined",
 #endif
               __VERSION__);
-  std::printf("- sources: %s\n", env_or("RILBED_BENCH_SOURCE", "unknown (run through tools/bench.sh to print it)").c_str());
-  std::printf("- OpenCV %s (aruco from opencv_contrib), AprilTag %s; threads: OpenCV setNumThreads(0) and OpenCL "
-              "off, AprilTag nthreads = 1, rilbed single-threaded\n\n",
-              CV_VERSION, env_or("RILBED_BENCH_APRILTAG_VERSION", "3 (libapriltag)").c_str());
+  std::printf("- sources: %s\n",
+              env_or("RILBED_BENCH_SOURCE", "unknown (run through tools/bench.sh to print it)").c_str());
+  std::printf(
+      "- OpenCV %s (aruco from opencv_contrib), AprilTag %s; threads: OpenCV setNumThreads(0) and OpenCL "
+      "off, AprilTag nthreads = 1, rilbed single-threaded\n\n",
+      CV_VERSION, env_or("RILBED_BENCH_APRILTAG_VERSION", "3 (libapriltag)").c_str());
 
   // ---------------------------------------------------------------- Table 1 frames
   const double size1 = 32.0;
@@ -656,7 +655,7 @@ int main(int argc, char** argv) {
 
   const rv::MarkerFamily six = rv::MarkerFamily::six_ucp();
   const rv::MarkerFamily nine = rv::MarkerFamily::by_name("9ucp");
-  apriltag_family_t* tag_family = tag36h11_create();  // for drawing and the decimate-2 detector
+  apriltag_family_t* tag_family = tag36h11_create();   // for drawing and the decimate-2 detector
   apriltag_family_t* tag_family1 = tag36h11_create();  // the decimate-1 detector's own copy
   const auto dict50 = cv::aruco::getPredefinedDictionary(cv::aruco::DICT_4X4_50);
   const auto dict100 = cv::aruco::getPredefinedDictionary(cv::aruco::DICT_4X4_100);
@@ -668,8 +667,8 @@ int main(int argc, char** argv) {
       "are area-sampled (%dx%d samples per pixel, the same as rendering at %dx and downsampling with INTER_AREA) "
       "at sub-pixel positions and random headings, then Gaussian blur sigma %.1f px, Gaussian sensor noise sigma "
       "%.1f, 8-bit rounding, %s.\n",
-      kFrameSize.width, kFrameSize.height, kFloorGrey, imaging.light_ratio, kWhite, kBlack, supersample1,
-      supersample1, supersample1, imaging.blur_sigma, imaging.noise_sigma,
+      kFrameSize.width, kFrameSize.height, kFloorGrey, imaging.light_ratio, kWhite, kBlack, supersample1, supersample1,
+      supersample1, imaging.blur_sigma, imaging.noise_sigma,
       opt.jpeg ? "JPEG quality 85 (the luma of MJPG)" : "no JPEG (--no-jpeg)");
   std::printf(
       "- Table 1: %d frames per marker count; all markers %.0f px across on the outside (6UCP/9UCP: outer "
@@ -685,7 +684,8 @@ int main(int argc, char** argv) {
       "own state is left as it is. One untimed pass first (it also yields recall), then "
       "whole passes over the sequence until %.1f s per row are spent (at least %d, at most %d passes), in %d rounds "
       "in which the detectors of a table take turns (so that other load on a shared machine falls on all of them "
-      "alike); median and 90th percentile of the wall time over all timed frames. The CPU column is the median of the thread's own CPU "
+      "alike); median and 90th percentile of the wall time over all timed frames. The CPU column is the median of the "
+      "thread's own CPU "
       "time (CLOCK_THREAD_CPUTIME_ID) for the same calls: on a shared machine it leaves out time other processes "
       "took. From every sample the timer's own cost is subtracted: the median of %d empty intervals read the "
       "same way, %.3f us wall and %.3f us CPU on this run (reading the thread's CPU clock is a system call). "
@@ -792,8 +792,8 @@ int main(int argc, char** argv) {
     }
   }
 
-  std::printf("## Table 1 — speed and recall, %dx%d, markers %.0f px across\n\n", kFrameSize.width,
-              kFrameSize.height, size1);
+  std::printf("## Table 1 — speed and recall, %dx%d, markers %.0f px across\n\n", kFrameSize.width, kFrameSize.height,
+              size1);
   std::printf("### 8 markers\n\n");
   print_table1(rows8);
   std::printf("\n### 64 markers\n\n");
@@ -855,8 +855,8 @@ int main(int argc, char** argv) {
       "processes on a shared machine do not inflate (long calls are preempted more often than short ones, which "
       "flatters the fast detector's wall-time ratio).\n\n");
   const Row& full8 = rows8[0];
-  std::printf("- full-frame <= 1.5 ms/frame with 8 markers: %.3f ms wall, %.3f ms CPU (medians) — %s\n",
-              full8.median(), full8.cpu_median(), full8.cpu_median() <= 1.5 ? "met" : "NOT met");
+  std::printf("- full-frame <= 1.5 ms/frame with 8 markers: %.3f ms wall, %.3f ms CPU (medians) — %s\n", full8.median(),
+              full8.cpu_median(), full8.cpu_median() <= 1.5 ? "met" : "NOT met");
   for (const auto* rows : {&rows8, &rows64}) {
     const Row& full = (*rows)[0];
     const int n = rows == &rows8 ? 8 : 64;
@@ -875,9 +875,9 @@ int main(int argc, char** argv) {
     const Row& full = (*rows)[0];
     const Row& tracked = (*rows)[1];
     const double wall = full.median() / tracked.median(), cpu = full.cpu_median() / tracked.cpu_median();
-    std::printf("- tracked >= 10x faster than full-frame (%d markers): %.1fx wall, %.1fx CPU (%.3f vs %.3f ms CPU) — %s\n",
-                rows == &rows8 ? 8 : 64, wall, cpu, tracked.cpu_median(), full.cpu_median(),
-                cpu >= 10.0 ? "met" : "NOT met");
+    std::printf(
+        "- tracked >= 10x faster than full-frame (%d markers): %.1fx wall, %.1fx CPU (%.3f vs %.3f ms CPU) — %s\n",
+        rows == &rows8 ? 8 : 64, wall, cpu, tracked.cpu_median(), full.cpu_median(), cpu >= 10.0 ? "met" : "NOT met");
   }
   for (const AccuracyRow& r : acc_rows) {
     std::printf("- accuracy at %d px: centre %.3f px RMS (<= 0.3), heading %.2f deg RMS (<= 1.5) — %s\n", r.size,

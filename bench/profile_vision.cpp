@@ -18,7 +18,6 @@
 // each frame once just before it is timed.
 #include <opencv2/imgcodecs.hpp>
 
-
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -34,9 +33,9 @@
 
 namespace {
 
+using rilbed::bench::thread_cpu_ms;
 using rilbed::vision::MarkerFamily;
 using rilbed::vision::MarkerTracker;
-using rilbed::bench::thread_cpu_ms;
 
 struct Options {
   std::string dir;
@@ -159,10 +158,11 @@ int main(int argc, char** argv) {
     fills = static_cast<double>(fill_sum) / timed;
     edge_fits = static_cast<double>(edge_sum) / timed;
   }
-  std::printf("%s, %d markers (%s), %zu frames %dx%d, %s: median %.4f ms CPU per frame (lowest of %d runs of %d "
-              "passes; timer overhead %.2f us subtracted), p90 %.4f; per frame %.2f found, %.2f fills, %.2f edge fits\n",
-              opt.mode.c_str(), opt.ids, opt.ids <= 8 ? "6UCP" : "9UCP", frames.size(), frames.front().cols,
-              frames.front().rows, opt.warm ? "warm" : "cold", best_median, opt.runs, opt.passes, overhead_ms * 1e3, best_p90, found,
-              fills, edge_fits);
+  std::printf(
+      "%s, %d markers (%s), %zu frames %dx%d, %s: median %.4f ms CPU per frame (lowest of %d runs of %d "
+      "passes; timer overhead %.2f us subtracted), p90 %.4f; per frame %.2f found, %.2f fills, %.2f edge fits\n",
+      opt.mode.c_str(), opt.ids, opt.ids <= 8 ? "6UCP" : "9UCP", frames.size(), frames.front().cols,
+      frames.front().rows, opt.warm ? "warm" : "cold", best_median, opt.runs, opt.passes, overhead_ms * 1e3, best_p90,
+      found, fills, edge_fits);
   return 0;
 }

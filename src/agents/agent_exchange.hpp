@@ -25,9 +25,9 @@ struct RemoteOutput {
 /// What an exchange tells the run between quanta: a late answer, an agent process that
 /// stopped answering or came back. Recorded as the run's events.
 struct ExchangeNotice {
-  std::string kind;             ///< "agent" (events.csv kind)
-  int robot_id = 0;             ///< the robot concerned, 0 for a whole process
-  std::string detail;           ///< e.g. "lost: process host:pid stopped answering"
+  std::string kind;    ///< "agent" (events.csv kind)
+  int robot_id = 0;    ///< the robot concerned, 0 for a whole process
+  std::string detail;  ///< e.g. "lost: process host:pid stopped answering"
 };
 
 /// Where the inputs of remote controllers go and their outputs come from.

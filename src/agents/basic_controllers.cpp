@@ -112,14 +112,16 @@ ControlOutput GoToPoseController::step(const ControlInput& input) {
   const double distance = (config_.target.position_m - self.position_m).norm();
   const double heading_error = wrap_rad_pi(config_.target.heading_rad - self.heading_rad);
   if (placed_ && distance > 2.0 * config_.position_tolerance_m) placed_ = false;
-  if (placed_ || (distance <= config_.position_tolerance_m && std::abs(heading_error) <= config_.heading_tolerance_rad)) {
+  if (placed_ ||
+      (distance <= config_.position_tolerance_m && std::abs(heading_error) <= config_.heading_tolerance_rad)) {
     placed_ = true;
     waiting_since_us_.reset();
     return {{}, "placed"};
   }
   if (distance <= config_.position_tolerance_m) {
     // There: turn on the spot, slower as the heading comes right (1 unit is 17 deg/s).
-    const double turn = std::clamp(2.0 * heading_error, -config_.steering.max_turn_radps, config_.steering.max_turn_radps);
+    const double turn =
+        std::clamp(2.0 * heading_error, -config_.steering.max_turn_radps, config_.steering.max_turn_radps);
     WheelCommand w = wheels_from_twist(0.0, turn);
     if (w.left == 0 && w.right == 0) w = heading_error > 0 ? WheelCommand{-1, 1} : WheelCommand{1, -1};
     return {w, "align"};

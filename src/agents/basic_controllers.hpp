@@ -33,14 +33,14 @@ class WanderController final : public Controller {
 
 /// Knobs of the track follower.
 struct TrackFollowConfig {
-  double speed_mps = 0.06;            ///< speed along the track, m/s
-  double search_speed_mps = 0.08;     ///< speed while looking for a track, m/s
-  double search_turn_radps = 0.6;     ///< turn rate of the search arc, rad/s (a wide spiral)
-  double correction_turn_radps = 2.0; ///< turn rate when one side loses the track, rad/s
+  double speed_mps = 0.06;             ///< speed along the track, m/s
+  double search_speed_mps = 0.08;      ///< speed while looking for a track, m/s
+  double search_turn_radps = 0.6;      ///< turn rate of the search arc, rad/s (a wide spiral)
+  double correction_turn_radps = 2.0;  ///< turn rate when one side loses the track, rad/s
   /// A track sensor counts as on the track at or above this fraction of its readings' maximum.
   double on_track_fraction = 0.5;
-  int max_value = 255;                ///< the track sensors' Max Value (full scale)
-  double avoid_low = 0.35;            ///< proximity level where avoidance starts
+  int max_value = 255;      ///< the track sensors' Max Value (full scale)
+  double avoid_low = 0.35;  ///< proximity level where avoidance starts
   double avoid_high = 0.7;
   SteeringConfig steering;
 };
@@ -60,9 +60,9 @@ class TrackFollowController final : public Controller {
 
 /// Knobs of the beacon homer.
 struct BeaconHomingConfig {
-  std::optional<int> beacon_id;     ///< home on this beacon; nullopt: the first one seen
-  double speed_mps = 0.1;           ///< speed towards the beacon, m/s
-  double search_turn_radps = 1.0;   ///< turn rate while no beacon is in view, rad/s
+  std::optional<int> beacon_id;    ///< home on this beacon; nullopt: the first one seen
+  double speed_mps = 0.1;          ///< speed towards the beacon, m/s
+  double search_turn_radps = 1.0;  ///< turn rate while no beacon is in view, rad/s
   double avoid_low = 0.35;
   double avoid_high = 0.7;
   /// Proximity level straight ahead at which it considers itself arrived and stops.
@@ -84,8 +84,8 @@ class BeaconHomingController final : public Controller {
 
 /// Knobs of going to a pose (placing a real robot at a run's start pose).
 struct GoToPoseConfig {
-  Pose2 target;                     ///< where to end, field frame
-  double speed_mps = 0.04;          ///< top speed: slow, so the camera keeps up and a bump is harmless
+  Pose2 target;                         ///< where to end, field frame
+  double speed_mps = 0.04;              ///< top speed: slow, so the camera keeps up and a bump is harmless
   double position_tolerance_m = 0.01;   ///< close enough (the camera's error is far below this)
   double heading_tolerance_rad = 0.07;  ///< about 4 degrees
   /// Another robot nearer than this, ahead of it, makes it yield (a higher ID waits for a

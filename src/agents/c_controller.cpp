@@ -42,9 +42,7 @@ std::int32_t saturate(double v) {
 
 RegisterMap::RegisterMap() : words_(RILBED_REG_COUNT, 0) {}
 
-std::int32_t RegisterMap::peek(std::uint32_t address) const {
-  return address < words_.size() ? words_[address] : 0;
-}
+std::int32_t RegisterMap::peek(std::uint32_t address) const { return address < words_.size() ? words_[address] : 0; }
 
 void RegisterMap::poke(std::uint32_t address, std::int32_t value) {
   if (address >= words_.size() || !controller_writable(address)) {
@@ -89,7 +87,8 @@ void CControllerAdapter::load_inputs(const ControlInput& input) {
   }
   const int ranges = static_cast<int>(std::min<std::size_t>(s.ranges.size(), 8));
   r.set(RILBED_REG_RANGE_COUNT, ranges);
-  for (int i = 0; i < ranges; ++i) r.set(RILBED_REG_RANGE_0 + i, s.ranges[i].hit ? saturate(s.ranges[i].distance_m * 1000) : -1);
+  for (int i = 0; i < ranges; ++i)
+    r.set(RILBED_REG_RANGE_0 + i, s.ranges[i].hit ? saturate(s.ranges[i].distance_m * 1000) : -1);
   const int tracks = static_cast<int>(std::min<std::size_t>(s.track.size(), 16));
   r.set(RILBED_REG_TRACK_COUNT, tracks);
   for (int i = 0; i < tracks; ++i) r.set(RILBED_REG_TRACK_0 + i, s.track[i]);
@@ -142,5 +141,4 @@ int32_t rilbed_peek(uint32_t address) {
 void rilbed_poke(uint32_t address, int32_t value) {
   if (rilbed::agents::current_registers) rilbed::agents::current_registers->poke(address, value);
 }
-
 }

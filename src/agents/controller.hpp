@@ -56,10 +56,10 @@ struct TeamMessage {
 
 /// Everything a controller gets at one control step.
 struct ControlInput {
-  TimeUs t_us = 0;                          ///< simulated time of this step
-  int robot_id = 0;                         ///< the robot being controlled
-  environment::SensorReadings sensors;      ///< its sensors (virtual, real or combined)
-  std::optional<Pose2> pose;                ///< its pose from localisation (world or camera); nullopt if unknown
+  TimeUs t_us = 0;                      ///< simulated time of this step
+  int robot_id = 0;                     ///< the robot being controlled
+  environment::SensorReadings sensors;  ///< its sensors (virtual, real or combined)
+  std::optional<Pose2> pose;            ///< its pose from localisation (world or camera); nullopt if unknown
   /// The latest team broadcast (every member, possibly this robot too); empty unless the
   /// controller wants_team(). Valid only during the step() call it is passed to.
   std::span<const TeamMessage> team;

@@ -76,8 +76,8 @@ void check_entry(const ControllerEntry& e) {
 }  // namespace
 
 const std::vector<std::string>& known_sensor_names() {
-  static const std::vector<std::string> names = {"proximity", "range_finders", "beacon_finder", "track", "odometer",
-                                                 "pose"};
+  static const std::vector<std::string> names = {"proximity", "range_finders", "beacon_finder",
+                                                 "track",     "odometer",      "pose"};
   return names;
 }
 
@@ -148,7 +148,8 @@ void ControllerRegistry::add(ControllerEntry entry) {
 }
 
 const ControllerEntry* ControllerRegistry::find(std::string_view name) const {
-  const auto it = std::find_if(entries_.begin(), entries_.end(), [&](const ControllerEntry& e) { return e.name == name; });
+  const auto it =
+      std::find_if(entries_.begin(), entries_.end(), [&](const ControllerEntry& e) { return e.name == name; });
   return it == entries_.end() ? nullptr : &*it;
 }
 
@@ -191,7 +192,8 @@ std::string controllers_table(const ControllerRegistry& registry) {
   for (const ControllerEntry& e : registry.entries()) {
     std::vector<std::string> reads;
     for (const std::string& s : e.sensors) {
-      const bool needed = std::find(e.required_sensors.begin(), e.required_sensors.end(), s) != e.required_sensors.end();
+      const bool needed =
+          std::find(e.required_sensors.begin(), e.required_sensors.end(), s) != e.required_sensors.end();
       reads.push_back("`" + s + "`" + (needed ? " (required)" : ""));
     }
     out << "| `" << e.name << "` | " << e.summary << " | " << (reads.empty() ? "-" : joined(reads)) << " | "

@@ -31,7 +31,8 @@ BehaviourInputs ConvoyAgent::inputs(const ConvoyPerception& p) const {
   // the convoy up.
   const bool driving_on = distance > config_.standoff_m + config_.hold_tolerance_m;
   if (p.proximity && driving_on) {
-    in[static_cast<std::size_t>(Behaviour::kAvoid)] = obstacle_level(*p.proximity, config_.avoid_low, config_.avoid_high);
+    in[static_cast<std::size_t>(Behaviour::kAvoid)] =
+        obstacle_level(*p.proximity, config_.avoid_low, config_.avoid_high);
   }
   return in;
 }
@@ -45,8 +46,8 @@ Vec2 ConvoyAgent::repulsion(const ConvoyPerception& p) const {
     if (d < 1e-9 || d >= config_.repulse_radius_m) continue;
     // Grows from 0 at the radius to repulse_gain at contact (two radii of 27.5 mm).
     const double contact = 0.055;
-    const double strength = config_.repulse_gain * std::clamp((config_.repulse_radius_m - d) /
-                                                              (config_.repulse_radius_m - contact), 0.0, 1.0);
+    const double strength = config_.repulse_gain *
+                            std::clamp((config_.repulse_radius_m - d) / (config_.repulse_radius_m - contact), 0.0, 1.0);
     push = push + away / d * strength;
   }
   return push;
@@ -71,9 +72,7 @@ ControlOutput ConvoyAgent::step(const ConvoyPerception& p, double dt_s) {
         out.wheels = steer_to(*p.self, p.leader->position_m, config_.standoff_m, config_.steering, repulsion(p) * 0.5);
       }
       break;
-    case Behaviour::kWait:
-      out.wheels = {};
-      break;
+    case Behaviour::kWait: out.wheels = {}; break;
   }
   return out;
 }

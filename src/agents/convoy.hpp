@@ -53,7 +53,7 @@ struct ConvoyPerception {
   std::optional<Pose2> self;                              ///< own pose (field frame)
   std::optional<Pose2> leader;                            ///< agent k-1's pose, if k > 1 and known
   std::optional<environment::ProximityValues> proximity;  ///< own IR sensors
-  std::vector<Vec2> others_m;                             ///< positions of the other robots known (not self, the leader or the follower)
+  std::vector<Vec2> others_m;  ///< positions of the other robots known (not self, the leader or the follower)
 };
 
 /// One agent's convoy decision, as a pure step on an explicit state.
@@ -100,9 +100,9 @@ class CentralConvoy {
  public:
   /// One agent's state as the coordinator sees it.
   struct AgentView {
-    int id = 0;                                            ///< the robot's ID = its rank
-    std::optional<Pose2> pose;                             ///< nullopt: not localised
-    std::optional<environment::ProximityValues> proximity; ///< its sensors
+    int id = 0;                                             ///< the robot's ID = its rank
+    std::optional<Pose2> pose;                              ///< nullopt: not localised
+    std::optional<environment::ProximityValues> proximity;  ///< its sensors
   };
   explicit CentralConvoy(ConvoyConfig config = {});
   /// Commands for every agent in `agents` (any order) at time t_us, keyed by ID.

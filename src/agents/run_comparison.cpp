@@ -71,8 +71,7 @@ SummaryFacts read_summary(const std::filesystem::path& dir) {
         if (id.is_number_integer()) facts.real_robots.push_back(id.get<int>());
       }
     }
-  } catch (const std::exception&) {
-  }
+  } catch (const std::exception&) {}
   return facts;
 }
 
@@ -86,8 +85,7 @@ std::vector<std::uint64_t> seeds_in(const std::filesystem::path& dir) {
     if (name.find_first_not_of("0123456789", 5) != std::string::npos) continue;
     try {
       seeds.push_back(std::stoull(name.substr(5)));
-    } catch (const std::exception&) {
-    }
+    } catch (const std::exception&) {}
   }
   std::sort(seeds.begin(), seeds.end());
   return seeds;
@@ -136,7 +134,8 @@ BatchComparison compare_batches(const std::filesystem::path& a, const std::files
   BatchComparison c;
   const std::vector<std::uint64_t> sa = seeds_in(a), sb = seeds_in(b);
   if (sa.empty()) c.error = a.string() + ": no seed_<N> run folders (not a batch folder of rilbed run --seeds)";
-  if (c.error.empty() && sb.empty()) c.error = b.string() + ": no seed_<N> run folders (not a batch folder of rilbed run --seeds)";
+  if (c.error.empty() && sb.empty())
+    c.error = b.string() + ": no seed_<N> run folders (not a batch folder of rilbed run --seeds)";
   if (!c.error.empty()) return c;
   std::set_difference(sa.begin(), sa.end(), sb.begin(), sb.end(), std::back_inserter(c.only_a));
   std::set_difference(sb.begin(), sb.end(), sa.begin(), sa.end(), std::back_inserter(c.only_b));

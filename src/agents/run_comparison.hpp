@@ -4,8 +4,8 @@
 // run folder per seed, `seed_<N>/`) seed by seed.
 #pragma once
 
-#include <filesystem>
 #include <cstdint>
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <string>
@@ -22,13 +22,13 @@ struct RobotDifference {
 
 /// Two runs compared.
 struct RunComparison {
-  std::map<int, RobotDifference> robots;  ///< by robot ID (robots present in both runs)
+  std::map<int, RobotDifference> robots;               ///< by robot ID (robots present in both runs)
   std::optional<double> formation_a_s, formation_b_s;  ///< from each summary.json
-  double common_duration_s = 0;           ///< the span of time both runs cover
+  double common_duration_s = 0;                        ///< the span of time both runs cover
   /// The robots that are real in either run, or stand in for real ones (summary.json's
   /// real_robots and virtual_stand_ins); empty when neither run had any.
   std::vector<int> real_robots;
-  std::string error;                      ///< empty on success; names the file otherwise
+  std::string error;  ///< empty on success; names the file otherwise
   bool ok() const { return error.empty(); }
 };
 

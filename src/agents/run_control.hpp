@@ -20,15 +20,15 @@ struct ControlAction {
   /// kRefused records a command the console refused (a wrong token), as an event.
   enum class Kind { kPause, kResume, kRtFactor, kExit, kReset, kMode, kDrive, kVision, kRefused };
   Kind kind = Kind::kPause;
-  double rt_factor = 1.0;  ///< kRtFactor: the new factor
-  bool central = false;    ///< kMode: true for central mode, false for distributed
-  int robot_id = 0;        ///< kDrive: the robot
-  int left = 0, right = 0; ///< kDrive: wheel speeds, Khepera units (+-127, 8 mm/s each)
-  double duration_s = 0.0; ///< kDrive: for this long (simulated seconds), then its controller again
+  double rt_factor = 1.0;   ///< kRtFactor: the new factor
+  bool central = false;     ///< kMode: true for central mode, false for distributed
+  int robot_id = 0;         ///< kDrive: the robot
+  int left = 0, right = 0;  ///< kDrive: wheel speeds, Khepera units (+-127, 8 mm/s each)
+  double duration_s = 0.0;  ///< kDrive: for this long (simulated seconds), then its controller again
   /// kVision: settings by name (vision::kVisionSettingNames) and value, all or none applied
   std::vector<std::pair<std::string, double>> vision;
-  std::string who;         ///< who asked (for the run's events)
-  std::string what;        ///< kRefused: the command and why it was refused
+  std::string who;   ///< who asked (for the run's events)
+  std::string what;  ///< kRefused: the command and why it was refused
 };
 
 /// A handle on the run that is running, usable from any thread. Every action returns

@@ -57,7 +57,8 @@ void RunFolderWriter::on_detections(const FrameReport& frame) {
   for (const DetectionReport& d : frame.detections) {
     std::snprintf(row, sizeof row, "%lld,%.3f,%d,%.3f,%.3f,%.2f,%.4f,%.2f,%.5f,%.5f,%.2f\n",
                   static_cast<long long>(frame.frame), us_to_seconds(frame.t_us), d.id, d.u_px, d.v_px, d.heading_deg,
-                  d.score, d.diameter_px, d.pose.position_m.x, d.pose.position_m.y, wrap_deg_360(rad_to_deg(d.pose.heading_rad)));
+                  d.score, d.diameter_px, d.pose.position_m.x, d.pose.position_m.y,
+                  wrap_deg_360(rad_to_deg(d.pose.heading_rad)));
     detections_ << row;
   }
 }

@@ -17,7 +17,8 @@ AgentModel::AgentModel(Body& body, std::unique_ptr<Controller> controller, TimeU
       team_in_(add_input<TeamBroadcast>("team")),
       command_in_(add_input<AgentCommand>("command")),
       console_in_(add_input<ConsoleOrder>("console")) {
-  if (period_us <= 0) throw std::invalid_argument("agent " + std::to_string(body.id()) + ": control period must be > 0");
+  if (period_us <= 0)
+    throw std::invalid_argument("agent " + std::to_string(body.id()) + ": control period must be > 0");
   state_.commanded = commanded;
   state_.sigma_us = controller_ && !commanded ? first_step_us : sim::kInfinity;
 }
@@ -151,7 +152,8 @@ QuantumModel::QuantumModel(AgentExchange& exchange, std::vector<AgentModel*> age
       period_us_(period_us),
       t_us_(first_us) {
   if (period_us <= 0) throw std::invalid_argument("quantum: period must be > 0");
-  std::sort(agents_.begin(), agents_.end(), [](const AgentModel* a, const AgentModel* b) { return a->body().id() < b->body().id(); });
+  std::sort(agents_.begin(), agents_.end(),
+            [](const AgentModel* a, const AgentModel* b) { return a->body().id() < b->body().id(); });
 }
 
 void QuantumModel::internal_transition() {
@@ -191,8 +193,8 @@ void TeamBroadcaster::output() {
   t_us_ += period_us_;
 }
 
-CentralConvoyModel::CentralConvoyModel(std::vector<Body*> bodies, ConvoyConfig config, TimeUs period_us, TimeUs first_us,
-                                       bool active)
+CentralConvoyModel::CentralConvoyModel(std::vector<Body*> bodies, ConvoyConfig config, TimeUs period_us,
+                                       TimeUs first_us, bool active)
     : sim::AtomicModel<CentralState>("central_convoy", CentralState{0, active ? first_us : sim::kInfinity, {}}),
       bodies_(std::move(bodies)),
       config_(config),

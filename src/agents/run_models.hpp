@@ -17,8 +17,8 @@
 #include "agents/agent_exchange.hpp"
 #include "agents/body.hpp"
 #include "agents/controller.hpp"
-#include "agents/run_profile.hpp"
 #include "agents/convoy.hpp"
+#include "agents/run_profile.hpp"
 #include "sim/atomic.hpp"
 #include "sim/time.hpp"
 
@@ -39,10 +39,10 @@ struct AgentCommand {
 struct ConsoleOrder {
   enum class Kind { kDrive, kMode };
   Kind kind = Kind::kDrive;
-  int robot_id = 0;     ///< kDrive: the robot driven by hand
-  WheelCommand wheels;  ///< kDrive
-  TimeUs until_us = 0;  ///< kDrive: its controller (or the coordinator) takes over again at the first step from then
-  bool central = false; ///< kMode: the convoy's agents obey the central coordinator (else their own controllers)
+  int robot_id = 0;      ///< kDrive: the robot driven by hand
+  WheelCommand wheels;   ///< kDrive
+  TimeUs until_us = 0;   ///< kDrive: its controller (or the coordinator) takes over again at the first step from then
+  bool central = false;  ///< kMode: the convoy's agents obey the central coordinator (else their own controllers)
 };
 
 /// A robot driven by hand (the console's drive command) until a time.
@@ -53,11 +53,11 @@ struct ManualDrive {
 
 /// State of an agent model.
 struct AgentState {
-  TimeUs t_us = 0;                 ///< simulated time of the last transition
-  TimeUs sigma_us = 0;             ///< time left to the next control step
+  TimeUs t_us = 0;                                       ///< simulated time of the last transition
+  TimeUs sigma_us = 0;                                   ///< time left to the next control step
   std::shared_ptr<const std::vector<TeamMessage>> team;  ///< the latest broadcast, as received (shared, not copied)
-  ControlOutput last;              ///< the last command applied to the body
-  bool commanded = false;          ///< it obeys the "command" input (central mode), its controller idle
+  ControlOutput last;                                    ///< the last command applied to the body
+  bool commanded = false;             ///< it obeys the "command" input (central mode), its controller idle
   std::optional<ManualDrive> manual;  ///< driven by hand (its controller and commands set aside) until then
 };
 
@@ -130,7 +130,8 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   }
   /// The lines a step touches: those up to keep_sensors_ (see the members' order).
   std::size_t prefetch_bytes() const override {
-    return static_cast<std::size_t>(reinterpret_cast<const char*>(&keep_sensors_ + 1) - reinterpret_cast<const char*>(this));
+    return static_cast<std::size_t>(reinterpret_cast<const char*>(&keep_sensors_ + 1) -
+                                    reinterpret_cast<const char*>(this));
   }
 
  private:
@@ -146,12 +147,12 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   TimeUs period_us_;
   AgentExchange* remote_ = nullptr;  // serves this robot, or null
   bool profiled_ = false;
-  bool remote_done_ = false;         // the remote controller's done() at its last answer
+  bool remote_done_ = false;  // the remote controller's done() at its last answer
   bool keep_sensors_ = true;
   sim::Port<TeamBroadcast>& team_in_;
   sim::Port<AgentCommand>& command_in_;
   sim::Port<ConsoleOrder>& console_in_;
-  RunProfile times_;  // its own (agents may step on several threads at once)
+  RunProfile times_;                     // its own (agents may step on several threads at once)
   environment::SensorReadings sensors_;  // what its controller read at its last step, when kept
 };
 

@@ -37,7 +37,7 @@ struct PoseReport {
   /// bus decoder's (links::RunReportDecoder) view the message being decoded. An observer
   /// that keeps a report keeps a copy of its strings.
   std::string_view behaviour;
-  std::string_view health;     ///< "ok", "unseen", ...; valid as `behaviour` is
+  std::string_view health;  ///< "ok", "unseen", ...; valid as `behaviour` is
 };
 
 /// One robot's wheel command at one control step.
@@ -60,20 +60,20 @@ struct DetectionReport {
   double heading_deg = 0.0;       ///< on screen, counter-clockwise from +u, [0, 360)
   double score = 0.0;             ///< circular cross-covariance, [-1, 1]
   double diameter_px = 0.0;
-  Pose2 pose;                     ///< the same in the field frame
+  Pose2 pose;  ///< the same in the field frame
 };
 
 /// What the overhead camera found in one frame.
 struct FrameReport {
-  TimeUs t_us = 0;            ///< when the frame was taken (simulated time)
-  std::int64_t frame = 0;     ///< frame number, from 1
-  double process_ms = 0.0;    ///< wall time the vision pipeline took on it
+  TimeUs t_us = 0;          ///< when the frame was taken (simulated time)
+  std::int64_t frame = 0;   ///< frame number, from 1
+  double process_ms = 0.0;  ///< wall time the vision pipeline took on it
   std::span<const DetectionReport> detections;
 };
 
 /// The overhead camera of a run with real robots: how its frames map onto the field.
 struct CameraReport {
-  int width_px = 0;   ///< frame size
+  int width_px = 0;  ///< frame size
   int height_px = 0;
   /// Homogeneous undistorted pixels (u, v, 1) to homogeneous field metres, row-major.
   std::array<double, 9> image_to_field{1, 0, 0, 0, 1, 0, 0, 0, 1};
@@ -89,7 +89,7 @@ struct SensorGeometry {
     double mount_rad = 0.0, opening_rad = 0.0, max_m = 0.0;
     bool operator==(const Range&) const = default;
   };
-  std::vector<Range> ranges;       ///< ultrasonic, in reading order
+  std::vector<Range> ranges;  ///< ultrasonic, in reading order
   bool beacon_finder = false;
   double beacon_fov_rad = 0.0;
   /// Each track sensor's floor segments (their centres), in reading order.
@@ -112,15 +112,15 @@ struct WorldReport {
 
 /// The run's state.
 struct StatusReport {
-  TimeUs t_us = 0;          ///< simulated time
-  double wall_s = 0.0;      ///< wall-clock time since the run started
+  TimeUs t_us = 0;      ///< simulated time
+  double wall_s = 0.0;  ///< wall-clock time since the run started
   std::string scenario;
   std::uint64_t seed = 0;
-  std::string mode;         ///< "distributed" or "central"
+  std::string mode;  ///< "distributed" or "central"
   bool realtime = false;
   double rt_factor = 1.0;
-  std::string state;        ///< "running" or "ended"
-  std::string ended_by;     ///< when ended (RunResult::ended_by)
+  std::string state;     ///< "running" or "ended"
+  std::string ended_by;  ///< when ended (RunResult::ended_by)
   int robots = 0;
   int real_robots = 0;
   bool formed = false;

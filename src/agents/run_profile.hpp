@@ -11,7 +11,8 @@ struct RunProfile {
   /// thread had swept all along) and each agent's taking of its reading. With several
   /// threads, time summed over the threads, like behaviours_s.
   double sensing_s = 0.0;
-  double behaviours_s = 0.0;   ///< the controllers' steps (behaviour networks) and driving the bodies, summed over threads
+  double behaviours_s =
+      0.0;  ///< the controllers' steps (behaviour networks) and driving the bodies, summed over threads
   double integration_s = 0.0;  ///< moving the bodies (exact arcs, substeps) in the world's steps
   double collisions_s = 0.0;   ///< resolving collisions in the world's steps
   double monitor_s = 0.0;      ///< recording: trajectories, events, overlap check, observers

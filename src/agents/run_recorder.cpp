@@ -3,8 +3,8 @@
 #include <cmath>
 #include <cstdio>
 #include <ostream>
-#include <string>
 #include <stdexcept>
+#include <string>
 
 namespace rilbed::agents {
 
@@ -28,20 +28,21 @@ void write_legend(std::ostream& svg, double x, double top) {
   const double mid = top + 11.0;
   auto num = [](double v) { return format("%.1f", v); };
   svg << "<g class=\"legend\">\n";
-  svg << "<circle r=\"8\" fill=\"#888\" fill-opacity=\"0.35\" stroke=\"#888\" cx=\"" << num(x + 8) << "\" cy=\"" << num(mid)
-      << "\"/>\n";
+  svg << "<circle r=\"8\" fill=\"#888\" fill-opacity=\"0.35\" stroke=\"#888\" cx=\"" << num(x + 8) << "\" cy=\""
+      << num(mid) << "\"/>\n";
   svg << "<line stroke=\"#888\" stroke-width=\"1.5\" x1=\"" << num(x + 20) << "\" y1=\"" << num(mid) << "\" x2=\""
       << num(x + 44) << "\" y2=\"" << num(mid) << "\"/>\n";
   svg << "<text x=\"" << num(x + 50) << "\" y=\"" << num(mid + 4) << "\">virtual robot</text>\n";
   const double rx = x + 150;
   svg << "<rect width=\"16\" height=\"16\" x=\"" << num(rx) << "\" y=\"" << num(mid - 8)
       << "\" fill=\"#888\" fill-opacity=\"0.35\" stroke=\"#000\" stroke-width=\"2\"/>\n";
-  svg << "<line stroke=\"#888\" stroke-width=\"1.5\" stroke-dasharray=\"6,3\" x1=\"" << num(rx + 20) << "\" y1=\"" << num(mid)
-      << "\" x2=\"" << num(rx + 44) << "\" y2=\"" << num(mid) << "\"/>\n";
+  svg << "<line stroke=\"#888\" stroke-width=\"1.5\" stroke-dasharray=\"6,3\" x1=\"" << num(rx + 20) << "\" y1=\""
+      << num(mid) << "\" x2=\"" << num(rx + 44) << "\" y2=\"" << num(mid) << "\"/>\n";
   svg << "<text x=\"" << num(rx + 50) << "\" y=\"" << num(mid + 4) << "\">real robot (as the camera saw it)</text>\n";
   const double sx = rx + 260;
   svg << "<circle r=\"3\" fill=\"none\" stroke=\"#888\" cx=\"" << num(sx + 8) << "\" cy=\"" << num(mid) << "\"/>\n";
-  svg << "<text x=\"" << num(sx + 16) << "\" y=\"" << num(mid + 4) << "\">start (the last pose shows the heading)</text>\n";
+  svg << "<text x=\"" << num(sx + 16) << "\" y=\"" << num(mid + 4)
+      << "\">start (the last pose shows the heading)</text>\n";
   svg << "</g>\n";
 }
 
@@ -126,8 +127,8 @@ void RunRecorder::write_svg() const {
     return s.x + "," + s.y;
   };
   std::ofstream svg(dir_ / "trajectories.svg");
-  svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << format("%.0f", w) << "\" height=\"" << format("%.0f", h)
-      << "\" font-family=\"sans-serif\" font-size=\"11\">\n";
+  svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << format("%.0f", w) << "\" height=\""
+      << format("%.0f", h) << "\" font-family=\"sans-serif\" font-size=\"11\">\n";
   svg << "<rect x=\"" << margin << "\" y=\"" << margin << "\" width=\"" << field_.width_m * scale << "\" height=\""
       << field_.height_m * scale << "\" fill=\"#fafafa\" stroke=\"#2a2\" stroke-width=\"2\"/>\n";
   for (const auto& [points, width_m] : field_.tracks) {
@@ -156,7 +157,8 @@ void RunRecorder::write_svg() const {
     svg << "\"/>\n";
     if (!path.empty()) {
       const Screen start = screen(path.front());
-      svg << "<circle r=\"3\" fill=\"none\" stroke=\"" << c << "\" cx=\"" << start.x << "\" cy=\"" << start.y << "\"/>\n";
+      svg << "<circle r=\"3\" fill=\"none\" stroke=\"" << c << "\" cx=\"" << start.x << "\" cy=\"" << start.y
+          << "\"/>\n";
     }
     const auto it = last_pose_.find(id);
     if (it != last_pose_.end()) {
@@ -166,14 +168,16 @@ void RunRecorder::write_svg() const {
       const std::string& cx = centre.x;
       const std::string& cy = centre.y;
       if (real) {
-        svg << "<rect class=\"real\" width=\"" << format("%.1f", 2 * body_r) << "\" height=\"" << format("%.1f", 2 * body_r)
-            << "\" x=\"" << format("%.1f", std::stod(cx) - body_r) << "\" y=\"" << format("%.1f", std::stod(cy) - body_r)
-            << "\" fill=\"" << c << "\" fill-opacity=\"0.35\" stroke=\"#000\" stroke-width=\"2\"/>\n";
+        svg << "<rect class=\"real\" width=\"" << format("%.1f", 2 * body_r) << "\" height=\""
+            << format("%.1f", 2 * body_r) << "\" x=\"" << format("%.1f", std::stod(cx) - body_r) << "\" y=\""
+            << format("%.1f", std::stod(cy) - body_r) << "\" fill=\"" << c
+            << "\" fill-opacity=\"0.35\" stroke=\"#000\" stroke-width=\"2\"/>\n";
       } else {
         svg << "<circle class=\"virtual\" r=\"" << format("%.1f", body_r) << "\" fill=\"" << c
             << "\" fill-opacity=\"0.35\" stroke=\"" << c << "\" cx=\"" << cx << "\" cy=\"" << cy << "\"/>\n";
       }
-      svg << "<line stroke=\"#000\" x1=\"" << cx << "\" y1=\"" << cy << "\" x2=\"" << nose.x << "\" y2=\"" << nose.y << "\"/>\n";
+      svg << "<line stroke=\"#000\" x1=\"" << cx << "\" y1=\"" << cy << "\" x2=\"" << nose.x << "\" y2=\"" << nose.y
+          << "\"/>\n";
       svg << "<text x=\"" << cx << "\" y=\"" << cy << "\" dy=\"4\" text-anchor=\"middle\">" << id << "</text>\n";
     }
   }

@@ -44,7 +44,7 @@ struct RunEvent {
 struct FieldDrawing {
   double width_m = 1.5;
   double height_m = 1.2;
-  std::vector<std::vector<Vec2>> obstacles;               ///< closed polygons
+  std::vector<std::vector<Vec2>> obstacles;                  ///< closed polygons
   std::vector<std::pair<std::vector<Vec2>, double>> tracks;  ///< polylines with their width
   std::vector<Vec2> beacons;
   /// Robots that are real (drawn apart from virtual ones, with a legend).
@@ -78,7 +78,7 @@ class RunRecorder {
   std::filesystem::path dir_;
   FieldDrawing field_;
   std::ofstream trajectories_, events_;
-  std::map<int, std::vector<Vec2>> paths_;      // per robot, thinned
+  std::map<int, std::vector<Vec2>> paths_;  // per robot, thinned
   std::map<int, Pose2> last_pose_;
   std::map<int, int> sample_count_;
   int rows_since_flush_ = 0;

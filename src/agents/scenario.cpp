@@ -27,7 +27,8 @@ class Reader {
   }
   [[noreturn]] void fail(const YAML::Node& at, const std::string& what) const {
     const int line = at.Mark().line >= 0 ? at.Mark().line + 1 : 0;
-    throw ScenarioError(source_ + ":" + std::to_string(line) + ": " + (path_.empty() ? "(top level)" : path_) + ": " + what);
+    throw ScenarioError(source_ + ":" + std::to_string(line) + ": " + (path_.empty() ? "(top level)" : path_) + ": " +
+                        what);
   }
   [[noreturn]] void fail_key(const std::string& key, const std::string& what) const {
     throw ScenarioError(source_ + ":" + std::to_string(line_of(key)) + ": " + join(key) + ": " + what);
@@ -231,9 +232,9 @@ std::vector<RobotSpec> read_robots(const Reader& top, const ControllerRegistry& 
     }
     const std::string kind = r.text("kind", "virtual");
     if (kind == "virtual") {
-      base.kind = environment::RobotKind::Virtual;
+      base.kind = environment::RobotKind::kVirtual;
     } else if (kind == "real") {
-      base.kind = environment::RobotKind::Real;
+      base.kind = environment::RobotKind::kReal;
     } else {
       r.fail_key("kind", "must be virtual or real, not '" + kind + "'");
     }
@@ -252,7 +253,8 @@ std::vector<RobotSpec> read_robots(const Reader& top, const ControllerRegistry& 
           }
           if (!std::isfinite(v[k])) r.fail_key("pose", "must hold finite numbers");
         }
-        if (ids.size() > 1) r.fail_key("pose", "one pose cannot place several robots; use `random` or one entry per robot");
+        if (ids.size() > 1)
+          r.fail_key("pose", "one pose cannot place several robots; use `random` or one entry per robot");
         base.pose = Pose2{{v[0], v[1]}, deg_to_rad(v[2])};
       }
     }
@@ -289,7 +291,7 @@ std::vector<RobotSpec> read_robots(const Reader& top, const ControllerRegistry& 
                  base.controller.name + " needs `sensors: " + *sensor + ":` (see scenarios/README.md)");
     }
     if (r.has("link")) {
-      if (base.kind != environment::RobotKind::Real) r.fail_key("link", "only a robot of kind real has a link");
+      if (base.kind != environment::RobotKind::kReal) r.fail_key("link", "only a robot of kind real has a link");
       const Reader l = r.child("link");
       l.allow({"port", "baud", "model", "emulate", "placement", "faults", "reply_timeout_ms", "retries",
                "counters_period_ms"});
@@ -309,7 +311,8 @@ std::vector<RobotSpec> read_robots(const Reader& top, const ControllerRegistry& 
       if (placement == "drive") {
         link.placement = Placement::kDrive;
       } else if (placement == "teleport") {
-        if (!link.emulate) l.fail_key("placement", "only an emulated robot can be put in place by rilbed (a real one is driven there)");
+        if (!link.emulate)
+          l.fail_key("placement", "only an emulated robot can be put in place by rilbed (a real one is driven there)");
         link.placement = Placement::kTeleport;
       } else {
         l.fail_key("placement", "is drive or teleport, not '" + placement + "'");
@@ -320,7 +323,8 @@ std::vector<RobotSpec> read_robots(const Reader& top, const ControllerRegistry& 
         f.allow({"reply_delay_ms", "drop", "garbage", "corrupt", "disconnect_after_s", "replug_after_s"});
         link.faults.reply_delay_ms = f.integer("reply_delay_ms", 0);
         if (link.faults.reply_delay_ms < 0) f.fail_key("reply_delay_ms", "must not be negative");
-        for (auto [key, value] : {std::pair{"drop", &link.faults.drop}, {"garbage", &link.faults.garbage},
+        for (auto [key, value] : {std::pair{"drop", &link.faults.drop},
+                                  {"garbage", &link.faults.garbage},
                                   {"corrupt", &link.faults.corrupt}}) {
           *value = f.non_negative(key, 0.0);
           if (*value > 1.0) f.fail_key(key, "is a probability, at most 1");
@@ -329,7 +333,7 @@ std::vector<RobotSpec> read_robots(const Reader& top, const ControllerRegistry& 
         link.faults.replug_after_s = f.non_negative("replug_after_s", 0.0);
       }
       base.link = link;
-    } else if (base.kind == environment::RobotKind::Real) {
+    } else if (base.kind == environment::RobotKind::kReal) {
       r.fail(list[i], "a robot of kind real needs a `link` ({port: /dev/ttyUSB0, baud: 38400} or {emulate: true})");
     }
     for (int id : ids) {
@@ -387,7 +391,8 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source, const 
     if (!top.has(key)) return;
     const YAML::Node list = top.get(key);
     if (!list.IsSequence()) top.fail_key(key, "must be a list");
-    for (std::size_t i = 0; i < list.size(); ++i) read(Reader(list[i], source, std::string(key) + "[" + std::to_string(i) + "]"));
+    for (std::size_t i = 0; i < list.size(); ++i)
+      read(Reader(list[i], source, std::string(key) + "[" + std::to_string(i) + "]"));
   };
   each("obstacles", [&](const Reader& o) {
     o.allow({"name", "polygon"});
@@ -418,10 +423,10 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source, const 
     environment::MovingObstacleConfig c;
     const std::string shape = m.text("shape", "disc");
     if (shape == "disc") {
-      c.shape = environment::MovingShape::Disc;
+      c.shape = environment::MovingShape::kDisc;
       c.radius_m = m.positive("radius_m", c.radius_m);
     } else if (shape == "polygon") {
-      c.shape = environment::MovingShape::Polygon;
+      c.shape = environment::MovingShape::kPolygon;
       c.vertices_m = m.points("vertices");
     } else {
       m.fail_key("shape", "must be disc or polygon");
@@ -457,7 +462,8 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source, const 
     }
     const int sources = (cam.emulate ? 1 : 0) + (cam.device ? 1 : 0) + (cam.file.empty() ? 0 : 1);
     if (sources != 1) top.fail_key("camera", "give exactly one of `emulate: true`, `device: N` or `file: PATH`");
-    if (!cam.emulate && cam.calibration.empty()) c.fail_key("calibration", "a real camera needs its field calibration file");
+    if (!cam.emulate && cam.calibration.empty())
+      c.fail_key("calibration", "a real camera needs its field calibration file");
     s.camera = cam;
   }
   if (top.has("safety")) {
@@ -496,7 +502,8 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source, const 
       const auto parsed = parse_id_list(a.text("ids", ""), 1, 100000);
       if (!parsed.ok()) a.fail_key("ids", parsed.error);
       for (const int id : parsed.ids) {
-        const auto robot = std::find_if(s.robots.begin(), s.robots.end(), [&](const RobotSpec& r) { return r.id == id; });
+        const auto robot =
+            std::find_if(s.robots.begin(), s.robots.end(), [&](const RobotSpec& r) { return r.id == id; });
         if (robot == s.robots.end()) a.fail_key("ids", "there is no robot " + std::to_string(id));
         if (robot->controller.name == "none") a.fail_key("ids", "robot " + std::to_string(id) + " has no controller");
       }
@@ -520,7 +527,7 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source, const 
     s.agents = spec;
   }
   const bool any_real = std::any_of(s.robots.begin(), s.robots.end(),
-                                    [](const RobotSpec& r) { return r.kind == environment::RobotKind::Real; });
+                                    [](const RobotSpec& r) { return r.kind == environment::RobotKind::kReal; });
   if (any_real && !s.camera) top.fail_key("camera", "a scenario with real robots needs a `camera` to see them");
   // The static map validates its own geometry; report its complaint against the file.
   try {
@@ -573,7 +580,9 @@ class PlacedPoints {
   PlacedPoints(double width_m, double height_m, double spacing_m)
       // A hair wider than the spacing: two points nearer than it never round two cells apart.
       : cell_m_(std::max(spacing_m, std::sqrt(std::max(width_m * height_m, 1e-12) / double(1 << 20))) * (1.0 + 1e-9)),
-        nx_(cells_along(width_m)), ny_(cells_along(height_m)), head_(static_cast<std::size_t>(nx_) * ny_, -1) {}
+        nx_(cells_along(width_m)),
+        ny_(cells_along(height_m)),
+        head_(static_cast<std::size_t>(nx_) * ny_, -1) {}
   void add(Vec2 p) {
     const std::size_t c = cell(index_x(p.x), index_y(p.y));
     next_.push_back(head_[c]);
@@ -634,7 +643,7 @@ std::vector<Pose2> draw_initial_poses(const Scenario& scenario, std::mt19937_64&
     // A moving obstacle where it starts, by its bounding circle (a polygon's vertices are
     // relative to its position).
     for (const auto& m : scenario.moving_obstacles) {
-      double reach_m = m.shape == environment::MovingShape::Disc ? m.radius_m : 0.0;
+      double reach_m = m.shape == environment::MovingShape::kDisc ? m.radius_m : 0.0;
       for (const Vec2& v : m.vertices_m) reach_m = std::max(reach_m, std::hypot(v.x, v.y));
       if (environment::distance_sq(p, m.position_m) < (reach_m + margin) * (reach_m + margin)) return false;
     }
@@ -656,8 +665,9 @@ std::vector<Pose2> draw_initial_poses(const Scenario& scenario, std::mt19937_64&
       done = true;
     }
     if (!done) {
-      throw ScenarioError(scenario.source.string() + ":" + std::to_string(scenario.robots[i].line) + ": no free place for robot " +
-                          std::to_string(scenario.robots[i].id) + " after 10000 tries: the field is too crowded");
+      throw ScenarioError(scenario.source.string() + ":" + std::to_string(scenario.robots[i].line) +
+                          ": no free place for robot " + std::to_string(scenario.robots[i].id) +
+                          " after 10000 tries: the field is too crowded");
     }
   }
   return poses;
@@ -666,7 +676,7 @@ std::vector<Pose2> draw_initial_poses(const Scenario& scenario, std::mt19937_64&
 std::vector<int> real_robot_ids(const Scenario& scenario) {
   std::vector<int> ids;
   for (const RobotSpec& r : scenario.robots) {
-    if (r.kind == environment::RobotKind::Real) ids.push_back(r.id);
+    if (r.kind == environment::RobotKind::kReal) ids.push_back(r.id);
   }
   return ids;
 }

@@ -42,14 +42,14 @@ enum class Placement { kTeleport, kDrive };
 
 /// How a real robot is reached (used by runs with real robots).
 struct LinkSpec {
-  std::string port;            ///< serial device, e.g. /dev/ttyUSB0; empty when emulated
-  int baud = 0;                ///< 0: the model's own (Khepera 38400, e-puck 115200)
-  std::string model = "khepera2";  ///< protocol variant: khepera2 | epuck
-  bool emulate = false;        ///< start an emulated Khepera on a pseudo-terminal instead
+  std::string port;                         ///< serial device, e.g. /dev/ttyUSB0; empty when emulated
+  int baud = 0;                             ///< 0: the model's own (Khepera 38400, e-puck 115200)
+  std::string model = "khepera2";           ///< protocol variant: khepera2 | epuck
+  bool emulate = false;                     ///< start an emulated Khepera on a pseudo-terminal instead
   Placement placement = Placement::kDrive;  ///< `placement:` (emulated robots: teleport by default)
-  int reply_timeout_ms = 250;  ///< how long one command waits for its reply
-  int retries = 3;             ///< further attempts before a command fails
-  int counters_period_ms = 200;  ///< read the wheel counters (`H`) this often (0: never)
+  int reply_timeout_ms = 250;               ///< how long one command waits for its reply
+  int retries = 3;                          ///< further attempts before a command fails
+  int counters_period_ms = 200;             ///< read the wheel counters (`H`) this often (0: never)
   /// Faults the emulated robot injects (emulate only): reply delay, dropped, garbled and
   /// corrupted replies (probabilities per reply), and an unplug after some seconds,
   /// plugged back in after some more (0: never).
@@ -62,13 +62,13 @@ struct LinkSpec {
 
 /// The overhead camera of a run with real robots.
 struct CameraSpec {
-  bool emulate = false;          ///< render the emulated real robots (their true poses) instead of a real camera
-  std::optional<int> device;     ///< a live camera's index
-  std::string file;              ///< recorded footage (a video, an image directory or sequence)
-  std::string calibration;       ///< field calibration file (OpenCV YAML); not used when emulated
-  double fps = 30.0;             ///< frames per second (emulated, or the rate a file is replayed at)
+  bool emulate = false;             ///< render the emulated real robots (their true poses) instead of a real camera
+  std::optional<int> device;        ///< a live camera's index
+  std::string file;                 ///< recorded footage (a video, an image directory or sequence)
+  std::string calibration;          ///< field calibration file (OpenCV YAML); not used when emulated
+  double fps = 30.0;                ///< frames per second (emulated, or the rate a file is replayed at)
   double marker_diameter_m = 0.05;  ///< outer diameter of the printed markers
-  std::string family = "6ucp";   ///< marker family
+  std::string family = "6ucp";      ///< marker family
   /// The vision settings the run starts with (`vision: {brightness: 0, contrast: 1, ...}`,
   /// what the web panel shows for the settings a person tuned).
   vision::VisionSettings vision;
@@ -86,7 +86,7 @@ struct ControllerSpec {
 /// One robot of a scenario.
 struct RobotSpec {
   int id = 0;
-  environment::RobotKind kind = environment::RobotKind::Virtual;
+  environment::RobotKind kind = environment::RobotKind::kVirtual;
   std::optional<Pose2> pose;  ///< nullopt: a random free pose drawn from the run's seed
   ControllerSpec controller;
   environment::WheelNoiseConfig noise;
@@ -122,30 +122,31 @@ struct AgentsSpec {
   /// shell-quoted text (what ssh hands to the remote shell). The scenario itself goes to
   /// the command's standard input, which the agent keeps open as its lifeline: when the run
   /// goes, the connection closes and the remote agent ends.
-  std::vector<std::string> launch = {"ssh", "-T", "-o", "BatchMode=yes", "-o", "ConnectTimeout=10", "{host}", "{command}"};
+  std::vector<std::string> launch = {"ssh",    "-T",       "-o", "BatchMode=yes", "-o", "ConnectTimeout=10",
+                                     "{host}", "{command}"};
   /// The rilbed binary on the hosts; empty: this binary's own absolute path (machines set
   /// up alike, or a shared file system).
   std::string remote_rilbed;
 };
 
 struct Scenario {
-  std::string name;                 ///< the file's `name`, else its stem
-  std::filesystem::path source;     ///< the file it came from
+  std::string name;              ///< the file's `name`, else its stem
+  std::filesystem::path source;  ///< the file it came from
   ConvoyMode mode = ConvoyMode::kDistributed;
   environment::StaticMapConfig map;
   std::vector<environment::MovingObstacleConfig> moving_obstacles;
-  TimeUs physics_step_us = 20'000;     ///< world integration step
-  TimeUs control_period_us = 100'000;  ///< controllers run this often
+  TimeUs physics_step_us = 20'000;       ///< world integration step
+  TimeUs control_period_us = 100'000;    ///< controllers run this often
   TimeUs broadcast_period_us = 100'000;  ///< team broadcast (distributed mode)
-  double duration_s = 120.0;        ///< default run length
-  ConvoyConfig convoy;              ///< the convoy's knobs (the `convoy:` block)
-  std::optional<CameraSpec> camera; ///< how real robots are seen (required when there are real robots)
+  double duration_s = 120.0;             ///< default run length
+  ConvoyConfig convoy;                   ///< the convoy's knobs (the `convoy:` block)
+  std::optional<CameraSpec> camera;      ///< how real robots are seen (required when there are real robots)
   /// Safety for real robots: stop one the camera has not seen for this long, milliseconds.
   int lost_timeout_ms = 500;
   /// Safety: stop a real robot whose centre comes nearer than this to the field's edge, metres.
   double geofence_margin_m = 0.0;
-  std::vector<RobotSpec> robots;    ///< sorted by ID
-  std::optional<AgentsSpec> agents; ///< controllers in other processes (the `agents:` block)
+  std::vector<RobotSpec> robots;     ///< sorted by ID
+  std::optional<AgentsSpec> agents;  ///< controllers in other processes (the `agents:` block)
   /// The controllers its robots were checked against when it was read; the run makes
   /// them from it. Never null for a scenario read by load_scenario() or parse_scenario().
   std::shared_ptr<const ControllerRegistry> controllers;

@@ -3,13 +3,13 @@
 #include "environment/random.hpp"
 
 #include <algorithm>
-#include <mutex>
 #include <atomic>
 #include <bit>
 #include <chrono>
-#include <ctime>
 #include <cmath>
+#include <ctime>
 #include <map>
+#include <mutex>
 #include <set>
 #include <sstream>
 
@@ -110,7 +110,10 @@ class VisionModel final : public sim::AtomicModel<TimeUs> {  // state: time to t
  public:
   using Grab = std::function<std::optional<cv::Mat>()>;
   VisionModel(environment::World& world, vision::FieldTracker tracker, Grab grab, TimeUs period_us)
-      : sim::AtomicModel<TimeUs>("camera", 0), world_(world), tracker_(std::move(tracker)), grab_(std::move(grab)),
+      : sim::AtomicModel<TimeUs>("camera", 0),
+        world_(world),
+        tracker_(std::move(tracker)),
+        grab_(std::move(grab)),
         period_us_(period_us) {}
   /// Tells `observer` (may be null) what every frame shows; `observer` outlives the run.
   void report_to(RunObserver* observer) {
@@ -131,9 +134,10 @@ class VisionModel final : public sim::AtomicModel<TimeUs> {  // state: time to t
     frames_.fetch_add(1, std::memory_order_relaxed);
     const auto start = std::chrono::steady_clock::now();
     const std::vector<vision::FieldObservation> seen = tracker_.process(*frame);
-    const double process_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const double process_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     for (const vision::FieldObservation& o : seen) {
-      if (!world_.has_robot(o.id) || world_.robot(o.id).kind != environment::RobotKind::Real) continue;
+      if (!world_.has_robot(o.id) || world_.robot(o.id).kind != environment::RobotKind::kReal) continue;
       world_.set_observed_pose(o.id, o.pose, t_us_);
       ++sightings_;
     }
@@ -182,12 +186,13 @@ class VisionModel final : public sim::AtomicModel<TimeUs> {  // state: time to t
 };
 
 // The camera of a scenario with real robots, ready to add to the run.
-std::shared_ptr<VisionModel> make_camera(const Scenario& scenario, const RunOptions& options, environment::World& world) {
+std::shared_ptr<VisionModel> make_camera(const Scenario& scenario, const RunOptions& options,
+                                         environment::World& world) {
   const CameraSpec& cam = *scenario.camera;
   const std::string where = scenario.source.string() + ":" + std::to_string(cam.line) + ": camera";
   std::vector<int> real_ids;
   for (const RobotSpec& r : scenario.robots) {
-    if (r.kind == environment::RobotKind::Real) real_ids.push_back(r.id);
+    if (r.kind == environment::RobotKind::kReal) real_ids.push_back(r.id);
   }
   if (real_ids.empty()) return nullptr;
   vision::MarkerFamily family = vision::MarkerFamily::six_ucp();
@@ -203,8 +208,8 @@ std::shared_ptr<VisionModel> make_camera(const Scenario& scenario, const RunOpti
     config.fps = cam.fps;
     config.marker_diameter_m = cam.marker_diameter_m;
     config.seed = options.seed;
-    auto camera = std::make_shared<vision::EmulatedOverheadCamera>(scenario.map.field.width_m, scenario.map.field.height_m,
-                                                                   family, config);
+    auto camera = std::make_shared<vision::EmulatedOverheadCamera>(scenario.map.field.width_m,
+                                                                   scenario.map.field.height_m, family, config);
     vision::FieldTracker tracker(family, real_ids, camera->calibration());
     tracker.set_settings(cam.vision);
     auto markers = options.emulated_markers;
@@ -226,8 +231,8 @@ std::shared_ptr<VisionModel> make_camera(const Scenario& scenario, const RunOpti
   VisionModel::Grab grab = [source]() -> std::optional<cv::Mat> {
     for (;;) {
       vision::FrameResult r = source->next();
-      if (r.kind == vision::FrameResult::Kind::Frame) return r.image;
-      if (r.kind == vision::FrameResult::Kind::End) return std::nullopt;
+      if (r.kind == vision::FrameResult::Kind::kFrame) return r.image;
+      if (r.kind == vision::FrameResult::Kind::kEnd) return std::nullopt;
       // A bad frame is skipped (the frame source names it); the next one is tried.
     }
   };
@@ -236,10 +241,10 @@ std::shared_ptr<VisionModel> make_camera(const Scenario& scenario, const RunOpti
 
 int party_code(const environment::BodyRef& b) {
   switch (b.kind) {
-    case environment::BodyKind::Robot: return b.id;
-    case environment::BodyKind::Wall: return -1;
-    case environment::BodyKind::Obstacle: return -2;
-    case environment::BodyKind::MovingObstacle: return -3;
+    case environment::BodyKind::kRobot: return b.id;
+    case environment::BodyKind::kWall: return -1;
+    case environment::BodyKind::kObstacle: return -2;
+    case environment::BodyKind::kMovingObstacle: return -3;
   }
   return 0;
 }
@@ -251,8 +256,8 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   struct Setup {
     environment::World* world = nullptr;
     WorldModel* world_model = nullptr;
-    std::vector<AgentModel*> agents;         // by ID order
-    std::vector<int> convoy_ids;             // 1..N, empty when there is no convoy
+    std::vector<AgentModel*> agents;  // by ID order
+    std::vector<int> convoy_ids;      // 1..N, empty when there is no convoy
     RunRecorder* recorder = nullptr;
     const RunOptions* options = nullptr;
     sim::Coordinator** coordinator = nullptr;  // set once built
@@ -267,7 +272,8 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     core::WorkerPool* workers = nullptr;        // reads the agents on these threads when set
   };
   explicit MonitorModel(Setup setup)
-      : sim::AtomicModel<TimeUs>("monitor", 1), s_(std::move(setup)),
+      : sim::AtomicModel<TimeUs>("monitor", 1),
+        s_(std::move(setup)),
         formation_(std::max<int>(1, static_cast<int>(s_.convoy_ids.size()))) {
     last_behaviour_.assign(s_.agents.size(), {});
     last_health_.assign(s_.agents.size(), "ok");
@@ -352,8 +358,8 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
       sensor_reports_.push_back({id, &a->sensors()});
       const environment::RobotState& state = s_.world->robot(id);
       const auto pose = a->body().pose();
-      if (!pose && !state.observed && state.kind == environment::RobotKind::Real) continue;  // never seen
-      reports_.push_back({id, state.kind == environment::RobotKind::Real, pose.has_value(), pose.value_or(state.pose),
+      if (!pose && !state.observed && state.kind == environment::RobotKind::kReal) continue;  // never seen
+      reports_.push_back({id, state.kind == environment::RobotKind::kReal, pose.has_value(), pose.value_or(state.pose),
                           a->behaviour(), a->body().health()});
     }
     observer.on_poses(t, reports_);
@@ -391,7 +397,7 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
     if (o && new_second) o->on_world(t, s_.world_report);
     for (const auto& e : s_.world_model->drain()) {
       ++r.collisions;
-      if (e.second.kind == environment::BodyKind::Robot) ++r.robot_collisions;
+      if (e.second.kind == environment::BodyKind::kRobot) ++r.robot_collisions;
       record({e.t_us, "collision", party_code(e.first), party_code(e.second),
               to_string(e.first) + " touched " + to_string(e.second)});
     }
@@ -408,8 +414,8 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
         record({t, "health", change.id, 0, std::string(change.old_health) + " -> " + std::string(change.health)});
       }
       if (change.behaviour != change.old_behaviour && !change.old_behaviour.empty()) {
-        record({t, "behaviour", change.id, 0,
-                std::string(change.old_behaviour) + " -> " + std::string(change.behaviour)});
+        record(
+            {t, "behaviour", change.id, 0, std::string(change.old_behaviour) + " -> " + std::string(change.behaviour)});
       }
     }
     samples_.clear();
@@ -500,17 +506,18 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
       read(0, s_.agents.size());
     }
     // Chunks merge in any order; the events follow agent order.
-    std::sort(changed_.begin(), changed_.end(), [](const AgentChange& x, const AgentChange& y) { return x.agent < y.agent; });
+    std::sort(changed_.begin(), changed_.end(),
+              [](const AgentChange& x, const AgentChange& y) { return x.agent < y.agent; });
   }
 
   // One sample's term of the trajectory digest: of the time, id, position and heading,
   // bit for bit. The digest of a step is the sum of its samples' terms (in any order).
   static std::uint64_t sample_digest(TimeUs t, int id, const Pose2& pose) {
     std::uint64_t h = 0x6a09e667f3bcc909ULL;
-    for (const std::uint64_t word : {static_cast<std::uint64_t>(t), static_cast<std::uint64_t>(id),
-                                     std::bit_cast<std::uint64_t>(pose.position_m.x),
-                                     std::bit_cast<std::uint64_t>(pose.position_m.y),
-                                     std::bit_cast<std::uint64_t>(pose.heading_rad)})
+    for (const std::uint64_t word :
+         {static_cast<std::uint64_t>(t), static_cast<std::uint64_t>(id),
+          std::bit_cast<std::uint64_t>(pose.position_m.x), std::bit_cast<std::uint64_t>(pose.position_m.y),
+          std::bit_cast<std::uint64_t>(pose.heading_rad)})
       h = environment::mix64(h ^ word) + 0x9e3779b97f4a7c15ULL;
     return h;
   }
@@ -589,8 +596,8 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   TimeUs next_report_us_ = 0;
   TimeUs next_overlap_check_us_ = 0;
   std::vector<std::optional<TrajectorySample>> read_samples_;  // read_agents, when listed_: per agent
-  std::uint64_t step_digest_ = 0;       // read_agents: the sum of this step's sample digests
-  std::vector<AgentChange> changed_;    // read_agents: agents whose health or behaviour changed, in order
+  std::uint64_t step_digest_ = 0;                              // read_agents: the sum of this step's sample digests
+  std::vector<AgentChange> changed_;  // read_agents: agents whose health or behaviour changed, in order
   bool all_concurrent_ = false;
   bool listed_ = false;  // the samples are recorded, kept or watched by the formation monitor
   std::vector<PoseReport> reports_;
@@ -617,7 +624,7 @@ class ControlModel final : public sim::AtomicModel<std::vector<ConsoleOrder>> { 
     MonitorModel* monitor = nullptr;
     sim::RealTimeClock* clock = nullptr;  // null in a fast run
     RunObserver* observer = nullptr;
-    VisionModel* camera = nullptr;        // the overhead camera, if any (its settings)
+    VisionModel* camera = nullptr;  // the overhead camera, if any (its settings)
   };
   explicit ControlModel(Setup setup)
       : sim::AtomicModel<std::vector<ConsoleOrder>>("control", {}),
@@ -685,8 +692,8 @@ class ControlModel final : public sim::AtomicModel<std::vector<ConsoleOrder>> { 
         // A held drive (the web panel's, renewed every few tenths of a second) is one
         // event while its speeds stay and it does not lapse, not one per renewal.
         const auto last = drives_.find(a.robot_id);
-        const bool renewal = last != drives_.end() && last->second.wheels == o.wheels && last->second.until_us >= t_us_ &&
-                             last->second.who == a.who;
+        const bool renewal = last != drives_.end() && last->second.wheels == o.wheels &&
+                             last->second.until_us >= t_us_ && last->second.who == a.who;
         drives_[a.robot_id] = {o.wheels, o.until_us, a.who};
         if (renewal) break;
         std::ostringstream text;
@@ -709,7 +716,8 @@ class ControlModel final : public sim::AtomicModel<std::vector<ConsoleOrder>> { 
         text << " set by " << a.who;
         s_.monitor->record_event({t_us_, "console", 0, 0, text.str()});
         // Viewers see the new settings at once, not at the next second's status.
-        if (s_.observer) s_.observer->on_status(s_.monitor->status(t_us_, s_.clock && s_.clock->paused() ? "paused" : "running"));
+        if (s_.observer)
+          s_.observer->on_status(s_.monitor->status(t_us_, s_.clock && s_.clock->paused() ? "paused" : "running"));
         break;
       }
       case ControlAction::Kind::kRefused:
@@ -791,24 +799,28 @@ nlohmann::json RunResult::summary() const {
   j["ended_by"] = ended_by;
   if (!loop_latency_ms.empty()) {
     const std::vector<double> ms(loop_latency_ms.begin(), loop_latency_ms.end());
-    j["loop_latency_ms"] = {{"p50", percentile(ms, 0.5)}, {"p99", percentile(ms, 0.99)},
-                            {"max", *std::max_element(ms.begin(), ms.end())}, {"steps", ms.size()}};
+    j["loop_latency_ms"] = {{"p50", percentile(ms, 0.5)},
+                            {"p99", percentile(ms, 0.99)},
+                            {"max", *std::max_element(ms.begin(), ms.end())},
+                            {"steps", ms.size()}};
   }
   return j;
 }
 
 std::unique_ptr<Controller> make_controller(const Scenario& scenario, const RobotSpec& spec) {
-  const std::string where = scenario.source.string() + ":" + std::to_string(spec.line) + ": robot " + std::to_string(spec.id);
+  const std::string where =
+      scenario.source.string() + ":" + std::to_string(spec.line) + ": robot " + std::to_string(spec.id);
   const std::shared_ptr<const ControllerRegistry> registry =
       scenario.controllers ? scenario.controllers : default_controllers();
   const ControllerEntry* entry = registry->find(spec.controller.name);
   if (!entry) {
-    throw ScenarioError(where + ": unknown controller '" + spec.controller.name + "' (known: " + registry->names_text() +
-                        ")");
+    throw ScenarioError(where + ": unknown controller '" + spec.controller.name +
+                        "' (known: " + registry->names_text() + ")");
   }
   // A scenario read from a file was checked already; one built in code is checked here.
   if (const auto problem = check_params(*entry, spec.controller.params)) {
-    throw ScenarioError(where + ": " + (problem->key.empty() ? "" : "params." + problem->key + ": ") + problem->problem);
+    throw ScenarioError(where + ": " + (problem->key.empty() ? "" : "params." + problem->key + ": ") +
+                        problem->problem);
   }
   if (const auto sensor = missing_sensor(*entry, spec.sensors)) {
     throw ScenarioError(where + ": " + entry->name + " needs `sensors: " + *sensor + ":`");
@@ -845,7 +857,8 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   }
   for (std::size_t k = 0; k < convoy_ids.size(); ++k) {
     if (convoy_ids[k] != static_cast<int>(k) + 1) {
-      throw ScenarioError(scenario.source.string() + ": convoy robots must have IDs 1..N (agent k follows agent k-1); found " +
+      throw ScenarioError(scenario.source.string() +
+                          ": convoy robots must have IDs 1..N (agent k follows agent k-1); found " +
                           std::to_string(convoy_ids[k]) + " where " + std::to_string(k + 1) + " was expected");
     }
   }
@@ -884,11 +897,11 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
     } catch (const std::invalid_argument& e) {
       throw ScenarioError(scenario.source.string() + ":" + std::to_string(spec.line) + ": " + e.what());
     }
-    if (spec.kind == environment::RobotKind::Real) {
+    if (spec.kind == environment::RobotKind::kReal) {
       std::unique_ptr<Body> body = real_bodies ? real_bodies(spec, world) : nullptr;
       if (!body) {
-        throw ScenarioError(scenario.source.string() + ":" + std::to_string(spec.line) + ": robot " + std::to_string(spec.id) +
-                            " is real, and this run has no serial links for real robots");
+        throw ScenarioError(scenario.source.string() + ":" + std::to_string(spec.line) + ": robot " +
+                            std::to_string(spec.id) + " is real, and this run has no serial links for real robots");
       }
       bodies.push_back(std::move(body));
     } else {
@@ -906,8 +919,8 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   for (std::size_t i = 0; i < scenario.robots.size(); ++i) {
     auto controller = make_controller(scenario, scenario.robots[i]);
     const bool commanded = central && i < convoy_ids.size();
-    agents.push_back(&root->emplace<AgentModel>(*bodies[i], std::move(controller), scenario.control_period_us, 0, commanded,
-                                                options.remote_agents));
+    agents.push_back(&root->emplace<AgentModel>(*bodies[i], std::move(controller), scenario.control_period_us, 0,
+                                                commanded, options.remote_agents));
   }
   // The readings each step are kept for an observer only (the GUI and the bus report them).
   if (!options.observer)
@@ -929,7 +942,8 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   if (!convoy_ids.empty()) {
     std::vector<Body*> convoy_bodies;
     for (std::size_t i = 0; i < convoy_ids.size(); ++i) convoy_bodies.push_back(bodies[i].get());
-    central_model = &root->emplace<CentralConvoyModel>(convoy_bodies, scenario.convoy, scenario.control_period_us, 0, central);
+    central_model =
+        &root->emplace<CentralConvoyModel>(convoy_bodies, scenario.convoy, scenario.control_period_us, 0, central);
     for (std::size_t i = 0; i < convoy_ids.size(); ++i) {
       root->couple(*central_model->find_output("commands"), *agents[i]->find_input("command"));
     }
@@ -965,7 +979,9 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
     setup.world_report = world_report(scenario, real_ids);
     if (camera) {
       const CameraSpec& cam = *scenario.camera;
-      setup.world_report.camera = camera->camera_report(cam.emulate ? "emulated" : cam.device ? "device " + std::to_string(*cam.device) : cam.file);
+      setup.world_report.camera = camera->camera_report(cam.emulate  ? "emulated"
+                                                        : cam.device ? "device " + std::to_string(*cam.device)
+                                                                     : cam.file);
     }
   }
   sim::FastClock fast_clock;
@@ -988,8 +1004,8 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
   // The console's way in: a root input coupled to the control model.
   sim::Port<ControlAction>* control_in = nullptr;
   if (options.control) {
-    auto& control = root->emplace<ControlModel>(
-        ControlModel::Setup{agents, &monitor, options.realtime ? &real_clock : nullptr, options.observer, camera.get()});
+    auto& control = root->emplace<ControlModel>(ControlModel::Setup{
+        agents, &monitor, options.realtime ? &real_clock : nullptr, options.observer, camera.get()});
     control_in = &root->add_input<ControlAction>("control");
     root->couple(*control_in, control.input());
     for (AgentModel* a : agents) root->couple(control.orders(), *a->find_input("console"));
@@ -1011,8 +1027,8 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
     std::optional<vision::VisionSettings> vision_now;
     if (camera) vision_now = camera->vision();
     options.control->attach(
-        [&paused, &central_now, realtime, has_real, has_convoy, ids, vision_now](const ControlAction& a) mutable
-        -> std::optional<std::string> {
+        [&paused, &central_now, realtime, has_real, has_convoy, ids,
+         vision_now](const ControlAction& a) mutable -> std::optional<std::string> {
           switch (a.kind) {
             case ControlAction::Kind::kPause:
               if (!realtime) return "a fast run cannot be paused (it is not paced to the clock)";
@@ -1035,7 +1051,8 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
             case ControlAction::Kind::kDrive:
               if (!ids.contains(a.robot_id)) return "this run has no robot " + std::to_string(a.robot_id);
               if (paused.load()) return "the run is paused: resume it first";
-              if (std::abs(a.left) > 127 || std::abs(a.right) > 127) return "wheel speeds are -127..127 (Khepera units)";
+              if (std::abs(a.left) > 127 || std::abs(a.right) > 127)
+                return "wheel speeds are -127..127 (Khepera units)";
               if (!(a.duration_s > 0.0) || !std::isfinite(a.duration_s)) return "the seconds must be above 0";
               return std::nullopt;
             case ControlAction::Kind::kVision: {
@@ -1051,8 +1068,7 @@ RunResult run_scenario(const Scenario& scenario, const RunOptions& options, cons
             }
             case ControlAction::Kind::kExit:
             case ControlAction::Kind::kReset:
-            case ControlAction::Kind::kRefused:
-              return std::nullopt;
+            case ControlAction::Kind::kRefused: return std::nullopt;
           }
           return "unknown action";
         },

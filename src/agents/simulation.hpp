@@ -79,25 +79,26 @@ struct RunOptions {
 /// What a run came to.
 struct RunResult {
   std::uint64_t seed = 0;
-  int convoy_size = 0;                      ///< robots with the convoy controller (0: no convoy)
-  bool formed = false;                      ///< the convoy formed (see FormationMonitor)
-  std::optional<double> formation_time_s;   ///< when the hold that formed it began
-  int collisions = 0;                       ///< contact episodes (robot–anything)
-  int robot_collisions = 0;                 ///< of those, robot–robot
-  double max_overlap_m = 0.0;               ///< largest overlap seen at the control steps checked (RunOptions::overlap_check_us)
+  int convoy_size = 0;                     ///< robots with the convoy controller (0: no convoy)
+  bool formed = false;                     ///< the convoy formed (see FormationMonitor)
+  std::optional<double> formation_time_s;  ///< when the hold that formed it began
+  int collisions = 0;                      ///< contact episodes (robot–anything)
+  int robot_collisions = 0;                ///< of those, robot–robot
+  double max_overlap_m = 0.0;  ///< largest overlap seen at the control steps checked (RunOptions::overlap_check_us)
   double simulated_s = 0.0;
-  double wall_s = 0.0;                      ///< the whole call, building the world included
-  double run_wall_s = 0.0;                  ///< the DEVS run alone (what sim-bench reports)
-  double run_cpu_s = 0.0;                   ///< CPU time of the run's threads (the caller's and RunOptions::threads' workers) in the DEVS run
+  double wall_s = 0.0;      ///< the whole call, building the world included
+  double run_wall_s = 0.0;  ///< the DEVS run alone (what sim-bench reports)
+  double run_cpu_s =
+      0.0;  ///< CPU time of the run's threads (the caller's and RunOptions::threads' workers) in the DEVS run
   /// A 64-bit digest of every trajectory sample (the sum of a hash of each sample's time,
   /// id, position and heading, bit for bit): equal digests mean, but for a tiny chance,
   /// the same trajectories (runs on different thread counts are compared by it).
   std::uint64_t trajectory_digest = 0;
   /// With RunOptions::profile: where run_wall_s went (the rest is the DEVS kernel's).
   std::optional<RunProfile> profile;
-  std::string ended_by;                     ///< "duration", "formed", "done" or "interrupt"
-  std::vector<int> not_done;                ///< with stop_when_done: the robots whose agent was not done at the end
-  std::vector<TrajectorySample> trajectory; ///< with keep_in_memory only
+  std::string ended_by;                      ///< "duration", "formed", "done" or "interrupt"
+  std::vector<int> not_done;                 ///< with stop_when_done: the robots whose agent was not done at the end
+  std::vector<TrajectorySample> trajectory;  ///< with keep_in_memory only
   /// A real-time run with an observer: how far behind the wall clock each control step
   /// finished, its reports handed to the observer, ms (what a viewer's cost adds to).
   std::vector<float> loop_latency_ms;

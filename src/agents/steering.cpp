@@ -5,8 +5,7 @@
 
 namespace rilbed::agents {
 
-WheelCommand steer_to(const Pose2& self, Vec2 target_m, double standoff_m, const SteeringConfig& config,
-                      Vec2 repulse) {
+WheelCommand steer_to(const Pose2& self, Vec2 target_m, double standoff_m, const SteeringConfig& config, Vec2 repulse) {
   const Vec2 to = target_m - self.position_m;
   const double distance = to.norm();
   if (distance < 1e-9) return {};

@@ -72,8 +72,8 @@ void AgentProcesses::stop() {
   started_.clear();
 }
 
-bool AgentProcesses::spawn(const std::vector<std::string>& args, bool search_path, const std::string& input, Started& started,
-                           std::string& error) {
+bool AgentProcesses::spawn(const std::vector<std::string>& args, bool search_path, const std::string& input,
+                           Started& started, std::string& error) {
   std::vector<std::string> copy = args;
   std::vector<char*> argv;
   for (std::string& a : copy) argv.push_back(a.data());
@@ -176,7 +176,8 @@ std::vector<std::vector<int>> split_ids(const std::vector<int>& ids, int process
   return groups;
 }
 
-std::vector<AgentPlacement> place_agents(const std::vector<int>& ids, int processes, const std::vector<std::string>& hosts) {
+std::vector<AgentPlacement> place_agents(const std::vector<int>& ids, int processes,
+                                         const std::vector<std::string>& hosts) {
   std::vector<AgentPlacement> out;
   for (std::vector<int>& group : split_ids(ids, processes)) {
     const std::string host = hosts.empty() ? std::string() : hosts[out.size() % hosts.size()];

@@ -65,7 +65,8 @@ std::vector<std::vector<int>> split_ids(const std::vector<int>& ids, int process
 
 /// `ids` split into `processes` groups (split_ids), group i placed on hosts[i % size], or
 /// on this machine when there are no hosts.
-std::vector<AgentPlacement> place_agents(const std::vector<int>& ids, int processes, const std::vector<std::string>& hosts);
+std::vector<AgentPlacement> place_agents(const std::vector<int>& ids, int processes,
+                                         const std::vector<std::string>& hosts);
 
 /// `text` quoted for a POSIX shell as one word ('...', a ' inside as '\'').
 std::string shell_quote(const std::string& text);

@@ -3,8 +3,8 @@
 // The controllers are built from the scenario exactly as `rilbed run` builds them, afresh
 // for each run; the run sends their inputs each control step and applies their answers.
 #include <signal.h>
-#include <unistd.h>
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -13,10 +13,10 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
-#include <string_view>
 #include <set>
-#include <thread>
 #include <string>
+#include <string_view>
+#include <thread>
 #include <vector>
 
 #include "agents/scenario.hpp"
@@ -121,7 +121,8 @@ int agent_command(const AgentArgs& args) {
   // Every ID must be a robot of the scenario with a controller; each is built once here,
   // so that a bad parameter shows now rather than when a run starts.
   for (const int id : ids) {
-    const auto spec = std::find_if(scenario.robots.begin(), scenario.robots.end(), [&](const auto& r) { return r.id == id; });
+    const auto spec =
+        std::find_if(scenario.robots.begin(), scenario.robots.end(), [&](const auto& r) { return r.id == id; });
     if (spec == scenario.robots.end()) {
       spdlog::error("agent: {} has no robot {}", scenario.source.string(), id);
       return kExitUsage;
@@ -150,7 +151,8 @@ int agent_command(const AgentArgs& args) {
   config.robot_ids = ids;
   config.once = args.once;
   links::AgentServer server(*lcm, *answers, config, [&scenario](int id) {
-    const auto spec = std::find_if(scenario.robots.begin(), scenario.robots.end(), [&](const auto& r) { return r.id == id; });
+    const auto spec =
+        std::find_if(scenario.robots.begin(), scenario.robots.end(), [&](const auto& r) { return r.id == id; });
     return agents::make_controller(scenario, *spec);
   });
   std::signal(SIGINT, on_agent_signal);
@@ -164,9 +166,9 @@ int agent_command(const AgentArgs& args) {
   server.serve(agent_interrupted);
   if (!args.quiet) {
     const auto& c = server.counters();
-    std::printf("agent %s: %lld run(s), %lld steps, %lld repeated answers, %lld quanta skipped\n", server.session().c_str(),
-                static_cast<long long>(c.runs), static_cast<long long>(c.steps), static_cast<long long>(c.repeats),
-                static_cast<long long>(c.skipped));
+    std::printf("agent %s: %lld run(s), %lld steps, %lld repeated answers, %lld quanta skipped\n",
+                server.session().c_str(), static_cast<long long>(c.runs), static_cast<long long>(c.steps),
+                static_cast<long long>(c.repeats), static_cast<long long>(c.skipped));
   }
   return 0;
 }
@@ -177,7 +179,8 @@ void add_agent_command(CLI::App& app) {
   auto args = std::make_shared<AgentArgs>();
   CLI::App* cmd = app.add_subcommand(
       "agent", "Run some robots' controllers in this process, for a run on an LCM bus that lists them as remote");
-  CLI::Option* file = cmd->add_option("--scenario", args->scenario, "The run's scenario file")->check(CLI::ExistingFile);
+  CLI::Option* file =
+      cmd->add_option("--scenario", args->scenario, "The run's scenario file")->check(CLI::ExistingFile);
   cmd->add_option("--scenario-stdin", args->scenario_stdin,
                   "Read the scenario from standard input instead, up to a line '...' or its end; NAME is the file it "
                   "came from (its default name, and in messages). After a '...' line the agent ends when its input "

@@ -44,7 +44,6 @@ using vision::FieldCalibrationResult;
 using vision::LensModel;
 using vision::PointCorrespondence;
 
-
 /// A value parsed from an option, or a message naming the option and what is wrong.
 template <typename T>
 struct Parsed {
@@ -376,8 +375,8 @@ int run_field(const FieldOptions& o) {
     const auto points = find_markers(image, job, who);
     point_count = points.size();
     if (points.size() < 4) {
-      std::cerr << who << "only " << points.size() << " of the " << job.markers.size() << " markers were found in --image '"
-                << o.image << "'; at least 4 are needed\n";
+      std::cerr << who << "only " << points.size() << " of the " << job.markers.size()
+                << " markers were found in --image '" << o.image << "'; at least 4 are needed\n";
       return kExitFailure;
     }
     result = vision::field_from_correspondences(points, job.width_m, job.height_m, image.size(), lens);

@@ -67,7 +67,8 @@ int compare_two_batches(const std::string& a, const std::string& b) {
   for (const std::uint64_t seed : c.only_a) spdlog::warn("seed {} is only in {}", seed, a);
   for (const std::uint64_t seed : c.only_b) spdlog::warn("seed {} is only in {}", seed, b);
   std::printf("%zu seeds; A = %s, B = %s; RMS of each robot's distance between A and B at equal times%s:\n\n",
-              c.seeds.size(), a.c_str(), b.c_str(), c.seeds.front().runs.real_robots.empty() ? "" : " (its real robots)");
+              c.seeds.size(), a.c_str(), b.c_str(),
+              c.seeds.front().runs.real_robots.empty() ? "" : " (its real robots)");
   std::string header = "| seed |", rule = "| ---: |";
   for (const int id : c.robots) {
     header += " robot " + std::to_string(id) + " RMS m |";
@@ -99,7 +100,8 @@ int compare_two_batches(const std::string& a, const std::string& b) {
       size_of_difference.push_back(std::abs(*diff));
       ++both_formed;
     }
-    row += " " + cell("%.1f", run.formation_a_s) + " | " + cell("%.1f", run.formation_b_s) + " | " + cell("%+.1f", diff) + " |";
+    row += " " + cell("%.1f", run.formation_a_s) + " | " + cell("%.1f", run.formation_b_s) + " | " +
+           cell("%+.1f", diff) + " |";
     std::printf("%s\n", row.c_str());
   }
   auto stat_row = [&](const char* name, double p, bool size_for_difference) {
@@ -107,9 +109,12 @@ int compare_two_batches(const std::string& a, const std::string& b) {
     for (const auto& values : rms) {
       row += " " + cell("%.4f", values.empty() ? std::nullopt : std::optional<double>(percentile(values, p))) + " |";
     }
-    auto of = [&](const std::vector<double>& v) { return v.empty() ? std::nullopt : std::optional<double>(percentile(v, p)); };
+    auto of = [&](const std::vector<double>& v) {
+      return v.empty() ? std::nullopt : std::optional<double>(percentile(v, p));
+    };
     row += " " + cell("%.1f", of(formed_a)) + " | " + cell("%.1f", of(formed_b)) + " | " +
-           cell(size_for_difference ? "%.1f" : "%+.1f", of(size_for_difference ? size_of_difference : difference)) + " |";
+           cell(size_for_difference ? "%.1f" : "%+.1f", of(size_for_difference ? size_of_difference : difference)) +
+           " |";
     std::printf("%s\n", row.c_str());
   };
   stat_row("median", 0.5, false);
@@ -127,7 +132,8 @@ void add_compare_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "compare", "Compare two run folders, or two batch folders seed by seed (e.g. all virtual vs with real robots)");
   cmd->add_option("run_a", *a, "First run folder (rilbed run --out), or batch folder (rilbed run --seeds N --out)")
-      ->required()->check(CLI::ExistingDirectory);
+      ->required()
+      ->check(CLI::ExistingDirectory);
   cmd->add_option("run_b", *b, "Second run or batch folder")->required()->check(CLI::ExistingDirectory);
   cmd->callback([a, b] {
     const bool batch_a = agents::is_batch_folder(*a), batch_b = agents::is_batch_folder(*b);

@@ -8,8 +8,8 @@
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -58,11 +58,11 @@ int console_command(const ConsoleArgs& args) {
     spdlog::error("console: --for goes with drive only");
     return kExitUsage;
   }
-  const auto reply = links::send_console_command(*lcm, links::Channels::with_prefix(args.prefix), token, args.words.front(),
-                                                 rest, args.timeout_ms);
+  const auto reply = links::send_console_command(*lcm, links::Channels::with_prefix(args.prefix), token,
+                                                 args.words.front(), rest, args.timeout_ms);
   if (!reply) {
-    std::fprintf(stderr, "rilbed console: no run answered on %s within %d ms (channel %sRILBED_CONSOLE)\n", args.url.c_str(),
-                 args.timeout_ms, args.prefix.c_str());
+    std::fprintf(stderr, "rilbed console: no run answered on %s within %d ms (channel %sRILBED_CONSOLE)\n",
+                 args.url.c_str(), args.timeout_ms, args.prefix.c_str());
     return kExitFailure;
   }
   if (!reply->accepted) {
@@ -78,19 +78,23 @@ int console_command(const ConsoleArgs& args) {
 void add_console_command(CLI::App& app) {
   auto args = std::make_shared<ConsoleArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "console", "Steer a running run over its LCM bus: pause | resume | exit | reset | rt-factor F | mode | drive | "
-                 "vision (needs the run's token)");
+      "console",
+      "Steer a running run over its LCM bus: pause | resume | exit | reset | rt-factor F | mode | drive | "
+      "vision (needs the run's token)");
   cmd->add_option("--lcm", args->url, "LCM URL of the run's bus")->required();
   cmd->add_option("--channel-prefix", args->prefix, "The run's channel prefix");
   cmd->add_option("--token", args->token, "The run's token (default: from the run's token file, if you can read it)");
   cmd->add_option("--timeout-ms", args->timeout_ms, "How long to wait for the run's answer")
-      ->check(CLI::PositiveNumber)->default_val(1000);
-  cmd->add_option("command", args->words,
-                  "pause | resume | exit | reset | rt-factor F | mode central|distributed | drive ID LEFT RIGHT --for S "
-                  "(wheel speeds in Khepera units, -127..127, 8 mm/s each) | vision NAME VALUE [NAME VALUE]... "
-                  "(brightness -128..128, contrast 0.2..5, threshold 1..255, min_diameter_px and max_diameter_px "
-                  "6..4000, min_score 0..1)")
-      ->required()->expected(1, 13);
+      ->check(CLI::PositiveNumber)
+      ->default_val(1000);
+  cmd->add_option(
+         "command", args->words,
+         "pause | resume | exit | reset | rt-factor F | mode central|distributed | drive ID LEFT RIGHT --for S "
+         "(wheel speeds in Khepera units, -127..127, 8 mm/s each) | vision NAME VALUE [NAME VALUE]... "
+         "(brightness -128..128, contrast 0.2..5, threshold 1..255, min_diameter_px and max_diameter_px "
+         "6..4000, min_score 0..1)")
+      ->required()
+      ->expected(1, 13);
   cmd->add_option("--for", args->for_s, "With drive: seconds (simulated) to drive, then the robot's controller again")
       ->check(CLI::PositiveNumber);
   cmd->callback([args] { exit_code() = console_command(*args); });

@@ -1,9 +1,9 @@
 // `rilbed detect`: runs the overhead-camera pipeline over recorded footage or a live
 // camera and writes one CSV row per identified marker per frame.
-#include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include <atomic>
 #include <chrono>
@@ -14,9 +14,9 @@
 #include <optional>
 
 #include "app/commands.hpp"
-#include "links/lcm_frame_source.hpp"
 #include "core/geometry.hpp"
 #include "core/id_list.hpp"
+#include "links/lcm_frame_source.hpp"
 #include "vision/field_mapping.hpp"
 #include "vision/frame_source.hpp"
 #include "vision/marker_tracker.hpp"
@@ -102,9 +102,9 @@ int run_detect(const DetectOptions& opt) {
   }
 
   // A run's recording (--record-frames) is footage too: its frames go through the pipeline again.
-  vision::OpenResult opened = opt.camera >= 0                         ? vision::open_camera(opt.camera)
+  vision::OpenResult opened = opt.camera >= 0                     ? vision::open_camera(opt.camera)
                               : links::is_lcm_log_path(opt.input) ? links::open_lcm_frames(opt.input)
-                                                                      : vision::open_frame_source(opt.input);
+                                                                  : vision::open_frame_source(opt.input);
   if (!opened.ok()) {
     spdlog::error("{}", opened.error);
     return kExitFailure;
@@ -171,11 +171,15 @@ int run_detect(const DetectOptions& opt) {
     }
     if (!opt.annotate.empty()) {
       cv::Mat bgr;
-      if (r.image.channels() == 1) cv::cvtColor(r.image, bgr, cv::COLOR_GRAY2BGR); else bgr = r.image.clone();
+      if (r.image.channels() == 1)
+        cv::cvtColor(r.image, bgr, cv::COLOR_GRAY2BGR);
+      else
+        bgr = r.image.clone();
       annotate_frame(bgr, found, r.index);
       if (!annotated.isOpened()) {
         const double fps = source.fps() > 0 ? source.fps() : 30.0;
-        annotated.open(opt.annotate, cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps, bgr.size());
+        annotated.open(opt.annotate, cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps,
+                       bgr.size());
         if (!annotated.isOpened()) spdlog::error("--annotate: cannot write '{}'", opt.annotate);
       }
       if (annotated.isOpened()) annotated.write(bgr);
@@ -191,8 +195,8 @@ int run_detect(const DetectOptions& opt) {
   csv->flush();
 
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::fprintf(stderr, "summary: %ld frames read, %ld bad frames skipped, %ld detections%s\n", frames, bad_frames,
-               rows, g_interrupted ? " (interrupted)" : "");
+  std::fprintf(stderr, "summary: %ld frames read, %ld bad frames skipped, %ld detections%s\n", frames, bad_frames, rows,
+               g_interrupted ? " (interrupted)" : "");
   for (int id : ids) {
     const long n = per_id.count(id) ? per_id[id] : 0;
     std::fprintf(stderr, "  id %3d: %6ld frames (%5.1f%%)\n", id, n, frames ? 100.0 * n / frames : 0.0);
@@ -203,7 +207,8 @@ int run_detect(const DetectOptions& opt) {
                frames / std::max(wall, 1e-9), frames / std::max(pipeline_s, 1e-9),
                frames ? 1000.0 * pipeline_s / frames : 0.0);
   if (frames == 0) {
-    spdlog::error("no frame could be read from {}", opt.camera >= 0 ? "camera " + std::to_string(opt.camera) : opt.input);
+    spdlog::error("no frame could be read from {}",
+                  opt.camera >= 0 ? "camera " + std::to_string(opt.camera) : opt.input);
     return kExitFailure;
   }
   return 0;

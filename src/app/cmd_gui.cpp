@@ -49,8 +49,8 @@ gui_web::ConsoleSink lcm_console_sink(const GuiArgs& args) {
     if (!lcm) return {false, "cannot reach the bus " + args.url + ": " + error};
     std::string token = args.run_token;
     if (token.empty()) token = links::read_token(links::token_path(args.prefix)).value_or("");
-    const auto reply = links::send_console_command(*lcm, links::Channels::with_prefix(args.prefix), token, request.command,
-                                                   request.args, 1000, 200, request.client);
+    const auto reply = links::send_console_command(*lcm, links::Channels::with_prefix(args.prefix), token,
+                                                   request.command, request.args, 1000, 200, request.client);
     if (!reply) return {false, "no run answered on " + args.url + " within a second"};
     return {reply->accepted != 0, reply->reason};
   };
@@ -66,8 +66,9 @@ int gui_command(const GuiArgs& args) {
     return kExitUsage;
   }
   if (args.url.rfind("memq://", 0) == 0) {
-    spdlog::error("gui: memq:// is a bus inside one process, and no run can be heard on it from here: give the run's "
-                  "URL (rilbed run --lcm 'udpm://239.255.76.67:7667?ttl=0')");
+    spdlog::error(
+        "gui: memq:// is a bus inside one process, and no run can be heard on it from here: give the run's "
+        "URL (rilbed run --lcm 'udpm://239.255.76.67:7667?ttl=0')");
     return kExitUsage;
   }
   std::string error;
@@ -83,15 +84,16 @@ int gui_command(const GuiArgs& args) {
   links::RunReportDecoder decoder(run_channels, *gui);
   std::vector<std::unique_ptr<links::LcmSubscription>> subscriptions;
   long bad = 0;
-  for (const std::string* c : {&run_channels.world, &run_channels.poses, &run_channels.events, &run_channels.status,
-                               &run_channels.summary, &run_channels.wheels, &run_channels.sensors, &run_channels.detections,
-                               &run_channels.camera, &run_channels.frames, &run_channels.sensor_layout,
-                               &run_channels.vision}) {
-    subscriptions.push_back(std::make_unique<links::LcmSubscription>(*lcm, *c, [&](const std::string& ch, const void* d, std::size_t n) {
-      if (const auto problem = decoder.decode(ch, d, n)) {
-        if (++bad <= 5) spdlog::warn("gui: {} (skipped)", *problem);
-      }
-    }));
+  for (const std::string* c :
+       {&run_channels.world, &run_channels.poses, &run_channels.events, &run_channels.status, &run_channels.summary,
+        &run_channels.wheels, &run_channels.sensors, &run_channels.detections, &run_channels.camera,
+        &run_channels.frames, &run_channels.sensor_layout, &run_channels.vision}) {
+    subscriptions.push_back(
+        std::make_unique<links::LcmSubscription>(*lcm, *c, [&](const std::string& ch, const void* d, std::size_t n) {
+          if (const auto problem = decoder.decode(ch, d, n)) {
+            if (++bad <= 5) spdlog::warn("gui: {} (skipped)", *problem);
+          }
+        }));
   }
   std::printf("rilbed gui: %s (the run on %s)\n", gui->url().c_str(), args.url.c_str());
   std::fflush(stdout);
@@ -110,7 +112,8 @@ int gui_command(const GuiArgs& args) {
 
 void add_gui_command(CLI::App& app) {
   auto args = std::make_shared<GuiArgs>();
-  CLI::App* cmd = app.add_subcommand("gui", "Serve the web control panel (Foxglove WebSocket protocol) for a run on an LCM bus");
+  CLI::App* cmd =
+      app.add_subcommand("gui", "Serve the web control panel (Foxglove WebSocket protocol) for a run on an LCM bus");
   cmd->add_option("--lcm", args->url, "LCM URL of the run's bus (e.g. udpm://239.255.76.67:7667?ttl=0)")->required();
   cmd->add_option("--channel-prefix", args->prefix, "The run's channel prefix");
   cmd->add_option("--token", args->run_token, "The run's console token (default: from the run's token file)");

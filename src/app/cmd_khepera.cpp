@@ -100,7 +100,8 @@ bool wait_for_handshake(const links::KheperaLink& link) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   const links::LinkStatus status = link.status();
-  spdlog::error("{}", status.last_error.empty() ? "khepera " + link.port() + ": no reply to the handshake" : status.last_error);
+  spdlog::error(
+      "{}", status.last_error.empty() ? "khepera " + link.port() + ": no reply to the handshake" : status.last_error);
   return false;
 }
 
@@ -218,21 +219,27 @@ void add_khepera_command(CLI::App& app) {
   cmd->add_option("--port", args->port, "Serial device (/dev/ttyUSB0, /dev/rfcomm0, an emulator's pty)")->required();
   cmd->add_option("--baud", args->baud, "Baud rate (default: the model's: khepera2 38400, epuck 115200)")
       ->check(CLI::IsMember({9600u, 19200u, 38400u, 57600u, 115200u}));
-  cmd->add_option("--model", args->model, "Robot model")->check(CLI::IsMember({"khepera2", "epuck"}))->default_val("khepera2");
+  cmd->add_option("--model", args->model, "Robot model")
+      ->check(CLI::IsMember({"khepera2", "epuck"}))
+      ->default_val("khepera2");
   cmd->add_option("--timeout-ms", args->timeout_ms, "Reply timeout per attempt, milliseconds")
-      ->check(CLI::PositiveNumber)->default_val(250);
+      ->check(CLI::PositiveNumber)
+      ->default_val(250);
   cmd->add_option("--retries", args->retries, "Further attempts before a command fails")
-      ->check(CLI::NonNegativeNumber)->default_val(3);
+      ->check(CLI::NonNegativeNumber)
+      ->default_val(3);
   cmd->add_flag("--verbose", args->verbose, "Log every retry, stray line and reopen");
   cmd->require_subcommand(1);
 
-  CLI::App* info = cmd->add_subcommand("info", "Print the firmware versions, the 8 proximity values and the wheel counters");
+  CLI::App* info =
+      cmd->add_subcommand("info", "Print the firmware versions, the 8 proximity values and the wheel counters");
   info->fallthrough();
   info->callback([args] { exit_code() = khepera_command(*args, Action::kInfo); });
 
-  CLI::App* drive = cmd->add_subcommand(
-      "drive", "Drive at wheel speeds L R (units of 8 mm/s on a Khepera) for --for seconds, then stop "
-               "(SIGINT/SIGTERM stop it early; exit status 130)");
+  CLI::App* drive =
+      cmd->add_subcommand("drive",
+                          "Drive at wheel speeds L R (units of 8 mm/s on a Khepera) for --for seconds, then stop "
+                          "(SIGINT/SIGTERM stop it early; exit status 130)");
   drive->fallthrough();
   drive->add_option("left", args->left_units, "Left wheel speed, units")->required();
   drive->add_option("right", args->right_units, "Right wheel speed, units")->required();

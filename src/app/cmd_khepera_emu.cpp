@@ -111,8 +111,7 @@ int emulator_command(const EmulatorArgs& args) {
   spdlog::info("emulated {} on {} (until SIGINT or SIGTERM)", args.model, emulator->slave_path());
 
   int signal = 0;
-  while (::sigwait(&signals, &signal) != 0) {
-  }
+  while (::sigwait(&signals, &signal) != 0) {}
   const links::WheelSpeeds last = emulator->last_speeds();
   const Pose2 final_pose = emulator->true_pose();
   const environment::OdometryReading counters = emulator->counters();
@@ -132,13 +131,18 @@ int emulator_command(const EmulatorArgs& args) {
 
 void add_khepera_emu_command(CLI::App& app) {
   auto args = std::make_shared<EmulatorArgs>();
-  CLI::App* cmd = app.add_subcommand(
-      "khepera-emu", "Emulate a Khepera on a pseudo-terminal: prints the device path, serves until SIGINT/SIGTERM, "
-                     "then prints the last commanded speeds");
-  cmd->add_option("--model", args->model, "Robot model")->check(CLI::IsMember({"khepera2", "epuck"}))->default_val("khepera2");
-  cmd->add_option("--delay-ms", args->delay_ms, "Delay every reply by this many milliseconds")->check(CLI::NonNegativeNumber);
+  CLI::App* cmd =
+      app.add_subcommand("khepera-emu",
+                         "Emulate a Khepera on a pseudo-terminal: prints the device path, serves until SIGINT/SIGTERM, "
+                         "then prints the last commanded speeds");
+  cmd->add_option("--model", args->model, "Robot model")
+      ->check(CLI::IsMember({"khepera2", "epuck"}))
+      ->default_val("khepera2");
+  cmd->add_option("--delay-ms", args->delay_ms, "Delay every reply by this many milliseconds")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--drop", args->drop, "Probability that a reply is not sent")->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--garbage", args->garbage, "Probability of random bytes before a reply")->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--garbage", args->garbage, "Probability of random bytes before a reply")
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--corrupt", args->corrupt, "Probability that a reply is corrupted (letter, field count, number)")
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--disconnect-after", args->disconnect_after_s, "Unplug after this many seconds")
@@ -151,10 +155,12 @@ void add_khepera_emu_command(CLI::App& app) {
                   "Keep a symlink here to the current pty (survives a replug; printed instead of the pty)");
   cmd->add_option("--seed", args->seed, "Seed of the fault dice")->default_val(1);
   // Firmware that words its replies differently (other BIOS versions, independent peers).
-  cmd->add_option("--versions", args->versions,
-                  "What the versions reply carries after its letter (Khepera: BIOS,protocol, any text, e.g. 5.02,5.01)");
+  cmd->add_option(
+      "--versions", args->versions,
+      "What the versions reply carries after its letter (Khepera: BIOS,protocol, any text, e.g. 5.02,5.01)");
   cmd->add_flag("--upper-case", args->upper_case, "Reply letters in upper case (N,... instead of n,...)");
-  cmd->add_option("--line-end", args->line_end, "What ends a reply")->check(CLI::IsMember({"crlf", "lf", "cr"}))
+  cmd->add_option("--line-end", args->line_end, "What ends a reply")
+      ->check(CLI::IsMember({"crlf", "lf", "cr"}))
       ->default_val("crlf");
   cmd->add_option("--extra-fields", args->extra_fields, "Text appended to every reply's fields (e.g. ,0,ok)");
   cmd->add_option("--trailing-spaces", args->trailing_spaces, "Spaces before each reply's line end")

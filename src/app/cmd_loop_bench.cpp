@@ -53,11 +53,11 @@ int loop_bench(const LoopArgs& args) {
   std::vector<Pose2> real_poses;
   for (int i = 0; i < args.real; ++i) {
     const int cols = 4;
-    real_poses.push_back({{args.field_w * (0.2 + 0.6 * (i % cols) / (cols - 1)), args.field_h * (0.3 + 0.15 * (i / cols))},
-                          0.5 * i});
+    real_poses.push_back(
+        {{args.field_w * (0.2 + 0.6 * (i % cols) / (cols - 1)), args.field_h * (0.3 + 0.15 * (i / cols))}, 0.5 * i});
     environment::RobotConfig rc;
     rc.id = i + 1;
-    rc.kind = environment::RobotKind::Real;
+    rc.kind = environment::RobotKind::kReal;
     rc.pose = real_poses.back();
     world.add_robot(rc);
   }
@@ -172,13 +172,14 @@ int loop_bench(const LoopArgs& args) {
   for (const auto& e : emulators) stopped += e->last_speeds() == links::WheelSpeeds{0, 0};
 
   std::printf("## Loop latency (rilbed loop-bench)\n\n");
-  std::printf("%d real robots (emulated Kheperas on pseudo-terminals, reached over the serial link) and %d virtual ones "
-              "on a %.1f x %.1f m field, 8 IR sensors each, the wander controller. Per frame (%d frames, %dx%d, rendered "
-              "by the emulated camera before the clock starts): detect and track the real robots, place them in the world, "
-              "sense (virtual + the robot's own N values), decide and drive; then wait for each link to write its `D` on "
-              "the port. One thread for the loop (each link has its own I/O thread). Markers seen: %.1f of %d per frame.\n\n",
-              args.real, args.virtual_robots, args.field_w, args.field_h, args.frames, args.width, args.height,
-              static_cast<double>(seen_total) / args.frames, args.real);
+  std::printf(
+      "%d real robots (emulated Kheperas on pseudo-terminals, reached over the serial link) and %d virtual ones "
+      "on a %.1f x %.1f m field, 8 IR sensors each, the wander controller. Per frame (%d frames, %dx%d, rendered "
+      "by the emulated camera before the clock starts): detect and track the real robots, place them in the world, "
+      "sense (virtual + the robot's own N values), decide and drive; then wait for each link to write its `D` on "
+      "the port. One thread for the loop (each link has its own I/O thread). Markers seen: %.1f of %d per frame.\n\n",
+      args.real, args.virtual_robots, args.field_w, args.field_h, args.frames, args.width, args.height,
+      static_cast<double>(seen_total) / args.frames, args.real);
   std::printf("| measure | median ms | p99 ms | max ms |\n| --- | ---: | ---: | ---: |\n");
   auto row = [](const char* name, const std::vector<double>& v) {
     std::printf("| %s | %.3f | %.3f | %.3f |\n", name, percentile(v, 0.5), percentile(v, 0.99),
@@ -188,9 +189,10 @@ int loop_bench(const LoopArgs& args) {
   row("processing, CPU time of the loop thread", processing_cpu_ms);
   row("frame arrival to `D` written on the port (per robot)", to_port_ms);
   row("the rest of the frame: world step, 100 virtual controllers every 3rd frame", other_ms);
-  std::printf("\nTarget: <= 2 ms median processing on one core. `D` written for %zu of %d robot-frames; "
-              "%d of %d robots stopped at the end.\n",
-              to_port_ms.size(), args.real * args.frames, stopped, args.real);
+  std::printf(
+      "\nTarget: <= 2 ms median processing on one core. `D` written for %zu of %d robot-frames; "
+      "%d of %d robots stopped at the end.\n",
+      to_port_ms.size(), args.real * args.frames, stopped, args.real);
   return 0;
 }
 
@@ -198,9 +200,12 @@ int loop_bench(const LoopArgs& args) {
 
 void add_loop_bench_command(CLI::App& app) {
   auto args = std::make_shared<LoopArgs>();
-  CLI::App* cmd = app.add_subcommand("loop-bench", "Loop latency from a camera frame to the D command on the serial port");
+  CLI::App* cmd =
+      app.add_subcommand("loop-bench", "Loop latency from a camera frame to the D command on the serial port");
   cmd->add_option("--real", args->real, "Real (emulated) robots")->check(CLI::Range(1, 16))->default_val(args->real);
-  cmd->add_option("--virtual", args->virtual_robots, "Virtual robots")->check(CLI::Range(0, 10000))->default_val(args->virtual_robots);
+  cmd->add_option("--virtual", args->virtual_robots, "Virtual robots")
+      ->check(CLI::Range(0, 10000))
+      ->default_val(args->virtual_robots);
   cmd->add_option("--frames", args->frames, "Frames to time")->check(CLI::PositiveNumber)->default_val(args->frames);
   cmd->callback([args] { exit_code() = loop_bench(*args); });
 }

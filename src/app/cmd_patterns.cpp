@@ -28,7 +28,6 @@ using vision::MarkerFamily;
 using vision::PatternFormat;
 using vision::PatternResult;
 
-
 /// The options as typed on the command line.
 struct PatternsOptions {
   std::string ids;  ///< empty: every ID of the family
@@ -43,7 +42,7 @@ struct PatternsOptions {
 struct PatternsJob {
   MarkerFamily family = MarkerFamily::six_ucp();
   std::vector<int> ids;
-  PatternFormat format = PatternFormat::pdf;
+  PatternFormat format = PatternFormat::kPdf;
   double diameter_mm = 50.0;
   int size_px = 512;
   fs::path out_dir;
@@ -83,7 +82,7 @@ std::optional<UsageError> make_job(const PatternsOptions& o, PatternsJob& job) {
   if (!(o.diameter_mm > 0.0) || !std::isfinite(o.diameter_mm)) {
     return UsageError{"--diameter-mm: " + number_text(o.diameter_mm) + " is not a positive length"};
   }
-  if (job.format == PatternFormat::pdf && o.diameter_mm > vision::max_sheet_diameter_mm()) {
+  if (job.format == PatternFormat::kPdf && o.diameter_mm > vision::max_sheet_diameter_mm()) {
     return UsageError{"--diameter-mm: " + number_text(o.diameter_mm) + " mm does not fit on the A4 sheet (at most " +
                       number_text(vision::max_sheet_diameter_mm()) + " mm); use --format svg for larger markers"};
   }
@@ -108,9 +107,9 @@ std::optional<std::string> prepare_out_dir(const fs::path& dir) {
 
 PatternResult write_one(const PatternsJob& job, int id, const fs::path& path) {
   switch (job.format) {
-    case PatternFormat::svg: return vision::write_marker_svg(job.family, id, job.diameter_mm, path);
-    case PatternFormat::pdf: return vision::write_marker_pdf(job.family, id, job.diameter_mm, path);
-    case PatternFormat::png: return vision::write_marker_png(job.family, id, job.size_px, path);
+    case PatternFormat::kSvg: return vision::write_marker_svg(job.family, id, job.diameter_mm, path);
+    case PatternFormat::kPdf: return vision::write_marker_pdf(job.family, id, job.diameter_mm, path);
+    case PatternFormat::kPng: return vision::write_marker_png(job.family, id, job.size_px, path);
   }
   return PatternResult{"unhandled pattern format"};
 }
@@ -130,7 +129,7 @@ int write_all(const PatternsJob& job) {
     }
     std::cout << path.string() << "\n";
   }
-  if (job.format == PatternFormat::pdf) {
+  if (job.format == PatternFormat::kPdf) {
     const fs::path path = job.out_dir / vision::sheet_file_name(job.family);
     if (const PatternResult r = vision::write_marker_sheet_pdf(job.family, job.ids, job.diameter_mm, path); !r.ok()) {
       std::cerr << "rilbed patterns: " << r.error << "\n";
@@ -163,8 +162,7 @@ void add_patterns_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--px", options->size_px, "PNG width and height in pixels")->capture_default_str();
   cmd->add_option("--out", options->out_dir, "Output directory, created if missing")->capture_default_str();
-  cmd->add_option("--family", options->family, "Marker family: 6ucp, or kucp for k in 7..14")
-      ->capture_default_str();
+  cmd->add_option("--family", options->family, "Marker family: 6ucp, or kucp for k in 7..14")->capture_default_str();
   cmd->callback([options] { exit_code() = run_patterns(*options); });
 }
 

@@ -83,8 +83,8 @@ agents::RunResult run_once(const agents::Scenario& scenario, std::uint64_t seed,
   return agents::run_scenario(scenario, o);
 }
 
-std::optional<Row> bench_one(const QuantumBenchArgs& args, lcm::LCM& lcm, lcm::LCM& answers, const std::filesystem::path& dir, int robots,
-                             int processes, int quanta) {
+std::optional<Row> bench_one(const QuantumBenchArgs& args, lcm::LCM& lcm, lcm::LCM& answers,
+                             const std::filesystem::path& dir, int robots, int processes, int quanta) {
   const std::filesystem::path file = write_scenario(dir, robots, quanta);
   agents::Scenario scenario = agents::load_scenario(file);
   const agents::RunResult local = run_once(scenario, args.seed, nullptr);
@@ -102,7 +102,8 @@ std::optional<Row> bench_one(const QuantumBenchArgs& args, lcm::LCM& lcm, lcm::L
   config.robot_ids = ids;
   config.record_exchange_times = true;
   links::RemoteAgents remote(lcm, answers, config);
-  if (const auto missing = remote.wait_for_agents(std::chrono::seconds(20), [&] { return agents_here.ended_early(); })) {
+  if (const auto missing =
+          remote.wait_for_agents(std::chrono::seconds(20), [&] { return agents_here.ended_early(); })) {
     spdlog::error("quantum-bench: {}", *missing);
     return std::nullopt;
   }
@@ -121,7 +122,8 @@ std::optional<Row> bench_one(const QuantumBenchArgs& args, lcm::LCM& lcm, lcm::L
   row.same_result = local.trajectory.size() == r.trajectory.size() &&
                     std::equal(local.trajectory.begin(), local.trajectory.end(), r.trajectory.begin(),
                                [](const auto& a, const auto& b) {
-                                 return a.t_us == b.t_us && a.id == b.id && a.pose.position_m.x == b.pose.position_m.x &&
+                                 return a.t_us == b.t_us && a.id == b.id &&
+                                        a.pose.position_m.x == b.pose.position_m.x &&
                                         a.pose.position_m.y == b.pose.position_m.y && a.behaviour == b.behaviour;
                                });
   return row;
@@ -130,11 +132,11 @@ std::optional<Row> bench_one(const QuantumBenchArgs& args, lcm::LCM& lcm, lcm::L
 void print_row(const Row& r) {
   const auto spread = kSpreadProcesses.find(r.robots);
   const double bus = std::max(0.0, r.ms_per_quantum - r.local_ms_per_quantum);
-  std::printf("| %d | %d | %s | %d | %.3f | %.0f | %.3f | %.3f | %.3f | %.3f (%.0f %%) | %lld | %lld | %s |\n", r.robots,
-              r.processes, spread == kSpreadProcesses.end() ? "—" : std::to_string(spread->second).c_str(), r.quanta,
-              r.ms_per_quantum, 1000.0 / r.ms_per_quantum, r.exchange_p50, r.exchange_p99, r.local_ms_per_quantum, bus,
-              r.ms_per_quantum > 0.0 ? 100.0 * bus / r.ms_per_quantum : 0.0, r.repeats, r.lost,
-              r.same_result ? "yes" : "NO");
+  std::printf("| %d | %d | %s | %d | %.3f | %.0f | %.3f | %.3f | %.3f | %.3f (%.0f %%) | %lld | %lld | %s |\n",
+              r.robots, r.processes, spread == kSpreadProcesses.end() ? "—" : std::to_string(spread->second).c_str(),
+              r.quanta, r.ms_per_quantum, 1000.0 / r.ms_per_quantum, r.exchange_p50, r.exchange_p99,
+              r.local_ms_per_quantum, bus, r.ms_per_quantum > 0.0 ? 100.0 * bus / r.ms_per_quantum : 0.0, r.repeats,
+              r.lost, r.same_result ? "yes" : "NO");
   std::fflush(stdout);
 }
 
@@ -154,7 +156,8 @@ int quantum_bench_command(const QuantumBenchArgs& args) {
     const IdListResult robots = parse_id_list(args.robots, 1, 100'000, "list");
     const IdListResult processes = parse_id_list(args.processes, 1, 64, "list");
     if (!robots.ok() || !processes.ok()) {
-      spdlog::error("quantum-bench: {}", !robots.ok() ? "--robots: " + robots.error : "--processes: " + processes.error);
+      spdlog::error("quantum-bench: {}",
+                    !robots.ok() ? "--robots: " + robots.error : "--processes: " + processes.error);
       return kExitUsage;
     }
     for (int n : robots.ids) {
@@ -168,10 +171,12 @@ int quantum_bench_command(const QuantumBenchArgs& args) {
   std::unique_ptr<lcm::LCM> lcm = links::open_lcm(args.url, error);
   std::unique_ptr<lcm::LCM> answers = lcm ? links::open_lcm(links::agent_reply_url(args.url), error) : nullptr;
   if (!lcm || !answers || args.url.rfind("memq://", 0) == 0) {
-    spdlog::error("quantum-bench: {}", lcm ? "the agents run in other processes: give a bus they reach, not memq://" : error);
+    spdlog::error("quantum-bench: {}",
+                  lcm ? "the agents run in other processes: give a bus they reach, not memq://" : error);
     return kExitUsage;
   }
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("rilbed-qbench-" + std::to_string(getpid()));
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("rilbed-qbench-" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
   struct Remove {
     std::filesystem::path dir;
@@ -183,27 +188,31 @@ int quantum_bench_command(const QuantumBenchArgs& args) {
   char host[256] = {};
   gethostname(host, sizeof host - 1);
   std::printf("## Time per quantum (rilbed quantum-bench), after paper 000 section 10\n\n");
-  std::printf("A lock-step run (fast mode) of N wandering Kheperas (8 IR sensors each, Braitenberg avoidance, the lab's "
-              "density), their controllers in P `rilbed agent` processes on this machine (%s, %ld cores), on the bus %s%s%s. "
-              "One quantum is one control step of 100 ms simulated: the processes get their robots' sensor readings and "
-              "poses in one quantum_t (one per process when all would not fit in a datagram) and each answers its robots' "
-              "wheel commands in one quantum_reply_t, on the next port. Timed: the whole DEVS run "
-              "(world, sensors, exchange) divided by its quanta; the exchange alone (p50, p99: sending, the agents' "
-              "work, the answers); the same run in one process; their difference, the bus's cost. Same result: the "
-              "remote run's trajectories equal the in-process run's.\n\n",
-              host, sysconf(_SC_NPROCESSORS_ONLN), args.url.c_str(), args.condition.empty() ? "" : "; ",
-              args.condition.c_str());
-  std::printf("| robots | processes | SPREAD's processes (Table 10-1) | quanta | ms per quantum | quanta per s | exchange p50 ms | "
-              "exchange p99 ms | one process: ms per quantum | bus ms per quantum (share) | repeats | lost | same result |\n");
+  std::printf(
+      "A lock-step run (fast mode) of N wandering Kheperas (8 IR sensors each, Braitenberg avoidance, the lab's "
+      "density), their controllers in P `rilbed agent` processes on this machine (%s, %ld cores), on the bus %s%s%s. "
+      "One quantum is one control step of 100 ms simulated: the processes get their robots' sensor readings and "
+      "poses in one quantum_t (one per process when all would not fit in a datagram) and each answers its robots' "
+      "wheel commands in one quantum_reply_t, on the next port. Timed: the whole DEVS run "
+      "(world, sensors, exchange) divided by its quanta; the exchange alone (p50, p99: sending, the agents' "
+      "work, the answers); the same run in one process; their difference, the bus's cost. Same result: the "
+      "remote run's trajectories equal the in-process run's.\n\n",
+      host, sysconf(_SC_NPROCESSORS_ONLN), args.url.c_str(), args.condition.empty() ? "" : "; ",
+      args.condition.c_str());
+  std::printf(
+      "| robots | processes | SPREAD's processes (Table 10-1) | quanta | ms per quantum | quanta per s | exchange p50 "
+      "ms | "
+      "exchange p99 ms | one process: ms per quantum | bus ms per quantum (share) | repeats | lost | same result |\n");
   std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |\n");
   for (const auto& [n, p] : grid) {
     const auto row = bench_one(args, *lcm, *answers, dir, n, p, quanta_of[n]);
     if (!row) return kExitFailure;
     print_row(*row);
   }
-  std::printf("\nSPREAD (12 486 DX2 66 MHz PCs on 10 Mbit/s Ethernet, one process per sensor, actuator, controller and "
-              "memory) reports its times per quantum only as a figure (Fig. 10-1), not in numbers; its best speed-up was "
-              "35 robots on 12 machines about 5 times faster than on one, and the network, not the CPUs, bound it.\n");
+  std::printf(
+      "\nSPREAD (12 486 DX2 66 MHz PCs on 10 Mbit/s Ethernet, one process per sensor, actuator, controller and "
+      "memory) reports its times per quantum only as a figure (Fig. 10-1), not in numbers; its best speed-up was "
+      "35 robots on 12 machines about 5 times faster than on one, and the network, not the CPUs, bound it.\n");
   return 0;
 }
 
@@ -219,9 +228,11 @@ void add_quantum_bench_command(CLI::App& app) {
       ->check(CLI::Range(10, 1'000'000));
   cmd->add_option("--lcm", args->url, "The bus the agents reach (e.g. udpm://239.255.76.67:7667?ttl=0)")->required();
   cmd->add_option("--channel-prefix", args->prefix, "Channel prefix of the bench's messages")->default_val("QBENCH_");
-  cmd->add_flag("--table", args->table, "The paper's grid: 1, 5, ..., 40 robots over 1, 2, 4, 8, 12 processes, and 1,000 robots over 8");
+  cmd->add_flag("--table", args->table,
+                "The paper's grid: 1, 5, ..., 40 robots over 1, 2, 4, 8, 12 processes, and 1,000 robots over 8");
   cmd->add_option("--seed", args->seed, "Seed of the start poses and sensor noise");
-  cmd->add_option("--condition", args->condition, "A note on the bus's condition, printed with the table (e.g. 10 % loss)");
+  cmd->add_option("--condition", args->condition,
+                  "A note on the bus's condition, printed with the table (e.g. 10 % loss)");
   cmd->callback([args] { exit_code() = quantum_bench_command(*args); });
 }
 

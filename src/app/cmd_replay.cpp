@@ -112,16 +112,22 @@ int publish(const ReplayArgs& args) {
 
 void add_replay_command(CLI::App& app) {
   auto args = std::make_shared<ReplayArgs>();
-  CLI::App* cmd = app.add_subcommand("replay", "A recorded run again: its run folder (--out), or published on a bus (--lcm)");
+  CLI::App* cmd =
+      app.add_subcommand("replay", "A recorded run again: its run folder (--out), or published on a bus (--lcm)");
   cmd->add_option("log", args->log, "LCM log written by rilbed run --record")->required()->check(CLI::ExistingFile);
   auto* out = cmd->add_option("--out", args->out, "Write the run folder here (as the run wrote it)");
   auto* url = cmd->add_option("--lcm", args->lcm_url, "Publish the recording on this LCM bus at the recorded pace");
   out->excludes(url);
   cmd->add_option("--channel-prefix", args->prefix, "The recorded run's channel prefix (with --out)");
-  cmd->add_option("--speed", args->speed, "With --lcm: this many times the recorded pace")->check(CLI::PositiveNumber)->needs(url);
+  cmd->add_option("--speed", args->speed, "With --lcm: this many times the recorded pace")
+      ->check(CLI::PositiveNumber)
+      ->needs(url);
   cmd->add_option("--from", args->from_s, "With --lcm: start this many seconds into the recording")
-      ->check(CLI::NonNegativeNumber)->needs(url);
-  cmd->add_option("--to", args->to_s, "With --lcm: stop this many seconds into the recording")->check(CLI::PositiveNumber)->needs(url);
+      ->check(CLI::NonNegativeNumber)
+      ->needs(url);
+  cmd->add_option("--to", args->to_s, "With --lcm: stop this many seconds into the recording")
+      ->check(CLI::PositiveNumber)
+      ->needs(url);
   cmd->callback([args, out, url] {
     if (out->count() == 0 && url->count() == 0) {
       spdlog::error("replay: give --out DIR (write the run folder) or --lcm URL (publish it)");

@@ -6,8 +6,8 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
@@ -15,27 +15,27 @@
 #include <iostream>
 #include <limits>
 #include <map>
-#include <stdexcept>
 #include <mutex>
+#include <stdexcept>
 #include <thread>
 
 #include <nlohmann/json.hpp>
 
-#include "agents/scenario.hpp"
 #include "agents/run_folder_writer.hpp"
+#include "agents/scenario.hpp"
 #include "agents/simulation.hpp"
 #include "agents/status_line.hpp"
 #include "app/agent_processes.hpp"
 #include "app/commands.hpp"
+#include "app/panel_options.hpp"
 #include "core/id_list.hpp"
 #include "core/statistics.hpp"
-#include "app/panel_options.hpp"
 #include "gui_web/gui_service.hpp"
 #include "links/lcm_bus.hpp"
 #include "links/lcm_console.hpp"
-#include "links/remote_agents.hpp"
 #include "links/placement.hpp"
 #include "links/real_robots.hpp"
+#include "links/remote_agents.hpp"
 
 namespace rilbed::app {
 
@@ -53,9 +53,12 @@ extern "C" void on_signal(int) { interrupted.store(true); }
 std::atomic<bool> batch_aborted{false};
 
 void log_to_spdlog(links::LogLevel level, const std::string& message) {
-  if (level == links::LogLevel::kError) spdlog::error("{}", message);
-  else if (level == links::LogLevel::kWarning) spdlog::warn("{}", message);
-  else if (level == links::LogLevel::kInfo) spdlog::info("{}", message);
+  if (level == links::LogLevel::kError)
+    spdlog::error("{}", message);
+  else if (level == links::LogLevel::kWarning)
+    spdlog::warn("{}", message);
+  else if (level == links::LogLevel::kInfo)
+    spdlog::info("{}", message);
 }
 
 void print_emulated_last_speeds(const links::RealRobots& real) {
@@ -94,14 +97,14 @@ struct RunArgs {
   bool quiet = false;
   std::string mode;  // overrides the scenario's
   bool all_virtual = false;
-  std::string lcm_url;        // publish the run on this LCM bus (empty: no bus)
-  std::string record;         // write every message of the run to this LCM log
-  bool record_frames = false; // and the camera's frames (JPEG)
+  std::string lcm_url;         // publish the run on this LCM bus (empty: no bus)
+  std::string record;          // write every message of the run to this LCM log
+  bool record_frames = false;  // and the camera's frames (JPEG)
   std::string channel_prefix;
-  bool no_place = false;      // real robots start where they stand
+  bool no_place = false;  // real robots start where they stand
   double place_timeout_s = 90.0;
-  bool gui = false;           // serve the web control panel from this process
-  PanelOptions panel;          // with --gui
+  bool gui = false;    // serve the web control panel from this process
+  PanelOptions panel;  // with --gui
 };
 
 // The console sink of `rilbed run --gui`: a browser's command acts on this run's own
@@ -125,11 +128,12 @@ gui_web::ConsoleSink run_control_sink(agents::RunControl& control) {
 
 // Puts the real robots at the start poses of `seed` (links::place_real_robots), reports
 // what it did, and throws when they could not be placed (the batch then ends).
-void place_or_throw(links::RealRobots& real, const agents::Scenario& scenario, std::uint64_t seed, const RunArgs& args) {
+void place_or_throw(links::RealRobots& real, const agents::Scenario& scenario, std::uint64_t seed,
+                    const RunArgs& args) {
   const std::vector<Pose2> poses = agents::start_poses(scenario, seed);
   std::map<int, Pose2> targets;
   for (std::size_t i = 0; i < scenario.robots.size(); ++i) {
-    if (scenario.robots[i].kind == environment::RobotKind::Real) targets[scenario.robots[i].id] = poses[i];
+    if (scenario.robots[i].kind == environment::RobotKind::kReal) targets[scenario.robots[i].id] = poses[i];
   }
   links::PlacementOptions o;
   o.timeout_s = args.place_timeout_s;
@@ -143,9 +147,10 @@ void place_or_throw(links::RealRobots& real, const agents::Scenario& scenario, s
   }
   if (!r.offset_m.empty()) {
     std::string offsets;
-    for (const auto& [id, d] : r.offset_m) offsets += fmt::format("{}robot {}: {:.1f} mm", offsets.empty() ? "" : ", ", id, d * 1000.0);
-    spdlog::info("seed {}: real robots driven to their start poses in {:.1f} s (left from the pose: {})", seed, r.wall_s,
-                 offsets);
+    for (const auto& [id, d] : r.offset_m)
+      offsets += fmt::format("{}robot {}: {:.1f} mm", offsets.empty() ? "" : ", ", id, d * 1000.0);
+    spdlog::info("seed {}: real robots driven to their start poses in {:.1f} s (left from the pose: {})", seed,
+                 r.wall_s, offsets);
   }
   if (!r.placed_by_operator.empty()) {
     spdlog::info("seed {}: robots {} placed by the operator", seed, id_list_text(r.placed_by_operator));
@@ -156,16 +161,17 @@ void print_result(const agents::RunResult& r) {
   char formed[64] = "no convoy";
   if (r.convoy_size > 0) std::snprintf(formed, sizeof formed, "convoy not formed");
   if (r.formation_time_s) std::snprintf(formed, sizeof formed, "formed at %.1f s", *r.formation_time_s);
-  std::printf("seed %llu: %s; %d collisions (%d robot-robot), max overlap %.2g m; %.1f s simulated in %.2f s (ended by %s)\n",
-              static_cast<unsigned long long>(r.seed), formed, r.collisions, r.robot_collisions, r.max_overlap_m,
-              r.simulated_s, r.wall_s, r.ended_by.c_str());
+  std::printf(
+      "seed %llu: %s; %d collisions (%d robot-robot), max overlap %.2g m; %.1f s simulated in %.2f s (ended by %s)\n",
+      static_cast<unsigned long long>(r.seed), formed, r.collisions, r.robot_collisions, r.max_overlap_m, r.simulated_s,
+      r.wall_s, r.ended_by.c_str());
 }
 
 // Runs one seed of a batch (its options already hold the seed and out_dir).
 using SeedRunner = std::function<agents::RunResult(const agents::RunOptions&)>;
 
-int run_batch(const agents::Scenario& scenario, const RunArgs& args, agents::RunOptions base, const SeedRunner& run_seed,
-              int max_jobs) {
+int run_batch(const agents::Scenario& scenario, const RunArgs& args, agents::RunOptions base,
+              const SeedRunner& run_seed, int max_jobs) {
   const int n = args.seeds;
   std::vector<agents::RunResult> results(n);
   std::vector<std::string> errors(n);
@@ -195,8 +201,10 @@ int run_batch(const agents::Scenario& scenario, const RunArgs& args, agents::Run
   const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   const int jobs = std::clamp(args.jobs > 0 ? args.jobs : cores / std::max(1, args.threads), 1, max_jobs);
   if (jobs * args.threads > cores)
-    spdlog::warn("{} runs at once on {} threads each is more threads than this machine's {} cores: they will wait on "
-                 "each other", jobs, args.threads, cores);
+    spdlog::warn(
+        "{} runs at once on {} threads each is more threads than this machine's {} cores: they will wait on "
+        "each other",
+        jobs, args.threads, cores);
   std::vector<std::thread> threads;
   for (int j = 0; j < std::min(jobs, n); ++j) threads.emplace_back(worker);
   for (auto& t : threads) t.join();
@@ -239,10 +247,13 @@ int run_batch(const agents::Scenario& scenario, const RunArgs& args, agents::Run
   batch["per_run"] = runs;
   if (!args.out.empty()) {
     std::filesystem::create_directories(args.out);
-    std::ofstream(std::filesystem::path(args.out) / "batch.json") << batch.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
+    std::ofstream(std::filesystem::path(args.out) / "batch.json")
+        << batch.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
   }
-  std::printf("\n| scenario | mode | runs | formed | formation time median s | formation time p95 s | collisions (robot-robot) | max overlap m | wall s (%d jobs) |\n",
-              jobs);
+  std::printf(
+      "\n| scenario | mode | runs | formed | formation time median s | formation time p95 s | collisions (robot-robot) "
+      "| max overlap m | wall s (%d jobs) |\n",
+      jobs);
   std::printf("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
   char median[32] = "-", p95[32] = "-";
   if (!times.empty()) {
@@ -268,8 +279,8 @@ int run_command(const RunArgs& args) {
     // The same robots, poses and controllers, every one virtual: the simulation half of a
     // sim-to-real comparison (`rilbed compare`).
     for (agents::RobotSpec& r : scenario.robots) {
-      if (r.kind == environment::RobotKind::Real) stand_ins.push_back(r.id);
-      r.kind = environment::RobotKind::Virtual;
+      if (r.kind == environment::RobotKind::kReal) stand_ins.push_back(r.id);
+      r.kind = environment::RobotKind::kVirtual;
       r.link.reset();
     }
     scenario.camera.reset();
@@ -277,9 +288,10 @@ int run_command(const RunArgs& args) {
   const std::vector<int> real_ids = agents::real_robot_ids(scenario);
   if (!real_ids.empty() && args.fast) {
     // Safe default: real robots move in wall-clock time, whatever the simulation's clock.
-    spdlog::error("{}: robots {} are real and move in wall-clock time, so --fast cannot run them: leave --fast out "
-                  "(runs with real robots are real time), or add --all-virtual to run them as virtual robots",
-                  args.scenario, id_list_text(real_ids));
+    spdlog::error(
+        "{}: robots {} are real and move in wall-clock time, so --fast cannot run them: leave --fast out "
+        "(runs with real robots are real time), or add --all-virtual to run them as virtual robots",
+        args.scenario, id_list_text(real_ids));
     return kExitUsage;
   }
   if (args.mode == "central") scenario.mode = agents::ConvoyMode::kCentral;
@@ -406,7 +418,8 @@ int run_command(const RunArgs& args) {
         std::uint64_t refused = 0;
         for (const auto& [channel, count] : publisher.counts()) refused += count.failures;
         if (refused > 0) {
-          spdlog::warn("seed {}: the bus refused {} of the run's messages (they were lost; a firewall?)", o.seed, refused);
+          spdlog::warn("seed {}: the bus refused {} of the run's messages (they were lost; a firewall?)", o.seed,
+                       refused);
         }
       }
       return r;
@@ -468,7 +481,8 @@ int run_command(const RunArgs& args) {
   // live until every run has stopped them.
   std::unique_ptr<links::RealRobots> real;
   agents::RealBodyFactory real_bodies;
-  SeedRunner run_seed = on_bus([&](const agents::RunOptions& o) { return agents::run_scenario(scenario, o, real_bodies); });
+  SeedRunner run_seed =
+      on_bus([&](const agents::RunOptions& o) { return agents::run_scenario(scenario, o, real_bodies); });
   if (!real_ids.empty()) {
     real = std::make_unique<links::RealRobots>(scenario, log_to_spdlog);
     real_bodies = real->body_factory();
@@ -487,9 +501,10 @@ int run_command(const RunArgs& args) {
   if (scenario.agents) {
     const agents::AgentsSpec& spec = *scenario.agents;
     if (!network_bus) {
-      spdlog::error("{}: its agents run in other processes, which need a bus they reach: give --lcm URL "
-                    "(e.g. udpm://239.255.76.67:7667?ttl=0)",
-                    args.scenario);
+      spdlog::error(
+          "{}: its agents run in other processes, which need a bus they reach: give --lcm URL "
+          "(e.g. udpm://239.255.76.67:7667?ttl=0)",
+          args.scenario);
       return kExitUsage;
     }
     std::string error;
@@ -510,8 +525,10 @@ int run_command(const RunArgs& args) {
     config.scenario_name = scenario.name;
     config.robot_ids = spec.ids;
     for (const int id : spec.ids) {
-      const auto robot = std::find_if(scenario.robots.begin(), scenario.robots.end(), [&](const auto& r) { return r.id == id; });
-      if (const auto c = agents::make_controller(scenario, *robot); c && c->wants_team()) config.team_readers.insert(id);
+      const auto robot =
+          std::find_if(scenario.robots.begin(), scenario.robots.end(), [&](const auto& r) { return r.id == id; });
+      if (const auto c = agents::make_controller(scenario, *robot); c && c->wants_team())
+        config.team_readers.insert(id);
     }
     config.realtime = options.realtime;
     config.resend_ms = spec.resend_ms;
@@ -528,11 +545,12 @@ int run_command(const RunArgs& args) {
       agents::RunResult r = inner(o);
       const links::RemoteAgentsCounters& c = remote.counters();
       if (!args.quiet) {
-        std::printf("agents: %lld quanta sent, %lld sent again, %lld duplicate answers, %lld late, %lld processes lost, "
-                    "%lld robots rejoined\n",
-                    static_cast<long long>(c.quanta_sent), static_cast<long long>(c.repeats),
-                    static_cast<long long>(c.duplicates), static_cast<long long>(c.late),
-                    static_cast<long long>(c.lost_processes), static_cast<long long>(c.rejoins));
+        std::printf(
+            "agents: %lld quanta sent, %lld sent again, %lld duplicate answers, %lld late, %lld processes lost, "
+            "%lld robots rejoined\n",
+            static_cast<long long>(c.quanta_sent), static_cast<long long>(c.repeats),
+            static_cast<long long>(c.duplicates), static_cast<long long>(c.late),
+            static_cast<long long>(c.lost_processes), static_cast<long long>(c.rejoins));
         std::fflush(stdout);
       }
       return r;
@@ -551,7 +569,8 @@ int run_command(const RunArgs& args) {
     // With real robots one run after another: the robots are the same ones.
     // With real robots one run after another (the robots are the same ones), and on a bus
     // others watch too (a watcher follows one run at a time).
-    const int status = run_batch(scenario, args, options, run_seed, real || network_bus ? 1 : std::numeric_limits<int>::max());
+    const int status =
+        run_batch(scenario, args, options, run_seed, real || network_bus ? 1 : std::numeric_limits<int>::max());
     if (real) print_emulated_last_speeds(*real);
     return status;
   }
@@ -578,17 +597,22 @@ int run_command(const RunArgs& args) {
 void add_run_command(CLI::App& app) {
   auto args = std::make_shared<RunArgs>();
   CLI::App* cmd = app.add_subcommand("run", "Run a scenario (simulation; robot-in-the-loop when it has real robots)");
-  cmd->add_option("scenario", args->scenario, "Scenario file (YAML, see scenarios/README.md)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("scenario", args->scenario, "Scenario file (YAML, see scenarios/README.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
   auto* fast = cmd->add_flag("--fast", args->fast,
                              "As fast as the CPU allows (the default without real robots; an error with them)");
-  auto* realtime = cmd->add_flag("--realtime", args->realtime, "Paced to the wall clock (the default with real robots)");
+  auto* realtime =
+      cmd->add_flag("--realtime", args->realtime, "Paced to the wall clock (the default with real robots)");
   fast->excludes(realtime);
   cmd->add_option("--rt-factor", args->rt_factor, "With --realtime: simulated seconds per wall second")
-      ->check(CLI::PositiveNumber)->needs(realtime);
+      ->check(CLI::PositiveNumber)
+      ->needs(realtime);
   cmd->add_option("--duration", args->duration_s, "Simulated seconds to run (default: the scenario's duration_s)")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--stop-when-formed", args->stop_when_formed, "End 5 s after the convoy formed");
-  cmd->add_option("--seed", args->seed, "Seed of the initial poses and the noise (first seed of a batch)")->default_val(1);
+  cmd->add_option("--seed", args->seed, "Seed of the initial poses and the noise (first seed of a batch)")
+      ->default_val(1);
   cmd->add_option("--seeds", args->seeds, "Run a batch of N seeds (seed, seed+1, ...) and print its table")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--out", args->out, "Write the run folder here (a batch: one folder per seed and batch.json)");
@@ -601,12 +625,14 @@ void add_run_command(CLI::App& app) {
       ->default_val(1);
   cmd->add_option("--mode", args->mode, "Override the scenario's convoy mode")
       ->check(CLI::IsMember({"central", "distributed"}));
-  cmd->add_flag("--all-virtual", args->all_virtual,
-                "Make every real robot virtual (same poses and controllers): the simulation half of a sim-to-real comparison");
+  cmd->add_flag(
+      "--all-virtual", args->all_virtual,
+      "Make every real robot virtual (same poses and controllers): the simulation half of a sim-to-real comparison");
   cmd->add_option("--lcm", args->lcm_url,
                   "Publish the run on this LCM bus, visible to other processes (e.g. udpm://239.255.76.67:7667?ttl=0; "
                   "default: memq://, the run's own in-process bus, which sends nothing on the network)");
-  cmd->add_option("--channel-prefix", args->channel_prefix, "Put this before every channel name (two runs on one network)");
+  cmd->add_option("--channel-prefix", args->channel_prefix,
+                  "Put this before every channel name (two runs on one network)");
   cmd->add_option("--record", args->record,
                   "Write every message of the run to this LCM log (lcm-logplayer plays it; rilbed replay reads it)");
   cmd->add_flag("--record-frames", args->record_frames,
@@ -617,7 +643,8 @@ void add_run_command(CLI::App& app) {
                 "to the run's start poses)");
   cmd->add_option("--place-timeout", args->place_timeout_s,
                   "Seconds the real robots get to drive to their start poses before the operator is asked")
-      ->check(CLI::PositiveNumber)->default_val(90);
+      ->check(CLI::PositiveNumber)
+      ->default_val(90);
   cmd->add_flag("--gui", args->gui, "Serve the web control panel from this run (prints its URL with a fresh token)");
   add_panel_options(*cmd, args->panel, "With --gui: ");
   cmd->add_flag("--quiet", args->quiet, "No per-second status (realtime) or per-run lines (batch)");

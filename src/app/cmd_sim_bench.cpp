@@ -2,15 +2,15 @@
 #include <spdlog/spdlog.h>
 #include <sys/resource.h>
 
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
-#include <vector>
 #include <cstdio>
 #include <memory>
 #include <optional>
 #include <sstream>
 #include <utility>
+#include <vector>
 
 #include "agents/scenario.hpp"
 #include "agents/simulation.hpp"
@@ -54,25 +54,33 @@ agents::Scenario bench_scenario(int robots, const BenchArgs& args) {
 // routing, the world model's own bookkeeping, and the clock reads themselves).
 template <class Split>
 void print_splits(const std::vector<Split>& splits) {
-  std::printf("\nWhere the time goes (one more run of each row above, timed in parts with steady_clock, three reads "
-              "per robot and step, which make that run slower: by how much, against the median of the untimed runs, is "
-              "the last column; `--no-split` leaves it out): wall ms per simulated "
-              "second, and the share of that run. With "
-              "more than one thread, sensing and behaviours run on all threads at once: their columns are the time "
-              "summed over the threads, divided by the thread count.\n\n"
-              "| robots | threads | sensing | behaviours | integration | collisions | recording | DEVS kernel and the rest | timed run slower by |\n"
-              "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+  std::printf(
+      "\nWhere the time goes (one more run of each row above, timed in parts with steady_clock, three reads "
+      "per robot and step, which make that run slower: by how much, against the median of the untimed runs, is "
+      "the last column; `--no-split` leaves it out): wall ms per simulated "
+      "second, and the share of that run. With "
+      "more than one thread, sensing and behaviours run on all threads at once: their columns are the time "
+      "summed over the threads, divided by the thread count.\n\n"
+      "| robots | threads | sensing | behaviours | integration | collisions | recording | DEVS kernel and the rest | "
+      "timed run slower by |\n"
+      "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
   for (const Split& s : splits) {
     agents::RunProfile p = s.profile;
     p.sensing_s /= s.threads;
     p.behaviours_s /= s.threads;
-    const double parts[] = {p.sensing_s, p.behaviours_s, p.integration_s, p.collisions_s, p.monitor_s,
-                            std::max(0.0, s.run_s - p.sensing_s - p.behaviours_s - p.integration_s - p.collisions_s - p.monitor_s)};
+    const double parts[] = {
+        p.sensing_s,
+        p.behaviours_s,
+        p.integration_s,
+        p.collisions_s,
+        p.monitor_s,
+        std::max(0.0, s.run_s - p.sensing_s - p.behaviours_s - p.integration_s - p.collisions_s - p.monitor_s)};
     std::printf("| %d | %d |", s.robots, s.threads);
     for (const double part_s : parts) {
       std::printf(" %.1f (%.0f %%) |", 1000.0 * part_s / s.simulated_s, 100.0 * part_s / std::max(1e-9, s.run_s));
     }
-    std::printf(" %+.0f %% |\n", 100.0 * (s.run_s / s.simulated_s / std::max(1e-12, s.plain_wall_per_simulated_s) - 1.0));
+    std::printf(" %+.0f %% |\n",
+                100.0 * (s.run_s / s.simulated_s / std::max(1e-12, s.plain_wall_per_simulated_s) - 1.0));
   }
 }
 
@@ -92,20 +100,26 @@ int bench_command(const BenchArgs& args) {
     return kExitUsage;
   }
   std::printf("## Simulation speed (rilbed sim-bench)\n\n");
-  std::printf("Virtual Kheperas (55 mm discs) with all 8 IR proximity sensors (cones of +-30 deg, 50 mm range, noise), "
-              "the wander controller (Braitenberg avoidance), wheel slip 2 %%, collisions on (robot-robot, robot-wall), "
-              "control period 100 ms, physics step %.0f ms (exact arcs, collision substeps as needed), a field of %.2f "
-              "robots per m^2 (the lab's 8 robots on 1.5 x 1.2 m), random starts (seed %llu). The whole DEVS "
-              "run (world model, one atomic model per agent, monitor; no files written) on the given threads (`--threads`: "
-              "agents and robot motion spread over them, collisions and recording on the run's thread), timed from the "
-              "first event to the last (building the world, the start-up column, excluded); wall and the CPU time of the "
-              "run's threads, medians of --repeat runs; speed-up is against the same count on the fewest threads; peak "
-              "memory is the process's resident peak so far (getrusage). Every run of a count, on any threads, must give the "
-              "same trajectories (the \"same\" column).\n\n",
-              args.physics_step_ms, args.density_per_m2, static_cast<unsigned long long>(args.seed));
-  std::printf("| robots | threads | field m | simulated s | start-up s | wall s (median of %d) | CPU s (median) | wall ms per simulated s | real-time factor (wall) | real-time factor (CPU) | us per robot-step (CPU) | speed-up | peak memory MB | collisions | max overlap m (each simulated s) | same |\n",
-              args.repeat);
-  std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |\n");
+  std::printf(
+      "Virtual Kheperas (55 mm discs) with all 8 IR proximity sensors (cones of +-30 deg, 50 mm range, noise), "
+      "the wander controller (Braitenberg avoidance), wheel slip 2 %%, collisions on (robot-robot, robot-wall), "
+      "control period 100 ms, physics step %.0f ms (exact arcs, collision substeps as needed), a field of %.2f "
+      "robots per m^2 (the lab's 8 robots on 1.5 x 1.2 m), random starts (seed %llu). The whole DEVS "
+      "run (world model, one atomic model per agent, monitor; no files written) on the given threads (`--threads`: "
+      "agents and robot motion spread over them, collisions and recording on the run's thread), timed from the "
+      "first event to the last (building the world, the start-up column, excluded); wall and the CPU time of the "
+      "run's threads, medians of --repeat runs; speed-up is against the same count on the fewest threads; peak "
+      "memory is the process's resident peak so far (getrusage). Every run of a count, on any threads, must give the "
+      "same trajectories (the \"same\" column).\n\n",
+      args.physics_step_ms, args.density_per_m2, static_cast<unsigned long long>(args.seed));
+  std::printf(
+      "| robots | threads | field m | simulated s | start-up s | wall s (median of %d) | CPU s (median) | wall ms per "
+      "simulated s | real-time factor (wall) | real-time factor (CPU) | us per robot-step (CPU) | speed-up | peak "
+      "memory MB | collisions | max overlap m (each simulated s) | same |\n",
+      args.repeat);
+  std::printf(
+      "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- "
+      "|\n");
   struct Split {
     int robots = 0;
     int threads = 1;
@@ -209,10 +223,12 @@ int bench_command(const BenchArgs& args) {
         if (ti == 0 && label.empty()) first_threads_wall_s = wall_s;
         const agents::RunResult& r = t.r;
         const double steps = n * r.simulated_s / 0.1;
-        std::printf("| %d%s | %d | %.1f x %.1f | %.1f | %.3f | %.3f | %.3f | %.1f | %.1f | %.1f | %.2f | %.2f | %.0f | %d | %.2g | %s |\n", n,
-                    label.c_str(), threads, s.map.field.width_m, s.map.field.height_m, r.simulated_s, startup_s, wall_s,
-                    cpu_s, 1000.0 * wall_s / r.simulated_s, r.simulated_s / wall_s, r.simulated_s / cpu_s, 1e6 * cpu_s / steps,
-                    first_threads_wall_s / wall_s, peak_rss_mb(), r.collisions, r.max_overlap_m, same[ti] ? "yes" : "NO");
+        std::printf(
+            "| %d%s | %d | %.1f x %.1f | %.1f | %.3f | %.3f | %.3f | %.1f | %.1f | %.1f | %.2f | %.2f | %.0f | %d | "
+            "%.2g | %s |\n",
+            n, label.c_str(), threads, s.map.field.width_m, s.map.field.height_m, r.simulated_s, startup_s, wall_s,
+            cpu_s, 1000.0 * wall_s / r.simulated_s, r.simulated_s / wall_s, r.simulated_s / cpu_s, 1e6 * cpu_s / steps,
+            first_threads_wall_s / wall_s, peak_rss_mb(), r.collisions, r.max_overlap_m, same[ti] ? "yes" : "NO");
         return cpu_s;
       };
       const double plain_cpu = row(plain[ti], "");
@@ -230,13 +246,15 @@ int bench_command(const BenchArgs& args) {
   if (!splits.empty()) print_splits(splits);
   if (any_differs) spdlog::error("runs of the same robot count gave different trajectories (the \"same\" column)");
   if (!buses.empty()) {
-    std::printf("\nThe bus: every message of the run published on it (rows \"(bus ...)\"): the world and status every "
-                "simulated second; every robot's pose, wheel command and sensor readings every control step; each event. "
-                "Nobody in this process listens; on memq:// (the default bus of `rilbed run`) that means nothing is even "
-                "encoded. CPU cost of the bus against the same run without it (medians), and that extra CPU per "
-                "simulated second, which is the share of one core the bus takes when the run goes in real time:\n\n"
-                "| robots |");
-    for (const Bus& b : buses) std::printf(" %s: slower by | %s: share of a core at real time |", b.url.c_str(), b.url.c_str());
+    std::printf(
+        "\nThe bus: every message of the run published on it (rows \"(bus ...)\"): the world and status every "
+        "simulated second; every robot's pose, wheel command and sensor readings every control step; each event. "
+        "Nobody in this process listens; on memq:// (the default bus of `rilbed run`) that means nothing is even "
+        "encoded. CPU cost of the bus against the same run without it (medians), and that extra CPU per "
+        "simulated second, which is the share of one core the bus takes when the run goes in real time:\n\n"
+        "| robots |");
+    for (const Bus& b : buses)
+      std::printf(" %s: slower by | %s: share of a core at real time |", b.url.c_str(), b.url.c_str());
     std::printf("\n| ---: |");
     for (std::size_t k = 0; k < buses.size(); ++k) std::printf(" ---: | ---: |");
     std::printf("\n");
@@ -246,9 +264,10 @@ int bench_command(const BenchArgs& args) {
       std::printf("\n");
     }
     for (const Bus& b : buses) {
-      std::printf("\nMessages and bytes per channel on %s, all its runs together:\n\n| channel | messages | bytes | "
-                  "failed publishes |\n| --- | ---: | ---: | ---: |\n",
-                  b.url.c_str());
+      std::printf(
+          "\nMessages and bytes per channel on %s, all its runs together:\n\n| channel | messages | bytes | "
+          "failed publishes |\n| --- | ---: | ---: | ---: |\n",
+          b.url.c_str());
       const auto counts_now = b.publisher->counts();
       if (counts_now.empty()) std::printf("| (none: nothing was encoded) | 0 | 0 | 0 |\n");
       for (const auto& [channel, c] : counts_now) {
@@ -265,14 +284,20 @@ int bench_command(const BenchArgs& args) {
 void add_sim_bench_command(CLI::App& app) {
   auto args = std::make_shared<BenchArgs>();
   CLI::App* cmd = app.add_subcommand("sim-bench", "Time the simulation with many virtual robots (prints a table)");
-  cmd->add_option("--robots", args->robots, "Robot counts, a list or ranges (e.g. 100,1000,10000)")->default_val(args->robots);
-  cmd->add_option("--seconds", args->seconds, "Simulated seconds per count")->check(CLI::PositiveNumber)->default_val(args->seconds);
-  cmd->add_option("--physics-step-ms", args->physics_step_ms, "World integration step")->check(CLI::PositiveNumber)
+  cmd->add_option("--robots", args->robots, "Robot counts, a list or ranges (e.g. 100,1000,10000)")
+      ->default_val(args->robots);
+  cmd->add_option("--seconds", args->seconds, "Simulated seconds per count")
+      ->check(CLI::PositiveNumber)
+      ->default_val(args->seconds);
+  cmd->add_option("--physics-step-ms", args->physics_step_ms, "World integration step")
+      ->check(CLI::PositiveNumber)
       ->default_val(args->physics_step_ms);
-  cmd->add_option("--density", args->density_per_m2, "Robots per square metre")->check(CLI::PositiveNumber)
+  cmd->add_option("--density", args->density_per_m2, "Robots per square metre")
+      ->check(CLI::PositiveNumber)
       ->default_val(args->density_per_m2);
   cmd->add_option("--seed", args->seed, "Seed")->default_val(args->seed);
-  cmd->add_option("--repeat", args->repeat, "Runs per count; the table shows medians")->check(CLI::PositiveNumber)
+  cmd->add_option("--repeat", args->repeat, "Runs per count; the table shows medians")
+      ->check(CLI::PositiveNumber)
       ->default_val(args->repeat);
   cmd->add_option("--lcm", args->lcm_urls,
                   "Also time each count with the run published on this LCM bus, nobody listening (repeatable; e.g. "

@@ -1,8 +1,8 @@
 // `rilbed synth`: renders footage of marked robots with the synthetic overhead camera
 // and writes it with its ground truth and calibration, as datasets/ holds it.
+#include <spdlog/spdlog.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
-#include <spdlog/spdlog.h>
 
 #include <cstdint>
 #include <filesystem>
@@ -26,8 +26,8 @@ struct SynthOptions {
   int width = 1280;
   int height = 720;
   std::string format = "avi";
-  int first_scene = 0;      // stress: the first scene written
-  int frames_per_scene = 4; // stress: each scene's clip
+  int first_scene = 0;       // stress: the first scene written
+  int frames_per_scene = 4;  // stress: each scene's clip
 };
 
 // `--preset stress`: scenes of the vision stress set, each its own camera, floor, light and
@@ -47,8 +47,9 @@ int run_stress_synth(const SynthOptions& opt, const std::filesystem::path& dir) 
   std::ofstream truth(dir / "ground_truth.csv");
   truth << "frame,id,u,v,heading_deg,scene,diameter_px,occluded,touching\n";
   std::ofstream scenes(dir / "scenes.csv");
-  scenes << "scene,first_frame,frames,marker_diameter_px,blur_sigma_px,motion_blur_px,motion_blur_angle_deg,noise_sigma,"
-            "jpeg_quality,light_ratio,vignetting,tilt_deg,k1,floor,floor_source,floor_grey,clutter_items,robots\n";
+  scenes
+      << "scene,first_frame,frames,marker_diameter_px,blur_sigma_px,motion_blur_px,motion_blur_angle_deg,noise_sigma,"
+         "jpeg_quality,light_ratio,vignetting,tilt_deg,k1,floor,floor_source,floor_grey,clutter_items,robots\n";
   char line[512];
   int frame = 0;
   for (int k = opt.first_scene; frame < opt.frames; ++k) {
@@ -60,7 +61,8 @@ int run_stress_synth(const SynthOptions& opt, const std::filesystem::path& dir) 
                   vision::floor_name(c.floor), c.floor_source.c_str(), c.floor_grey, c.clutter_items, c.robots);
     scenes << line;
     std::snprintf(line, sizeof line, "scene_%04d.yaml", k);
-    if (const std::string err = vision::save_field_calibration(scene.calibration, (dir / "calibration" / line).string());
+    if (const std::string err =
+            vision::save_field_calibration(scene.calibration, (dir / "calibration" / line).string());
         !err.empty()) {
       spdlog::error("{}", err);
       return kExitFailure;
@@ -72,8 +74,8 @@ int run_stress_synth(const SynthOptions& opt, const std::filesystem::path& dir) 
         return kExitFailure;
       }
       for (const auto& t : scene.truth[f]) {
-        std::snprintf(line, sizeof line, "%d,%d,%.3f,%.3f,%.3f,%d,%.2f,%.4f,%d\n", frame, t.id, t.u, t.v, t.heading_deg, k,
-                      t.diameter_px, t.occluded, t.touching ? 1 : 0);
+        std::snprintf(line, sizeof line, "%d,%d,%.3f,%.3f,%.3f,%d,%.2f,%.4f,%d\n", frame, t.id, t.u, t.v, t.heading_deg,
+                      k, t.diameter_px, t.occluded, t.touching ? 1 : 0);
         truth << line;
       }
     }
@@ -81,7 +83,8 @@ int run_stress_synth(const SynthOptions& opt, const std::filesystem::path& dir) 
   std::ofstream about(dir / "scene.txt");
   about << "rendered by: rilbed synth --preset stress --frames " << opt.frames << " --seed " << opt.seed << " --scene "
         << opt.first_scene << " --frames-per-scene " << opt.frames_per_scene << " --width " << opt.width << " --height "
-        << opt.height << "\nfamily 6ucp, IDs 1..8; each scene's conditions in scenes.csv, its calibration in "
+        << opt.height
+        << "\nfamily 6ucp, IDs 1..8; each scene's conditions in scenes.csv, its calibration in "
            "calibration/scene_NNNN.yaml\n";
   std::printf("wrote %d frames (frames/*.png), ground_truth.csv, scenes.csv, calibration/ and scene.txt to %s\n",
               opt.frames, opt.out.c_str());
@@ -147,14 +150,15 @@ int run_synth(const SynthOptions& opt) {
     }
     for (const auto& t : camera.truth(robots)) {
       if (!t.visible) continue;
-      std::snprintf(line, sizeof line, "%d,%d,%.3f,%.3f,%.3f,%.5f,%.5f,%.3f\n", f, t.id, t.u, t.v, t.heading_deg,
-                    t.x_m, t.y_m, t.theta_deg);
+      std::snprintf(line, sizeof line, "%d,%d,%.3f,%.3f,%.3f,%.5f,%.5f,%.3f\n", f, t.id, t.u, t.v, t.heading_deg, t.x_m,
+                    t.y_m, t.theta_deg);
       truth << line;
     }
   }
 
   const vision::FieldCalibration calib = preset.camera.field_calibration(preset.field_width_m, preset.field_height_m);
-  if (const std::string err = vision::save_field_calibration(calib, (dir / "calibration.yaml").string()); !err.empty()) {
+  if (const std::string err = vision::save_field_calibration(calib, (dir / "calibration.yaml").string());
+      !err.empty()) {
     spdlog::error("{}", err);
     return kExitFailure;
   }

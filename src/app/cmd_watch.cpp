@@ -44,8 +44,9 @@ class Watcher final : public agents::RunObserver {
     heard();
     if (world_scenario_ != w.scenario) {
       world_scenario_ = w.scenario;
-      std::printf("watching %s on %s: %zu robots (%zu real), field %.2f x %.2f m\n", w.scenario.c_str(), args_.url.c_str(),
-                  w.robot_ids.size(), w.field.real_robot_ids.size(), w.field.width_m, w.field.height_m);
+      std::printf("watching %s on %s: %zu robots (%zu real), field %.2f x %.2f m\n", w.scenario.c_str(),
+                  args_.url.c_str(), w.robot_ids.size(), w.field.real_robot_ids.size(), w.field.width_m,
+                  w.field.height_m);
       std::fflush(stdout);
     }
   }
@@ -175,9 +176,11 @@ int watch_command(const WatchArgs& args) {
   watcher.set_decoder(&decoder);
   // Raw bytes, decoded by the checked decoder.
   std::vector<std::unique_ptr<links::LcmSubscription>> subscriptions;
-  for (const std::string* channel : {&channels.world, &channels.poses, &channels.events, &channels.status, &channels.summary}) {
+  for (const std::string* channel :
+       {&channels.world, &channels.poses, &channels.events, &channels.status, &channels.summary}) {
     subscriptions.push_back(std::make_unique<links::LcmSubscription>(
-        *lcm, *channel, [&watcher](const std::string& c, const void* data, std::size_t size) { watcher.on_message(c, data, size); }));
+        *lcm, *channel,
+        [&watcher](const std::string& c, const void* data, std::size_t size) { watcher.on_message(c, data, size); }));
   }
   std::signal(SIGINT, on_watch_signal);
   std::signal(SIGTERM, on_watch_signal);
@@ -206,10 +209,12 @@ void add_watch_command(CLI::App& app) {
       "watch", "Show a run on an LCM bus: its status each second, every robot's behaviour and health, its events");
   cmd->add_option("--lcm", args->url, "LCM URL of the run's bus (e.g. udpm://239.255.76.67:7667?ttl=0)")->required();
   cmd->add_option("--channel-prefix", args->prefix, "The run's channel prefix (rilbed run --channel-prefix)");
-  cmd->add_option("--for", args->for_s, "Stop after this many seconds (default: until Ctrl-C)")->check(CLI::PositiveNumber);
+  cmd->add_option("--for", args->for_s, "Stop after this many seconds (default: until Ctrl-C)")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("--until-ended", args->until_ended, "Stop when the run ends");
   cmd->add_option("--silence", args->silence_s, "Say so when nothing is heard for this many seconds")
-      ->check(CLI::PositiveNumber)->default_val(2.0);
+      ->check(CLI::PositiveNumber)
+      ->default_val(2.0);
   cmd->callback([args] { exit_code() = watch_command(*args); });
 }
 

@@ -1,7 +1,7 @@
 // rilbed: the command line. Thin subcommands over the modules; see README.md.
-#include <opencv2/core/utils/logger.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+#include <opencv2/core/utils/logger.hpp>
 
 #include <csignal>
 #include <cstdlib>

@@ -40,9 +40,10 @@ std::unique_ptr<gui_web::GuiService> start_panel(const PanelOptions& o, std::str
   config.allowed_origins = o.allowed_origins;
   // The editor's lists and forms of controllers: the registry scenarios are checked against.
   config.documents["/controllers.json"] = {"application/json",
-                                            agents::controllers_json(*agents::default_controllers()).dump()};
+                                           agents::controllers_json(*agents::default_controllers()).dump()};
   if (o.bind != "127.0.0.1") {
-    spdlog::warn("gui: serving on {}: anyone who can reach it and has the URL's token can watch and steer the run", o.bind);
+    spdlog::warn("gui: serving on {}: anyone who can reach it and has the URL's token can watch and steer the run",
+                 o.bind);
   }
   try {
     return std::make_unique<gui_web::GuiService>(config, std::move(sink));

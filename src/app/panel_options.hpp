@@ -31,6 +31,7 @@ std::optional<std::string> check_panel_options(const PanelOptions& options);
 /// Starts the panel's service with `token` (empty: a fresh one) and `sink`, or logs why it
 /// cannot (an address it cannot listen on) and returns null. Warns when it serves beyond
 /// this machine. The options must have passed check_panel_options().
-std::unique_ptr<gui_web::GuiService> start_panel(const PanelOptions& options, std::string token, gui_web::ConsoleSink sink);
+std::unique_ptr<gui_web::GuiService> start_panel(const PanelOptions& options, std::string token,
+                                                 gui_web::ConsoleSink sink);
 
 }  // namespace rilbed::app

@@ -25,15 +25,36 @@ inline void fast_sincos(double a, double& sin_out, double& cos_out) {
   const double r = (a - static_cast<double>(k) * kHalfPiHigh) - static_cast<double>(k) * kHalfPiLow;
   const double r2 = r * r;
   // Horner in r^2 with 1/n! coefficients.
-  const double s = r * (1.0 + r2 * (-1.0 / 6 + r2 * (1.0 / 120 + r2 * (-1.0 / 5040 + r2 * (1.0 / 362880 +
-                  r2 * (-1.0 / 39916800 + r2 * (1.0 / 6227020800 + r2 * (-1.0 / 1307674368000))))))));
-  const double c = 1.0 + r2 * (-0.5 + r2 * (1.0 / 24 + r2 * (-1.0 / 720 + r2 * (1.0 / 40320 + r2 * (-1.0 / 3628800 +
-                   r2 * (1.0 / 479001600 + r2 * (-1.0 / 87178291200 + r2 * (1.0 / 20922789888000))))))));
+  const double s =
+      r * (1.0 + r2 * (-1.0 / 6 +
+                       r2 * (1.0 / 120 +
+                             r2 * (-1.0 / 5040 + r2 * (1.0 / 362880 +
+                                                       r2 * (-1.0 / 39916800 + r2 * (1.0 / 6227020800 +
+                                                                                     r2 * (-1.0 / 1307674368000))))))));
+  const double c =
+      1.0 +
+      r2 * (-0.5 + r2 * (1.0 / 24 +
+                         r2 * (-1.0 / 720 + r2 * (1.0 / 40320 +
+                                                  r2 * (-1.0 / 3628800 + r2 * (1.0 / 479001600 +
+                                                                               r2 * (-1.0 / 87178291200 +
+                                                                                     r2 * (1.0 / 20922789888000))))))));
   switch (k & 3) {  // two's complement: k & 3 is k mod 4 for negative k too
-    case 0: sin_out = s; cos_out = c; break;
-    case 1: sin_out = c; cos_out = -s; break;
-    case 2: sin_out = -s; cos_out = -c; break;
-    default: sin_out = -c; cos_out = s; break;
+    case 0:
+      sin_out = s;
+      cos_out = c;
+      break;
+    case 1:
+      sin_out = c;
+      cos_out = -s;
+      break;
+    case 2:
+      sin_out = -s;
+      cos_out = -c;
+      break;
+    default:
+      sin_out = -c;
+      cos_out = s;
+      break;
   }
 }
 
@@ -54,8 +75,8 @@ inline double fast_atan2(double y, double x) {
   }
   const double t2 = t * t;
   // (-1)^j / (2j + 1) for the powers 1, 3, ..., 27, summed by Horner in t^2.
-  constexpr double kSeries[] = {1.0,       -1.0 / 3,  1.0 / 5,   -1.0 / 7,  1.0 / 9,   -1.0 / 11, 1.0 / 13,
-                                -1.0 / 15, 1.0 / 17,  -1.0 / 19, 1.0 / 21,  -1.0 / 23, 1.0 / 25,  -1.0 / 27};
+  constexpr double kSeries[] = {1.0,       -1.0 / 3, 1.0 / 5,   -1.0 / 7, 1.0 / 9,   -1.0 / 11, 1.0 / 13,
+                                -1.0 / 15, 1.0 / 17, -1.0 / 19, 1.0 / 21, -1.0 / 23, 1.0 / 25,  -1.0 / 27};
   double p = 0.0;
   for (int j = static_cast<int>(std::size(kSeries)) - 1; j >= 0; --j) p = kSeries[j] + t2 * p;
   double angle = offset + t * p;

@@ -42,8 +42,8 @@ IdListResult parse_id_list(std::string_view text, int min_id, int max_id, std::s
       return result;
     }
     if (*lo < min_id || *hi > max_id) {
-      result.error = std::string(what) + " item '" + std::string(item) + "' is outside " +
-                     std::to_string(min_id) + ".." + std::to_string(max_id);
+      result.error = std::string(what) + " item '" + std::string(item) + "' is outside " + std::to_string(min_id) +
+                     ".." + std::to_string(max_id);
       return result;
     }
     for (int id = *lo; id <= *hi; ++id) result.ids.push_back(id);

@@ -51,7 +51,8 @@ double WorkerPool::worker_cpu_seconds() const {
   for (const std::thread& t : workers_) {
     clockid_t clock{};
     timespec ts{};
-    if (pthread_getcpuclockid(const_cast<std::thread&>(t).native_handle(), &clock) == 0 && clock_gettime(clock, &ts) == 0)
+    if (pthread_getcpuclockid(const_cast<std::thread&>(t).native_handle(), &clock) == 0 &&
+        clock_gettime(clock, &ts) == 0)
       total_s += static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
   }
   return total_s;

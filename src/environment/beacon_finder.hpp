@@ -2,9 +2,9 @@
 // each beacon in view, never the distance.
 #pragma once
 
-#include "environment/random.hpp"
 #include <string>
 #include <vector>
+#include "environment/random.hpp"
 
 #include "environment/scene.hpp"
 #include "environment/sensor_readings.hpp"

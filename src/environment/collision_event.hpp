@@ -11,16 +11,16 @@ namespace rilbed::environment {
 
 /// The kinds of things that can touch in the world.
 enum class BodyKind : std::uint8_t {
-  Robot,           ///< a robot, named by its robot id
-  Wall,            ///< a boundary wall of the field: 0 bottom (y = 0), 1 right, 2 top, 3 left
-  Obstacle,        ///< a static obstacle, named by its index in the map's obstacle list
-  MovingObstacle,  ///< a moving obstacle, named by the index add_moving_obstacle returned
+  kRobot,           ///< a robot, named by its robot id
+  kWall,            ///< a boundary wall of the field: 0 bottom (y = 0), 1 right, 2 top, 3 left
+  kObstacle,        ///< a static obstacle, named by its index in the map's obstacle list
+  kMovingObstacle,  ///< a moving obstacle, named by the index add_moving_obstacle returned
 };
 
 /// One party of a contact: a kind and the id (robot) or index (the others) within it.
 struct BodyRef {
-  BodyKind kind = BodyKind::Robot;  ///< what it is
-  int id = 0;                       ///< robot id, wall side, or obstacle index
+  BodyKind kind = BodyKind::kRobot;                  ///< what it is
+  int id = 0;                                        ///< robot id, wall side, or obstacle index
   auto operator<=>(const BodyRef&) const = default;  ///< by kind, then id (for sorting)
 };
 

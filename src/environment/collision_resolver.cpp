@@ -22,18 +22,18 @@ Box path_box(Vec2 from, Vec2 to, double margin) {
 }
 
 Contact mover_segment_contact(const MovingObstacle& m, Vec2 a, Vec2 b) {
-  if (m.shape() == MovingShape::Disc) return disc_segment_contact(m.position_m(), m.bounding_radius_m(), a, b);
+  if (m.shape() == MovingShape::kDisc) return disc_segment_contact(m.position_m(), m.bounding_radius_m(), a, b);
   return convex_polygon_segment_contact(m.world_vertices_m(), a, b);
 }
 
 // Contact of a robot's disc with a moving obstacle; the normal points towards the robot.
 Contact body_mover_contact(const Body& b, const MovingObstacle& m) {
-  if (m.shape() == MovingShape::Disc)
+  if (m.shape() == MovingShape::kDisc)
     return disc_disc_contact(b.position_m, b.radius_m, m.position_m(), m.bounding_radius_m());
   return disc_convex_polygon_contact(b.position_m, b.radius_m, m.world_vertices_m());
 }
 
-BodyRef robot_ref(const CollisionScene& s, std::size_t i) { return {BodyKind::Robot, s.body_ids[i]}; }
+BodyRef robot_ref(const CollisionScene& s, std::size_t i) { return {BodyKind::kRobot, s.body_ids[i]}; }
 
 }  // namespace
 
@@ -125,10 +125,12 @@ void CollisionResolver::for_each_by_id(const CollisionScene& s, Visit&& visit) c
 std::span<const std::uint32_t> CollisionResolver::robots_in_box_by_id(const CollisionScene& s, const Box& box) {
   in_box_.clear();
   s.grid.for_each_in_box(box, [&](int j) {
-    if (contains(box, s.bodies[static_cast<std::size_t>(j)].position_m)) in_box_.push_back(static_cast<std::uint32_t>(j));
+    if (contains(box, s.bodies[static_cast<std::size_t>(j)].position_m))
+      in_box_.push_back(static_cast<std::uint32_t>(j));
   });
   if (in_box_.size() > 1)
-    std::sort(in_box_.begin(), in_box_.end(), [&](std::uint32_t a, std::uint32_t b) { return s.body_ids[a] < s.body_ids[b]; });
+    std::sort(in_box_.begin(), in_box_.end(),
+              [&](std::uint32_t a, std::uint32_t b) { return s.body_ids[a] < s.body_ids[b]; });
   return in_box_;
 }
 
@@ -156,8 +158,10 @@ bool CollisionResolver::near_a_static(const CollisionScene& s, std::size_t i) co
   const Box box = path_box(b.pushable ? b.previous_m : b.position_m, b.position_m, b.radius_m + margin);
   s.statics.for_each_in_box(box, [&](const IndexedSegment& seg) {
     if (near) return;
-    if (b.pushable && path_crosses_segment(b.previous_m, b.position_m, seg.a_m, seg.b_m)) near = true;
-    else if (disc_segment_contact(b.position_m, b.radius_m, seg.a_m, seg.b_m).separation_m < margin) near = true;
+    if (b.pushable && path_crosses_segment(b.previous_m, b.position_m, seg.a_m, seg.b_m))
+      near = true;
+    else if (disc_segment_contact(b.position_m, b.radius_m, seg.a_m, seg.b_m).separation_m < margin)
+      near = true;
   });
   return near;
 }
@@ -195,7 +199,7 @@ bool CollisionResolver::robots_vs_robots(CollisionScene& s) {
       if (dist_sq >= (sum + margin) * (sum + margin)) continue;
       if (bi.pushable && bj.pushable) {
         const int a = s.body_ids[i], b = s.body_ids[j];
-        record({BodyKind::Robot, std::min(a, b)}, {BodyKind::Robot, std::max(a, b)});
+        record({BodyKind::kRobot, std::min(a, b)}, {BodyKind::kRobot, std::max(a, b)});
       } else {
         record(robot_ref(s, i), robot_ref(s, j));
       }
@@ -246,7 +250,7 @@ bool CollisionResolver::robots_vs_movers(CollisionScene& s) {
       Body& b = s.bodies[j];
       const Contact c = body_mover_contact(b, mover);
       if (c.separation_m >= margin) continue;
-      record(robot_ref(s, j), {BodyKind::MovingObstacle, static_cast<int>(m)});
+      record(robot_ref(s, j), {BodyKind::kMovingObstacle, static_cast<int>(m)});
       if (c.separation_m >= -tol) continue;
       const double depth = -c.separation_m;
       if (b.pushable) {
@@ -308,7 +312,7 @@ bool CollisionResolver::movers_vs_statics(CollisionScene& s) {
   const double margin = config_.contact_margin_m, tol = config_.tolerance_m;
   for (std::size_t m = 0; m < s.movers.size(); ++m) {
     MovingObstacle& mover = s.movers[m];
-    const BodyRef self{BodyKind::MovingObstacle, static_cast<int>(m)};
+    const BodyRef self{BodyKind::kMovingObstacle, static_cast<int>(m)};
     const Box box = path_box(mover.previous_m(), mover.position_m(), mover.bounding_radius_m() + margin);
     s.statics.segments_in_box(box, in_segments_);  // each once, by index (see robots_vs_statics)
     for (const std::uint32_t k : in_segments_) {

@@ -55,10 +55,10 @@ struct CollisionConfig {
 
 /// What the resolver works on, by reference: the World's arrays.
 struct CollisionScene {
-  std::span<Body> bodies;          ///< robots, by slot
-  std::span<const int> body_ids;   ///< robot id of each slot, for the events
-  SpatialGrid& grid;               ///< bodies hashed by cell; kept current by the resolver
-  const SegmentIndex& statics;     ///< walls and obstacle edges
+  std::span<Body> bodies;            ///< robots, by slot
+  std::span<const int> body_ids;     ///< robot id of each slot, for the events
+  SpatialGrid& grid;                 ///< bodies hashed by cell; kept current by the resolver
+  const SegmentIndex& statics;       ///< walls and obstacle edges
   std::span<MovingObstacle> movers;  ///< by index
   double max_body_radius_m = 0.0;
   /// The slots by ascending robot id (each once), or empty when slots are in id order.
@@ -136,10 +136,10 @@ class CollisionResolver {
   bool all_active_ = true;
   // The first pass visits only the robots that may touch something (found beforehand,
   // on the workers when set) and those that a push in the pass brought near something.
-  std::vector<std::uint8_t> near_robot_;   // at the pass's start: another robot within contact
-  std::vector<std::uint8_t> near_static_;  // at the pass's start: a wall or obstacle within contact, or crossed
-  std::vector<std::uint8_t> dirty_;        // near a robot moved in this pass
-  std::vector<std::uint32_t> in_box_;      // scratch of robots_in_box_by_id
+  std::vector<std::uint8_t> near_robot_;    // at the pass's start: another robot within contact
+  std::vector<std::uint8_t> near_static_;   // at the pass's start: a wall or obstacle within contact, or crossed
+  std::vector<std::uint8_t> dirty_;         // near a robot moved in this pass
+  std::vector<std::uint32_t> in_box_;       // scratch of robots_in_box_by_id
   std::vector<std::uint32_t> in_segments_;  // scratch: segments_in_box
   core::WorkerPool* workers_ = nullptr;
 };

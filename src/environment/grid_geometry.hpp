@@ -19,10 +19,10 @@ namespace rilbed::environment {
 /// one or a few blocks of 256 bytes of a per-cell int array, instead of on as many cache
 /// lines as rows, kilobytes apart on a large field.
 struct GridGeometry {
-  Vec2 origin_m;       ///< lower-left corner of cell (0, 0)
-  double cell_m = 0.1; ///< side of a cell
-  int nx = 1;          ///< columns
-  int ny = 1;          ///< rows
+  Vec2 origin_m;        ///< lower-left corner of cell (0, 0)
+  double cell_m = 0.1;  ///< side of a cell
+  int nx = 1;           ///< columns
+  int ny = 1;           ///< rows
 
   /// A grid covering `box` with cells of about `cell_m`; the cells are made larger when
   /// more than `max_cells` would be needed (memory and rebuild time grow with the count).

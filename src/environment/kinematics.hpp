@@ -22,9 +22,7 @@ inline constexpr double kKheperaRadius_m = 0.0275;
 inline constexpr double kKheperaWheelBase_m = 0.053;
 
 /// A wheel speed command clamped to the firmware's range [-127, 127].
-constexpr int clamp_speed_units(int units) {
-  return std::clamp(units, -kKheperaMaxSpeedUnits, kKheperaMaxSpeedUnits);
-}
+constexpr int clamp_speed_units(int units) { return std::clamp(units, -kKheperaMaxSpeedUnits, kKheperaMaxSpeedUnits); }
 
 /// Speed units (pulses per 10 ms) to metres per second.
 constexpr double speed_units_to_mps(int units) { return units * kKheperaSpeedUnit_mps; }

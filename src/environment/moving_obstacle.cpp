@@ -9,13 +9,12 @@ namespace {
 bool finite(Vec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); }
 }  // namespace
 
-MovingObstacle::MovingObstacle(MovingObstacleConfig config, const std::string& what)
-    : config_(std::move(config)) {
+MovingObstacle::MovingObstacle(MovingObstacleConfig config, const std::string& what) : config_(std::move(config)) {
   const std::string label = config_.name.empty() ? what : what + " (" + config_.name + ")";
   auto fail = [&](const std::string& why) { throw std::invalid_argument(label + ": " + why); };
   if (!finite(config_.position_m)) fail("position is not finite");
   if (!finite(config_.velocity_mps)) fail("velocity is not finite");
-  if (config_.shape == MovingShape::Disc) {
+  if (config_.shape == MovingShape::kDisc) {
     if (!std::isfinite(config_.radius_m) || config_.radius_m <= 0.0) fail("radius_m must be a positive number");
     bounding_radius_m_ = config_.radius_m;
   } else {
@@ -31,7 +30,7 @@ MovingObstacle::MovingObstacle(MovingObstacleConfig config, const std::string& w
   }
   position_m_ = previous_m_ = config_.position_m;
   velocity_mps_ = config_.velocity_mps;
-  if (config_.shape == MovingShape::Polygon) {
+  if (config_.shape == MovingShape::kPolygon) {
     for (const Vec2 p : config_.vertices_m) world_vertices_m_.push_back(position_m_ + p);
   }
 }

@@ -14,18 +14,18 @@
 namespace rilbed::environment {
 
 /// Shape of a moving obstacle.
-enum class MovingShape { Disc, Polygon };
+enum class MovingShape { kDisc, kPolygon };
 
 /// A moving obstacle as configured.
 struct MovingObstacleConfig {
-  MovingShape shape = MovingShape::Disc;  ///< which of the two below applies
-  double radius_m = 0.05;        ///< Disc: its radius
+  MovingShape shape = MovingShape::kDisc;  ///< which of the two below applies
+  double radius_m = 0.05;                  ///< Disc: its radius
   /// Polygon: convex, either orientation, relative to position_m, which must lie inside
   /// it (its centre, say). The polygon translates; it does not rotate.
   std::vector<Vec2> vertices_m;
-  Vec2 position_m;               ///< the disc's centre / the polygon's reference point
-  Vec2 velocity_mps;             ///< constant between bounces
-  std::string name;              ///< optional, for error messages
+  Vec2 position_m;    ///< the disc's centre / the polygon's reference point
+  Vec2 velocity_mps;  ///< constant between bounces
+  std::string name;   ///< optional, for error messages
 };
 
 /// The live state of one moving obstacle.

@@ -51,8 +51,7 @@ void ProximitySensor::nearest_distances(const Scene& scene, int body, Vec2 headi
                                distances_m);
 }
 
-void ProximitySensor::sense(const Scene& scene, int body, Vec2 heading, NoiseRng& rng,
-                            ProximityValues& out) const {
+void ProximitySensor::sense(const Scene& scene, int body, Vec2 heading, NoiseRng& rng, ProximityValues& out) const {
   std::array<double, kProximityCount> distances;
   nearest_distances(scene, body, heading, distances);
   const bool noisy = config_.noise_sd > 0.0;

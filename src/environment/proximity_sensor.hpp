@@ -5,8 +5,8 @@
 #pragma once
 
 #include <array>
-#include "environment/random.hpp"
 #include <string>
+#include "environment/random.hpp"
 
 #include "environment/scene.hpp"
 #include "environment/sensor_readings.hpp"

@@ -84,7 +84,8 @@ class NoiseRng {
 /// A uniform number in [0, 1) made of 53 random bits from one 64-bit draw of `rng`.
 template <class Rng>
 inline double uniform01(Rng& rng) {
-  static_assert(Rng::max() == std::numeric_limits<std::uint64_t>::max() && Rng::min() == 0, "needs 64 random bits per draw");
+  static_assert(Rng::max() == std::numeric_limits<std::uint64_t>::max() && Rng::min() == 0,
+                "needs 64 random bits per draw");
   return static_cast<double>(rng() >> 11) * 0x1.0p-53;
 }
 
@@ -115,8 +116,8 @@ namespace detail {
 /// x[i+1]/x[i]. Built once, thread-safely (a function-local static).
 struct ZigguratTables {
   static constexpr int kLayers = 128;
-  static constexpr double kTailStart = 3.442619855899;     // R
-  static constexpr double kLayerArea = 9.91256303526217e-3; // V
+  static constexpr double kTailStart = 3.442619855899;       // R
+  static constexpr double kLayerArea = 9.91256303526217e-3;  // V
   std::array<double, kLayers + 1> x{};
   std::array<double, kLayers> ratio{};
   ZigguratTables() {
@@ -149,7 +150,7 @@ inline double fast_normal(Rng& rng, const ZigguratTables& z) {
     const std::uint64_t bits = rng();
     const double u = 2.0 * (static_cast<double>(bits >> 11) * 0x1.0p-53) - 1.0;  // top 53 bits
     const std::size_t i = bits & 0x7f;                                           // low 7 bits
-    if (std::abs(u) < z.ratio[i]) return u * z.x[i];  // inside the layer's rectangle
+    if (std::abs(u) < z.ratio[i]) return u * z.x[i];                             // inside the layer's rectangle
     if (i == 0) {
       // The bottom layer's tail beyond R (Marsaglia 1964).
       double x, y;

@@ -2,9 +2,9 @@
 // nearest object inside its cone, nothing about where in the cone it is.
 #pragma once
 
-#include "environment/random.hpp"
 #include <string>
 #include <vector>
+#include "environment/random.hpp"
 
 #include "environment/scene.hpp"
 #include "environment/sensor_readings.hpp"

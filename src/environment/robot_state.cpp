@@ -4,7 +4,7 @@
 
 namespace rilbed::environment {
 
-std::string_view to_string(RobotKind kind) { return kind == RobotKind::Real ? "real" : "virtual"; }
+std::string_view to_string(RobotKind kind) { return kind == RobotKind::kReal ? "real" : "virtual"; }
 
 OdometryReading RobotState::odometer() const {
   // A small slack keeps exact multiples (1000 pulses after 80 mm) from flooring to 999

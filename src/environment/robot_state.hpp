@@ -14,20 +14,20 @@ namespace rilbed::environment {
 /// Virtual robots live only in the world: the world drives them from their wheel
 /// commands. Real robots are driven by the real world: the world takes their pose from
 /// outside (the camera) and never moves them.
-enum class RobotKind { Virtual, Real };
+enum class RobotKind { kVirtual, kReal };
 
 /// "virtual" or "real".
 std::string_view to_string(RobotKind kind);
 
 /// A robot to add to the world.
 struct RobotConfig {
-  int id = 0;                           ///< unique within the world
-  RobotKind kind = RobotKind::Virtual;  ///< virtual (driven here) or real (observed)
-  Pose2 pose;                           ///< initial pose, field frame
-  double radius_m = kKheperaRadius_m;   ///< the body is a disc of this radius
+  int id = 0;                            ///< unique within the world
+  RobotKind kind = RobotKind::kVirtual;  ///< virtual (driven here) or real (observed)
+  Pose2 pose;                            ///< initial pose, field frame
+  double radius_m = kKheperaRadius_m;    ///< the body is a disc of this radius
   double wheel_base_m = kKheperaWheelBase_m;
-  WheelNoiseConfig noise;               ///< virtual robots only
-  SensorSuiteConfig sensors;            ///< virtual sensors (fed by the world for either kind)
+  WheelNoiseConfig noise;     ///< virtual robots only
+  SensorSuiteConfig sensors;  ///< virtual sensors (fed by the world for either kind)
 };
 
 /// A robot's wheel commands, pulses per 10 ms (1 unit = 8 mm/s), in [-127, 127].
@@ -42,20 +42,20 @@ struct WheelUnits {
 /// the same line. The wheel commands are
 /// kept apart (World::wheel_speeds), in the agents' order, since agents write them.
 struct alignas(64) RobotState {
-  int id = 0;                          ///< as configured
-  RobotKind kind = RobotKind::Virtual; ///< as configured
-  Pose2 pose;                        ///< current pose, heading in [-pi, pi)
-  TimeUs pose_t_us = 0;              ///< when pose was last set (step end or observation)
+  int id = 0;                            ///< as configured
+  RobotKind kind = RobotKind::kVirtual;  ///< as configured
+  Pose2 pose;                            ///< current pose, heading in [-pi, pi)
+  TimeUs pose_t_us = 0;                  ///< when pose was last set (step end or observation)
   /// Real robots: whether the camera has placed it at least once (until then `pose` is
   /// only where the scenario put it).
   bool observed = false;
-  double radius_m = kKheperaRadius_m;        ///< body disc
+  double radius_m = kKheperaRadius_m;         ///< body disc
   double wheel_base_m = kKheperaWheelBase_m;  ///< between the wheels
   /// Wheel travel counted by the encoders since the counters were last set, metres
   /// (kept in metres so that fractions of a pulse are not lost between steps).
   double left_wheel_travel_m = 0.0;
   double right_wheel_travel_m = 0.0;
-  WheelNoiseConfig noise;     ///< as configured
+  WheelNoiseConfig noise;  ///< as configured
   // (Its sensors' configuration is World::sensor_config(id): kept out of this record,
   // which every step reads four times, so that a record is two cache lines, not five.)
 

@@ -11,7 +11,8 @@ void Scene::nearest_in_wedges(Vec2 centre, double reach_m, int exclude_body, std
     std::span<const Wedge> wedges;
     std::span<double> out;
     void disc(Vec2 c, double r) {
-      for (std::size_t k = 0; k < wedges.size(); ++k) out[k] = std::min(out[k], wedge_distance_to_disc(wedges[k], c, r));
+      for (std::size_t k = 0; k < wedges.size(); ++k)
+        out[k] = std::min(out[k], wedge_distance_to_disc(wedges[k], c, r));
     }
     void segment(Vec2 a, Vec2 b) {
       for (std::size_t k = 0; k < wedges.size(); ++k)
@@ -24,7 +25,7 @@ void Scene::nearest_in_wedges(Vec2 centre, double reach_m, int exclude_body, std
 bool Scene::sight_blocked(Vec2 from, Vec2 to) const {
   if (statics.blocks_sight(from, to)) return true;
   for (const MovingObstacle& m : movers) {
-    if (m.shape() == MovingShape::Disc) {
+    if (m.shape() == MovingShape::kDisc) {
       // Blocked when the line passes through the disc between its ends.
       const double r = m.bounding_radius_m();
       if (distance_sq_to_segment(m.position_m(), from, to) < r * r) return true;

@@ -18,13 +18,13 @@ namespace rilbed::environment {
 
 /// Read-only view of the world for sensing.
 struct Scene {
-  const SegmentIndex& statics;          ///< boundary walls (when on) and obstacle edges
-  const SegmentIndex& tracks;           ///< floor track segments, with their half widths
-  std::span<const Body> bodies;         ///< robots, by slot
-  const SpatialGrid& grid;              ///< bodies hashed by cell; current
+  const SegmentIndex& statics;             ///< boundary walls (when on) and obstacle edges
+  const SegmentIndex& tracks;              ///< floor track segments, with their half widths
+  std::span<const Body> bodies;            ///< robots, by slot
+  const SpatialGrid& grid;                 ///< bodies hashed by cell; current
   std::span<const MovingObstacle> movers;  ///< by index
   std::span<const BeaconConfig> beacons;   ///< the map's, in its order
-  double max_body_radius_m = 0.0;       ///< largest robot radius, to widen grid queries
+  double max_body_radius_m = 0.0;          ///< largest robot radius, to widen grid queries
 
   /// Calls visitor.disc(centre, radius_m) and visitor.segment(a, b) for every surface
   /// that may come within reach_m of p: robots (except slot `exclude_body`), wall and
@@ -45,7 +45,7 @@ struct Scene {
     for (const MovingObstacle& m : movers) {
       const double limit = reach_m + m.bounding_radius_m();
       if (distance_sq(p, m.position_m()) >= limit * limit) continue;
-      if (m.shape() == MovingShape::Disc) {
+      if (m.shape() == MovingShape::kDisc) {
         visitor.disc(m.position_m(), m.bounding_radius_m());
       } else {
         const auto& v = m.world_vertices_m();
@@ -80,7 +80,8 @@ struct Scene {
       }
       void disc(Vec2 c, double r) {
         ready();
-        for (std::size_t k = 0; k < wedges.size(); ++k) out[k] = std::min(out[k], wedge_distance_to_disc(wedges[k], c, r));
+        for (std::size_t k = 0; k < wedges.size(); ++k)
+          out[k] = std::min(out[k], wedge_distance_to_disc(wedges[k], c, r));
       }
       void segment(Vec2 a, Vec2 b) {
         ready();

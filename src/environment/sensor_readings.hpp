@@ -21,8 +21,8 @@ inline constexpr int kProximityCount = 8;
 /// the robot's forward direction, in the firmware's order (0 = left, 2 and 3 = front,
 /// 5 = right, 6 and 7 = back).
 inline constexpr std::array<double, kProximityCount> kProximityAngles_rad = {
-    deg_to_rad(90.0),  deg_to_rad(45.0),   deg_to_rad(10.0),   deg_to_rad(-10.0),
-    deg_to_rad(-45.0), deg_to_rad(-90.0),  deg_to_rad(-170.0), deg_to_rad(170.0)};
+    deg_to_rad(90.0),  deg_to_rad(45.0),  deg_to_rad(10.0),   deg_to_rad(-10.0),
+    deg_to_rad(-45.0), deg_to_rad(-90.0), deg_to_rad(-170.0), deg_to_rad(170.0)};
 
 /// Largest proximity value (an object touching the sensor); 0 is nothing in range.
 inline constexpr int kProximityMax = 1023;
@@ -33,8 +33,8 @@ using ProximityValues = std::array<int, kProximityCount>;
 
 /// An ultrasonic range finder's reading: the distance to the nearest object in its cone.
 struct RangeReading {
-  bool hit = false;          ///< false: nothing within range
-  double distance_m = 0.0;   ///< distance to the nearest object, metres (the range when !hit)
+  bool hit = false;         ///< false: nothing within range
+  double distance_m = 0.0;  ///< distance to the nearest object, metres (the range when !hit)
 };
 
 /// An IR beacon seen by the direction finder (paper 000 §6.10): its ID and bearing, no
@@ -54,12 +54,12 @@ struct OdometryReading {
 /// Everything one robot sensed at one instant. Sensors a robot does not carry are left
 /// empty (empty vectors, nullopt).
 struct SensorReadings {
-  TimeUs t_us = 0;                          ///< when the readings were taken
-  std::optional<ProximityValues> proximity; ///< the eight IR proximity sensors
-  std::vector<RangeReading> ranges;         ///< one per ultrasonic range finder, in configured order
-  std::vector<BeaconSighting> beacons;      ///< beacons in view of the direction finder
-  std::vector<int> track;                   ///< one value per track sensor, 0..its max value
-  std::optional<OdometryReading> odometry;  ///< wheel counters
+  TimeUs t_us = 0;                           ///< when the readings were taken
+  std::optional<ProximityValues> proximity;  ///< the eight IR proximity sensors
+  std::vector<RangeReading> ranges;          ///< one per ultrasonic range finder, in configured order
+  std::vector<BeaconSighting> beacons;       ///< beacons in view of the direction finder
+  std::vector<int> track;                    ///< one value per track sensor, 0..its max value
+  std::optional<OdometryReading> odometry;   ///< wheel counters
 };
 
 }  // namespace rilbed::environment

@@ -33,15 +33,19 @@ void SensorSuite::sense(const Scene& scene, int body, Pose2 pose, Vec2 heading, 
     out.proximity.reset();
   }
   range_finders_.sense(scene, body, heading, rng, out.ranges);
-  if (beacon_finder_) sense_beacons(*beacon_finder_, scene, pose, rng, out.beacons);
-  else out.beacons.clear();
+  if (beacon_finder_)
+    sense_beacons(*beacon_finder_, scene, pose, rng, out.beacons);
+  else
+    out.beacons.clear();
   out.track.resize(track_sensors_.size());
   for (std::size_t k = 0; k < track_sensors_.size(); ++k) {
     const TrackSensor& t = track_sensors_[k];
     out.track[k] = t.reading(t.covered_segments(scene, pose.position_m, heading), rng);
   }
-  if (odometer_ && odometry) out.odometry = *odometry;
-  else out.odometry.reset();
+  if (odometer_ && odometry)
+    out.odometry = *odometry;
+  else
+    out.odometry.reset();
 }
 
 }  // namespace rilbed::environment

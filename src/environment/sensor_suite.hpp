@@ -4,9 +4,9 @@
 
 #include <cmath>
 #include <optional>
-#include "environment/random.hpp"
 #include <string>
 #include <vector>
+#include "environment/random.hpp"
 
 #include "environment/beacon_finder.hpp"
 #include "environment/proximity_sensor.hpp"

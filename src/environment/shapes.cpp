@@ -60,8 +60,10 @@ bool polygon_is_convex(std::span<const Vec2> v) {
     const double turn = e0.cross(e1);
     if (turn == 0.0) continue;
     const int s = turn > 0.0 ? 1 : -1;
-    if (sign == 0) sign = s;
-    else if (s != sign) return false;
+    if (sign == 0)
+      sign = s;
+    else if (s != sign)
+      return false;
   }
   return sign != 0 && !polygon_self_intersects(v);
 }
@@ -205,8 +207,10 @@ double wedge_distance_to_segment(const Wedge& w, Vec2 a, Vec2 b) {
       return;
     }
     const double root = -g0 / g1;
-    if (g1 > 0.0) t_lo = std::max(t_lo, root);
-    else t_hi = std::min(t_hi, root);
+    if (g1 > 0.0)
+      t_lo = std::max(t_lo, root);
+    else
+      t_hi = std::min(t_hi, root);
   };
   clip(w.right_edge.cross(ra), w.right_edge.cross(ab));
   clip(ra.cross(w.left_edge), ab.cross(w.left_edge));

@@ -83,8 +83,8 @@ Box bounding_box(std::span<const Vec2> points);
 /// separate from the second, and the signed gap between their surfaces along it
 /// (negative: they overlap by -separation_m).
 struct Contact {
-  Vec2 normal;               ///< unit
-  double separation_m = 0.0; ///< gap; negative is overlap
+  Vec2 normal;                ///< unit
+  double separation_m = 0.0;  ///< gap; negative is overlap
 };
 
 /// Contact of the disc (centre, radius_m) with segment [a, b]. The normal points from
@@ -119,8 +119,7 @@ struct Wedge {
 /// Builds the wedge with apex `apex_m`, unit axis `axis`, and half angle given by its
 /// cosine and sine (precomputed by the caller, who usually has them).
 inline Wedge make_wedge(Vec2 apex_m, Vec2 axis, double cos_half, double sin_half) {
-  return Wedge{apex_m, axis,
-               Vec2{axis.x * cos_half - axis.y * sin_half, axis.x * sin_half + axis.y * cos_half},
+  return Wedge{apex_m, axis, Vec2{axis.x * cos_half - axis.y * sin_half, axis.x * sin_half + axis.y * cos_half},
                Vec2{axis.x * cos_half + axis.y * sin_half, -axis.x * sin_half + axis.y * cos_half}};
 }
 

@@ -90,7 +90,8 @@ class SpatialGrid {
     const int r0 = geometry_.row(box.lo_m.y), r1 = geometry_.row(box.hi_m.y);
     for (int r = r0; r <= r1; ++r) {
       for (int c = c0; c <= c1; ++c) {
-        for (std::int32_t i = head_[static_cast<std::size_t>(geometry_.cell(c, r))]; i >= 0; i = next_[static_cast<std::size_t>(i)])
+        for (std::int32_t i = head_[static_cast<std::size_t>(geometry_.cell(c, r))]; i >= 0;
+             i = next_[static_cast<std::size_t>(i)])
           f(static_cast<int>(i));
       }
     }

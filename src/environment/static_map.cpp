@@ -59,8 +59,7 @@ StaticMap::StaticMap(StaticMapConfig config) : config_(std::move(config)) {
     const std::string what = "beacon " + std::to_string(i) + " (id " + std::to_string(b.id) + ")";
     if (!finite(b.position_m)) fail(what, "position is not finite");
     if (!std::isfinite(b.facing_rad)) fail(what, "facing_rad is not finite");
-    if (!(b.aperture_rad > 0.0 && b.aperture_rad <= 2.0 * kPi + 1e-12))
-      fail(what, "aperture_rad must be in (0, 2 pi]");
+    if (!(b.aperture_rad > 0.0 && b.aperture_rad <= 2.0 * kPi + 1e-12)) fail(what, "aperture_rad must be in (0, 2 pi]");
     if (!std::isfinite(b.range_m) || b.range_m <= 0.0) fail(what, "range_m must be a positive number");
     if (!beacon_ids.insert(b.id).second) fail(what, "another beacon has the same id");
   }

@@ -16,16 +16,16 @@ namespace rilbed::environment {
 
 /// The rectangular field robots drive on.
 struct FieldConfig {
-  double width_m = 1.5;          ///< extent along x; the lab's field is 1.5 x 1.2 m
-  double height_m = 1.2;         ///< extent along y
-  bool boundary_walls = true;    ///< walls along the four edges; without them robots may leave
+  double width_m = 1.5;        ///< extent along x; the lab's field is 1.5 x 1.2 m
+  double height_m = 1.2;       ///< extent along y
+  bool boundary_walls = true;  ///< walls along the four edges; without them robots may leave
 };
 
 /// A static obstacle: a closed polygon, convex or not (not self-intersecting). The last
 /// vertex connects back to the first; repeating the first vertex at the end is allowed.
 struct ObstacleConfig {
   std::vector<Vec2> vertices_m;  ///< field frame, at least three
-  std::string name;  ///< optional; error messages use it beside the index
+  std::string name;              ///< optional; error messages use it beside the index
 };
 
 /// A reflective track on the floor (paper 000 §8): a polyline of the given width that the
@@ -41,11 +41,11 @@ struct TrackConfig {
 /// it is within range_m of the beacon, inside its aperture, and no obstacle blocks the
 /// line between them.
 struct BeaconConfig {
-  int id = 0;                        ///< what the direction finder reports; unique per map
-  Vec2 position_m;                   ///< field frame
-  double facing_rad = 0.0;           ///< direction of the aperture's middle
-  double aperture_rad = 2.0 * kPi;   ///< full opening angle, (0, 2 pi]; 2 pi shines all round
-  double range_m = 2.0;              ///< how far its signal reaches
+  int id = 0;                       ///< what the direction finder reports; unique per map
+  Vec2 position_m;                  ///< field frame
+  double facing_rad = 0.0;          ///< direction of the aperture's middle
+  double aperture_rad = 2.0 * kPi;  ///< full opening angle, (0, 2 pi]; 2 pi shines all round
+  double range_m = 2.0;             ///< how far its signal reaches
 };
 
 /// Everything static, as given (the World validates it through StaticMap).

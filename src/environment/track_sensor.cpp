@@ -26,7 +26,8 @@ std::vector<int> cells_per_ring(int n) {
     remainders.push_back({exact - std::floor(exact), j});
   }
   std::stable_sort(remainders.begin(), remainders.end(), [](auto a, auto b) { return a.first > b.first; });
-  for (std::size_t k = 0; given < n; ++k, ++given) ++cells[static_cast<std::size_t>(remainders[k % remainders.size()].second)];
+  for (std::size_t k = 0; given < n; ++k, ++given)
+    ++cells[static_cast<std::size_t>(remainders[k % remainders.size()].second)];
   // A ring left without cells (only possible for tiny N) is dropped.
   std::erase(cells, 0);
   return cells;
@@ -80,8 +81,8 @@ TrackFootprint track_footprint(const TrackSensorConfig& c) {
 TrackSensor::TrackSensor(TrackSensorConfig config, const std::string& what) : config_(config) {
   auto fail = [&](const std::string& why) { throw std::invalid_argument(what + ": track sensor: " + why); };
   const TrackSensorConfig& c = config_;
-  for (const double v : {c.mount_x_m, c.mount_y_m, c.mount_yaw_deg, c.height_mm, c.inclination_deg,
-                         c.cone_angle_deg, c.coverage_percent, c.error_level_percent})
+  for (const double v : {c.mount_x_m, c.mount_y_m, c.mount_yaw_deg, c.height_mm, c.inclination_deg, c.cone_angle_deg,
+                         c.coverage_percent, c.error_level_percent})
     if (!std::isfinite(v)) fail("a parameter is not finite");
   if (c.height_mm <= 0.0) fail("height_mm must be positive");
   if (c.inclination_deg < 0.0 || c.inclination_deg >= 90.0) fail("inclination_deg must be in [0, 90)");
@@ -100,7 +101,8 @@ TrackSensor::TrackSensor(TrackSensorConfig config, const std::string& what) : co
 int TrackSensor::covered_segments(const Scene& scene, Vec2 position_m, Vec2 heading) const {
   int covered = 0;
   for (const Vec2 p : footprint_.points_m) {
-    const Vec2 world{position_m.x + heading.x * p.x - heading.y * p.y, position_m.y + heading.y * p.x + heading.x * p.y};
+    const Vec2 world{position_m.x + heading.x * p.x - heading.y * p.y,
+                     position_m.y + heading.y * p.x + heading.x * p.y};
     if (scene.on_track(world)) ++covered;
   }
   return covered;

@@ -25,9 +25,9 @@
 // [0, max_value].
 #pragma once
 
-#include "environment/random.hpp"
 #include <string>
 #include <vector>
+#include "environment/random.hpp"
 
 #include "environment/scene.hpp"
 
@@ -36,8 +36,8 @@ namespace rilbed::environment {
 /// One track sensor element: one key per parameter of the paper's configuration block
 /// (defaults are the paper's example), plus where it sits on the robot.
 struct TrackSensorConfig {
-  double mount_x_m = 0.0;     ///< position on the robot, metres forward of the centre
-  double mount_y_m = 0.0;     ///< position on the robot, metres left of the centre
+  double mount_x_m = 0.0;  ///< position on the robot, metres forward of the centre
+  double mount_y_m = 0.0;  ///< position on the robot, metres left of the centre
   /// Direction the element leans towards, degrees counter-clockwise from the robot's
   /// forward direction (only matters when inclined).
   double mount_yaw_deg = 0.0;

@@ -22,7 +22,8 @@ constexpr std::size_t kStorePrefetch = 8;
 bool finite(Vec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); }
 
 void validate_config(const WorldConfig& c) {
-  if (!std::isfinite(c.cell_size_m) || c.cell_size_m < 0.0) throw std::invalid_argument("world: cell_size_m must be >= 0");
+  if (!std::isfinite(c.cell_size_m) || c.cell_size_m < 0.0)
+    throw std::invalid_argument("world: cell_size_m must be >= 0");
   if (c.max_grid_cells < 1) throw std::invalid_argument("world: max_grid_cells must be >= 1");
   if (!std::isfinite(c.max_substep_travel_m) || c.max_substep_travel_m < 0.0)
     throw std::invalid_argument("world: max_substep_travel_m must be >= 0");
@@ -46,12 +47,12 @@ std::vector<IndexedSegment> static_segments(const StaticMap& map) {
   std::vector<IndexedSegment> segments;
   if (map.field().boundary_walls) {
     const auto walls = map.wall_segments();
-    for (int k = 0; k < 4; ++k) segments.push_back({walls[k][0], walls[k][1], {BodyKind::Wall, k}, 0.0});
+    for (int k = 0; k < 4; ++k) segments.push_back({walls[k][0], walls[k][1], {BodyKind::kWall, k}, 0.0});
   }
   for (std::size_t i = 0; i < map.obstacles().size(); ++i) {
     const auto& v = map.obstacles()[i].vertices_m;
     for (std::size_t k = 0; k < v.size(); ++k)
-      segments.push_back({v[k], v[(k + 1) % v.size()], {BodyKind::Obstacle, static_cast<int>(i)}, 0.0});
+      segments.push_back({v[k], v[(k + 1) % v.size()], {BodyKind::kObstacle, static_cast<int>(i)}, 0.0});
   }
   return segments;
 }
@@ -60,7 +61,7 @@ std::vector<IndexedSegment> track_segments(const StaticMap& map) {
   std::vector<IndexedSegment> segments;
   for (std::size_t i = 0; i < map.tracks().size(); ++i) {
     const TrackConfig& t = map.tracks()[i];
-    const BodyRef owner{BodyKind::Obstacle, static_cast<int>(i)};
+    const BodyRef owner{BodyKind::kObstacle, static_cast<int>(i)};
     for (std::size_t k = 0; k + 1 < t.points_m.size(); ++k)
       segments.push_back({t.points_m[k], t.points_m[k + 1], owner, 0.5 * t.width_m});
     if (t.closed) segments.push_back({t.points_m.back(), t.points_m.front(), owner, 0.5 * t.width_m});
@@ -94,19 +95,21 @@ std::size_t World::slot(int id) const {
 
 const RobotState& World::robot(int id) const { return robots_[slot(id)]; }
 
-Scene World::scene() const {
-  return Scene{statics_, tracks_, bodies_, grid_, movers_, map_.beacons(), max_radius_m_};
-}
+Scene World::scene() const { return Scene{statics_, tracks_, bodies_, grid_, movers_, map_.beacons(), max_radius_m_}; }
 
 void World::check_placement_free(const std::string& what, Vec2 p, double r, int exclude_slot) const {
   const double tol = config_.collision.tolerance_m;
   if (map_.field().boundary_walls) {
     const FieldConfig& f = map_.field();
     const char* wall = nullptr;
-    if (p.x - r < -tol) wall = "the left wall";
-    else if (p.x + r > f.width_m + tol) wall = "the right wall";
-    else if (p.y - r < -tol) wall = "the bottom wall";
-    else if (p.y + r > f.height_m + tol) wall = "the top wall";
+    if (p.x - r < -tol)
+      wall = "the left wall";
+    else if (p.x + r > f.width_m + tol)
+      wall = "the right wall";
+    else if (p.y - r < -tol)
+      wall = "the bottom wall";
+    else if (p.y + r > f.height_m + tol)
+      wall = "the top wall";
     if (wall) throw std::invalid_argument(what + ": placed overlapping " + wall);
   }
   if (const int inside = map_.obstacle_containing(p); inside >= 0)
@@ -120,11 +123,12 @@ void World::check_placement_free(const std::string& what, Vec2 p, double r, int 
     const Body& b = bodies_[static_cast<std::size_t>(j)];
     const double sum = r + b.radius_m - tol;
     if (distance_sq(p, b.position_m) < sum * sum)
-      throw std::invalid_argument(what + ": placed overlapping robot " + std::to_string(ids_[static_cast<std::size_t>(j)]));
+      throw std::invalid_argument(what + ": placed overlapping robot " +
+                                  std::to_string(ids_[static_cast<std::size_t>(j)]));
   });
   for (std::size_t m = 0; m < movers_.size(); ++m) {
     const MovingObstacle& mover = movers_[m];
-    const Contact c = mover.shape() == MovingShape::Disc
+    const Contact c = mover.shape() == MovingShape::kDisc
                           ? disc_disc_contact(p, r, mover.position_m(), mover.bounding_radius_m())
                           : disc_convex_polygon_contact(p, r, mover.world_vertices_m());
     if (c.separation_m < -tol)
@@ -135,8 +139,10 @@ void World::check_placement_free(const std::string& what, Vec2 p, double r, int 
 void World::add_robot(const RobotConfig& c) {
   const std::string what = label(c.id);
   if (slot_of_.contains(c.id)) throw std::invalid_argument(what + ": another robot has this id");
-  if (!finite(c.pose.position_m) || !std::isfinite(c.pose.heading_rad)) throw std::invalid_argument(what + ": pose is not finite");
-  if (!std::isfinite(c.radius_m) || c.radius_m <= 0.0) throw std::invalid_argument(what + ": radius_m must be a positive number");
+  if (!finite(c.pose.position_m) || !std::isfinite(c.pose.heading_rad))
+    throw std::invalid_argument(what + ": pose is not finite");
+  if (!std::isfinite(c.radius_m) || c.radius_m <= 0.0)
+    throw std::invalid_argument(what + ": radius_m must be a positive number");
   if (!std::isfinite(c.wheel_base_m) || c.wheel_base_m <= 0.0)
     throw std::invalid_argument(what + ": wheel_base_m must be a positive number");
   const WheelNoiseConfig& n = c.noise;
@@ -144,7 +150,7 @@ void World::add_robot(const RobotConfig& c) {
   if (!std::isfinite(n.left_bias) || !std::isfinite(n.right_bias) || n.left_bias <= -1.0 || n.right_bias <= -1.0)
     throw std::invalid_argument(what + ": noise biases must be finite and above -1");
   SensorSuite suite(c.sensors, what);  // validates the sensors
-  if (c.kind == RobotKind::Virtual) check_placement_free(what, c.pose.position_m, c.radius_m, -1);
+  if (c.kind == RobotKind::kVirtual) check_placement_free(what, c.pose.position_m, c.radius_m, -1);
 
   RobotState state;
   state.id = c.id;
@@ -166,7 +172,7 @@ void World::add_robot(const RobotConfig& c) {
     slot_of_.reserve(want);
   }
   robots_.push_back(std::move(state));
-  bodies_.push_back({c.pose.position_m, c.pose.position_m, c.radius_m, c.kind == RobotKind::Virtual});
+  bodies_.push_back({c.pose.position_m, c.pose.position_m, c.radius_m, c.kind == RobotKind::kVirtual});
   ids_.push_back(c.id);
   added_of_slot_.push_back(static_cast<std::uint32_t>(added_order_.size()));
   added_order_.push_back(c.id);
@@ -210,7 +216,8 @@ void World::remove_robot(int id) {
     slot_of_[ids_[s]] = s;
     set_dense_slot(ids_[s], static_cast<std::int32_t>(s));
   }
-  robots_.pop_back(), bodies_.pop_back(), ids_.pop_back(), suite_of_.pop_back(), motion_.pop_back(), headings_.pop_back();
+  robots_.pop_back(), bodies_.pop_back(), ids_.pop_back(), suite_of_.pop_back(), motion_.pop_back(),
+      headings_.pop_back();
   added_of_slot_.pop_back();
   slot_of_.erase(id);
   set_dense_slot(id, -1);
@@ -268,7 +275,8 @@ void World::refresh_max_radius() {
 void World::prefetch(int id) const {
   // Its readings, pose and wheel commands are in the agents' order (the CPU's own
   // prefetcher follows that): the id table's entry, found by id, is what to ask for.
-  if (id >= 0 && static_cast<std::size_t>(id) < by_id_.size()) __builtin_prefetch(&by_id_[static_cast<std::size_t>(id)]);
+  if (id >= 0 && static_cast<std::size_t>(id) < by_id_.size())
+    __builtin_prefetch(&by_id_[static_cast<std::size_t>(id)]);
 }
 
 void World::set_wheel_speeds(int id, int left_units, int right_units) {
@@ -278,7 +286,7 @@ void World::set_wheel_speeds(int id, int left_units, int right_units) {
 void World::set_observed_pose(int id, Pose2 pose, TimeUs t_us) {
   const std::size_t s = slot(id);
   RobotState& r = robots_[s];
-  if (r.kind != RobotKind::Real) throw std::invalid_argument(label(id) + ": set_observed_pose is for real robots");
+  if (r.kind != RobotKind::kReal) throw std::invalid_argument(label(id) + ": set_observed_pose is for real robots");
   if (!finite(pose.position_m) || !std::isfinite(pose.heading_rad))
     throw std::invalid_argument(label(id) + ": observed pose is not finite");
   r.pose = {pose.position_m, wrap_rad_pi(pose.heading_rad)};
@@ -303,7 +311,7 @@ int World::add_moving_obstacle(const MovingObstacleConfig& config) {
   MovingObstacle mover(config, what);
   const double tol = config_.collision.tolerance_m;
   auto overlaps_segment = [&](Vec2 a, Vec2 b) {
-    const Contact c = mover.shape() == MovingShape::Disc
+    const Contact c = mover.shape() == MovingShape::kDisc
                           ? disc_segment_contact(mover.position_m(), mover.bounding_radius_m(), a, b)
                           : convex_polygon_segment_contact(mover.world_vertices_m(), a, b);
     return c.separation_m < -tol;
@@ -321,7 +329,7 @@ int World::add_moving_obstacle(const MovingObstacleConfig& config) {
   }
   for (std::size_t j = 0; j < bodies_.size(); ++j) {
     const Body& b = bodies_[j];
-    const Contact c = mover.shape() == MovingShape::Disc
+    const Contact c = mover.shape() == MovingShape::kDisc
                           ? disc_disc_contact(b.position_m, b.radius_m, mover.position_m(), mover.bounding_radius_m())
                           : disc_convex_polygon_contact(b.position_m, b.radius_m, mover.world_vertices_m());
     if (c.separation_m < -tol) throw std::invalid_argument(what + ": placed overlapping " + label(ids_[j]));
@@ -367,7 +375,7 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us) {
     for_robot_slots([&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         const RobotState& r = robots_[i];
-        if (r.kind == RobotKind::Virtual) set_arc(i, step_wheels_mps_[i], r.wheel_base_m, h_s, substeps);
+        if (r.kind == RobotKind::kVirtual) set_arc(i, step_wheels_mps_[i], r.wheel_base_m, h_s, substeps);
       }
     });
   }
@@ -392,7 +400,7 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us) {
   }
   for (const int pushed : resolver_.pushed()) {
     const auto i = static_cast<std::size_t>(pushed);
-    if (robots_[i].kind != RobotKind::Virtual) continue;  // (the resolver pushes none: they are not pushable)
+    if (robots_[i].kind != RobotKind::kVirtual) continue;  // (the resolver pushes none: they are not pushable)
     robots_[i].pose.position_m = bodies_[i].position_m;
     poses_[added_of_slot_[i]].position_m = bodies_[i].position_m;
   }
@@ -406,7 +414,7 @@ double World::start_wheels(std::size_t begin, std::size_t end, double dt_s) {
   double max_travel_m = 0.0;
   for (std::size_t i = begin; i < end; ++i) {
     RobotState& r = robots_[i];
-    if (r.kind != RobotKind::Virtual) continue;
+    if (r.kind != RobotKind::kVirtual) continue;
     // In added order, where the agents wrote: a small table, but not in cache at 100,000
     // robots once the step's passes went through memory, so asked for a few robots ahead.
     if (i + kStorePrefetch < end) __builtin_prefetch(&commands_[added_of_slot_[i + kStorePrefetch]]);
@@ -441,7 +449,8 @@ void World::move_substep(std::size_t begin, std::size_t end, bool last, TimeUs e
     Motion& m = motion_[i];
     const Vec2 d = m.local_step_m;
     b.position_m = b.position_m + Vec2{m.heading.x * d.x - m.heading.y * d.y, m.heading.y * d.x + m.heading.x * d.y};
-    m.heading = {m.heading.x * m.cos_turn - m.heading.y * m.sin_turn, m.heading.y * m.cos_turn + m.heading.x * m.sin_turn};
+    m.heading = {m.heading.x * m.cos_turn - m.heading.y * m.sin_turn,
+                 m.heading.y * m.cos_turn + m.heading.x * m.sin_turn};
     // The step's end pose at once, while the records are in cache (a pass of its own
     // read them from memory again at 100,000 robots); the few robots the collisions
     // step() resolves after the move are set again after them.
@@ -510,7 +519,7 @@ SensorReadings World::sense(int id, TimeUs t_us, NoiseRng& rng) const {
   const std::size_t s = slot(id);
   const RobotState& r = robots_[s];
   std::optional<OdometryReading> odometry;
-  if (r.kind == RobotKind::Virtual) odometry = r.odometer();
+  if (r.kind == RobotKind::kVirtual) odometry = r.odometer();
   SensorReadings out;
   suite_pool_[suite_of_[s]].sense(scene(), static_cast<int>(s), r.pose, headings_[s], odometry, t_us, rng, out);
   return out;
@@ -521,10 +530,14 @@ void World::sense_into(int id, TimeUs t_us, SensorReadings& out) const {
     const std::size_t added = added_index(id);
     const StoredReadings& stored = ahead_[added];
     out.t_us = stored.t_us;
-    if (stored.has_proximity) out.proximity = stored.proximity;
-    else out.proximity.reset();
-    if (stored.has_odometry) out.odometry = stored.odometry;
-    else out.odometry.reset();
+    if (stored.has_proximity)
+      out.proximity = stored.proximity;
+    else
+      out.proximity.reset();
+    if (stored.has_odometry)
+      out.odometry = stored.odometry;
+    else
+      out.odometry.reset();
     if (stored.has_lists) {
       const StoredLists& lists = ahead_lists_[added];
       out.ranges = lists.ranges, out.beacons = lists.beacons, out.track = lists.track;
@@ -554,7 +567,8 @@ void World::store_readings(std::size_t added, SensorReadings& readings) {
 void World::sense_ahead(TimeUs t_us) {
   if (ahead_valid_ && ahead_t_us_ == t_us) return;
   ahead_.resize(robots_.size());  // by index in added_order_
-  const bool lists = std::any_of(suite_pool_.begin(), suite_pool_.end(), [](const SensorSuite& x) { return x.has_lists(); });
+  const bool lists =
+      std::any_of(suite_pool_.begin(), suite_pool_.end(), [](const SensorSuite& x) { return x.has_lists(); });
   ahead_lists_.resize(lists ? robots_.size() : 0);
   const Scene sc = scene();
   // Slot order is by place (renumber_by_place): a robot's neighbours were just read.
@@ -596,8 +610,9 @@ void World::renumber_by_place() {
   for (std::size_t i = 0; i < n; ++i) {
     keys[i] = {static_cast<std::uint64_t>(g.cell_of(bodies_[i].position_m)), ids_[i], static_cast<std::uint32_t>(i)};
   }
-  std::sort(keys.begin(), keys.end(),
-            [](const RenumberKey& a, const RenumberKey& b) { return a.place != b.place ? a.place < b.place : a.id < b.id; });
+  std::sort(keys.begin(), keys.end(), [](const RenumberKey& a, const RenumberKey& b) {
+    return a.place != b.place ? a.place < b.place : a.id < b.id;
+  });
   new_order_.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
     new_order_[k] = keys[k].slot;
@@ -623,7 +638,7 @@ void World::renumber_by_place() {
 void World::sense_slot(const Scene& scene, std::size_t s, TimeUs t_us, SensorReadings& out) const {
   const RobotState& r = robots_[s];
   std::optional<OdometryReading> odometry;
-  if (r.kind == RobotKind::Virtual) odometry = r.odometer();
+  if (r.kind == RobotKind::kVirtual) odometry = r.odometer();
   NoiseRng rng = NoiseRng::keyed(config_.noise_seed, r.id, t_us, NoisePurpose::kSensing);
   suite_pool_[suite_of_[s]].sense(scene, static_cast<int>(s), r.pose, headings_[s], odometry, t_us, rng, out);
 }
@@ -643,7 +658,8 @@ WorldSnapshot World::snapshot() const {
     snap.robots.push_back({r.id, r.kind, r.pose, r.radius_m, commands_[k].left, commands_[k].right});
   }
   for (const MovingObstacle& m : movers_)
-    snap.moving_obstacles.push_back({m.shape(), m.position_m(), m.velocity_mps(), m.bounding_radius_m(), m.world_vertices_m()});
+    snap.moving_obstacles.push_back(
+        {m.shape(), m.position_m(), m.velocity_mps(), m.bounding_radius_m(), m.world_vertices_m()});
   const auto events = resolver_.events();
   snap.collisions.assign(events.begin(), events.end());
   return snap;
@@ -680,7 +696,7 @@ double World::overlap_of(std::size_t i) const {
   });
   if (map_.obstacle_containing(b.position_m) >= 0) worst = std::max(worst, b.radius_m);
   for (const MovingObstacle& m : movers_) {
-    const Contact c = m.shape() == MovingShape::Disc
+    const Contact c = m.shape() == MovingShape::kDisc
                           ? disc_disc_contact(b.position_m, b.radius_m, m.position_m(), m.bounding_radius_m())
                           : disc_convex_polygon_contact(b.position_m, b.radius_m, m.world_vertices_m());
     worst = std::max(worst, -c.separation_m);

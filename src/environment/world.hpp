@@ -258,12 +258,13 @@ class World {
   std::vector<RobotState> robots_;
   std::vector<Body> bodies_;
   std::vector<int> ids_;
-  std::vector<std::uint32_t> suite_of_;          // per slot: its suite in suite_pool_
-  std::vector<SensorSuite> suite_pool_;          // the distinct suites
-  std::vector<SensorSuiteConfig> suite_configs_; // their configurations
-  std::vector<Motion> motion_;  // a step's substeps (only when it has more than one)
-  std::vector<Vec2> step_wheels_mps_;  // per slot: left (x) and right (y) ground speeds over the step
-  std::vector<Vec2> headings_;  // (cos, sin) of each robot's heading: computed when placed or seen, rotated by each step with the pose (equal to a few ulps)
+  std::vector<std::uint32_t> suite_of_;           // per slot: its suite in suite_pool_
+  std::vector<SensorSuite> suite_pool_;           // the distinct suites
+  std::vector<SensorSuiteConfig> suite_configs_;  // their configurations
+  std::vector<Motion> motion_;                    // a step's substeps (only when it has more than one)
+  std::vector<Vec2> step_wheels_mps_;             // per slot: left (x) and right (y) ground speeds over the step
+  std::vector<Vec2> headings_;  // (cos, sin) of each robot's heading: computed when placed or seen, rotated by each
+                                // step with the pose (equal to a few ulps)
   // Every robot's id (has_robot); its slot, which slot() reads only for ids without a
   // dense entry in by_id_, is kept current for those only (renumbering does not touch the
   // others' entries).
@@ -307,7 +308,7 @@ class World {
   // Packs `readings` as robot (added index) `added`'s record.
   void store_readings(std::size_t added, SensorReadings& readings);
   std::vector<StoredReadings> ahead_;
-  std::vector<StoredLists> ahead_lists_;  // by added index; empty unless a suite has lists
+  std::vector<StoredLists> ahead_lists_;      // by added index; empty unless a suite has lists
   std::vector<std::uint32_t> added_of_slot_;  // per slot: its robot's index in added_order_
   std::vector<Pose2> poses_;                  // each robot's pose, by index in added_order_
   std::vector<WheelUnits> commands_;          // each robot's wheel commands, by index in added_order_

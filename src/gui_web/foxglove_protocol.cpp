@@ -127,7 +127,8 @@ std::variant<ClientText, std::string> parse_client_advertise(Fields& f) {
 std::vector<std::string> parameter_names(Fields& f) {
   std::vector<std::string> names;
   if (const json* list = f.array("parameterNames")) {
-    for (std::size_t i = 0; i < list->size() && !f.problem(); ++i) names.push_back(f.string((*list)[i], item("parameterNames", i)));
+    for (std::size_t i = 0; i < list->size() && !f.problem(); ++i)
+      names.push_back(f.string((*list)[i], item("parameterNames", i)));
   }
   return names;
 }
@@ -199,7 +200,8 @@ std::variant<ClientText, std::string> parse_client_text(std::string_view text) {
 std::variant<ClientMessage, std::string> parse_client_binary(std::span<const std::uint8_t> frame) {
   if (frame.empty()) return std::string("empty binary message");
   if (frame[0] != 0x01) return "unknown binary opcode " + std::to_string(frame[0]);
-  if (frame.size() < 5) return "message of " + std::to_string(frame.size()) + " bytes is shorter than its 5-byte header";
+  if (frame.size() < 5)
+    return "message of " + std::to_string(frame.size()) + " bytes is shorter than its 5-byte header";
   ClientMessage m;
   m.channel_id = static_cast<std::uint32_t>(frame[1]) | (static_cast<std::uint32_t>(frame[2]) << 8) |
                  (static_cast<std::uint32_t>(frame[3]) << 16) | (static_cast<std::uint32_t>(frame[4]) << 24);
@@ -235,7 +237,8 @@ std::string advertise(std::span<const Channel> channels) {
 }
 
 std::string unadvertise(std::span<const std::uint32_t> channel_ids) {
-  return dump(json{{"op", "unadvertise"}, {"channelIds", std::vector<std::uint32_t>(channel_ids.begin(), channel_ids.end())}});
+  return dump(
+      json{{"op", "unadvertise"}, {"channelIds", std::vector<std::uint32_t>(channel_ids.begin(), channel_ids.end())}});
 }
 
 std::string status(Level level, const std::string& message, const std::string& id) {

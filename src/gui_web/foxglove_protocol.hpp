@@ -31,8 +31,8 @@ struct Channel {
   std::uint32_t id = 0;
   std::string topic;
   std::string encoding = "json";
-  std::string schema_name;             ///< e.g. "rilbed.poses_t", "foxglove.SceneUpdate"
-  std::string schema;                  ///< the JSON Schema, as text
+  std::string schema_name;  ///< e.g. "rilbed.poses_t", "foxglove.SceneUpdate"
+  std::string schema;       ///< the JSON Schema, as text
   std::string schema_encoding = "jsonschema";
 };
 
@@ -83,8 +83,8 @@ struct SubscribeParameterUpdates {
 struct UnsubscribeParameterUpdates {
   std::vector<std::string> names;
 };
-using ClientText = std::variant<Subscribe, Unsubscribe, ClientAdvertise, ClientUnadvertise, GetParameters, SetParameters,
-                                SubscribeParameterUpdates, UnsubscribeParameterUpdates>;
+using ClientText = std::variant<Subscribe, Unsubscribe, ClientAdvertise, ClientUnadvertise, GetParameters,
+                                SetParameters, SubscribeParameterUpdates, UnsubscribeParameterUpdates>;
 
 /// A client's binary Client Message Data frame: a message on one of its channels. The
 /// payload is a view into the frame.

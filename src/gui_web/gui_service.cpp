@@ -40,7 +40,9 @@ GuiService::GuiService(WebServerConfig config, ConsoleSink sink, ManualDriveConf
                                       std::string_view payload) { return on_client_message(client, topic, payload); };
   handlers.on_client_gone = [this](const std::string& client) { on_client_gone(client); };
   handlers.on_set_parameters = [this](const std::string& client, const std::vector<foxglove::Parameter>& parameters,
-                                      const std::optional<std::string>& id) { on_set_parameters(client, parameters, id); };
+                                      const std::optional<std::string>& id) {
+    on_set_parameters(client, parameters, id);
+  };
   server_ = std::make_unique<WebServer>(config_, std::move(handlers));
   channels_ = std::make_unique<RunChannels>(*server_);
   thread_ = std::thread([this] { loop(); });
@@ -80,7 +82,8 @@ GuiCounters GuiService::counters() const {
 std::optional<std::string> GuiService::on_client_message(const std::string& client, const std::string& topic,
                                                          std::string_view payload) {
   if (topic == "/rilbed/drive") return on_drive_message(client, payload);
-  if (topic != "/rilbed/console") return "this server takes messages on /rilbed/console and /rilbed/drive, not " + topic;
+  if (topic != "/rilbed/console")
+    return "this server takes messages on /rilbed/console and /rilbed/drive, not " + topic;
   const auto j = nlohmann::json::parse(payload, nullptr, false);
   if (j.is_discarded() || !j.is_object() || !j.contains("command") || !j["command"].is_string()) {
     return std::string("a console message is {\"command\": \"pause\", \"args\": []}");
@@ -103,23 +106,27 @@ std::optional<std::string> GuiService::on_client_message(const std::string& clie
 std::optional<std::string> GuiService::on_drive_message(const std::string& client, std::string_view payload) {
   const auto j = nlohmann::json::parse(payload, nullptr, false);
   const char* usage = "a drive message is {\"id\": 4, \"left\": 20, \"right\": 20} or {\"id\": 4, \"release\": true}";
-  if (j.is_discarded() || !j.is_object() || !j.contains("id") || !j["id"].is_number_integer()) return std::string(usage);
+  if (j.is_discarded() || !j.is_object() || !j.contains("id") || !j["id"].is_number_integer())
+    return std::string(usage);
   const long long id = j["id"].get<long long>();
   if (id < 0 || id > 1'000'000) return "'" + j["id"].dump() + "' is not a robot ID";
   const int robot = static_cast<int>(id);
   std::lock_guard lock(mutex_);
   if (j.value("release", false)) {
     const auto it = holds_.find(robot);
-    if (it == holds_.end() || it->second.client != client || it->second.ending) return "robot " + std::to_string(robot) + " is not yours to release";
+    if (it == holds_.end() || it->second.client != client || it->second.ending)
+      return "robot " + std::to_string(robot) + " is not yours to release";
     it->second.ending = true;
     wake_.notify_all();
     return std::nullopt;
   }
-  if (!j.contains("left") || !j.contains("right") || !j["left"].is_number_integer() || !j["right"].is_number_integer()) {
+  if (!j.contains("left") || !j.contains("right") || !j["left"].is_number_integer() ||
+      !j["right"].is_number_integer()) {
     return std::string(usage);
   }
   const long long left = j["left"].get<long long>(), right = j["right"].get<long long>();
-  if (std::llabs(left) > 127 || std::llabs(right) > 127) return std::string("wheel speeds are -127..127 (Khepera units)");
+  if (std::llabs(left) > 127 || std::llabs(right) > 127)
+    return std::string("wheel speeds are -127..127 (Khepera units)");
   // One robot per client: taking another gives the first one back.
   for (auto& [other, hold] : holds_) {
     if (other != robot && hold.client == client) hold.ending = true;
@@ -129,7 +136,8 @@ std::optional<std::string> GuiService::on_drive_message(const std::string& clien
     // A new driver (or a take-over: the last driver's hold ends here, without a gap).
     // Told to the last driver alone (a status on its socket): its page lets go of the robot.
     if (!hold.client.empty()) {
-      server_->tell(hold.client, foxglove::Level::kWarning, "robot " + std::to_string(robot) + " taken over by " + client);
+      server_->tell(hold.client, foxglove::Level::kWarning,
+                    "robot " + std::to_string(robot) + " taken over by " + client);
     }
     hold = Hold{};
     hold.client = client;
@@ -252,13 +260,17 @@ void GuiService::drive_tick(std::unique_lock<std::mutex>& lock) {
   lock.unlock();
   std::vector<std::pair<int, ConsoleAnswer>> refusals;
   for (const Order& o : orders) {
-    const ConsoleAnswer answer = sink_({o.client, "drive",
-                                        {std::to_string(o.robot), std::to_string(o.left), std::to_string(o.right),
-                                         seconds_text(hold_s)},
-                                        std::nullopt,
-                                        std::nullopt});
+    const ConsoleAnswer answer =
+        sink_({o.client,
+               "drive",
+               {std::to_string(o.robot), std::to_string(o.left), std::to_string(o.right), seconds_text(hold_s)},
+               std::nullopt,
+               std::nullopt});
     if (!answer.accepted) refusals.emplace_back(o.robot, answer);
-    if (o.final_stop) channels_->console_reply(0, answer.accepted, "robot " + std::to_string(o.robot) + " stopped and given back to its controller", o.client);
+    if (o.final_stop)
+      channels_->console_reply(0, answer.accepted,
+                               "robot " + std::to_string(o.robot) + " stopped and given back to its controller",
+                               o.client);
   }
   lock.lock();
   counts_.drive_commands += orders.size();
@@ -268,7 +280,8 @@ void GuiService::drive_tick(std::unique_lock<std::mutex>& lock) {
     const auto it = holds_.find(robot);
     if (it == holds_.end() || it->second.last_refusal == answer.reason) continue;
     it->second.last_refusal = answer.reason;
-    channels_->console_reply(0, false, "drive robot " + std::to_string(robot) + ": " + answer.reason, it->second.client);
+    channels_->console_reply(0, false, "drive robot " + std::to_string(robot) + ": " + answer.reason,
+                             it->second.client);
   }
 }
 
@@ -278,7 +291,9 @@ bool GuiService::wants_steps() const { return server_->clients() > 0; }
 
 void GuiService::on_world(TimeUs t_us, const agents::WorldReport& world) { channels_->on_world(t_us, world); }
 void GuiService::on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) { channels_->on_poses(t_us, poses); }
-void GuiService::on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wheels) { channels_->on_wheels(t_us, wheels); }
+void GuiService::on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wheels) {
+  channels_->on_wheels(t_us, wheels);
+}
 void GuiService::on_sensors(TimeUs t_us, std::span<const agents::SensorReport> sensors) {
   channels_->on_sensors(t_us, sensors);
 }

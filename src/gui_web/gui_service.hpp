@@ -114,7 +114,8 @@ class GuiService final : public agents::RunObserver {
   void on_detections(const agents::FrameReport& frame) override;
   bool wants_frame_jpegs() const override { return true; }
   /// Passes at most max_camera_fps frames a second on, and only while someone watches.
-  void on_frame_jpeg(TimeUs t_us, std::int64_t frame, int width_px, int height_px, std::span<const std::uint8_t> jpeg) override;
+  void on_frame_jpeg(TimeUs t_us, std::int64_t frame, int width_px, int height_px,
+                     std::span<const std::uint8_t> jpeg) override;
   void on_event(const agents::RunEvent& event) override;
   void on_status(const agents::StatusReport& status) override;
   void on_summary(TimeUs t_us, const nlohmann::json& summary) override;
@@ -124,15 +125,16 @@ class GuiService final : public agents::RunObserver {
   // One robot held by one client.
   struct Hold {
     std::string client;
-    int left = 0, right = 0;          // the client's last key-held speeds
-    Clock::time_point last_key{};     // when they came
-    bool ending = false;              // released, gone or taken over: one stop, then forgotten
+    int left = 0, right = 0;                  // the client's last key-held speeds
+    Clock::time_point last_key{};             // when they came
+    bool ending = false;                      // released, gone or taken over: one stop, then forgotten
     std::optional<std::pair<int, int>> sent;  // the speeds of the last hold sent to the run
     Clock::time_point sent_at{};
-    std::string last_refusal;         // the run's last refusal, told to the client once
+    std::string last_refusal;  // the run's last refusal, told to the client once
   };
 
-  std::optional<std::string> on_client_message(const std::string& client, const std::string& topic, std::string_view payload);
+  std::optional<std::string> on_client_message(const std::string& client, const std::string& topic,
+                                               std::string_view payload);
   std::optional<std::string> on_drive_message(const std::string& client, std::string_view payload);
   void on_client_gone(const std::string& client);
   void on_set_parameters(const std::string& client, const std::vector<foxglove::Parameter>& parameters,

@@ -30,22 +30,39 @@ json time_of(TimeUs t_us) {
 }
 json point(double x, double y, double z = 0.0) { return {{"x", x}, {"y", y}, {"z", z}}; }
 json pose(double x, double y, double z, double yaw_rad) {
-  return {{"position", point(x, y, z)}, {"orientation", {{"x", 0.0}, {"y", 0.0}, {"z", std::sin(yaw_rad / 2)}, {"w", std::cos(yaw_rad / 2)}}}};
+  return {{"position", point(x, y, z)},
+          {"orientation", {{"x", 0.0}, {"y", 0.0}, {"z", std::sin(yaw_rad / 2)}, {"w", std::cos(yaw_rad / 2)}}}};
 }
 json color(double r, double g, double b, double a = 1.0) { return {{"r", r}, {"g", g}, {"b", b}, {"a", a}}; }
 
 json entity(TimeUs t_us, const std::string& id) {
-  return {{"timestamp", time_of(t_us)}, {"frame_id", "field"}, {"id", id}, {"lifetime", {{"sec", 0}, {"nsec", 0}}},
-          {"frame_locked", false}, {"metadata", json::array()}, {"arrows", json::array()}, {"cubes", json::array()},
-          {"spheres", json::array()}, {"cylinders", json::array()}, {"lines", json::array()}, {"triangles", json::array()},
-          {"texts", json::array()}, {"models", json::array()}};
+  return {{"timestamp", time_of(t_us)},
+          {"frame_id", "field"},
+          {"id", id},
+          {"lifetime", {{"sec", 0}, {"nsec", 0}}},
+          {"frame_locked", false},
+          {"metadata", json::array()},
+          {"arrows", json::array()},
+          {"cubes", json::array()},
+          {"spheres", json::array()},
+          {"cylinders", json::array()},
+          {"lines", json::array()},
+          {"triangles", json::array()},
+          {"texts", json::array()},
+          {"models", json::array()}};
 }
 
 json line(const std::vector<Vec2>& points, bool loop, double thickness_m, const json& c) {
   json pts = json::array();
   for (const Vec2& p : points) pts.push_back(point(p.x, p.y));
-  return {{"type", loop ? 1 : 0}, {"pose", pose(0, 0, 0, 0)}, {"thickness", thickness_m}, {"scale_invariant", false},
-          {"points", pts}, {"color", c}, {"colors", json::array()}, {"indices", json::array()}};
+  return {{"type", loop ? 1 : 0},
+          {"pose", pose(0, 0, 0, 0)},
+          {"thickness", thickness_m},
+          {"scale_invariant", false},
+          {"points", pts},
+          {"color", c},
+          {"colors", json::array()},
+          {"indices", json::array()}};
 }
 
 // The parts of foxglove.SceneUpdate this server fills (Foxglove reads the datatypes of
@@ -56,17 +73,37 @@ std::string scene_schema() {
   const json pose_s = object_of({{"position", vec3}, {"orientation", quat}});
   const json color_s = object_of({{"r", number()}, {"g", number()}, {"b", number()}, {"a", number()}});
   const json time_s = object_of({{"sec", integer()}, {"nsec", integer()}});
-  const json cylinder = object_of({{"pose", pose_s}, {"size", vec3}, {"bottom_scale", number()}, {"top_scale", number()}, {"color", color_s}});
-  const json text_s = object_of({{"pose", pose_s}, {"billboard", boolean()}, {"font_size", number()}, {"scale_invariant", boolean()},
-                                 {"color", color_s}, {"text", text()}});
-  const json line_s = object_of({{"type", integer()}, {"pose", pose_s}, {"thickness", number()}, {"scale_invariant", boolean()},
-                                 {"points", array_of(vec3)}, {"color", color_s}, {"colors", array_of(color_s)},
+  const json cylinder = object_of(
+      {{"pose", pose_s}, {"size", vec3}, {"bottom_scale", number()}, {"top_scale", number()}, {"color", color_s}});
+  const json text_s = object_of({{"pose", pose_s},
+                                 {"billboard", boolean()},
+                                 {"font_size", number()},
+                                 {"scale_invariant", boolean()},
+                                 {"color", color_s},
+                                 {"text", text()}});
+  const json line_s = object_of({{"type", integer()},
+                                 {"pose", pose_s},
+                                 {"thickness", number()},
+                                 {"scale_invariant", boolean()},
+                                 {"points", array_of(vec3)},
+                                 {"color", color_s},
+                                 {"colors", array_of(color_s)},
                                  {"indices", array_of(integer())}});
-  const json arrow = object_of({{"pose", pose_s}, {"shaft_length", number()}, {"shaft_diameter", number()},
-                                {"head_length", number()}, {"head_diameter", number()}, {"color", color_s}});
-  const json entity_s = object_of({{"timestamp", time_s}, {"frame_id", text()}, {"id", text()}, {"lifetime", time_s},
-                                   {"frame_locked", boolean()}, {"cylinders", array_of(cylinder)}, {"texts", array_of(text_s)},
-                                   {"lines", array_of(line_s)}, {"arrows", array_of(arrow)}});
+  const json arrow = object_of({{"pose", pose_s},
+                                {"shaft_length", number()},
+                                {"shaft_diameter", number()},
+                                {"head_length", number()},
+                                {"head_diameter", number()},
+                                {"color", color_s}});
+  const json entity_s = object_of({{"timestamp", time_s},
+                                   {"frame_id", text()},
+                                   {"id", text()},
+                                   {"lifetime", time_s},
+                                   {"frame_locked", boolean()},
+                                   {"cylinders", array_of(cylinder)},
+                                   {"texts", array_of(text_s)},
+                                   {"lines", array_of(line_s)},
+                                   {"arrows", array_of(arrow)}});
   const json deletion = object_of({{"timestamp", time_s}, {"type", integer()}, {"id", text()}});
   return object_schema("foxglove.SceneUpdate", {{"deletions", array_of(deletion)}, {"entities", array_of(entity_s)}});
 }
@@ -112,59 +149,120 @@ foxglove::Channel channel(const std::string& topic, const std::string& schema_na
 }  // namespace
 
 RunChannels::RunChannels(WebServer& server) : server_(server) {
-  const json robot_pose = object_of({{"id", integer()}, {"real", boolean()}, {"seen", boolean()}, {"x_m", number()},
-                                     {"y_m", number()}, {"theta_rad", number()}, {"behaviour", text()}, {"health", text()}});
+  const json robot_pose = object_of({{"id", integer()},
+                                     {"real", boolean()},
+                                     {"seen", boolean()},
+                                     {"x_m", number()},
+                                     {"y_m", number()},
+                                     {"theta_rad", number()},
+                                     {"behaviour", text()},
+                                     {"health", text()}});
   const json polyline = array_of(object_of({{"x_m", number()}, {"y_m", number()}}));
-  world_ = server_.add_channel(channel("/rilbed/world", "rilbed.world",
-      object_schema("rilbed.world", {{"t_s", number()}, {"scenario", text()}, {"width_m", number()}, {"height_m", number()},
-                                     {"walls", boolean()}, {"obstacles", array_of(polyline)},
-                                     {"tracks", array_of(object_of({{"points", polyline}, {"width_m", number()}}))},
-                                     {"beacons", polyline},
-                                     {"robots", array_of(object_of({{"id", integer()}, {"real", boolean()},
-                                                                    {"sensors", object_of({{"ir_range_m", number()},
-                                                                                           {"ranges", array_of(object_of({{"mount_rad", number()}, {"opening_rad", number()}, {"max_m", number()}}))},
-                                                                                           {"beacon_finder", boolean()},
-                                                                                           {"beacon_fov_rad", number()},
-                                                                                           {"tracks", array_of(polyline)}})}}))}})), /*latched=*/true);
+  world_ = server_.add_channel(
+      channel("/rilbed/world", "rilbed.world",
+              object_schema(
+                  "rilbed.world",
+                  {{"t_s", number()},
+                   {"scenario", text()},
+                   {"width_m", number()},
+                   {"height_m", number()},
+                   {"walls", boolean()},
+                   {"obstacles", array_of(polyline)},
+                   {"tracks", array_of(object_of({{"points", polyline}, {"width_m", number()}}))},
+                   {"beacons", polyline},
+                   {"robots",
+                    array_of(object_of({{"id", integer()},
+                                        {"real", boolean()},
+                                        {"sensors", object_of({{"ir_range_m", number()},
+                                                               {"ranges", array_of(object_of({{"mount_rad", number()},
+                                                                                              {"opening_rad", number()},
+                                                                                              {"max_m", number()}}))},
+                                                               {"beacon_finder", boolean()},
+                                                               {"beacon_fov_rad", number()},
+                                                               {"tracks", array_of(polyline)}})}}))}})),
+      /*latched=*/true);
   status_ = server_.add_channel(channel("/rilbed/status", "rilbed.status",
-      object_schema("rilbed.status", {{"t_s", number()}, {"wall_s", number()}, {"scenario", text()}, {"seed", integer()},
-                                      {"mode", text()}, {"realtime", boolean()}, {"rt_factor", number()}, {"state", text()},
-                                      {"ended_by", text()}, {"robots", integer()}, {"real_robots", integer()},
-                                      {"formed", boolean()}, {"formation_time_s", number()}, {"collisions", integer()},
-                                      {"loop_latency_ms", number()}, {"camera_fps", number()}, {"frames", integer()}})), /*latched=*/true);
-  poses_ = server_.add_channel(channel("/rilbed/poses", "rilbed.poses",
-      object_schema("rilbed.poses", {{"t_s", number()}, {"robots", array_of(robot_pose)}})), /*latched=*/true);
-  wheels_ = server_.add_channel(channel("/rilbed/wheels", "rilbed.wheels",
-      object_schema("rilbed.wheels", {{"t_s", number()}, {"robots", array_of(object_of({{"id", integer()}, {"left_units", integer()},
-                                                                                        {"right_units", integer()}}))}})));
-  sensors_ = server_.add_channel(channel("/rilbed/sensors", "rilbed.sensors",
+                                        object_schema("rilbed.status", {{"t_s", number()},
+                                                                        {"wall_s", number()},
+                                                                        {"scenario", text()},
+                                                                        {"seed", integer()},
+                                                                        {"mode", text()},
+                                                                        {"realtime", boolean()},
+                                                                        {"rt_factor", number()},
+                                                                        {"state", text()},
+                                                                        {"ended_by", text()},
+                                                                        {"robots", integer()},
+                                                                        {"real_robots", integer()},
+                                                                        {"formed", boolean()},
+                                                                        {"formation_time_s", number()},
+                                                                        {"collisions", integer()},
+                                                                        {"loop_latency_ms", number()},
+                                                                        {"camera_fps", number()},
+                                                                        {"frames", integer()}})),
+                                /*latched=*/true);
+  poses_ =
+      server_.add_channel(channel("/rilbed/poses", "rilbed.poses",
+                                  object_schema("rilbed.poses", {{"t_s", number()}, {"robots", array_of(robot_pose)}})),
+                          /*latched=*/true);
+  wheels_ = server_.add_channel(channel(
+      "/rilbed/wheels", "rilbed.wheels",
+      object_schema("rilbed.wheels",
+                    {{"t_s", number()},
+                     {"robots", array_of(object_of(
+                                    {{"id", integer()}, {"left_units", integer()}, {"right_units", integer()}}))}})));
+  sensors_ = server_.add_channel(channel(
+      "/rilbed/sensors", "rilbed.sensors",
       object_schema("rilbed.sensors", {{"t_s", number()},
-                                       {"robots", array_of(object_of({{"id", integer()}, {"proximity", array_of(integer())},
-                                                                      {"range_m", array_of(number())}, {"range_hit", array_of(boolean())},
+                                       {"robots", array_of(object_of({{"id", integer()},
+                                                                      {"proximity", array_of(integer())},
+                                                                      {"range_m", array_of(number())},
+                                                                      {"range_hit", array_of(boolean())},
                                                                       {"beacon_id", array_of(integer())},
                                                                       {"beacon_bearing_rad", array_of(number())},
                                                                       {"track", array_of(integer())}}))}})));
-  detections_ = server_.add_channel(channel("/rilbed/detections", "rilbed.detections",
-      object_schema("rilbed.detections", {{"t_s", number()}, {"frame", integer()}, {"process_ms", number()},
-                                          {"detections", array_of(object_of({{"id", integer()}, {"u_px", number()}, {"v_px", number()},
-                                                                             {"heading_deg", number()}, {"score", number()},
-                                                                             {"diameter_px", number()}, {"x_m", number()},
-                                                                             {"y_m", number()}, {"theta_rad", number()}}))}})));
-  events_ = server_.add_channel(channel("/rilbed/events", "rilbed.event",
-      object_schema("rilbed.event", {{"t_s", number()}, {"kind", text()}, {"id", integer()}, {"other", integer()}, {"detail", text()}})));
-  summary_ = server_.add_channel(channel("/rilbed/summary", "rilbed.summary", object_schema("rilbed.summary", json::object())));
+  detections_ = server_.add_channel(
+      channel("/rilbed/detections", "rilbed.detections",
+              object_schema("rilbed.detections", {{"t_s", number()},
+                                                  {"frame", integer()},
+                                                  {"process_ms", number()},
+                                                  {"detections", array_of(object_of({{"id", integer()},
+                                                                                     {"u_px", number()},
+                                                                                     {"v_px", number()},
+                                                                                     {"heading_deg", number()},
+                                                                                     {"score", number()},
+                                                                                     {"diameter_px", number()},
+                                                                                     {"x_m", number()},
+                                                                                     {"y_m", number()},
+                                                                                     {"theta_rad", number()}}))}})));
+  events_ = server_.add_channel(
+      channel("/rilbed/events", "rilbed.event",
+              object_schema(
+                  "rilbed.event",
+                  {{"t_s", number()}, {"kind", text()}, {"id", integer()}, {"other", integer()}, {"detail", text()}})));
+  summary_ = server_.add_channel(
+      channel("/rilbed/summary", "rilbed.summary", object_schema("rilbed.summary", json::object())));
   scene_ = server_.add_channel(channel("/rilbed/scene", "foxglove.SceneUpdate", scene_schema()), /*latched=*/true);
   const json time_s = object_of({{"sec", integer()}, {"nsec", integer()}});
-  camera_ = server_.add_channel(channel("/rilbed/camera", "foxglove.CompressedImage",
-      object_schema("foxglove.CompressedImage", {{"timestamp", time_s}, {"frame_id", text()},
-                                                 {"data", {{"type", "string"}, {"contentEncoding", "base64"}}},
-                                                 {"format", text()}})));
-  camera_calibration_ = server_.add_channel(channel("/rilbed/camera_calibration", "rilbed.camera",
-      object_schema("rilbed.camera", {{"t_s", number()}, {"width_px", integer()}, {"height_px", integer()},
-                                      {"image_to_field", array_of(number())}, {"field_to_image", array_of(number())},
-                                      {"lens_distortion", boolean()}, {"source", text()}})), /*latched=*/true);
-  console_reply_ = server_.add_channel(channel("/rilbed/console_reply", "rilbed.console_reply",
-      object_schema("rilbed.console_reply", {{"t_s", number()}, {"accepted", boolean()}, {"reason", text()}, {"client", text()}})));
+  camera_ = server_.add_channel(
+      channel("/rilbed/camera", "foxglove.CompressedImage",
+              object_schema("foxglove.CompressedImage", {{"timestamp", time_s},
+                                                         {"frame_id", text()},
+                                                         {"data", {{"type", "string"}, {"contentEncoding", "base64"}}},
+                                                         {"format", text()}})));
+  camera_calibration_ =
+      server_.add_channel(channel("/rilbed/camera_calibration", "rilbed.camera",
+                                  object_schema("rilbed.camera", {{"t_s", number()},
+                                                                  {"width_px", integer()},
+                                                                  {"height_px", integer()},
+                                                                  {"image_to_field", array_of(number())},
+                                                                  {"field_to_image", array_of(number())},
+                                                                  {"lens_distortion", boolean()},
+                                                                  {"source", text()}})),
+                          /*latched=*/true);
+  console_reply_ = server_.add_channel(
+      channel("/rilbed/console_reply", "rilbed.console_reply",
+              object_schema("rilbed.console_reply",
+                            {{"t_s", number()}, {"accepted", boolean()}, {"reason", text()}, {"client", text()}})));
   server_.set_latch_source(poses_, [latest = latest_](std::uint64_t& t_ns) { return latest->build(false, t_ns); });
   server_.set_latch_source(scene_, [latest = latest_](std::uint64_t& t_ns) { return latest->build(true, t_ns); });
   worker_ = std::thread([this] {
@@ -192,50 +290,82 @@ json RunChannels::world_json(TimeUs t_us, const agents::WorldReport& w) {
   std::vector<json> geometries;
   for (const agents::SensorGeometry& g : w.sensor_geometries) {
     json ranges = json::array();
-    for (const auto& r : g.ranges) ranges.push_back({{"mount_rad", r.mount_rad}, {"opening_rad", r.opening_rad}, {"max_m", r.max_m}});
+    for (const auto& r : g.ranges)
+      ranges.push_back({{"mount_rad", r.mount_rad}, {"opening_rad", r.opening_rad}, {"max_m", r.max_m}});
     json tracks = json::array();
     for (const auto& element : g.track_points_m) tracks.push_back(points(element));
-    geometries.push_back({{"ir_range_m", g.ir_range_m}, {"ranges", ranges}, {"beacon_finder", g.beacon_finder},
-                          {"beacon_fov_rad", g.beacon_fov_rad}, {"tracks", tracks}});
+    geometries.push_back({{"ir_range_m", g.ir_range_m},
+                          {"ranges", ranges},
+                          {"beacon_finder", g.beacon_finder},
+                          {"beacon_fov_rad", g.beacon_fov_rad},
+                          {"tracks", tracks}});
   }
   json robots = json::array();
   for (const int id : w.robot_ids) {
     json robot = {{"id", id}, {"real", w.field.real_robot_ids.contains(id)}};
     const auto it = w.sensor_geometry_of.find(id);
-    if (it != w.sensor_geometry_of.end() && it->second >= 0 && static_cast<std::size_t>(it->second) < geometries.size()) {
+    if (it != w.sensor_geometry_of.end() && it->second >= 0 &&
+        static_cast<std::size_t>(it->second) < geometries.size()) {
       robot["sensors"] = geometries[static_cast<std::size_t>(it->second)];
     }
     robots.push_back(std::move(robot));
   }
-  return {{"t_s", seconds(t_us)}, {"scenario", w.scenario}, {"width_m", w.field.width_m}, {"height_m", w.field.height_m},
-          {"walls", w.walls}, {"obstacles", obstacles}, {"tracks", tracks}, {"beacons", points(w.field.beacons)}, {"robots", robots}};
+  return {{"t_s", seconds(t_us)},
+          {"scenario", w.scenario},
+          {"width_m", w.field.width_m},
+          {"height_m", w.field.height_m},
+          {"walls", w.walls},
+          {"obstacles", obstacles},
+          {"tracks", tracks},
+          {"beacons", points(w.field.beacons)},
+          {"robots", robots}};
 }
 
 json RunChannels::poses_json(TimeUs t_us, std::span<const agents::PoseReport> poses) {
   json robots = json::array();
   for (const auto& p : poses) {
-    robots.push_back({{"id", p.id}, {"real", p.real}, {"seen", p.seen}, {"x_m", p.pose.position_m.x}, {"y_m", p.pose.position_m.y},
-                      {"theta_rad", p.pose.heading_rad}, {"behaviour", p.behaviour}, {"health", p.health}});
+    robots.push_back({{"id", p.id},
+                      {"real", p.real},
+                      {"seen", p.seen},
+                      {"x_m", p.pose.position_m.x},
+                      {"y_m", p.pose.position_m.y},
+                      {"theta_rad", p.pose.heading_rad},
+                      {"behaviour", p.behaviour},
+                      {"health", p.health}});
   }
   return {{"t_s", seconds(t_us)}, {"robots", robots}};
 }
 
 json RunChannels::status_json(const agents::StatusReport& s) {
-  return {{"t_s", seconds(s.t_us)}, {"wall_s", s.wall_s}, {"scenario", s.scenario}, {"seed", s.seed}, {"mode", s.mode},
-          {"realtime", s.realtime}, {"rt_factor", s.rt_factor}, {"state", s.state}, {"ended_by", s.ended_by},
-          {"robots", s.robots}, {"real_robots", s.real_robots}, {"formed", s.formed},
-          {"formation_time_s", s.formation_time_s ? json(*s.formation_time_s) : json(nullptr)}, {"collisions", s.collisions},
-          {"loop_latency_ms", s.loop_latency_ms}, {"camera_fps", s.camera_fps}, {"frames", s.frames}};
+  return {{"t_s", seconds(s.t_us)},
+          {"wall_s", s.wall_s},
+          {"scenario", s.scenario},
+          {"seed", s.seed},
+          {"mode", s.mode},
+          {"realtime", s.realtime},
+          {"rt_factor", s.rt_factor},
+          {"state", s.state},
+          {"ended_by", s.ended_by},
+          {"robots", s.robots},
+          {"real_robots", s.real_robots},
+          {"formed", s.formed},
+          {"formation_time_s", s.formation_time_s ? json(*s.formation_time_s) : json(nullptr)},
+          {"collisions", s.collisions},
+          {"loop_latency_ms", s.loop_latency_ms},
+          {"camera_fps", s.camera_fps},
+          {"frames", s.frames}};
 }
 
-json RunChannels::scene_json(TimeUs t_us, std::span<const agents::PoseReport> poses, const std::optional<agents::WorldReport>& world) {
+json RunChannels::scene_json(TimeUs t_us, std::span<const agents::PoseReport> poses,
+                             const std::optional<agents::WorldReport>& world) {
   json entities = json::array();
   if (world) {
     json field = entity(t_us, "field");
     const double w = world->field.width_m, h = world->field.height_m;
     field["lines"].push_back(line({{0, 0}, {w, 0}, {w, h}, {0, h}}, true, 0.01, color(0.1, 0.7, 0.1)));
     for (const auto& o : world->field.obstacles) field["lines"].push_back(line(o, true, 0.01, color(0.3, 0.3, 0.3)));
-    for (const auto& [ps, width_m] : world->field.tracks) field["lines"].push_back(line(ps, false, width_m, color(0.2, 0.2, 0.2, 0.6)));
+    for (const auto& [ps, width_m] : world->field.tracks)
+      field["lines"].push_back(line(ps, false, width_m, color(0.2, 0.2, 0.2, 0.6)));
     entities.push_back(std::move(field));
   }
   constexpr double kDiameter_m = 0.055;  // a Khepera
@@ -243,12 +373,23 @@ json RunChannels::scene_json(TimeUs t_us, std::span<const agents::PoseReport> po
     json e = entity(t_us, "robot " + std::to_string(p.id));
     const json c = p.real ? color(0.15, 0.35, 0.9, p.seen ? 0.9 : 0.4) : color(0.9, 0.15, 0.15, 0.8);
     const double x = p.pose.position_m.x, y = p.pose.position_m.y;
-    e["cylinders"].push_back({{"pose", pose(x, y, 0.01, p.pose.heading_rad)}, {"size", point(kDiameter_m, kDiameter_m, 0.02)},
-                              {"bottom_scale", 1.0}, {"top_scale", 1.0}, {"color", c}});
-    e["arrows"].push_back({{"pose", pose(x, y, 0.025, p.pose.heading_rad)}, {"shaft_length", 0.03}, {"shaft_diameter", 0.006},
-                           {"head_length", 0.012}, {"head_diameter", 0.014}, {"color", color(0, 0, 0)}});
-    e["texts"].push_back({{"pose", pose(x, y, 0.06, 0)}, {"billboard", true}, {"font_size", 12.0}, {"scale_invariant", true},
-                          {"color", color(0, 0, 0)}, {"text", std::to_string(p.id) + " " + std::string(p.behaviour)}});
+    e["cylinders"].push_back({{"pose", pose(x, y, 0.01, p.pose.heading_rad)},
+                              {"size", point(kDiameter_m, kDiameter_m, 0.02)},
+                              {"bottom_scale", 1.0},
+                              {"top_scale", 1.0},
+                              {"color", c}});
+    e["arrows"].push_back({{"pose", pose(x, y, 0.025, p.pose.heading_rad)},
+                           {"shaft_length", 0.03},
+                           {"shaft_diameter", 0.006},
+                           {"head_length", 0.012},
+                           {"head_diameter", 0.014},
+                           {"color", color(0, 0, 0)}});
+    e["texts"].push_back({{"pose", pose(x, y, 0.06, 0)},
+                          {"billboard", true},
+                          {"font_size", 12.0},
+                          {"scale_invariant", true},
+                          {"color", color(0, 0, 0)},
+                          {"text", std::to_string(p.id) + " " + std::string(p.behaviour)}});
     entities.push_back(std::move(e));
   }
   return {{"deletions", json::array()}, {"entities", entities}};
@@ -306,8 +447,12 @@ void RunChannels::on_world(TimeUs t_us, const agents::WorldReport& world) {
       const agents::CameraReport& c = *world.camera;
       const auto to_image = inverse(c.image_to_field);
       send(camera_calibration_, t_us,
-           {{"t_s", seconds(t_us)}, {"width_px", c.width_px}, {"height_px", c.height_px}, {"image_to_field", c.image_to_field},
-            {"field_to_image", to_image ? json(*to_image) : json(nullptr)}, {"lens_distortion", c.lens_distortion},
+           {{"t_s", seconds(t_us)},
+            {"width_px", c.width_px},
+            {"height_px", c.height_px},
+            {"image_to_field", c.image_to_field},
+            {"field_to_image", to_image ? json(*to_image) : json(nullptr)},
+            {"lens_distortion", c.lens_distortion},
             {"source", c.source}});
     }
     send(world_, t_us, world_json(t_us, world));
@@ -372,7 +517,8 @@ void RunChannels::on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wh
   if (!server_.subscribed(wheels_)) return;  // nobody would get it
   post(wheels_, true, [this, t_us, copy = std::vector<agents::WheelReport>(wheels.begin(), wheels.end())] {
     json robots = json::array();
-    for (const auto& w : copy) robots.push_back({{"id", w.id}, {"left_units", w.wheels.left}, {"right_units", w.wheels.right}});
+    for (const auto& w : copy)
+      robots.push_back({{"id", w.id}, {"left_units", w.wheels.left}, {"right_units", w.wheels.right}});
     send(wheels_, t_us, {{"t_s", seconds(t_us)}, {"robots", robots}});
   });
 }
@@ -394,8 +540,13 @@ void RunChannels::on_sensors(TimeUs t_us, std::span<const agents::SensorReport> 
         ids.push_back(b.id);
         bearings.push_back(b.bearing_rad);
       }
-      robots.push_back({{"id", id}, {"proximity", s.proximity ? json(*s.proximity) : json::array()}, {"range_m", ranges},
-                        {"range_hit", hits}, {"beacon_id", ids}, {"beacon_bearing_rad", bearings}, {"track", s.track}});
+      robots.push_back({{"id", id},
+                        {"proximity", s.proximity ? json(*s.proximity) : json::array()},
+                        {"range_m", ranges},
+                        {"range_hit", hits},
+                        {"beacon_id", ids},
+                        {"beacon_bearing_rad", bearings},
+                        {"track", s.track}});
     }
     send(sensors_, t_us, {{"t_s", seconds(t_us)}, {"robots", robots}});
   });
@@ -408,17 +559,25 @@ void RunChannels::on_detections(const agents::FrameReport& f) {
         copy = std::vector<agents::DetectionReport>(f.detections.begin(), f.detections.end())] {
          json list = json::array();
          for (const auto& d : copy) {
-           list.push_back({{"id", d.id}, {"u_px", d.u_px}, {"v_px", d.v_px}, {"heading_deg", d.heading_deg}, {"score", d.score},
-                           {"diameter_px", d.diameter_px}, {"x_m", d.pose.position_m.x}, {"y_m", d.pose.position_m.y},
+           list.push_back({{"id", d.id},
+                           {"u_px", d.u_px},
+                           {"v_px", d.v_px},
+                           {"heading_deg", d.heading_deg},
+                           {"score", d.score},
+                           {"diameter_px", d.diameter_px},
+                           {"x_m", d.pose.position_m.x},
+                           {"y_m", d.pose.position_m.y},
                            {"theta_rad", d.pose.heading_rad}});
          }
-         send(detections_, t_us, {{"t_s", seconds(t_us)}, {"frame", frame}, {"process_ms", process_ms}, {"detections", list}});
+         send(detections_, t_us,
+              {{"t_s", seconds(t_us)}, {"frame", frame}, {"process_ms", process_ms}, {"detections", list}});
        });
 }
 
 void RunChannels::on_event(const agents::RunEvent& e) {
   post(events_, false, [this, e] {
-    send(events_, e.t_us, {{"t_s", seconds(e.t_us)}, {"kind", e.kind}, {"id", e.id}, {"other", e.other}, {"detail", e.detail}});
+    send(events_, e.t_us,
+         {{"t_s", seconds(e.t_us)}, {"kind", e.kind}, {"id", e.id}, {"other", e.other}, {"detail", e.detail}});
   });
 }
 
@@ -432,13 +591,15 @@ void RunChannels::on_summary(TimeUs t_us, const nlohmann::json& summary) {
 
 void RunChannels::camera_frame(TimeUs t_us, std::span<const std::uint8_t> jpeg) {
   post(camera_, true, [this, t_us, copy = std::vector<std::uint8_t>(jpeg.begin(), jpeg.end())] {
-    send(camera_, t_us, {{"timestamp", time_of(t_us)}, {"frame_id", "camera"}, {"data", base64(copy)}, {"format", "jpeg"}});
+    send(camera_, t_us,
+         {{"timestamp", time_of(t_us)}, {"frame_id", "camera"}, {"data", base64(copy)}, {"format", "jpeg"}});
   });
 }
 
 void RunChannels::console_reply(TimeUs t_us, bool accepted, const std::string& reason, const std::string& client) {
   post(console_reply_, false, [this, t_us, accepted, reason, client] {
-    send(console_reply_, t_us, {{"t_s", seconds(t_us)}, {"accepted", accepted}, {"reason", reason}, {"client", client}});
+    send(console_reply_, t_us,
+         {{"t_s", seconds(t_us)}, {"accepted", accepted}, {"reason", reason}, {"client", client}});
   });
 }
 

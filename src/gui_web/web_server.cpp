@@ -126,15 +126,15 @@ struct WebServer::Impl {
   mutable std::mutex mutex;                 // guards channels and counters
   std::vector<foxglove::Channel> channels;  // every channel offered, in id order
   WebServerCounters counts;
-  std::set<std::shared_ptr<WsSession>> sessions;  // the server's thread only
-  std::set<std::uint32_t> latched;                // guarded by mutex
-  std::map<std::uint32_t, int> subscribers;       // clients subscribed, by channel; guarded by mutex
+  std::set<std::shared_ptr<WsSession>> sessions;                  // the server's thread only
+  std::set<std::uint32_t> latched;                                // guarded by mutex
+  std::map<std::uint32_t, int> subscribers;                       // clients subscribed, by channel; guarded by mutex
   std::map<std::uint32_t, WebServer::LatchSource> latch_sources;  // set before clients come
   // The last message of each latched channel (the server's thread only).
   std::map<std::uint32_t, std::pair<std::uint64_t, std::shared_ptr<const std::string>>> latest;
   std::atomic<std::size_t> client_count{0};
   // Shutting down: the clients were sent a close frame; the timer ends the wait for them.
-  bool stopping = false;                 // the server's thread only
+  bool stopping = false;  // the server's thread only
   asio::steady_timer stop_timer{io};
   // The parameters' current values, by name (the server's thread only).
   std::map<std::string, nlohmann::json> parameters;
@@ -180,7 +180,8 @@ struct WebServer::Impl {
       if (origin == allowed) return true;
     }
     const std::string p = ":" + std::to_string(port);
-    for (const std::string& host : {std::string("127.0.0.1"), std::string("localhost"), std::string("[::1]"), config.bind_address}) {
+    for (const std::string& host :
+         {std::string("127.0.0.1"), std::string("localhost"), std::string("[::1]"), config.bind_address}) {
       if (origin == "http://" + host + p) return true;
     }
     return false;
@@ -196,8 +197,7 @@ struct WebServer::Impl {
 // One WebSocket client: its subscriptions, its channels, its send queue.
 class WsSession : public std::enable_shared_from_this<WsSession> {
  public:
-  WsSession(tcp::socket socket, WebServer::Impl& server)
-      : ws_(std::move(socket)), server_(server) {
+  WsSession(tcp::socket socket, WebServer::Impl& server) : ws_(std::move(socket)), server_(server) {
     beast::error_code ec;
     const auto remote = beast::get_lowest_layer(ws_).socket().remote_endpoint(ec);
     name_ = ec ? std::string("client") : remote.address().to_string() + ":" + std::to_string(remote.port());
@@ -297,7 +297,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   // a client that does not keep up sees the newest state, late.
   void make_room(std::size_t bytes) {
     std::size_t dropped = 0;
-    for (auto it = queue_.begin() + (writing_ ? 1 : 0); it != queue_.end() && queued_bytes_ + bytes > server_.config.max_queued_bytes;) {
+    for (auto it = queue_.begin() + (writing_ ? 1 : 0);
+         it != queue_.end() && queued_bytes_ + bytes > server_.config.max_queued_bytes;) {
       if (!it->binary) {
         ++it;
         continue;
@@ -311,8 +312,10 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     const auto now = std::chrono::steady_clock::now();
     if (now - last_drop_status_ >= std::chrono::seconds(1)) {
       last_drop_status_ = now;
-      send_text(foxglove::status(foxglove::Level::kWarning, "Send buffer limit reached: this client does not keep up, "
-                                                            "older messages were dropped", "slow"));
+      send_text(foxglove::status(foxglove::Level::kWarning,
+                                 "Send buffer limit reached: this client does not keep up, "
+                                 "older messages were dropped",
+                                 "slow"));
     }
   }
 
@@ -372,11 +375,14 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void handle(const foxglove::Subscribe& m) {
     for (const auto& s : m.subscriptions) {
       if (!server_.has_channel(s.channel_id)) {
-        refuse(foxglove::Level::kWarning, "Channel " + std::to_string(s.channel_id) + " is not available; ignoring subscription");
+        refuse(foxglove::Level::kWarning,
+               "Channel " + std::to_string(s.channel_id) + " is not available; ignoring subscription");
       } else if (sub_to_channel_.contains(s.id)) {
-        refuse(foxglove::Level::kError, "Client subscription id " + std::to_string(s.id) + " was already used; ignoring subscription");
+        refuse(foxglove::Level::kError,
+               "Client subscription id " + std::to_string(s.id) + " was already used; ignoring subscription");
       } else if (channel_to_sub_.contains(s.channel_id)) {
-        refuse(foxglove::Level::kWarning, "Client already subscribed to channel " + std::to_string(s.channel_id) + "; ignoring subscription");
+        refuse(foxglove::Level::kWarning,
+               "Client already subscribed to channel " + std::to_string(s.channel_id) + "; ignoring subscription");
       } else {
         sub_to_channel_[s.id] = s.channel_id;
         channel_to_sub_[s.channel_id] = s.id;
@@ -395,7 +401,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     for (const std::uint32_t id : m.subscription_ids) {
       const auto it = sub_to_channel_.find(id);
       if (it == sub_to_channel_.end()) {
-        refuse(foxglove::Level::kWarning, "Client subscription id " + std::to_string(id) + " did not exist; ignoring unsubscription");
+        refuse(foxglove::Level::kWarning,
+               "Client subscription id " + std::to_string(id) + " did not exist; ignoring unsubscription");
         continue;
       }
       channel_to_sub_.erase(it->second);
@@ -408,7 +415,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
       if (client_channels_.contains(c.id)) {
         refuse(foxglove::Level::kError, "Channel " + std::to_string(c.id) + " was already advertised");
       } else if (c.encoding != "json") {
-        refuse(foxglove::Level::kError, "Channel " + std::to_string(c.id) + ": encoding '" + c.encoding + "' is not supported (json is)");
+        refuse(foxglove::Level::kError,
+               "Channel " + std::to_string(c.id) + ": encoding '" + c.encoding + "' is not supported (json is)");
       } else if (client_channels_.size() >= foxglove::kMaxItems) {
         refuse(foxglove::Level::kError, "Too many client channels");
       } else {
@@ -421,24 +429,28 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   }
   void handle(const foxglove::GetParameters& m) {
     if (!server_.handlers.on_set_parameters) {
-      return refuse(foxglove::Level::kError, "Operation 'getParameters' not supported as server capability 'parameters' is missing");
+      return refuse(foxglove::Level::kError,
+                    "Operation 'getParameters' not supported as server capability 'parameters' is missing");
     }
     answer_parameters(m.names, m.id);
   }
   void handle(const foxglove::SetParameters& m) {
     if (!server_.handlers.on_set_parameters) {
-      return refuse(foxglove::Level::kError, "Operation 'setParameters' not supported as server capability 'parameters' is missing");
+      return refuse(foxglove::Level::kError,
+                    "Operation 'setParameters' not supported as server capability 'parameters' is missing");
     }
     // The owner answers (answer_parameters) once it has tried them.
     server_.handlers.on_set_parameters(name_, m.parameters, m.id);
   }
   void handle(const foxglove::SubscribeParameterUpdates& m) {
     if (!server_.handlers.on_set_parameters) {
-      return refuse(foxglove::Level::kError,
-                    "Operation 'subscribeParameterUpdates' not supported as server capability 'parametersSubscribe' is missing");
+      return refuse(
+          foxglove::Level::kError,
+          "Operation 'subscribeParameterUpdates' not supported as server capability 'parametersSubscribe' is missing");
     }
     for (const std::string& name : m.names) {
-      if (parameter_subscriptions_.size() >= foxglove::kMaxItems) return refuse(foxglove::Level::kError, "Too many parameter subscriptions");
+      if (parameter_subscriptions_.size() >= foxglove::kMaxItems)
+        return refuse(foxglove::Level::kError, "Too many parameter subscriptions");
       parameter_subscriptions_.insert(name);
     }
   }
@@ -461,7 +473,6 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   }
 
  private:
-
   void on_binary(std::span<const std::uint8_t> bytes) {
     auto parsed = foxglove::parse_client_binary(bytes);
     if (auto* why = std::get_if<std::string>(&parsed)) return refuse(foxglove::Level::kError, *why);
@@ -519,9 +530,11 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     set_cookie_ = by_query;
     if (websocket::is_upgrade(req)) {
       if (target.path != "/ws") return refuse(req, http::status::not_found, "the WebSocket is at /ws\n");
-      if (!server_.origin_allowed(sv(req[http::field::origin]), sv(req[http::field::host]))) return refuse(req, http::status::forbidden, "Origin not allowed\n");
+      if (!server_.origin_allowed(sv(req[http::field::origin]), sv(req[http::field::host])))
+        return refuse(req, http::status::forbidden, "Origin not allowed\n");
       if (!offers_subprotocol(sv(req[http::field::sec_websocket_protocol]))) {
-        return refuse(req, http::status::bad_request, "Missing expected sec-websocket-protocol header (foxglove.websocket.v1)\n");
+        return refuse(req, http::status::bad_request,
+                      "Missing expected sec-websocket-protocol header (foxglove.websocket.v1)\n");
       }
       stream_.expires_never();
       auto session = std::make_shared<WsSession>(stream_.release_socket(), server_);
@@ -546,7 +559,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     if (server_.config.web_root.empty() || path.find("..") != std::string::npos || path.empty() || path[0] != '/') {
       return respond(req, http::status::not_found, "text/plain", "not found\n");
     }
-    const std::filesystem::path file = server_.config.web_root / (path == "/" ? std::string("index.html") : path.substr(1));
+    const std::filesystem::path file =
+        server_.config.web_root / (path == "/" ? std::string("index.html") : path.substr(1));
     std::ifstream in(file, std::ios::binary);
     if (!in) return respond(req, http::status::not_found, "text/plain", "not found\n");
     std::ostringstream body;
@@ -559,13 +573,15 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     respond(req, status, "text/plain", why);
   }
 
-  void respond(const http::request<http::string_body>& req, http::status status, const std::string& type, std::string body) {
+  void respond(const http::request<http::string_body>& req, http::status status, const std::string& type,
+               std::string body) {
     auto res = std::make_shared<http::response<http::string_body>>(status, req.version());
     res->set(http::field::server, "rilbed");
     res->set(http::field::content_type, type);
     res->set(http::field::cache_control, "no-store");
     if (set_cookie_ && status == http::status::ok) {
-      res->set(http::field::set_cookie, cookie_name() + "=" + server_.config.token + "; Path=/; HttpOnly; SameSite=Strict");
+      res->set(http::field::set_cookie,
+               cookie_name() + "=" + server_.config.token + "; Path=/; HttpOnly; SameSite=Strict");
     }
     res->keep_alive(false);
     res->body() = req.method() == http::verb::head ? std::string() : std::move(body);
@@ -613,8 +629,8 @@ WebServer::WebServer(WebServerConfig config, Handlers handlers) : impl_(std::mak
   if (!ec) m.acceptor.bind(endpoint, ec);
   if (!ec) m.acceptor.listen(asio::socket_base::max_listen_connections, ec);
   if (ec) {
-    throw std::runtime_error("web server: cannot listen on " + m.config.bind_address + ":" + std::to_string(m.config.port) +
-                             ": " + ec.message());
+    throw std::runtime_error("web server: cannot listen on " + m.config.bind_address + ":" +
+                             std::to_string(m.config.port) + ": " + ec.message());
   }
   m.port = m.acceptor.local_endpoint().port();
   m.accept();
@@ -715,7 +731,8 @@ void WebServer::set_parameters(std::vector<foxglove::Parameter> values) {
   });
 }
 
-void WebServer::answer_parameters(const std::string& client, std::vector<std::string> names, std::optional<std::string> id) {
+void WebServer::answer_parameters(const std::string& client, std::vector<std::string> names,
+                                  std::optional<std::string> id) {
   Impl& m = *impl_;
   asio::post(m.io, [&m, client, names = std::move(names), id = std::move(id)] {
     for (const auto& s : m.sessions) {

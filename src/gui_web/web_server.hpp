@@ -19,10 +19,10 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
-#include <map>
 #include <string_view>
 #include <vector>
 
@@ -39,15 +39,16 @@ struct ServedDocument {
 
 /// How the server listens and what it allows; each knob says what it costs.
 struct WebServerConfig {
-  std::string bind_address = "127.0.0.1";  ///< anything else opens the run to the network
-  std::uint16_t port = 8080;               ///< 0: any free port (tests; port() tells which)
-  std::string token;                       ///< required on every request; must not be empty
-  std::string name = "rilbed";             ///< serverInfo's name
-  std::string session_id;                  ///< serverInfo's sessionId (a run)
-  std::filesystem::path web_root;          ///< the page's files; empty: no page, only /ws
-  std::size_t max_queued_bytes = 8u << 20; ///< per client; more memory lets a slow client lag longer
+  std::string bind_address = "127.0.0.1";    ///< anything else opens the run to the network
+  std::uint16_t port = 8080;                 ///< 0: any free port (tests; port() tells which)
+  std::string token;                         ///< required on every request; must not be empty
+  std::string name = "rilbed";               ///< serverInfo's name
+  std::string session_id;                    ///< serverInfo's sessionId (a run)
+  std::filesystem::path web_root;            ///< the page's files; empty: no page, only /ws
+  std::size_t max_queued_bytes = 8u << 20;   ///< per client; more memory lets a slow client lag longer
   std::size_t max_message_bytes = 1u << 20;  ///< largest message a client may send; larger closes its socket (1009)
-  std::vector<std::string> allowed_origins;  ///< Origins allowed besides the server's own, e.g. "https://app.foxglove.dev"
+  std::vector<std::string>
+      allowed_origins;  ///< Origins allowed besides the server's own, e.g. "https://app.foxglove.dev"
   /// Documents served at their paths ("/controllers.json"), under the same token as the
   /// page's files, even without a web root; their memory is held while the server runs.
   std::map<std::string, ServedDocument> documents;
@@ -55,10 +56,10 @@ struct WebServerConfig {
 
 /// What the server counted (all clients together).
 struct WebServerCounters {
-  std::uint64_t connections = 0;        ///< WebSocket clients accepted
-  std::uint64_t refused = 0;            ///< requests refused: token, Origin, subprotocol, method
-  std::uint64_t messages_sent = 0;      ///< data messages queued to clients
-  std::uint64_t messages_dropped = 0;   ///< data messages dropped for clients that did not keep up
+  std::uint64_t connections = 0;          ///< WebSocket clients accepted
+  std::uint64_t refused = 0;              ///< requests refused: token, Origin, subprotocol, method
+  std::uint64_t messages_sent = 0;        ///< data messages queued to clients
+  std::uint64_t messages_dropped = 0;     ///< data messages dropped for clients that did not keep up
   std::uint64_t bad_client_messages = 0;  ///< client messages answered with an error status
 };
 

@@ -48,8 +48,10 @@ agents::TeamMessage from_lcm(const rilbed::team_member_t& m) {
 rilbed::agent_output_t to_lcm(const agents::RemoteOutput& output) {
   rilbed::agent_output_t m;
   m.id = output.robot_id;
-  m.left_units = static_cast<std::int16_t>(std::clamp(output.output.wheels.left, -agents::kMaxWheelUnits, agents::kMaxWheelUnits));
-  m.right_units = static_cast<std::int16_t>(std::clamp(output.output.wheels.right, -agents::kMaxWheelUnits, agents::kMaxWheelUnits));
+  m.left_units =
+      static_cast<std::int16_t>(std::clamp(output.output.wheels.left, -agents::kMaxWheelUnits, agents::kMaxWheelUnits));
+  m.right_units = static_cast<std::int16_t>(
+      std::clamp(output.output.wheels.right, -agents::kMaxWheelUnits, agents::kMaxWheelUnits));
   m.behaviour = std::string(output.output.behaviour);
   m.done = output.done;
   return m;
@@ -70,7 +72,8 @@ bool plausible(const rilbed::quantum_t& q) {
   for (const rilbed::agent_input_t& in : q.inputs) {
     if (in.has_pose && !(finite(in.x_m) && finite(in.y_m) && finite(in.theta_rad))) return false;
     const rilbed::robot_sensors_t& s = in.sensors;
-    if (!s.proximity.empty() && s.proximity.size() != static_cast<std::size_t>(environment::kProximityCount)) return false;
+    if (!s.proximity.empty() && s.proximity.size() != static_cast<std::size_t>(environment::kProximityCount))
+      return false;
     for (const std::int16_t v : s.proximity) {
       if (v < 0 || v > environment::kProximityMax) return false;
     }
@@ -90,10 +93,10 @@ std::string_view intern_behaviour(std::string_view name) {
   // names rilbed's own controllers use are there from the start, so that a peer sending
   // junk names cannot make them "other".
   static std::mutex mutex;
-  static std::set<std::string, std::less<>> names = {
-      "idle",  "console", "lost",   "search", "follow", "wait", "avoid", "unknown", "cruise", "arrived", "home",
-      "placed", "yield",  "place",  "align",  "c0",     "c1",   "c2",    "c3",      "c4",     "c5",      "c6",
-      "c7",    "c?"};
+  static std::set<std::string, std::less<>> names = {"idle",  "console", "lost",   "search",  "follow", "wait",
+                                                     "avoid", "unknown", "cruise", "arrived", "home",   "placed",
+                                                     "yield", "place",   "align",  "c0",      "c1",     "c2",
+                                                     "c3",    "c4",      "c5",     "c6",      "c7",     "c?"};
   if (name.size() > kMaxLength) return "other";
   std::lock_guard lock(mutex);
   if (const auto it = names.find(name); it != names.end()) return *it;

@@ -31,8 +31,9 @@ AgentServer::AgentServer(lcm::LCM& quanta, lcm::LCM& answers, AgentServerConfig 
   std::ostringstream s;
   s << host_name() << ":" << getpid() << ":" << std::hex << rd();
   session_ = s.str();
-  quantum_sub_ = std::make_unique<LcmSubscription>(
-      quanta_, config_.channels.quantum, [this](const std::string&, const void* d, std::size_t n) { on_quantum(d, n); });
+  quantum_sub_ =
+      std::make_unique<LcmSubscription>(quanta_, config_.channels.quantum,
+                                        [this](const std::string&, const void* d, std::size_t n) { on_quantum(d, n); });
 }
 
 AgentServer::~AgentServer() { finish_run(); }
@@ -126,8 +127,8 @@ void AgentServer::serve(const std::atomic<bool>& stop) {
   auto last_hello = Clock::now() - std::chrono::hours(1);
   while (!stop.load()) {
     const auto now = Clock::now();
-    const bool idle = run_.empty() || run_ended_ ||
-                      now - last_quantum_at_ > std::chrono::milliseconds(config_.silence_ms);
+    const bool idle =
+        run_.empty() || run_ended_ || now - last_quantum_at_ > std::chrono::milliseconds(config_.silence_ms);
     if (idle && now - last_hello >= std::chrono::milliseconds(config_.hello_ms)) {
       hello();
       last_hello = now;

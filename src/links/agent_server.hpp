@@ -22,14 +22,14 @@ namespace rilbed::links {
 
 /// Knobs of an agent process.
 struct AgentServerConfig {
-  Channels channels;             ///< with the run's channel prefix
-  std::string scenario_name;     ///< announced; a run of another scenario does not take it
-  std::vector<int> robot_ids;    ///< the robots whose controllers it runs
-  int hello_ms = 200;            ///< announce this often until a run sends a quantum
+  Channels channels;           ///< with the run's channel prefix
+  std::string scenario_name;   ///< announced; a run of another scenario does not take it
+  std::vector<int> robot_ids;  ///< the robots whose controllers it runs
+  int hello_ms = 200;          ///< announce this often until a run sends a quantum
   /// Announce again when no quantum came for this long (the run ended without its "end"
   /// reaching us, or a new run waits).
   int silence_ms = 1000;
-  bool once = false;             ///< return after the first run ends
+  bool once = false;  ///< return after the first run ends
   /// Each answer is sent this many times. A lock-step quantum waits for the last of its P
   /// answers, so on a lossy bus one lost answer in P costs the whole step a repeat round
   /// (with 10 % loss and 12 processes, 7 steps in 10); a second copy makes that 1 in 10.
@@ -39,11 +39,11 @@ struct AgentServerConfig {
 
 /// What an agent process has counted.
 struct AgentServerCounters {
-  std::int64_t runs = 0;         ///< runs served (a new run nonce each)
-  std::int64_t steps = 0;        ///< quanta stepped
-  std::int64_t repeats = 0;      ///< quanta answered again without stepping (the run's repeats)
-  std::int64_t skipped = 0;      ///< quanta that never arrived before a later one (real time)
-  std::int64_t refused = 0;      ///< messages that were not well formed, or held values no robot reads (plausible())
+  std::int64_t runs = 0;     ///< runs served (a new run nonce each)
+  std::int64_t steps = 0;    ///< quanta stepped
+  std::int64_t repeats = 0;  ///< quanta answered again without stepping (the run's repeats)
+  std::int64_t skipped = 0;  ///< quanta that never arrived before a later one (real time)
+  std::int64_t refused = 0;  ///< messages that were not well formed, or held values no robot reads (plausible())
 };
 
 class AgentServer {
@@ -82,7 +82,7 @@ class AgentServer {
   AgentServerConfig config_;
   ControllerFactory make_;
   std::string session_;
-  std::string run_;                    // the run being served, empty between runs
+  std::string run_;  // the run being served, empty between runs
   bool run_ended_ = false;
   std::int64_t last_quantum_ = -1;
   rilbed::quantum_reply_t last_reply_;  // sent again for a repeat

@@ -86,7 +86,8 @@ PtyPair open_pty_pair() {
   ::cfmakeraw(&tio);
   tio.c_cflag |= CSTOPB | CLOCAL | CREAD;  // 8N2 as the firmware uses
   ::cfsetspeed(&tio, B38400);
-  if (::tcsetattr(pty.slave.get(), TCSANOW, &tio) != 0) throw errno_error("emulated Khepera: tcsetattr " + pty.slave_path);
+  if (::tcsetattr(pty.slave.get(), TCSANOW, &tio) != 0)
+    throw errno_error("emulated Khepera: tcsetattr " + pty.slave_path);
   // Never block the serving thread on a client that does not read.
   const int flags = ::fcntl(pty.master.get(), F_GETFL);
   if (flags < 0 || ::fcntl(pty.master.get(), F_SETFL, flags | O_NONBLOCK) != 0) {
@@ -97,7 +98,8 @@ PtyPair open_pty_pair() {
 
 void check_faults(const EmulatorFaults& f) {
   auto probability = [](double p, const char* name) {
-    if (!(p >= 0.0 && p <= 1.0)) throw std::invalid_argument(std::string("emulated Khepera: ") + name + " must be in 0..1");
+    if (!(p >= 0.0 && p <= 1.0))
+      throw std::invalid_argument(std::string("emulated Khepera: ") + name + " must be in 0..1");
   };
   probability(f.drop_probability, "drop probability");
   probability(f.garbage_probability, "garbage probability");
@@ -213,7 +215,8 @@ struct KheperaEmulator::State {
     assembler.discard_partial();
     update_stable_link_locked();
     if (faults.replug_after_s > 0.0) {
-      replug_at = now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(faults.replug_after_s));
+      replug_at =
+          now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(faults.replug_after_s));
     }
   }
 
@@ -258,7 +261,9 @@ struct KheperaEmulator::State {
     return encode_reply(m, reply);
   }
 
-  bool roll(double probability) { return probability > 0.0 && std::uniform_real_distribution<double>(0.0, 1.0)(rng) < probability; }
+  bool roll(double probability) {
+    return probability > 0.0 && std::uniform_real_distribution<double>(0.0, 1.0)(rng) < probability;
+  }
 
   std::string garbage() {
     std::string bytes;
@@ -296,13 +301,15 @@ struct KheperaEmulator::State {
   std::string styled(const std::string& reply) const {
     const ReplyStyle& style = config.style;
     std::string body = reply.substr(0, reply.size() - 2);  // without CR LF
-    if (style.upper_case_letter && !body.empty()) body[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(body[0])));
+    if (style.upper_case_letter && !body.empty())
+      body[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(body[0])));
     if (style.spaces_after_commas) {
       std::string spaced;
       for (const char c : body) spaced += c == ',' ? std::string(", ") : std::string(1, c);
       body = std::move(spaced);
     }
-    return body + style.extra_fields + std::string(static_cast<std::size_t>(style.trailing_spaces), ' ') + style.line_end;
+    return body + style.extra_fields + std::string(static_cast<std::size_t>(style.trailing_spaces), ' ') +
+           style.line_end;
   }
 
   void queue_locked(Clock::time_point due, std::string bytes) {
@@ -405,7 +412,8 @@ void KheperaEmulator::serve() {
       auto consider = [&](Clock::time_point t) { next = next ? std::min(*next, t) : t; };
       if (!s.outbox.empty()) consider(s.outbox.front().due);
       if (!s.timed_disconnect_done && s.faults.disconnect_after_s > 0.0) {
-        consider(s.started + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s.faults.disconnect_after_s)));
+        consider(s.started + std::chrono::duration_cast<Clock::duration>(
+                                 std::chrono::duration<double>(s.faults.disconnect_after_s)));
       }
       if (s.replug_at) consider(*s.replug_at);
       if (next) {
@@ -422,8 +430,7 @@ void KheperaEmulator::serve() {
     const int ready = ::poll(fds.data(), fds.size(), timeout_ms);
     if (ready < 0) continue;  // EINTR (a signal for the process): go round
     if (fds[0].revents & POLLIN) {
-      while (::read(s.wake_pipe[0].get(), buffer.data(), buffer.size()) > 0) {
-      }
+      while (::read(s.wake_pipe[0].get(), buffer.data(), buffer.size()) > 0) {}
     }
     if (master_open && (fds[1].revents & (POLLIN | POLLHUP | POLLERR))) {
       const ssize_t n = ::read(s.pty.master.get(), buffer.data(), buffer.size());

@@ -16,8 +16,8 @@
 #include <thread>
 #include <vector>
 
-#include <boost/asio/io_context.hpp>
 #include <boost/asio/executor_work_guard.hpp>
+#include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
 #include <boost/asio/serial_port.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -42,9 +42,9 @@ std::string supported_bauds_text() {
 struct Job {
   Command command{};
   std::function<void(const Result<Reply>&)> done{};  // may be empty (polls, wished speeds)
-  bool is_poll = false;                            // queued by a poll or request_*(), deduplicated
-  bool is_wished_speeds = false;                   // from set_speeds() / stop()
-  std::uint64_t wish_serial = 0;                   // which wish it carries
+  bool is_poll = false;                              // queued by a poll or request_*(), deduplicated
+  bool is_wished_speeds = false;                     // from set_speeds() / stop()
+  std::uint64_t wish_serial = 0;                     // which wish it carries
   // Set by query() when its caller stopped waiting: a command nobody waits for any more
   // is not sent (a late "set speeds" could override a stop sent since).
   std::shared_ptr<std::atomic<bool>> abandoned{};
@@ -124,7 +124,8 @@ struct KheperaLink::Impl {
   }
 
   std::string command_label(const Command& command) const {
-    return std::string(1, config.model.command_letter(command.kind)) + " (" + std::string(command_kind_name(command.kind)) + ")";
+    return std::string(1, config.model.command_letter(command.kind)) + " (" +
+           std::string(command_kind_name(command.kind)) + ")";
   }
 
   void set_state(LinkState state, const std::string& error = {}) {
@@ -167,7 +168,8 @@ struct KheperaLink::Impl {
     if (ec) {
       boost::system::error_code ignored;
       serial.close(ignored);
-      return prefix + "cannot configure as a serial port (" + std::to_string(config.baud) + " baud, 8N2): " + ec.message();
+      return prefix + "cannot configure as a serial port (" + std::to_string(config.baud) +
+             " baud, 8N2): " + ec.message();
     }
     // Bytes left from before (a reply nobody read) would glue onto the first reply.
     ::tcflush(serial.native_handle(), TCIOFLUSH);
@@ -195,7 +197,8 @@ struct KheperaLink::Impl {
     const std::string error = prefix + "port lost: " + reason;
     count([](LinkCounters& c) { ++c.port_losses; });
     set_state(LinkState::kLost, error);
-    log(LogLevel::kError, "port lost (" + reason + "); reopening every " + std::to_string(config.reopen_interval_ms) + " ms");
+    log(LogLevel::kError,
+        "port lost (" + reason + "); reopening every " + std::to_string(config.reopen_interval_ms) + " ms");
     fail_all(error);
     schedule_reopen();
   }
@@ -218,7 +221,8 @@ struct KheperaLink::Impl {
   void start_read() {
     serial.async_read_some(asio::buffer(read_buffer),
                            [this, generation = port_generation](const boost::system::error_code& ec, std::size_t n) {
-                             if (ec == asio::error::operation_aborted || generation != port_generation || !port_open) return;
+                             if (ec == asio::error::operation_aborted || generation != port_generation || !port_open)
+                               return;
                              if (ec) {
                                port_lost(ec == asio::error::eof ? std::string("end of file") : ec.message());
                                return;
@@ -291,7 +295,8 @@ struct KheperaLink::Impl {
       }
       if (skip || (job.abandoned && job.abandoned->load())) {
         // Once stopping, the stop is the last speeds the robot gets.
-        finish_job(job, Failure{prefix + command_label(job.command) + (skip ? " dropped: the link is stopping" : " abandoned")});
+        finish_job(job, Failure{prefix + command_label(job.command) +
+                                (skip ? " dropped: the link is stopping" : " abandoned")});
         continue;
       }
       Result<EncodedCommand> encoded = encode_command(config.model, job.command);
@@ -330,7 +335,8 @@ struct KheperaLink::Impl {
                           port_lost("write failed: " + ec.message());
                           return;
                         }
-                        if (speeds && config.on_speeds_written) config.on_speeds_written(*speeds, std::chrono::steady_clock::now());
+                        if (speeds && config.on_speeds_written)
+                          config.on_speeds_written(*speeds, std::chrono::steady_clock::now());
                       });
     reply_timer.expires_after(std::chrono::milliseconds(config.reply_timeout_ms));
     reply_timer.async_wait([this, id = f.attempt_id](const boost::system::error_code& ec) {
@@ -401,8 +407,8 @@ struct KheperaLink::Impl {
       return;
     }
     count([](LinkCounters& c) { ++c.stray_lines; });
-    log(LogLevel::kDebug, "ignoring a stray line while waiting for " + command_label(in_flight->job.command) + ": " +
-                              printable(line));
+    log(LogLevel::kDebug,
+        "ignoring a stray line while waiting for " + command_label(in_flight->job.command) + ": " + printable(line));
   }
 
   void complete(Reply reply) {
@@ -493,7 +499,8 @@ KheperaLink::KheperaLink(LinkConfig config) {
   const std::string prefix = "khepera " + config.port + ": ";
   if (config.baud == 0) config.baud = config.model.default_baud;
   if (std::find(kSupportedBauds.begin(), kSupportedBauds.end(), config.baud) == kSupportedBauds.end()) {
-    throw std::invalid_argument(prefix + "baud rate " + std::to_string(config.baud) + " is not one of " + supported_bauds_text());
+    throw std::invalid_argument(prefix + "baud rate " + std::to_string(config.baud) + " is not one of " +
+                                supported_bauds_text());
   }
   if (config.reply_timeout_ms <= 0) throw std::invalid_argument(prefix + "reply timeout must be > 0 ms");
   if (config.retries < 0) throw std::invalid_argument(prefix + "retries must be >= 0");
@@ -517,11 +524,12 @@ std::optional<std::string> KheperaLink::start() {
   std::optional<std::string> failure = m.try_open();
   if (failure) {
     m.set_state(LinkState::kLost, *failure);
-    m.log(LogLevel::kError, failure->substr(m.prefix.size()) + "; retrying every " +
-                                std::to_string(m.config.reopen_interval_ms) + " ms");
+    m.log(LogLevel::kError,
+          failure->substr(m.prefix.size()) + "; retrying every " + std::to_string(m.config.reopen_interval_ms) + " ms");
     m.schedule_reopen();
   } else {
-    m.log(LogLevel::kInfo, "open at " + std::to_string(m.config.baud) + " baud, 8N2, " + std::string(m.config.model.name));
+    m.log(LogLevel::kInfo,
+          "open at " + std::to_string(m.config.baud) + " baud, 8N2, " + std::string(m.config.model.name));
     m.schedule_next();
   }
   m.arm_poll(m.proximity_timer, m.config.proximity_period_ms, CommandKind::kReadProximity);
@@ -641,8 +649,8 @@ Result<Reply> KheperaLink::query(const Command& command, std::chrono::millisecon
   });
   if (future.wait_for(timeout) != std::future_status::ready) {
     abandoned->store(true);
-    return Failure{m.prefix + "no answer to " + m.command_label(command) + " within " + std::to_string(timeout.count()) +
-                   " ms"};
+    return Failure{m.prefix + "no answer to " + m.command_label(command) + " within " +
+                   std::to_string(timeout.count()) + " ms"};
   }
   return future.get();
 }

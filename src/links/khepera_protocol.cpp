@@ -16,9 +16,8 @@ constexpr std::int64_t kInt32Max = std::numeric_limits<std::int32_t>::max();
 constexpr std::size_t index_of(CommandKind kind) { return static_cast<std::size_t>(kind); }
 
 constexpr std::array<CommandKind, kCommandKindCount> kAllKinds = {
-    CommandKind::kReadVersions,  CommandKind::kSetSpeeds,      CommandKind::kReadSpeeds,
-    CommandKind::kSetCounters,   CommandKind::kReadCounters,   CommandKind::kReadProximity,
-    CommandKind::kReadAmbient,   CommandKind::kSetLed};
+    CommandKind::kReadVersions, CommandKind::kSetSpeeds,     CommandKind::kReadSpeeds,  CommandKind::kSetCounters,
+    CommandKind::kReadCounters, CommandKind::kReadProximity, CommandKind::kReadAmbient, CommandKind::kSetLed};
 
 RobotModel make_khepera2() {
   RobotModel m;
@@ -125,7 +124,8 @@ Result<std::vector<std::int64_t>> parse_command_values(std::string_view after_le
   }
   for (std::size_t i = 0; i < fields.size(); ++i) {
     const std::optional<std::int64_t> value = parse_integer(fields[i], false);
-    if (!value) return Failure{what + ": value " + std::to_string(i + 1) + " " + printable(fields[i]) + " is not an integer"};
+    if (!value)
+      return Failure{what + ": value " + std::to_string(i + 1) + " " + printable(fields[i]) + " is not an integer"};
     if (*value < min || *value > max) {
       return Failure{what + ": value " + std::to_string(i + 1) + " = " + std::to_string(*value) + " is outside " +
                      std::to_string(min) + ".." + std::to_string(max)};
@@ -166,8 +166,8 @@ Result<std::vector<std::int64_t>> parse_reply_values(CommandKind kind, std::stri
     const std::optional<std::int64_t> value = parse_integer(field, true);
     if (!value) return Failure{what + ": " + label + " " + printable(field) + " is not an integer"};
     if (*value < min || *value > max) {
-      return Failure{what + ": " + label + " = " + std::to_string(*value) + " is outside " + std::to_string(min) + ".." +
-                     std::to_string(max)};
+      return Failure{what + ": " + label + " = " + std::to_string(*value) + " is outside " + std::to_string(min) +
+                     ".." + std::to_string(max)};
     }
     values.push_back(*value);
   }
@@ -318,11 +318,10 @@ Result<EncodedCommand> encode_command(const RobotModel& model, const Command& co
         return Failure{"LED " + std::to_string(first) + " does not exist on a " + std::string(model.name) + " (0.." +
                        std::to_string(model.led_count - 1) + ")"};
       }
-      if (second < 0 || second > 2) return Failure{"LED action " + std::to_string(second) + " is not 0 (off), 1 (on) or 2 (toggle)"};
+      if (second < 0 || second > 2)
+        return Failure{"LED action " + std::to_string(second) + " is not 0 (off), 1 (on) or 2 (toggle)"};
       break;
-    default:
-      encoded.bytes += '\r';
-      return encoded;
+    default: encoded.bytes += '\r'; return encoded;
   }
   encoded.bytes += ',' + std::to_string(first) + ',' + std::to_string(second) + '\r';
   return encoded;
@@ -414,15 +413,12 @@ Result<Reply> decode_reply(const RobotModel& model, CommandKind expected, std::s
   const std::vector<std::int64_t>& v = values.value();
   switch (expected) {
     case CommandKind::kReadSpeeds:
-    case CommandKind::kReadCounters:
-      reply.wheels = {v[0], v[1]};
-      break;
+    case CommandKind::kReadCounters: reply.wheels = {v[0], v[1]}; break;
     case CommandKind::kReadProximity:
     case CommandKind::kReadAmbient:
       for (std::size_t i = 0; i < reply.sensors.size(); ++i) reply.sensors[i] = static_cast<int>(v[i]);
       break;
-    default:
-      break;  // acknowledgements: whatever follows the letter is ignored
+    default: break;  // acknowledgements: whatever follows the letter is ignored
   }
   return reply;
 }
@@ -445,8 +441,7 @@ std::string encode_reply(const RobotModel& model, const Reply& reply) {
     case CommandKind::kReadAmbient:
       for (const int value : reply.sensors) bytes += ',' + std::to_string(value);
       break;
-    default:
-      break;
+    default: break;
   }
   return bytes + "\r\n";
 }

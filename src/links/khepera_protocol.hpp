@@ -109,7 +109,9 @@ struct Command {
   std::int64_t second = 0;  ///< right speed, right counter or LED action
 
   static Command read_versions() { return {CommandKind::kReadVersions}; }
-  static Command set_speeds(int left_units, int right_units) { return {CommandKind::kSetSpeeds, left_units, right_units}; }
+  static Command set_speeds(int left_units, int right_units) {
+    return {CommandKind::kSetSpeeds, left_units, right_units};
+  }
   static Command read_speeds() { return {CommandKind::kReadSpeeds}; }
   static Command set_counters(std::int64_t left_pulses, std::int64_t right_pulses) {
     return {CommandKind::kSetCounters, left_pulses, right_pulses};

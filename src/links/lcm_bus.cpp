@@ -6,10 +6,10 @@
 
 #include <algorithm>
 #include <cctype>
-#include <fstream>
-#include <iterator>
 #include <chrono>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <type_traits>
 #include <utility>
@@ -410,7 +410,8 @@ environment::SensorReadings from_lcm(const rilbed::robot_sensors_t& m, TimeUs t_
     std::copy(m.proximity.begin(), m.proximity.end(), values.begin());
     s.proximity = values;
   }
-  for (std::size_t k = 0; k < m.range_m.size() && k < m.range_hit.size(); ++k) s.ranges.push_back({m.range_hit[k] != 0, m.range_m[k]});
+  for (std::size_t k = 0; k < m.range_m.size() && k < m.range_hit.size(); ++k)
+    s.ranges.push_back({m.range_hit[k] != 0, m.range_m[k]});
   for (std::size_t k = 0; k < m.beacon_id.size() && k < m.beacon_bearing_rad.size(); ++k) {
     s.beacons.push_back({m.beacon_id[k], m.beacon_bearing_rad[k]});
   }
@@ -418,7 +419,6 @@ environment::SensorReadings from_lcm(const rilbed::robot_sensors_t& m, TimeUs t_
   if (m.has_odometry) s.odometry = environment::OdometryReading{m.left_pulses, m.right_pulses};
   return s;
 }
-
 
 RunReportDecoder::RunReportDecoder(Channels channels, agents::RunObserver& observer)
     : channels_(std::move(channels)), observer_(observer) {}
@@ -471,7 +471,8 @@ std::optional<std::string> RunReportDecoder::decode(const std::string& channel, 
         // Elements in reading order, each point naming its own: a jump ahead is a bad message.
         if (element < 0 || static_cast<std::size_t>(element) > out.track_points_m.size() ||
             (static_cast<std::size_t>(element) + 1 < out.track_points_m.size())) {
-          return channel + ": track point " + std::to_string(k) + " names element " + std::to_string(element) + " out of order";
+          return channel + ": track point " + std::to_string(k) + " names element " + std::to_string(element) +
+                 " out of order";
         }
         if (static_cast<std::size_t>(element) == out.track_points_m.size()) out.track_points_m.emplace_back();
         out.track_points_m.back().push_back({g.track_x_m[k], g.track_y_m[k]});
@@ -481,8 +482,8 @@ std::optional<std::string> RunReportDecoder::decode(const std::string& channel, 
     std::map<int, int> of;
     for (std::size_t k = 0; k < m.robot_ids.size(); ++k) {
       if (m.geometry_of[k] < 0 || m.geometry_of[k] >= m.num_geometries) {
-        return channel + ": robot " + std::to_string(m.robot_ids[k]) + " has geometry " + std::to_string(m.geometry_of[k]) +
-               " of " + std::to_string(m.num_geometries);
+        return channel + ": robot " + std::to_string(m.robot_ids[k]) + " has geometry " +
+               std::to_string(m.geometry_of[k]) + " of " + std::to_string(m.num_geometries);
       }
       of[m.robot_ids[k]] = m.geometry_of[k];
     }
@@ -528,7 +529,8 @@ std::optional<std::string> RunReportDecoder::decode(const std::string& channel, 
     if (!decode_checked(data, size, m)) return bad("detections_t");
     detections_.clear();
     for (const rilbed::detection_t& d : m.detections) {
-      detections_.push_back({d.id, d.u_px, d.v_px, d.heading_deg, d.score, d.diameter_px, Pose2{{d.x_m, d.y_m}, d.theta_rad}});
+      detections_.push_back(
+          {d.id, d.u_px, d.v_px, d.heading_deg, d.score, d.diameter_px, Pose2{{d.x_m, d.y_m}, d.theta_rad}});
     }
     observer_.on_detections({m.utime, m.frame, m.process_ms, detections_});
   } else if (channel == channels_.frames) {
@@ -584,8 +586,8 @@ std::optional<LcmLogReader::Event> LcmLogReader::next() {
   constexpr std::uint32_t kSync = 0xEDA1DA01;
   constexpr std::size_t kHeader = 4 + 8 + 8 + 4 + 4;
   auto u32 = [this](std::size_t at) {
-    return (std::uint32_t{bytes_[at]} << 24) | (std::uint32_t{bytes_[at + 1]} << 16) | (std::uint32_t{bytes_[at + 2]} << 8) |
-           std::uint32_t{bytes_[at + 3]};
+    return (std::uint32_t{bytes_[at]} << 24) | (std::uint32_t{bytes_[at + 1]} << 16) |
+           (std::uint32_t{bytes_[at + 2]} << 8) | std::uint32_t{bytes_[at + 3]};
   };
   auto u64 = [&](std::size_t at) { return (std::uint64_t{u32(at)} << 32) | u32(at + 4); };
   while (pos_ + 4 <= bytes_.size()) {
@@ -628,11 +630,21 @@ class LcmRunPublisher::Fanout final : public agents::RunObserver {
   bool wants_frame_images() const override {
     return std::any_of(observers.begin(), observers.end(), [](auto* o) { return o->wants_frame_images(); });
   }
-  void on_world(TimeUs t, const agents::WorldReport& w) override { each([&](auto& o) { o.on_world(t, w); }); }
-  void on_poses(TimeUs t, std::span<const agents::PoseReport> p) override { each([&](auto& o) { o.on_poses(t, p); }); }
-  void on_wheels(TimeUs t, std::span<const agents::WheelReport> w) override { each([&](auto& o) { o.on_wheels(t, w); }); }
-  void on_sensors(TimeUs t, std::span<const agents::SensorReport> s) override { each([&](auto& o) { o.on_sensors(t, s); }); }
-  void on_detections(const agents::FrameReport& f) override { each([&](auto& o) { o.on_detections(f); }); }
+  void on_world(TimeUs t, const agents::WorldReport& w) override {
+    each([&](auto& o) { o.on_world(t, w); });
+  }
+  void on_poses(TimeUs t, std::span<const agents::PoseReport> p) override {
+    each([&](auto& o) { o.on_poses(t, p); });
+  }
+  void on_wheels(TimeUs t, std::span<const agents::WheelReport> w) override {
+    each([&](auto& o) { o.on_wheels(t, w); });
+  }
+  void on_sensors(TimeUs t, std::span<const agents::SensorReport> s) override {
+    each([&](auto& o) { o.on_sensors(t, s); });
+  }
+  void on_detections(const agents::FrameReport& f) override {
+    each([&](auto& o) { o.on_detections(f); });
+  }
   void on_frame_image(TimeUs t, std::int64_t n, const cv::Mat& image) override {
     each([&](auto& o) {
       if (o.wants_frame_images()) o.on_frame_image(t, n, image);
@@ -646,9 +658,15 @@ class LcmRunPublisher::Fanout final : public agents::RunObserver {
       if (o.wants_frame_jpegs()) o.on_frame_jpeg(t, n, w, h, jpeg);
     });
   }
-  void on_event(const agents::RunEvent& e) override { each([&](auto& o) { o.on_event(e); }); }
-  void on_status(const agents::StatusReport& s) override { each([&](auto& o) { o.on_status(s); }); }
-  void on_summary(TimeUs t, const nlohmann::json& j) override { each([&](auto& o) { o.on_summary(t, j); }); }
+  void on_event(const agents::RunEvent& e) override {
+    each([&](auto& o) { o.on_event(e); });
+  }
+  void on_status(const agents::StatusReport& s) override {
+    each([&](auto& o) { o.on_status(s); });
+  }
+  void on_summary(TimeUs t, const nlohmann::json& j) override {
+    each([&](auto& o) { o.on_summary(t, j); });
+  }
 
  private:
   template <typename F>
@@ -670,7 +688,8 @@ void LcmRunPublisher::add_local_subscriber(agents::RunObserver& observer) {
   fanout_->observers.push_back(&observer);
 }
 
-std::unique_ptr<LcmSubscription> LcmRunPublisher::subscribe(const std::string& channel, LcmSubscription::Handler handler) {
+std::unique_ptr<LcmSubscription> LcmRunPublisher::subscribe(const std::string& channel,
+                                                            LcmSubscription::Handler handler) {
   auto subscription = std::make_unique<LcmSubscription>(lcm_, channel, std::move(handler));
   ++bus_subscribers_;
   return subscription;
@@ -707,8 +726,9 @@ void LcmRunPublisher::publish(const std::string& channel, const Message& message
   if (options_.log) {
     lcm::LogEvent event;
     event.eventnum = log_events_++;
-    event.timestamp = std::chrono::duration_cast<std::chrono::microseconds>(
-                          std::chrono::system_clock::now().time_since_epoch()).count();
+    event.timestamp =
+        std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+            .count();
     event.channel = channel;
     event.datalen = size;
     event.data = buffer_.data();
@@ -717,28 +737,29 @@ void LcmRunPublisher::publish(const std::string& channel, const Message& message
   if (local_decoder_) local_decoder_->decode(channel, buffer_.data(), static_cast<std::size_t>(size));
   if (to_bus && options_.in_process) {
     // memq:// queues every message until handled: deliver to the in-process subscribers now.
-    while (lcm_.handleTimeout(0) > 0) {
-    }
+    while (lcm_.handleTimeout(0) > 0) {}
   }
 }
 
 void LcmRunPublisher::republish_world_and_status() {
   std::lock_guard lock(mutex_);
   if (options_.in_process && bus_subscribers_ == 0) return;
-  if (!last_world_.empty()) lcm_.publish(channels_.world, last_world_.data(), static_cast<unsigned>(last_world_.size()));
-  if (!last_status_.empty()) lcm_.publish(channels_.status, last_status_.data(), static_cast<unsigned>(last_status_.size()));
+  if (!last_world_.empty())
+    lcm_.publish(channels_.world, last_world_.data(), static_cast<unsigned>(last_world_.size()));
+  if (!last_status_.empty())
+    lcm_.publish(channels_.status, last_status_.data(), static_cast<unsigned>(last_status_.size()));
 }
 
 void LcmRunPublisher::repeat_end() {
   std::lock_guard lock(mutex_);
   if (options_.in_process && bus_subscribers_ == 0) return;
-  if (!last_status_.empty()) lcm_.publish(channels_.status, last_status_.data(), static_cast<unsigned>(last_status_.size()));
+  if (!last_status_.empty())
+    lcm_.publish(channels_.status, last_status_.data(), static_cast<unsigned>(last_status_.size()));
   if (!last_summary_.empty()) {
     lcm_.publish(channels_.summary, last_summary_.data(), static_cast<unsigned>(last_summary_.size()));
   }
   if (options_.in_process) {
-    while (lcm_.handleTimeout(0) > 0) {
-    }
+    while (lcm_.handleTimeout(0) > 0) {}
   }
 }
 

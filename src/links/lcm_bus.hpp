@@ -4,12 +4,12 @@
 // lcm-gen makes from the same .lcm files in any language.
 #pragma once
 
-#include <lcm/lcm-cpp.hpp>
 #include <lcm/lcm.h>
+#include <lcm/lcm-cpp.hpp>
 
-#include <cstdint>
 #include <atomic>
 #include <chrono>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
@@ -20,16 +20,16 @@
 #include <vector>
 
 #include "agents/run_observer.hpp"
+#include "rilbed/camera_t.hpp"
 #include "rilbed/detections_t.hpp"
 #include "rilbed/event_t.hpp"
-#include "rilbed/camera_t.hpp"
-#include "rilbed/sensor_layout_t.hpp"
 #include "rilbed/frame_t.hpp"
 #include "rilbed/poses_t.hpp"
+#include "rilbed/sensor_layout_t.hpp"
 #include "rilbed/sensors_t.hpp"
 #include "rilbed/status_t.hpp"
-#include "rilbed/vision_settings_t.hpp"
 #include "rilbed/summary_t.hpp"
+#include "rilbed/vision_settings_t.hpp"
 #include "rilbed/wheels_t.hpp"
 #include "rilbed/world_t.hpp"
 
@@ -57,22 +57,22 @@ class LcmSubscription {
 
 /// The channel names of a run; `prefix` (e.g. "LAB2_") lets two runs share a network.
 struct Channels {
-  std::string poses = "RILBED_POSES";    ///< rilbed::poses_t, every control step
-  std::string events = "RILBED_EVENTS";  ///< rilbed::event_t, each event
-  std::string status = "RILBED_STATUS";  ///< rilbed::status_t, every simulated second and at the end
-  std::string world = "RILBED_WORLD";    ///< rilbed::world_t, at the start and every simulated second
-  std::string summary = "RILBED_SUMMARY";  ///< rilbed::summary_t, once when the run ends
-  std::string wheels = "RILBED_WHEELS";    ///< rilbed::wheels_t, every control step
-  std::string sensors = "RILBED_SENSORS";  ///< rilbed::sensors_t, every control step
+  std::string poses = "RILBED_POSES";            ///< rilbed::poses_t, every control step
+  std::string events = "RILBED_EVENTS";          ///< rilbed::event_t, each event
+  std::string status = "RILBED_STATUS";          ///< rilbed::status_t, every simulated second and at the end
+  std::string world = "RILBED_WORLD";            ///< rilbed::world_t, at the start and every simulated second
+  std::string summary = "RILBED_SUMMARY";        ///< rilbed::summary_t, once when the run ends
+  std::string wheels = "RILBED_WHEELS";          ///< rilbed::wheels_t, every control step
+  std::string sensors = "RILBED_SENSORS";        ///< rilbed::sensors_t, every control step
   std::string detections = "RILBED_DETECTIONS";  ///< rilbed::detections_t, every camera frame
-  std::string frames = "RILBED_FRAMES";    ///< rilbed::frame_t (JPEG), every camera frame, only when asked for
-  std::string camera = "RILBED_CAMERA";    ///< rilbed::camera_t, before each world_t of a run with a camera
+  std::string frames = "RILBED_FRAMES";          ///< rilbed::frame_t (JPEG), every camera frame, only when asked for
+  std::string camera = "RILBED_CAMERA";          ///< rilbed::camera_t, before each world_t of a run with a camera
   std::string sensor_layout = "RILBED_SENSOR_LAYOUT";  ///< rilbed::sensor_layout_t, before each world_t
   std::string vision = "RILBED_VISION";    ///< rilbed::vision_settings_t, before each status_t of a run with a camera
   std::string console = "RILBED_CONSOLE";  ///< rilbed::console_command_t, from consoles
   std::string console_reply = "RILBED_CONSOLE_REPLY";  ///< rilbed::console_reply_t, the run's answers
-  std::string agent_hello = "RILBED_AGENT_HELLO";  ///< rilbed::agent_hello_t, from agent processes (issue 18)
-  std::string quantum = "RILBED_QUANTUM";          ///< rilbed::quantum_t, the run's quanta to agent processes
+  std::string agent_hello = "RILBED_AGENT_HELLO";      ///< rilbed::agent_hello_t, from agent processes (issue 18)
+  std::string quantum = "RILBED_QUANTUM";              ///< rilbed::quantum_t, the run's quanta to agent processes
   std::string quantum_reply = "RILBED_QUANTUM_REPLY";  ///< rilbed::quantum_reply_t, their answers
   /// The same names behind `prefix`.
   static Channels with_prefix(const std::string& prefix);
@@ -144,7 +144,7 @@ class RunReportDecoder {
   std::vector<agents::DetectionReport> detections_;
   bool summary_seen_ = false;
   std::optional<rilbed::status_t> last_status_;
-  std::optional<agents::CameraReport> camera_;  // the last camera_t, for the next world_t
+  std::optional<agents::CameraReport> camera_;             // the last camera_t, for the next world_t
   std::vector<agents::SensorGeometry> sensor_geometries_;  // the last sensor_layout_t, for the next world_t
   std::map<int, int> sensor_geometry_of_;
   std::optional<vision::VisionSettings> vision_;  // the last vision_settings_t, for the next status_t
@@ -199,10 +199,10 @@ struct ChannelCount {
 class LcmRunPublisher final : public agents::RunObserver {
  public:
   struct Options {
-    bool in_process = false;       ///< the bus is memq://
-    lcm::LogFile* log = nullptr;   ///< also write every message here (not owned)
-    bool frames = false;           ///< publish the camera frames themselves (RILBED_FRAMES, JPEG)
-    int jpeg_quality = 90;         ///< of those frames; higher is larger and closer to the camera's
+    bool in_process = false;      ///< the bus is memq://
+    lcm::LogFile* log = nullptr;  ///< also write every message here (not owned)
+    bool frames = false;          ///< publish the camera frames themselves (RILBED_FRAMES, JPEG)
+    int jpeg_quality = 90;        ///< of those frames; higher is larger and closer to the camera's
     /// Hand the local subscribers that want them (a web panel) a frame at most this often,
     /// wall milliseconds, without putting it on the bus or in the log; 0: never. Each
     /// costs a JPEG encoding (about 2 ms for 640 x 480).

@@ -222,7 +222,8 @@ void fields(Walk& w, const rilbed::sensor_geometry_t*) {
 void fields(Walk& w, const rilbed::sensor_layout_t*) {
   w.i64();
   const std::int32_t geometries = w.count(w.i32(), 8 + 4 + 1 + 8 + 4);  // the smallest geometry
-  for (std::int32_t k = 0; k < geometries && w.ok(); ++k) fields(w, static_cast<const rilbed::sensor_geometry_t*>(nullptr));
+  for (std::int32_t k = 0; k < geometries && w.ok(); ++k)
+    fields(w, static_cast<const rilbed::sensor_geometry_t*>(nullptr));
   const std::int32_t robots = w.count(w.i32(), 2 * 4);
   w.skip(static_cast<std::size_t>(robots) * 2 * 4);
 }

@@ -16,20 +16,20 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "rilbed/agent_hello_t.hpp"
+#include "rilbed/camera_t.hpp"
 #include "rilbed/console_command_t.hpp"
 #include "rilbed/console_reply_t.hpp"
 #include "rilbed/detections_t.hpp"
 #include "rilbed/event_t.hpp"
-#include "rilbed/camera_t.hpp"
-#include "rilbed/sensor_layout_t.hpp"
 #include "rilbed/frame_t.hpp"
 #include "rilbed/poses_t.hpp"
 #include "rilbed/quantum_reply_t.hpp"
 #include "rilbed/quantum_t.hpp"
+#include "rilbed/sensor_layout_t.hpp"
 #include "rilbed/sensors_t.hpp"
 #include "rilbed/status_t.hpp"
-#include "rilbed/vision_settings_t.hpp"
 #include "rilbed/summary_t.hpp"
+#include "rilbed/vision_settings_t.hpp"
 #include "rilbed/wheels_t.hpp"
 #include "rilbed/world_t.hpp"
 
@@ -44,7 +44,8 @@ bool well_formed(const void* data, std::size_t size);
 /// throws, never allocates more than a small multiple of `size`.
 template <typename Message>
 bool decode_checked(const void* data, std::size_t size, Message& message) {
-  if (size > static_cast<std::size_t>(std::numeric_limits<int>::max()) || !well_formed<Message>(data, size)) return false;
+  if (size > static_cast<std::size_t>(std::numeric_limits<int>::max()) || !well_formed<Message>(data, size))
+    return false;
   try {
     const int length = static_cast<int>(size);
     return message.decode(data, 0, length) == length;

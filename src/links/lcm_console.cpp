@@ -43,8 +43,9 @@ std::string make_run_token() {
 
 std::filesystem::path token_path(const std::string& prefix) {
   const char* runtime = std::getenv("XDG_RUNTIME_DIR");
-  const std::filesystem::path dir = runtime && *runtime ? std::filesystem::path(runtime) / "rilbed"
-                                                        : std::filesystem::path("/tmp") / ("rilbed-" + std::to_string(::getuid()));
+  const std::filesystem::path dir = runtime && *runtime
+                                        ? std::filesystem::path(runtime) / "rilbed"
+                                        : std::filesystem::path("/tmp") / ("rilbed-" + std::to_string(::getuid()));
   return dir / (prefix + "token");
 }
 
@@ -132,8 +133,10 @@ std::variant<agents::ControlAction, std::string> parse_console_command(const ril
     char* end = nullptr;
     const double s = std::strtod(c.args[3].c_str(), &end);
     if (!id || *id < 0) return "'" + c.args[0] + "' is not a robot ID";
-    if (!left || std::abs(*left) > 127) return "left speed '" + c.args[1] + "' is not a whole number in -127..127 (Khepera units)";
-    if (!right || std::abs(*right) > 127) return "right speed '" + c.args[2] + "' is not a whole number in -127..127 (Khepera units)";
+    if (!left || std::abs(*left) > 127)
+      return "left speed '" + c.args[1] + "' is not a whole number in -127..127 (Khepera units)";
+    if (!right || std::abs(*right) > 127)
+      return "right speed '" + c.args[2] + "' is not a whole number in -127..127 (Khepera units)";
     if (end == c.args[3].c_str() || *end != '\0' || !std::isfinite(s) || s <= 0.0 || s > 600.0) {
       return "'" + c.args[3] + "' is not a number of seconds in (0, 600]";
     }
@@ -146,8 +149,9 @@ std::variant<agents::ControlAction, std::string> parse_console_command(const ril
   }
   if (c.command == "vision") {
     if (args == 0 || args % 2 != 0 || args > 2 * vision::kVisionSettingNames.size()) {
-      return std::string("'vision' takes NAME VALUE pairs (brightness, contrast, threshold, min_diameter_px, "
-                         "max_diameter_px, min_score)");
+      return std::string(
+          "'vision' takes NAME VALUE pairs (brightness, contrast, threshold, min_diameter_px, "
+          "max_diameter_px, min_score)");
     }
     vision::VisionSettings ranges;  // each value checked against its range here, the whole by the run
     for (std::size_t i = 0; i < args; i += 2) {
@@ -164,7 +168,8 @@ std::variant<agents::ControlAction, std::string> parse_console_command(const ril
     a.kind = agents::ControlAction::Kind::kVision;
     return a;
   }
-  return "unknown command '" + c.command + "' (pause, resume, exit, reset, rt-factor F, mode central|distributed, "
+  return "unknown command '" + c.command +
+         "' (pause, resume, exit, reset, rt-factor F, mode central|distributed, "
          "drive ID LEFT RIGHT --for S, vision NAME VALUE...)";
 }
 
@@ -173,7 +178,8 @@ namespace {
 // Equal strings in a time that does not depend on where they differ.
 bool same_token(const std::string& a, const std::string& b) {
   unsigned char diff = a.size() == b.size() ? 0 : 1;
-  for (std::size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i % std::max<std::size_t>(b.size(), 1)]);
+  for (std::size_t i = 0; i < a.size(); ++i)
+    diff |= static_cast<unsigned char>(a[i] ^ b[i % std::max<std::size_t>(b.size(), 1)]);
   return diff == 0 && !b.empty();
 }
 
@@ -201,7 +207,8 @@ struct LcmConsoleServer::Impl {
   // the run, for the retries of a console whose answer was lost (`exit` ends the run).
   std::atomic<std::int64_t> last_answer_ms{std::numeric_limits<std::int64_t>::min() / 2};
   static std::int64_t now_ms() {
-    return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
   }
 
   void wait_for_messages() {
@@ -265,7 +272,8 @@ struct LcmConsoleServer::Impl {
         for (const std::string& arg : c->args) reply.reason += " " + arg;
       }
     }
-    if (log) log("console: " + who + ": " + c->command + ": " + (reply.accepted ? "accepted" : "refused, " + reply.reason));
+    if (log)
+      log("console: " + who + ": " + c->command + ": " + (reply.accepted ? "accepted" : "refused, " + reply.reason));
     publish_encoded(lcm, channels.console_reply, reply);
     answered[key] = reply;
     last_answer_ms = now_ms();
@@ -284,7 +292,8 @@ LcmConsoleServer::LcmConsoleServer(lcm::LCM& lcm, Channels channels, std::string
   Impl& m = *impl_;
   m.while_paused = std::move(while_paused);
   m.subscription = std::make_unique<LcmSubscription>(
-      lcm, m.channels.console, [&m](const std::string& c, const void* data, std::size_t size) { m.on_message(c, data, size); });
+      lcm, m.channels.console,
+      [&m](const std::string& c, const void* data, std::size_t size) { m.on_message(c, data, size); });
   if (!own_thread) return;
   // A duplicate of LCM's descriptor: closing ours must not close LCM's.
   m.descriptor.assign(::dup(lcm.getFileno()));
@@ -333,7 +342,8 @@ std::optional<rilbed::console_reply_t> send_console_command(lcm::LCM& lcm, const
   std::array<char, 256> host{};
   ::gethostname(host.data(), host.size() - 1);
   rilbed::console_command_t c;
-  c.seq = static_cast<std::int64_t>(std::random_device{}()) << 20 ^ std::chrono::steady_clock::now().time_since_epoch().count();
+  c.seq = static_cast<std::int64_t>(std::random_device{}()) << 20 ^
+          std::chrono::steady_clock::now().time_since_epoch().count();
   c.client = std::string(host.data()) + ":" + std::to_string(::getpid());
   if (!on_behalf_of.empty()) c.client += " for " + on_behalf_of;
   c.token = token;
@@ -341,8 +351,9 @@ std::optional<rilbed::console_reply_t> send_console_command(lcm::LCM& lcm, const
   c.args = args;
   c.num_args = static_cast<std::int32_t>(args.size());
   ReplyCatcher catcher{c.seq, c.client, std::nullopt};
-  LcmSubscription subscription(lcm, channels.console_reply,
-                               [&catcher](const std::string&, const void* data, std::size_t size) { catcher.on_reply(data, size); });
+  LcmSubscription subscription(
+      lcm, channels.console_reply,
+      [&catcher](const std::string&, const void* data, std::size_t size) { catcher.on_reply(data, size); });
   const auto start = std::chrono::steady_clock::now();
   auto next_send = start;
   while (!catcher.reply) {

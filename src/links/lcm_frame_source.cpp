@@ -35,7 +35,8 @@ class LcmFrameSource final : public vision::FrameSource {
     const LcmLogReader::Event& e = events_[next_++];
     r.index = index;
     rilbed::frame_t m;
-    if (!decode_checked(e.data.data(), e.data.size(), m)) return error(r, "event " + std::to_string(e.eventnum) + " is not a rilbed.frame_t");
+    if (!decode_checked(e.data.data(), e.data.size(), m))
+      return error(r, "event " + std::to_string(e.eventnum) + " is not a rilbed.frame_t");
     r.name = "frame " + std::to_string(m.frame);
     if (m.format != "jpeg") return error(r, r.name + " is '" + m.format + "', not jpeg");
     cv::Mat image;
@@ -49,14 +50,14 @@ class LcmFrameSource final : public vision::FrameSource {
       return error(r, r.name + " is not an 8-bit JPEG image of its stated size " + std::to_string(m.width_px) + "x" +
                           std::to_string(m.height_px));
     }
-    r.kind = vision::FrameResult::Kind::Frame;
+    r.kind = vision::FrameResult::Kind::kFrame;
     r.image = std::move(image);
     return r;
   }
 
  private:
   vision::FrameResult error(vision::FrameResult r, const std::string& why) const {
-    r.kind = vision::FrameResult::Kind::Error;
+    r.kind = vision::FrameResult::Kind::kError;
     r.error = input() + ": " + why;
     return r;
   }
@@ -71,7 +72,8 @@ class LcmFrameSource final : public vision::FrameSource {
 bool is_lcm_log_path(const std::string& path) {
   if (path.size() < 4) return false;
   std::string ext = path.substr(path.size() - 4);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext == ".lcm";
 }
 

@@ -28,7 +28,7 @@ agents::Scenario placing_scenario(const agents::Scenario& scenario, const std::m
   s.moving_obstacles.clear();
   s.robots.clear();
   for (const agents::RobotSpec& r : scenario.robots) {
-    if (r.kind != environment::RobotKind::Real) continue;
+    if (r.kind != environment::RobotKind::kReal) continue;
     agents::RobotSpec spec = r;
     const auto target = targets.find(r.id);
     spec.pose = target != targets.end() ? target->second : Pose2{};
@@ -68,7 +68,7 @@ PlacementResult place_real_robots(RealRobots& robots, const std::map<int, Pose2>
   std::vector<int> drive_ids;
   for (const agents::RobotSpec& r : scenario.robots) {
     const auto target = targets.find(r.id);
-    if (r.kind != environment::RobotKind::Real || target == targets.end()) continue;
+    if (r.kind != environment::RobotKind::kReal || target == targets.end()) continue;
     const bool is_new = robots.emulator(r.id) == nullptr && r.link && r.link->emulate;
     robots.connect(r, target->second);  // a new emulated robot starts at its target
     if (is_new) continue;
@@ -107,7 +107,8 @@ PlacementResult place_real_robots(RealRobots& robots, const std::map<int, Pose2>
     for (const int id : r.not_done) {
       const auto seen = last.find(id);
       message += "\n  robot " + std::to_string(id) + " to " + pose_text(targets.at(id)) +
-                 (seen != last.end() ? " (the camera sees it at " + pose_text(seen->second) + ")" : " (the camera does not see it)");
+                 (seen != last.end() ? " (the camera sees it at " + pose_text(seen->second) + ")"
+                                     : " (the camera does not see it)");
     }
     if (!options.ask_operator) log(LogLevel::kWarning, message);
     if (!options.ask_operator || !options.ask_operator(message)) {

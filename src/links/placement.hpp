@@ -43,8 +43,8 @@ struct PlacementOptions {
 /// What placing came to.
 struct PlacementResult {
   bool ok = false;
-  std::string error;                   ///< why not, naming the robots
-  std::map<int, double> offset_m;      ///< each robot driven there: its distance from its pose at the end
+  std::string error;                    ///< why not, naming the robots
+  std::map<int, double> offset_m;       ///< each robot driven there: its distance from its pose at the end
   std::vector<int> placed_by_operator;  ///< robots the operator placed by hand
   double wall_s = 0.0;
 };

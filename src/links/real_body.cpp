@@ -11,7 +11,7 @@ namespace rilbed::links {
 RealBody::RealBody(int id, environment::World& world, std::shared_ptr<KheperaLink> link, RealBodyConfig config)
     : id_(id), world_(world), link_(std::move(link)), config_(config) {
   if (!link_) throw std::invalid_argument("robot " + std::to_string(id) + ": no link");
-  if (!world_.has_robot(id) || world_.robot(id).kind != environment::RobotKind::Real) {
+  if (!world_.has_robot(id) || world_.robot(id).kind != environment::RobotKind::kReal) {
     throw std::invalid_argument("robot " + std::to_string(id) + " is not a real robot of the world");
   }
   // The robot's own sensors are read as often as the controller could use them.
@@ -36,8 +36,9 @@ RealBody::~RealBody() {
   }
   // Nothing more software can do: say so loudly, so that someone goes to the robot.
   if (const LogCallback& log = link_->config().log) {
-    log(LogLevel::kError, "could not confirm that the robot stopped (its speeds never read back 0 0 within 10 s): "
-                          "switch it off by hand");
+    log(LogLevel::kError,
+        "could not confirm that the robot stopped (its speeds never read back 0 0 within 10 s): "
+        "switch it off by hand");
   }
 }
 
@@ -52,7 +53,8 @@ environment::SensorReadings RealBody::sense(TimeUs t_us) {
     for (int i = 0; i < environment::kProximityCount; ++i) {
       const int value = full_scale == environment::kProximityMax
                             ? real->value[i]
-                            : static_cast<int>(std::lround(static_cast<double>(real->value[i]) * environment::kProximityMax / full_scale));
+                            : static_cast<int>(std::lround(static_cast<double>(real->value[i]) *
+                                                           environment::kProximityMax / full_scale));
       (*r.proximity)[i] = std::max((*r.proximity)[i], value);
     }
   }
@@ -107,7 +109,8 @@ void RealBody::drive(const agents::WheelCommand& wheels) {
   }
   // Controllers speak Khepera units (8 mm/s); another model's firmware takes its own.
   const double per_unit = agents::kMetresPerSecondPerUnit / link_->config().model.speed_unit_mps;
-  link_->set_speeds(static_cast<int>(std::lround(wheels.left * per_unit)), static_cast<int>(std::lround(wheels.right * per_unit)));
+  link_->set_speeds(static_cast<int>(std::lround(wheels.left * per_unit)),
+                    static_cast<int>(std::lround(wheels.right * per_unit)));
 }
 
 void RealBody::stop() { link_->set_speeds(0, 0); }

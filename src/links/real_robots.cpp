@@ -72,7 +72,8 @@ std::shared_ptr<KheperaLink> RealRobots::connect(const agents::RobotSpec& spec, 
     std::lock_guard lock(mutex_);
     if (const auto it = links_.find(spec.id); it != links_.end()) return it->second;
   }
-  const std::string where = scenario_.source.string() + ":" + std::to_string(spec.line) + ": robot " + std::to_string(spec.id);
+  const std::string where =
+      scenario_.source.string() + ":" + std::to_string(spec.line) + ": robot " + std::to_string(spec.id);
   if (!spec.link) throw agents::ScenarioError(where + ": a real robot needs a link");
   LinkConfig config;
   config.model = model_named(spec.link->model, where);

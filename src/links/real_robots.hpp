@@ -6,8 +6,8 @@
 // with the emulated robots' true poses.
 #pragma once
 
-#include <functional>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>

@@ -40,10 +40,12 @@ int ms_between(Clock::time_point a, Clock::time_point b) {
 
 RemoteAgents::RemoteAgents(lcm::LCM& quanta, lcm::LCM& answers, RemoteAgentsConfig config)
     : quanta_(quanta), answers_(answers), config_(std::move(config)), run_(make_nonce()) {
-  hello_sub_ = std::make_unique<LcmSubscription>(
-      answers_, config_.channels.agent_hello, [this](const std::string&, const void* d, std::size_t n) { on_hello(d, n); });
-  reply_sub_ = std::make_unique<LcmSubscription>(
-      answers_, config_.channels.quantum_reply, [this](const std::string&, const void* d, std::size_t n) { on_reply(d, n); });
+  hello_sub_ =
+      std::make_unique<LcmSubscription>(answers_, config_.channels.agent_hello,
+                                        [this](const std::string&, const void* d, std::size_t n) { on_hello(d, n); });
+  reply_sub_ =
+      std::make_unique<LcmSubscription>(answers_, config_.channels.quantum_reply,
+                                        [this](const std::string&, const void* d, std::size_t n) { on_reply(d, n); });
 }
 
 RemoteAgents::~RemoteAgents() = default;
@@ -117,7 +119,8 @@ void RemoteAgents::on_reply(const void* data, std::size_t size) {
     into = &answered_;
     s.awaiting.reset();
     if (s.message < outgoing_.size() && !outgoing_[s.message].repeated) {
-      const double ms = std::chrono::duration<double, std::milli>(s.last_heard - outgoing_[s.message].first_sent_at).count();
+      const double ms =
+          std::chrono::duration<double, std::milli>(s.last_heard - outgoing_[s.message].first_sent_at).count();
       s.round_trip_ms = s.round_trip_ms < 0.0 ? ms : 0.9 * s.round_trip_ms + 0.1 * ms;
     }
   } else if (config_.realtime && reply.quantum < next_quantum_ && reply.quantum > next_quantum_ - 3) {
@@ -153,8 +156,9 @@ std::optional<std::string> RemoteAgents::wait_for_agents(std::chrono::millisecon
     const auto now = Clock::now();
     if (now >= until) {
       return "no agent process announced robot" + std::string(missing.size() > 1 ? "s " : " ") + join(missing) +
-             " within " + std::to_string(timeout.count() / 1000.0).substr(0, 4) + " s (start `rilbed agent --scenario FILE --ids " +
-             join(missing) + " --lcm URL` with this run's URL and channel prefix)";
+             " within " + std::to_string(timeout.count() / 1000.0).substr(0, 4) +
+             " s (start `rilbed agent --scenario FILE --ids " + join(missing) +
+             " --lcm URL` with this run's URL and channel prefix)";
     }
     answers_.handleTimeout(std::max(1, std::min(100, ms_between(now, until))));
   }
@@ -251,22 +255,21 @@ void RemoteAgents::lose(Session& s, const char* why) {
   s.awaiting.reset();
   s.unanswered_since.reset();
   ++counters_.lost_processes;
-  notices_.push_back({"agent", 0,
-                      "lost: process " + s.host + ":" + std::to_string(s.pid) + " (robots " + join(s.robot_ids) + ") " + why});
+  notices_.push_back(
+      {"agent", 0,
+       "lost: process " + s.host + ":" + std::to_string(s.pid) + " (robots " + join(s.robot_ids) + ") " + why});
 }
 
 void RemoteAgents::handle_for(std::chrono::milliseconds wait) {
   // handleTimeout returns after one message or the timeout: drain what is there.
   answers_.handleTimeout(static_cast<int>(std::max<std::int64_t>(0, wait.count())));
-  while (answers_.handleTimeout(0) > 0) {
-  }
+  while (answers_.handleTimeout(0) > 0) {}
 }
 
 std::vector<agents::RemoteOutput> RemoteAgents::exchange(TimeUs t_us) {
   const auto called = Clock::now();
   // Announcements and stale answers that arrived since the last instant.
-  while (answers_.handleTimeout(0) > 0) {
-  }
+  while (answers_.handleTimeout(0) > 0) {}
   std::vector<agents::RemoteOutput> out;
   if (config_.realtime) {
     out = std::move(late_);
@@ -279,7 +282,8 @@ std::vector<agents::RemoteOutput> RemoteAgents::exchange(TimeUs t_us) {
   std::vector<Session*> to;
   for (auto& [name, s] : sessions_) {
     if (s.lost) continue;
-    if (std::any_of(s.robot_ids.begin(), s.robot_ids.end(), [&](int id) { return pending_.contains(id); })) to.push_back(&s);
+    if (std::any_of(s.robot_ids.begin(), s.robot_ids.end(), [&](int id) { return pending_.contains(id); }))
+      to.push_back(&s);
   }
   const std::int64_t k = next_quantum_++;
   send(to, k, t_us, false);

@@ -38,11 +38,11 @@ namespace rilbed::links {
 
 /// Knobs of the exchange.
 struct RemoteAgentsConfig {
-  Channels channels;               ///< RILBED_AGENT_HELLO, RILBED_QUANTUM, RILBED_QUANTUM_REPLY (with the run's prefix)
-  std::string scenario_name;       ///< agents announcing another scenario are refused
-  std::vector<int> robot_ids;      ///< the robots whose controllers run elsewhere
-  std::set<int> team_readers;      ///< among them, those whose controllers read the team broadcast
-  bool realtime = false;           ///< real-time mode (see the file comment), else lock-step
+  Channels channels;           ///< RILBED_AGENT_HELLO, RILBED_QUANTUM, RILBED_QUANTUM_REPLY (with the run's prefix)
+  std::string scenario_name;   ///< agents announcing another scenario are refused
+  std::vector<int> robot_ids;  ///< the robots whose controllers run elsewhere
+  std::set<int> team_readers;  ///< among them, those whose controllers read the team broadcast
+  bool realtime = false;       ///< real-time mode (see the file comment), else lock-step
   /// A quantum not answered within this is sent again, at most: once a process has
   /// answered, the wait is three times its usual round trip (at least 1 ms), so that a
   /// lost datagram on a fast network costs a millisecond or two, not this. Lower recovers
@@ -60,14 +60,14 @@ struct RemoteAgentsConfig {
 
 /// What the exchange has counted since it was made.
 struct RemoteAgentsCounters {
-  std::int64_t quanta_sent = 0;    ///< quantum messages sent, repeats not included
-  std::int64_t repeats = 0;        ///< quantum messages sent again (no answer in time)
-  std::int64_t answers = 0;        ///< answers taken
-  std::int64_t duplicates = 0;     ///< answers to a quantum already answered, or stale ones
-  std::int64_t late = 0;           ///< real time: answers that missed their instant
-  std::int64_t refused = 0;        ///< messages that were not well formed, or not for this run
-  std::int64_t lost_processes = 0; ///< processes found dead
-  std::int64_t rejoins = 0;        ///< robots taken over by a new process after their process was lost
+  std::int64_t quanta_sent = 0;     ///< quantum messages sent, repeats not included
+  std::int64_t repeats = 0;         ///< quantum messages sent again (no answer in time)
+  std::int64_t answers = 0;         ///< answers taken
+  std::int64_t duplicates = 0;      ///< answers to a quantum already answered, or stale ones
+  std::int64_t late = 0;            ///< real time: answers that missed their instant
+  std::int64_t refused = 0;         ///< messages that were not well formed, or not for this run
+  std::int64_t lost_processes = 0;  ///< processes found dead
+  std::int64_t rejoins = 0;         ///< robots taken over by a new process after their process was lost
 };
 
 class RemoteAgents final : public agents::AgentExchange {
@@ -98,7 +98,7 @@ class RemoteAgents final : public agents::AgentExchange {
 
  private:
   struct Session {
-    std::string name;          // agent_hello_t.session
+    std::string name;  // agent_hello_t.session
     std::string host;
     int pid = 0;
     std::vector<int> robot_ids;
@@ -134,13 +134,13 @@ class RemoteAgents final : public agents::AgentExchange {
   RemoteAgentsConfig config_;
   std::string run_;
   std::int64_t next_quantum_ = 0;
-  std::vector<Outgoing> outgoing_;  // the messages of the quantum in flight
-  std::map<std::string, Session> sessions_;     // by session name
-  std::map<int, std::string> owner_;            // robot -> session name
-  std::map<int, agents::ControlInput> pending_; // submitted for the coming quantum, by robot
-  std::vector<agents::TeamMessage> team_;       // the team broadcast of the pending inputs
-  std::vector<agents::RemoteOutput> answered_;  // answers taken for the quantum in flight
-  std::vector<agents::RemoteOutput> late_;      // real time: answers that missed their instant
+  std::vector<Outgoing> outgoing_;                                 // the messages of the quantum in flight
+  std::map<std::string, Session> sessions_;                        // by session name
+  std::map<int, std::string> owner_;                               // robot -> session name
+  std::map<int, agents::ControlInput> pending_;                    // submitted for the coming quantum, by robot
+  std::vector<agents::TeamMessage> team_;                          // the team broadcast of the pending inputs
+  std::vector<agents::RemoteOutput> answered_;                     // answers taken for the quantum in flight
+  std::vector<agents::RemoteOutput> late_;                         // real time: answers that missed their instant
   std::optional<std::chrono::steady_clock::time_point> deadline_;  // real time: the current instant's deadline
   std::vector<agents::ExchangeNotice> notices_;
   RemoteAgentsCounters counters_;

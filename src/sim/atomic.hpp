@@ -69,8 +69,7 @@ class Atomic : public Component {
 template <class State>
 class AtomicModel : public Atomic {
  public:
-  AtomicModel(std::string id, State initial_state)
-      : Atomic(std::move(id)), state_(std::move(initial_state)) {}
+  AtomicModel(std::string id, State initial_state) : Atomic(std::move(id)), state_(std::move(initial_state)) {}
 
   /// The current state (read-only; valid until the next transition).
   const State& state() const { return state_; }

@@ -16,10 +16,10 @@ Clock::~Clock() = default;
 void FastClock::start(TimeUs sim_t_us) { now_us_.store(sim_t_us); }
 
 WaitResult FastClock::wait_until(TimeUs sim_t_us) {
-  if (stopped_.load()) return WaitResult::stopped;
+  if (stopped_.load()) return WaitResult::kStopped;
   // "Never" is not a time to jump to: keep the last finite time as now.
   if (sim_t_us != kInfinity && sim_t_us > now_us_.load()) now_us_.store(sim_t_us);
-  return WaitResult::reached;
+  return WaitResult::kReached;
 }
 
 void FastClock::stop() { stopped_.store(true); }
@@ -30,13 +30,11 @@ TimeUs FastClock::now_us() const { return now_us_.load(); }
 
 double RealTimeClock::checked_factor(double factor) {
   if (!(factor > 0.0) || !std::isfinite(factor))
-    throw std::invalid_argument("sim: a real-time factor must be positive and finite, not " +
-                                std::to_string(factor));
+    throw std::invalid_argument("sim: a real-time factor must be positive and finite, not " + std::to_string(factor));
   return factor;
 }
 
-RealTimeClock::RealTimeClock(double factor)
-    : factor_(checked_factor(factor)), anchor_wall_(WallClock::now()) {}
+RealTimeClock::RealTimeClock(double factor) : factor_(checked_factor(factor)), anchor_wall_(WallClock::now()) {}
 
 TimeUs RealTimeClock::now_locked(WallClock::time_point wall_now) const {
   if (paused_) return anchor_sim_us_;
@@ -98,10 +96,10 @@ WaitResult RealTimeClock::wait_until(TimeUs sim_t_us) {
   constexpr auto kMaxSleep = std::chrono::hours(1);
   std::unique_lock lock(mutex_);
   for (;;) {
-    if (stopped_) return WaitResult::stopped;
+    if (stopped_) return WaitResult::kStopped;
     if (notified_) {
       notified_ = false;
-      return WaitResult::woken;
+      return WaitResult::kWoken;
     }
     if (paused_) {
       changed_.wait(lock);
@@ -115,7 +113,7 @@ WaitResult RealTimeClock::wait_until(TimeUs sim_t_us) {
       const double wall_ns = (static_cast<double>(sim_t_us) - static_cast<double>(anchor_sim_us_)) * 1e3 / factor_;
       if (wall_ns < std::chrono::duration<double, std::nano>(deadline - anchor_wall_).count()) {
         const auto due = anchor_wall_ + std::chrono::nanoseconds(static_cast<std::int64_t>(std::ceil(wall_ns)));
-        if (wall_now >= due) return WaitResult::reached;
+        if (wall_now >= due) return WaitResult::kReached;
         deadline = due;
       }
     }

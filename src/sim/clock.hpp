@@ -12,9 +12,9 @@ namespace rilbed::sim {
 
 /// How Clock::wait_until ended.
 enum class WaitResult {
-  reached,  ///< simulated time reached the deadline
-  woken,    ///< notify() woke it early (an external event, or the coordinator stopping)
-  stopped,  ///< the clock was stopped: every wait now returns at once
+  kReached,  ///< simulated time reached the deadline
+  kWoken,    ///< notify() woke it early (an external event, or the coordinator stopping)
+  kStopped,  ///< the clock was stopped: every wait now returns at once
 };
 
 /// The strategy that maps simulated time to the world. The coordinator calls

@@ -37,26 +37,26 @@ class Component {
   /// an input of that name exists.
   template <class T>
   Port<T>& add_input(std::string name) {
-    return add_port<T>(std::move(name), PortDirection::input);
+    return add_port<T>(std::move(name), PortDirection::kInput);
   }
   /// Creates an output port for messages of type T. Throws std::invalid_argument when
   /// an output of that name exists.
   template <class T>
   Port<T>& add_output(std::string name) {
-    return add_port<T>(std::move(name), PortDirection::output);
+    return add_port<T>(std::move(name), PortDirection::kOutput);
   }
 
   /// The input port `name` as a Port<T>; throws std::invalid_argument when there is
   /// none or its type is not T.
   template <class T>
   Port<T>& input_port(std::string_view name) {
-    return static_cast<Port<T>&>(checked_port(PortDirection::input, name, typeid(T)));
+    return static_cast<Port<T>&>(checked_port(PortDirection::kInput, name, typeid(T)));
   }
   /// The output port `name` as a Port<T>; throws like input_port(). (Not named
   /// output(): that is the atomic models' output function.)
   template <class T>
   Port<T>& output_port(std::string_view name) {
-    return static_cast<Port<T>&>(checked_port(PortDirection::output, name, typeid(T)));
+    return static_cast<Port<T>&>(checked_port(PortDirection::kOutput, name, typeid(T)));
   }
   /// The input port `name`, or nullptr.
   PortBase* find_input(std::string_view name) const;
@@ -74,15 +74,14 @@ class Component {
   template <class T>
   Port<T>& add_port(std::string name, PortDirection direction) {
     check_new_port_name(direction, name);
-    auto& ports = direction == PortDirection::input ? inputs_ : outputs_;
+    auto& ports = direction == PortDirection::kInput ? inputs_ : outputs_;
     // Port's constructor is private (only components create ports): no make_unique.
     auto* port = new Port<T>(std::move(name), *this, direction);
     ports.emplace_back(port);
     return *port;
   }
   void check_new_port_name(PortDirection direction, const std::string& name) const;
-  PortBase& checked_port(PortDirection direction, std::string_view name,
-                         const std::type_info& type) const;
+  PortBase& checked_port(PortDirection direction, std::string_view name, const std::type_info& type) const;
 
   std::string id_;
   const Component* parent_ = nullptr;

@@ -19,10 +19,8 @@ void flatten(Component& component, std::vector<Atomic*>& atomics, CouplingsFrom&
     return;
   }
   auto* coupled = dynamic_cast<Coupled*>(&component);
-  if (!coupled)
-    throw std::invalid_argument("sim: '" + component.path() + "' is neither Atomic nor Coupled");
-  for (const auto& coupling : coupled->couplings())
-    couplings_from[coupling.from].push_back(coupling.to);
+  if (!coupled) throw std::invalid_argument("sim: '" + component.path() + "' is neither Atomic nor Coupled");
+  for (const auto& coupling : coupled->couplings()) couplings_from[coupling.from].push_back(coupling.to);
   for (const auto& child : coupled->children()) flatten(*child, atomics, couplings_from);
 }
 
@@ -45,8 +43,7 @@ void guarded(const Atomic& model, const char* what, TimeUs t_us, Body&& body) {
 
 }  // namespace
 
-Coordinator::Coordinator(std::shared_ptr<Component> root, Clock& clock)
-    : root_(std::move(root)), clock_(clock) {
+Coordinator::Coordinator(std::shared_ptr<Component> root, Clock& clock) : root_(std::move(root)), clock_(clock) {
   if (!root_) throw std::invalid_argument("sim: the coordinator needs a root model");
   CouplingsFrom couplings_from;
   flatten(*root_, atomics_, couplings_from);
@@ -104,7 +101,7 @@ void Coordinator::on_step(std::function<void(const StepReport&)> observer) {
 void Coordinator::check_root_port(const PortBase& port, PortDirection direction) const {
   if (&port.owner() != root_.get() || port.direction() != direction)
     throw std::invalid_argument("sim: " + port.describe() + " is not an " +
-                                (direction == PortDirection::input ? "input" : "output") +
+                                (direction == PortDirection::kInput ? "input" : "output") +
                                 " port of the root model '" + root_->path() + "'");
 }
 
@@ -120,12 +117,11 @@ void Coordinator::stop() {
 void Coordinator::run_until(TimeUs t_end_us) {
   check_usable();
   if (t_end_us < now_us())
-    throw std::invalid_argument("sim: run_until(" + std::to_string(t_end_us) +
-                                " us) is before the current time " + std::to_string(now_us()) + " us");
+    throw std::invalid_argument("sim: run_until(" + std::to_string(t_end_us) + " us) is before the current time " +
+                                std::to_string(now_us()) + " us");
   clock_.start(now_us());
   try {
-    while (advance(t_end_us) == Progress::stepped) {
-    }
+    while (advance(t_end_us) == Progress::kStepped) {}
   } catch (...) {
     failed_ = true;
     throw;
@@ -136,7 +132,7 @@ bool Coordinator::step() {
   check_usable();
   clock_.start(now_us());
   try {
-    return advance(kInfinity) == Progress::stepped;
+    return advance(kInfinity) == Progress::kStepped;
   } catch (...) {
     failed_ = true;
     throw;
@@ -145,27 +141,25 @@ bool Coordinator::step() {
 
 Coordinator::Progress Coordinator::advance(TimeUs t_limit_us) {
   for (;;) {
-    if (stop_requested_.load()) return Progress::stopped;
+    if (stop_requested_.load()) return Progress::kStopped;
     const TimeUs t_next_us = schedule_.top_time_us();
     const TimeUs target_us = std::min(t_next_us, t_limit_us);
     if (has_injections_.load(std::memory_order_acquire)) {
       // External events happen "now", but never before the last step nor after the
       // next scheduled event (a late wake-up must not skip it).
       do_step(std::clamp(clock_.now_us(), now_us(), target_us));
-      return Progress::stepped;
+      return Progress::kStepped;
     }
     switch (clock_.wait_until(target_us)) {
-      case WaitResult::stopped:
-        return Progress::stopped;
-      case WaitResult::woken:
-        continue;  // an injection or stop(): the checks above decide
-      case WaitResult::reached:
+      case WaitResult::kStopped: return Progress::kStopped;
+      case WaitResult::kWoken: continue;  // an injection or stop(): the checks above decide
+      case WaitResult::kReached:
         if (t_next_us <= t_limit_us && t_next_us != kInfinity) {
           do_step(t_next_us);
-          return Progress::stepped;
+          return Progress::kStepped;
         }
         if (t_limit_us != kInfinity) now_us_.store(t_limit_us, std::memory_order_relaxed);
-        return Progress::limit_reached;
+        return Progress::kLimitReached;
     }
   }
 }

@@ -35,8 +35,8 @@ class ModelError : public std::runtime_error {
 
 /// What one step did, for per-step observers.
 struct StepReport {
-  TimeUs t_us;                               ///< simulated time of the step
-  std::span<Atomic* const> transitioned;     ///< atomics that changed state, flat order
+  TimeUs t_us;                            ///< simulated time of the step
+  std::span<Atomic* const> transitioned;  ///< atomics that changed state, flat order
 };
 
 /// Runs a model: the root is flattened once, at construction, into atomics in
@@ -81,8 +81,8 @@ class Coordinator {
   /// throws, std::invalid_argument when t_end_us < now_us().
   void run_until(TimeUs t_end_us);
   /// Performs the next step (the next internal event, or pending injected messages),
-  /// waiting for it through the clock (started at now_us(), like run_until). Returns false when stopped, or when there is no
-  /// event at all and the clock does not block (a FastClock). Throws like run_until().
+  /// waiting for it through the clock (started at now_us(), like run_until). Returns false when stopped, or when there
+  /// is no event at all and the clock does not block (a FastClock). Throws like run_until().
   bool step();
   /// Ends the current run_until()/step() soon and makes later ones return at once
   /// (sticky). Thread-safe.
@@ -104,12 +104,11 @@ class Coordinator {
   /// std::invalid_argument when the port is not a root input.
   template <class T>
   void inject(Port<T>& root_input, T message) {
-    check_root_port(root_input, PortDirection::input);
+    check_root_port(root_input, PortDirection::kInput);
     {
       std::lock_guard lock(injections_mutex_);
-      injections_.push_back([&root_input, message = std::move(message)]() mutable {
-        root_input.add(std::move(message));
-      });
+      injections_.push_back(
+          [&root_input, message = std::move(message)]() mutable { root_input.add(std::move(message)); });
     }
     has_injections_.store(true, std::memory_order_release);
     clock_.notify();
@@ -119,11 +118,11 @@ class Coordinator {
   /// port of the root) carries messages. Listeners run in registration order. Throws
   /// std::invalid_argument when the port is not a root output.
   template <class T>
-  void on_output(Port<T>& root_output,
-                 std::function<void(TimeUs t_us, const std::vector<T>& messages)> listener) {
-    check_root_port(root_output, PortDirection::output);
-    output_listeners_.push_back({&root_output, [&root_output, listener = std::move(listener)](
-                                                   TimeUs t_us) { listener(t_us, root_output.messages()); }});
+  void on_output(Port<T>& root_output, std::function<void(TimeUs t_us, const std::vector<T>& messages)> listener) {
+    check_root_port(root_output, PortDirection::kOutput);
+    output_listeners_.push_back({&root_output, [&root_output, listener = std::move(listener)](TimeUs t_us) {
+                                   listener(t_us, root_output.messages());
+                                 }});
   }
 
   /// Calls `observer` after every step (after all transitions of that step).
@@ -152,14 +151,14 @@ class Coordinator {
     Atomic* model;
     std::vector<Route> outputs;  // one per output port, declaration order
     TimeUs last_t_us = 0;
-    bool concurrent = false;  // model->transitions_concurrent(), asked once
+    bool concurrent = false;         // model->transitions_concurrent(), asked once
     std::size_t prefetch_bytes = 0;  // model->prefetch_bytes(), asked once
   };
   struct OutputListener {
     PortBase* port;
     std::function<void(TimeUs)> call;
   };
-  enum class Progress { stepped, limit_reached, stopped };
+  enum class Progress { kStepped, kLimitReached, kStopped };
 
   void check_root_port(const PortBase& port, PortDirection direction) const;
   void check_usable() const;
@@ -186,11 +185,11 @@ class Coordinator {
   // model read only these, 100 KB at 100,000 models rather than their 5.6 MB of slots).
   static constexpr std::uint8_t kImminent = 1, kInfluenced = 2, kHasOutputs = 4;
   std::vector<std::uint8_t> marks_;
-  std::vector<std::size_t> emitting_;      // scratch: the imminent indices with output ports, flat order
-  std::vector<std::size_t> active_;        // scratch: imminent then influenced indices
-  std::vector<Atomic*> transitioned_;      // scratch for StepReport
-  core::WorkerPool* workers_ = nullptr;    // runs concurrent transitions, when set
-  std::vector<TimeUs> next_times_;         // scratch: next event time of active_[k]
+  std::vector<std::size_t> emitting_;    // scratch: the imminent indices with output ports, flat order
+  std::vector<std::size_t> active_;      // scratch: imminent then influenced indices
+  std::vector<Atomic*> transitioned_;    // scratch for StepReport
+  core::WorkerPool* workers_ = nullptr;  // runs concurrent transitions, when set
+  std::vector<TimeUs> next_times_;       // scratch: next event time of active_[k]
   std::vector<OutputListener> output_listeners_;
   std::vector<std::function<void(const StepReport&)>> step_observers_;
   std::atomic<TimeUs> now_us_{0};

@@ -113,10 +113,10 @@ class EventHeap {
     place(pos, item);
   }
 
-  std::vector<TimeUs> times_us_;     // item -> next time
-  std::vector<std::size_t> heap_;    // heap position -> item
+  std::vector<TimeUs> times_us_;       // item -> next time
+  std::vector<std::size_t> heap_;      // heap position -> item
   std::vector<std::size_t> position_;  // item -> heap position
-  std::vector<std::size_t> stack_;   // scratch for collect_at
+  std::vector<std::size_t> stack_;     // scratch for collect_at
 };
 
 }  // namespace rilbed::sim::detail

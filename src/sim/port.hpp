@@ -13,7 +13,7 @@ namespace rilbed::sim {
 class Component;
 
 /// Whether a port receives messages (input) or emits them (output).
-enum class PortDirection { input, output };
+enum class PortDirection { kInput, kOutput };
 
 /// The untyped face of a port, as couplings and the coordinator see it.
 ///

@@ -61,8 +61,7 @@ std::vector<int> hungarian_min_cost(const std::vector<std::vector<double>>& cost
 
 }  // namespace
 
-std::vector<int> assign_max_similarity(const std::vector<std::vector<double>>& similarity,
-                                       double min_similarity) {
+std::vector<int> assign_max_similarity(const std::vector<std::vector<double>>& similarity, double min_similarity) {
   const int rows = static_cast<int>(similarity.size());
   if (rows == 0) return {};
   const int cols = static_cast<int>(similarity[0].size());

@@ -12,8 +12,7 @@ namespace rilbed::vision {
 /// more than columns; every row must have the same length). Pairs below
 /// `min_similarity` are never made. Returns, for each row, the column it takes or -1.
 /// O(n^2 m) for n = min(rows, cols), m = max(rows, cols).
-std::vector<int> assign_max_similarity(const std::vector<std::vector<double>>& similarity,
-                                       double min_similarity);
+std::vector<int> assign_max_similarity(const std::vector<std::vector<double>>& similarity, double min_similarity);
 
 /// The same on a row-major `rows` x `cols` matrix (not owned; `similarity[r * cols + c]`),
 /// for a caller that keeps one buffer from frame to frame.

@@ -49,9 +49,9 @@ std::uint8_t deep_threshold(std::uint8_t threshold, std::uint8_t range, bool loc
 // The kernels below are written once with OpenCV's universal intrinsics (SSE2 on x86,
 // NEON on ARM, OpenCV's C++ emulation elsewhere), sixteen bytes per vector.
 namespace {
-using cv::v_uint8x16;
-using cv::v_uint16x8;
 using cv::v_float64x2;
+using cv::v_uint16x8;
+using cv::v_uint8x16;
 
 // Sixteen bytes from any address.
 v_uint8x16 load16(const std::uint8_t* p) { return cv::v_load(p); }
@@ -86,8 +86,8 @@ double Blob::disc_diameter_px() const { return 2.0 * std::sqrt(filled_area_px / 
 
 // Bookkeeping of one region (swept or filled).
 struct BlobDetector::Fill {
-  int area = 0;         // dark pixels in the region
-  int extent_area = 0;  // pixels within its row extents (a sweep's; the fill leaves 0)
+  int area = 0;                        // dark pixels in the region
+  int extent_area = 0;                 // pixels within its row extents (a sweep's; the fill leaves 0)
   int x0 = 0, x1 = 0, y0 = 0, y1 = 0;  // bounding box, inclusive
   bool touches_border = false;
   bool too_large = false;
@@ -422,8 +422,8 @@ void BlobDetector::build_dark_mask(const cv::Mat& grey, cv::Rect roi, bool local
           const v_uint8x16 v = step.pair ? load16(in + step.x0) : cv::v_load_low(in + step.x0);
           const v_uint8x16 limit = cv::v_load_aligned(step.limit.data());
           const v_uint8x16 deep_limit = cv::v_load_aligned(step.deep_limit.data());
-          const v_uint8x16 bits = ((cv::v_max(v, limit) == limit) & dark_bit) |
-                                  ((cv::v_max(v, deep_limit) == deep_limit) & deep_bit);
+          const v_uint8x16 bits =
+              ((cv::v_max(v, limit) == limit) & dark_bit) | ((cv::v_max(v, deep_limit) == deep_limit) & deep_bit);
           if (step.pair) {
             cv::v_store(out + step.x0, bits);
           } else {
@@ -726,8 +726,8 @@ struct ChordMoments {
 // (centre_along, centre_across): the difference in length plus the offset of the
 // midpoint, over the number of chords and the longest chord. Two chords per step in
 // vector lanes (two square roots in one instruction): this ran once per chord per candidate.
-double chord_error(const std::vector<std::array<double, 3>>& chords, double q_along, double q_mixed,
-                   double q_across, double centre_along, double centre_across) {
+double chord_error(const std::vector<std::array<double, 3>>& chords, double q_along, double q_mixed, double q_across,
+                   double centre_along, double centre_across) {
   const double inv_q_along = 1.0 / q_along;
   // The chord at offset d has half-length sqrt(disc) / q_along, with
   // disc = q_mixed^2 d^2 - q_along (q_across d^2 - 1) = q_along + k2 d^2.
@@ -805,8 +805,10 @@ bool BlobDetector::measure(const cv::Mat& grey, const Fill& fill, Blob& blob) co
     if (yb + 1 < grey.rows) bright_edges += bright(x, yb + 1);
     edges += 2;
     double a = yt - 0.5, b = yb + 0.5;
-    if (yt > 0) a = yt - edge_offset(grey.at<std::uint8_t>(yt - 1, x), grey.at<std::uint8_t>(yt, x), threshold_at(x, yt));
-    if (yb + 1 < grey.rows) b = yb + edge_offset(grey.at<std::uint8_t>(yb + 1, x), grey.at<std::uint8_t>(yb, x), threshold_at(x, yb));
+    if (yt > 0)
+      a = yt - edge_offset(grey.at<std::uint8_t>(yt - 1, x), grey.at<std::uint8_t>(yt, x), threshold_at(x, yt));
+    if (yb + 1 < grey.rows)
+      b = yb + edge_offset(grey.at<std::uint8_t>(yb + 1, x), grey.at<std::uint8_t>(yb, x), threshold_at(x, yb));
     cols.add(a, b, x);
     col_chords.push_back({a, b, static_cast<double>(x)});
   }
@@ -819,8 +821,8 @@ bool BlobDetector::measure(const cv::Mat& grey, const Fill& fill, Blob& blob) co
   const double cy = cols.along / cols.area;
   const double sxx = rows.along2 / rows.area - cx * cx;
   const double syy = cols.along2 / cols.area - cy * cy;
-  const double sxy = 0.5 * (rows.cross_along / rows.area - cx * rows.cross / rows.area +
-                            cols.cross_along / cols.area - cy * cols.cross / cols.area);
+  const double sxy = 0.5 * (rows.cross_along / rows.area - cx * rows.cross / rows.area + cols.cross_along / cols.area -
+                            cy * cols.cross / cols.area);
   const double det = sxx * syy - sxy * sxy;
   if (sxx <= 0.0 || syy <= 0.0 || det <= 0.0) return false;
 
@@ -966,8 +968,7 @@ void BlobDetector::reset_region(const Fill& fill) {
 std::vector<Blob> BlobDetector::scan(const cv::Mat& grey, cv::Rect roi) {
   std::vector<Blob> blobs;
   const double min_disc_d = config_.min_diameter_px * kDiscFraction;
-  const int step = config_.seed_row_step > 0 ? config_.seed_row_step
-                                             : std::max(1, static_cast<int>(min_disc_d / 4.0));
+  const int step = config_.seed_row_step > 0 ? config_.seed_row_step : std::max(1, static_cast<int>(min_disc_d / 4.0));
   for (int y = roi.y + step / 2; y < roi.y + roi.height; y += step) {
     const std::uint8_t* dark = dark_.ptr<std::uint8_t>(y);
     const std::size_t tile_row = static_cast<std::size_t>(tile_row_[y]) * tiles_x_;

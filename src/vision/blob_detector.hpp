@@ -144,27 +144,27 @@ class BlobDetector {
   // Column extents from the row extents, then measure(); false for a region too small.
   bool measure_region(const cv::Mat& grey, const Fill& fill, Blob& blob);
   bool centre_is_dark(const Blob& blob) const;  // the mask at the blob's centre pixel
-  void clear_swept_region(const Fill& fill);     // the mask within a sweep's row extents
+  void clear_swept_region(const Fill& fill);    // the mask within a sweep's row extents
   // Least area of a region that may be a marker's disc (config's smallest diameter,
   // foreshortened by max_axis_ratio, with a margin), pixels.
   double min_disc_area() const;
   // A cheap look at the region's bounding box and row extents before measure(): false
   // for a region far from any ellipse measure() would accept (long, thin or ragged).
   bool could_be_ellipse(const Fill& fill) const;
-  void reset_region(const Fill& fill);      // row and column extents back to empty
+  void reset_region(const Fill& fill);  // row and column extents back to empty
   void clear_row_extents(int y0, int y1);
   std::uint8_t threshold_at(int x, int y) const { return tile_threshold_[tile_row_[y] * tiles_x_ + tile_col_[x]]; }
 
   BlobDetectorConfig config_;
   cv::Size size_;
   int tiles_x_ = 0, tiles_y_ = 0;
-  std::vector<int> tile_col_, tile_row_;           // pixel column/row -> tile column/row
-  std::vector<std::uint8_t> tile_min_, tile_max_;  // raw tile statistics
-  std::vector<std::uint8_t> tile_threshold_;       // 0 marks a tile without contrast
-  std::vector<std::uint8_t> row_min_scratch_, row_max_scratch_;  // first pass of the 3x3 spread
-  std::vector<std::uint8_t> tile_range_;            // max - min over each tile's 3x3 neighbourhood
-  std::vector<std::int16_t> contrast_tiles_;        // per tile row: columns of tiles with contrast
-  std::vector<int> contrast_tile_count_;            // per tile row: how many are listed
+  std::vector<int> tile_col_, tile_row_;                                // pixel column/row -> tile column/row
+  std::vector<std::uint8_t> tile_min_, tile_max_;                       // raw tile statistics
+  std::vector<std::uint8_t> tile_threshold_;                            // 0 marks a tile without contrast
+  std::vector<std::uint8_t> row_min_scratch_, row_max_scratch_;         // first pass of the 3x3 spread
+  std::vector<std::uint8_t> tile_range_;                                // max - min over each tile's 3x3 neighbourhood
+  std::vector<std::int16_t> contrast_tiles_;                            // per tile row: columns of tiles with contrast
+  std::vector<int> contrast_tile_count_;                                // per tile row: how many are listed
   mutable std::vector<std::array<double, 3>> row_chords_, col_chords_;  // measure()'s scratch
   int fill_count_ = 0;
   int floor_range_ = 0;  // the floor's local contrast found by the last large search, grey levels
@@ -172,8 +172,8 @@ class BlobDetector {
   // current search (bit 1; bit 2 when it is dark enough to seed a fill): the fill and the
   // seed scan test one byte, and a fill clears what it takes. Valid inside the current
   // search's ROI only; written per tile of contrast.
-  cv::Mat dark_;          // a view into dark_storage_, the image's size
-  cv::Mat dark_storage_;  // dark_ with zero bytes beside each row
+  cv::Mat dark_;                            // a view into dark_storage_, the image's size
+  cv::Mat dark_storage_;                    // dark_ with zero bytes beside each row
   std::vector<std::uint8_t> dark_written_;  // per tile: its block of dark_ may hold nonzero bytes
   // `local_thresholds`: the tile thresholds come from this search's tile statistics
   // (not one fixed threshold), so those statistics may be consulted too.

@@ -16,8 +16,7 @@ namespace {
 // Kept identical so that our RMS equals the sample's on the same images.
 
 // findChessboardCorners flags the sample passes.
-constexpr int kChessboardFlags =
-    cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_FAST_CHECK | cv::CALIB_CB_NORMALIZE_IMAGE;
+constexpr int kChessboardFlags = cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_FAST_CHECK | cv::CALIB_CB_NORMALIZE_IMAGE;
 // cornerSubPix half window: the sample's -ws default of 11 (it passes Size(11, 11)).
 constexpr int kSubPixHalfWindowPx = 11;
 // cornerSubPix stop: 30 iterations or a move below 1e-4 px, as in the sample.
@@ -39,8 +38,7 @@ struct BoardView {
 };
 
 // Reads one image and looks for the board; fills the report's reason on failure.
-std::optional<BoardView> find_board(const std::string& path, cv::Size pattern,
-                                    CalibrationImageReport& report) {
+std::optional<BoardView> find_board(const std::string& path, cv::Size pattern, CalibrationImageReport& report) {
   // Checked first so that OpenCV does not log its own warning for a missing file.
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
@@ -61,8 +59,8 @@ std::optional<BoardView> find_board(const std::string& path, cv::Size pattern,
   }
   cv::Mat grey;
   cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
-  cv::cornerSubPix(grey, view.corners_px, cv::Size(kSubPixHalfWindowPx, kSubPixHalfWindowPx),
-                   cv::Size(-1, -1), kSubPixCriteria);
+  cv::cornerSubPix(grey, view.corners_px, cv::Size(kSubPixHalfWindowPx, kSubPixHalfWindowPx), cv::Size(-1, -1),
+                   kSubPixCriteria);
   return view;
 }
 
@@ -129,8 +127,8 @@ std::vector<std::vector<cv::Point2f>> select_views(std::vector<BoardView>& views
   for (auto& view : views) {
     auto& report = result.images[view.report_index];
     if (view.image_size != image_size) {
-      report.reason = "image is " + size_text(view.image_size) + ", the calibration images are " +
-                      size_text(image_size);
+      report.reason =
+          "image is " + size_text(view.image_size) + ", the calibration images are " + size_text(image_size);
       continue;
     }
     report.usable = true;
@@ -163,8 +161,8 @@ std::string solve(const std::vector<std::vector<cv::Point2f>>& image_points, con
 
 }  // namespace
 
-IntrinsicsResult calibrate_intrinsics(const std::vector<std::string>& image_paths,
-                                      const ChessboardSpec& board, int min_images) {
+IntrinsicsResult calibrate_intrinsics(const std::vector<std::string>& image_paths, const ChessboardSpec& board,
+                                      int min_images) {
   IntrinsicsResult result;
   if (result.error = validate_board(board); !result.error.empty()) return result;
   const cv::Size pattern(board.cols, board.rows);
@@ -181,9 +179,8 @@ IntrinsicsResult calibrate_intrinsics(const std::vector<std::string>& image_path
   intrinsics.board = board;
   const auto image_points = select_views(views, intrinsics.image_size, result, intrinsics);
   if (static_cast<int>(image_points.size()) < min_images) {
-    result.error = "only " + std::to_string(image_points.size()) + " of " +
-                   std::to_string(image_paths.size()) + " images are usable, at least " +
-                   std::to_string(min_images) + " are needed";
+    result.error = "only " + std::to_string(image_points.size()) + " of " + std::to_string(image_paths.size()) +
+                   " images are usable, at least " + std::to_string(min_images) + " are needed";
     return result;
   }
   if (result.error = solve(image_points, board, intrinsics); !result.error.empty()) return result;
@@ -218,7 +215,8 @@ std::string save_intrinsics(const CameraIntrinsics& intrinsics, const std::strin
   fs << "board_cols" << intrinsics.board.cols;
   fs << "board_rows" << intrinsics.board.rows;
   fs << "square_mm" << intrinsics.board.square_mm;
-  fs << "images_used" << "[";
+  fs << "images_used"
+     << "[";
   for (const auto& p : intrinsics.images_used) fs << p;
   fs << "]";
   fs.release();
@@ -298,8 +296,7 @@ std::string read_int(const cv::FileStorage& fs, const std::string& path, const s
   return {};
 }
 
-std::string read_real(const cv::FileStorage& fs, const std::string& path, const std::string& key,
-                      double& out) {
+std::string read_real(const cv::FileStorage& fs, const std::string& path, const std::string& key, double& out) {
   const cv::FileNode node = fs[key];
   if (node.empty()) return path + ": missing key '" + key + "'";
   if (!node.isReal() && !node.isInt()) return path + ": key '" + key + "' must be a number";
@@ -308,8 +305,8 @@ std::string read_real(const cv::FileStorage& fs, const std::string& path, const 
   return {};
 }
 
-std::string read_matrix(const cv::FileStorage& fs, const std::string& path, const std::string& key,
-                        int rows, int cols, cv::Mat& out) {
+std::string read_matrix(const cv::FileStorage& fs, const std::string& path, const std::string& key, int rows, int cols,
+                        cv::Mat& out) {
   const cv::FileNode node = fs[key];
   if (node.empty()) return path + ": missing key '" + key + "'";
   const std::string bad = path + ": key '" + key + "' must be a";
@@ -323,8 +320,8 @@ std::string read_matrix(const cv::FileStorage& fs, const std::string& path, cons
   }
   if (m.channels() != 1 || (rows > 0 && m.rows != rows) || (cols > 0 && m.cols != cols) ||
       (m.empty() && (rows > 0 || cols > 0))) {
-    return bad + " " + shape + " single-channel matrix, got " + std::to_string(m.rows) + "x" +
-           std::to_string(m.cols) + "x" + std::to_string(m.channels());
+    return bad + " " + shape + " single-channel matrix, got " + std::to_string(m.rows) + "x" + std::to_string(m.cols) +
+           "x" + std::to_string(m.channels());
   }
   if (!m.empty()) m.convertTo(m, CV_64F);
   if (!m.empty() && !all_finite(m)) return path + ": key '" + key + "' has a non-finite entry";

@@ -47,8 +47,8 @@ struct LensModel {
 struct CameraIntrinsics {
   cv::Size image_size;  ///< size of the images the lens model applies to, pixels
   LensModel lens;
-  double rms_px = 0.0;  ///< RMS reprojection error over all corners, pixels (0: unknown)
-  ChessboardSpec board;  ///< the target used (zeros: unknown)
+  double rms_px = 0.0;                   ///< RMS reprojection error over all corners, pixels (0: unknown)
+  ChessboardSpec board;                  ///< the target used (zeros: unknown)
   std::vector<std::string> images_used;  ///< paths of the images that took part
 };
 
@@ -87,8 +87,7 @@ inline constexpr int kMinCalibrationImages = 3;
 /// images of another size are skipped (reported as unusable, with both sizes). Fails
 /// when the board spec is invalid or fewer than `min_images` images are usable.
 /// Corner coordinates are in square_mm units, so extrinsics (not kept) would be in mm.
-IntrinsicsResult calibrate_intrinsics(const std::vector<std::string>& image_paths,
-                                      const ChessboardSpec& board,
+IntrinsicsResult calibrate_intrinsics(const std::vector<std::string>& image_paths, const ChessboardSpec& board,
                                       int min_images = kMinCalibrationImages);
 
 /// Writes `intrinsics` to `path` as OpenCV YAML (keys in the header comment), replacing
@@ -120,13 +119,12 @@ std::string open_for_reading(const std::string& path, cv::FileStorage& fs);
 std::string read_int(const cv::FileStorage& fs, const std::string& path, const std::string& key, int& out);
 
 /// Reads the finite number (integer or real) at top-level `key` into `out`.
-std::string read_real(const cv::FileStorage& fs, const std::string& path, const std::string& key,
-                      double& out);
+std::string read_real(const cv::FileStorage& fs, const std::string& path, const std::string& key, double& out);
 
 /// Reads the matrix at top-level `key` into `out` as CV_64F. `rows`/`cols` of -1 accept
 /// any count. Non-finite entries are an error.
-std::string read_matrix(const cv::FileStorage& fs, const std::string& path, const std::string& key,
-                        int rows, int cols, cv::Mat& out);
+std::string read_matrix(const cv::FileStorage& fs, const std::string& path, const std::string& key, int rows, int cols,
+                        cv::Mat& out);
 
 /// Reads camera_matrix and distortion_coefficients and validates them (validate_lens).
 std::string read_lens(const cv::FileStorage& fs, const std::string& path, LensModel& lens);

@@ -82,9 +82,9 @@ void sample_ellipse(const cv::Mat& grey, double centre_u, double centre_v, const
       // filled from memory), then the four pixels apart: bytes 0 to 3 of the lane, low
       // to high on a little-endian CPU.
       static_assert(std::endian::native == std::endian::little, "two 16-bit lanes read as one 32-bit lane");
-      const v_uint32x4 quads = cv::v_reinterpret_as_u32(v_uint16x8(pair(p0), pair(p0 + stride), pair(p1),
-                                                                   pair(p1 + stride), pair(p2), pair(p2 + stride),
-                                                                   pair(p3), pair(p3 + stride)));
+      const v_uint32x4 quads =
+          cv::v_reinterpret_as_u32(v_uint16x8(pair(p0), pair(p0 + stride), pair(p1), pair(p1 + stride), pair(p2),
+                                              pair(p2 + stride), pair(p3), pair(p3 + stride)));
       auto to_float = [](const v_uint32x4& x) { return cv::v_cvt_f32(cv::v_reinterpret_as_s32(x)); };
       const v_float32x4 a00 = to_float(quads & low_byte), a01 = to_float((quads >> 8) & low_byte);
       const v_float32x4 a10 = to_float((quads >> 16) & low_byte), a11 = to_float(quads >> 24);

@@ -573,7 +573,8 @@ void Decoder::match_all(const SampledSignal& signal, const Blob& blob, std::vect
     double rival = -1e300;
     for (int lag = 0; lag < n; ++lag) {
       const int apart = std::abs(lag - best);
-      if (std::min(apart, n - apart) > rival_guard_samples_) rival = std::max(rival, scratch[static_cast<std::size_t>(lag)]);
+      if (std::min(apart, n - apart) > rival_guard_samples_)
+        rival = std::max(rival, scratch[static_cast<std::size_t>(lag)]);
     }
     peaks.push_back({static_cast<double>(best), scratch[static_cast<std::size_t>(best)], rival});
     family_best = std::max(family_best, scratch[static_cast<std::size_t>(best)]);
@@ -603,7 +604,8 @@ bool Decoder::levels_agree(const cv::Mat& grey, const Blob& blob, const SampledS
   const int clear = std::max(1, n / 24);  // 15 degrees
   thread_local std::vector<double> colour;
   colour.resize(static_cast<std::size_t>(n));
-  for (int k = 0; k < n; ++k) colour[static_cast<std::size_t>(k)] = family_.colour_at(match.id, kMiddle, 360.0 * k / n - key_deg);
+  for (int k = 0; k < n; ++k)
+    colour[static_cast<std::size_t>(k)] = family_.colour_at(match.id, kMiddle, 360.0 * k / n - key_deg);
   // white_before[i]: white samples among the first i of the colours read twice round, so
   // that a window's count is a difference (a modulo per read cost more than the rest).
   thread_local std::vector<int> white_before;
@@ -627,7 +629,8 @@ bool Decoder::levels_agree(const cv::Mat& grey, const Blob& blob, const SampledS
     if (colour[static_cast<std::size_t>(k)] != 0.0) continue;
     // Black from k - clear to k + clear: no white sample in that window (around the circle).
     const int first = k - clear + n;  // index into the doubled counts, >= 0
-    if (white_before[static_cast<std::size_t>(first + 2 * clear + 1)] == white_before[static_cast<std::size_t>(first)]) {
+    if (white_before[static_cast<std::size_t>(first + 2 * clear + 1)] ==
+        white_before[static_cast<std::size_t>(first)]) {
       black_sum += signal.values[static_cast<std::size_t>(k)];
       ++black_count;
     }
@@ -663,7 +666,8 @@ bool Decoder::levels_agree(const cv::Mat& grey, const Blob& blob, const SampledS
   // The hole: a small circle half way out to its edge (within the image: the whole marker is).
   thread_local std::vector<float> hole;
   hole.resize(ring_directions_.cos.size());
-  sample_ellipse(grey, blob.u, blob.v, blob.shape, reach * 0.5 * MarkerFamily::hole_radius, ring_directions_, hole.data());
+  sample_ellipse(grey, blob.u, blob.v, blob.shape, reach * 0.5 * MarkerFamily::hole_radius, ring_directions_,
+                 hole.data());
   double hole_sum = 0.0;
   for (int k = 0; k < kRingSamples; ++k) hole_sum += hole[static_cast<std::size_t>(k)];
   return hole_sum / kRingSamples - signal.black_level <= config_.max_hole_excess * contrast;
@@ -820,8 +824,8 @@ std::optional<SpotCheck> Decoder::spot_check(const cv::Mat& grey, const Blob& bl
   // sampler takes them in one go.
   constexpr int kHalfGrid = 2, kGrid = 2 * kHalfGrid + 1;
   const double radius_px = std::sqrt(det);
-  const double step = std::clamp(0.6 / (0.5 * (kInner + kOuter) * radius_px), deg_to_rad(4.5),
-                                 deg_to_rad(kTrackReachDeg) / kHalfGrid);
+  const double step =
+      std::clamp(0.6 / (0.5 * (kInner + kOuter) * radius_px), deg_to_rad(4.5), deg_to_rad(kTrackReachDeg) / kHalfGrid);
   double grid_c[kGrid], grid_s[kGrid];
   fast_sincos(expected, grid_s[kHalfGrid], grid_c[kHalfGrid]);
   {

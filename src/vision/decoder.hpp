@@ -64,17 +64,17 @@ struct DecoderConfig {
 
 /// The angular signal sampled from one blob.
 struct SampledSignal {
-  bool usable = false;            ///< false when the contrast tests failed
-  std::vector<double> values;     ///< mean grey level per angle, CCW from the sampling axis
-  double ring_contrast = 0.0;     ///< white ring minus black ring, grey levels
-  double black_level = 0.0;       ///< median grey level of the black ring
-  double white_level = 0.0;       ///< median grey level of the white ring
+  bool usable = false;         ///< false when the contrast tests failed
+  std::vector<double> values;  ///< mean grey level per angle, CCW from the sampling axis
+  double ring_contrast = 0.0;  ///< white ring minus black ring, grey levels
+  double black_level = 0.0;    ///< median grey level of the black ring
+  double white_level = 0.0;    ///< median grey level of the white ring
 };
 
 /// The best match of a signal against one ID.
 struct CodeMatch {
   int id = 0;
-  double score = -1.0;        ///< circular cross-covariance at the best lag, [-1, 1]
+  double score = -1.0;  ///< circular cross-covariance at the best lag, [-1, 1]
   /// On screen, CCW from +u, [0, 360). Refined below the sampling step only for IDs
   /// within 0.1 of the best score (the only ones that can be assigned); others carry
   /// the whole-sample lag's heading.
@@ -181,10 +181,10 @@ class Decoder {
   // edge instead of one per sample.
   struct Ideal {
     int id = 0;
-    std::vector<double> edge;  // positions of colour changes, in samples, in [0, n)
-    std::vector<double> step;  // normalised level before the edge minus level after it
-    std::vector<int> edge_index;     // floor(edge + 0.5): the bin the edge falls in
-    std::vector<double> edge_frac;   // edge + 0.5 - edge_index
+    std::vector<double> edge;       // positions of colour changes, in samples, in [0, n)
+    std::vector<double> step;       // normalised level before the edge minus level after it
+    std::vector<int> edge_index;    // floor(edge + 0.5): the bin the edge falls in
+    std::vector<double> edge_frac;  // edge + 0.5 - edge_index
     // Edges in the order their running-integral bin boundaries are met going up from a
     // whole lag (by decreasing edge_frac): what refine_peak walks through.
     std::vector<int> knot_order;
@@ -217,7 +217,7 @@ class Decoder {
   double integral_at(const Prepared& p, double t) const;
   double heading_on_screen(const Blob& blob, double lag) const;
 
-  static constexpr int kRingSamples = 16;  // samples on each of the two rings (medians, a white-ring count)
+  static constexpr int kRingSamples = 16;    // samples on each of the two rings (medians, a white-ring count)
   static constexpr int kExhaustiveIds = 16;  // above this many IDs, decode by key and bits
   // A code bit whose slice mean lies within this fraction of the key's contrast from
   // the midpoint is ambiguous: the code with that bit flipped is scored as well.
@@ -241,7 +241,7 @@ class Decoder {
   };
   std::vector<SpotSlices> spot_slices_;
   double key_half_cos_ = 1.0, key_half_sin_ = 0.0;  // half the key slice's width, as a unit vector
-  int track_reach_samples_ = 0;  // kTrackReachDeg in samples, rounded up
+  int track_reach_samples_ = 0;                     // kTrackReachDeg in samples, rounded up
   int rival_guard_samples_ = 0;  // CodeMatch::rival_score's main lobe: lags this close to a peak are its own
   // Entries of the running integral past 2n + 2 that local_peak reads for the windows the
   // decoder uses (at most one lag either side, scored as two pairs of lags); a wider
@@ -258,7 +258,7 @@ class Decoder {
   MarkerFamily family_;  // the slices' colours, for levels_agree
   CircleDirections sample_directions_, ring_directions_;
   CircleDirections dense_ring_directions_;  // levels_agree's 64 reads of the white ring
-  std::vector<double> circle_radii_;  // as fractions of the marker's outer radius
+  std::vector<double> circle_radii_;        // as fractions of the marker's outer radius
   std::vector<int> ids_;
   std::vector<Ideal> ideals_;
 };

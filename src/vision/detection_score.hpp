@@ -30,13 +30,13 @@ MarkerRowsResult read_marker_csv(const std::string& path);
 
 /// How detections compare with the truth.
 struct DetectionScore {
-  int truth_markers = 0;    ///< (frame, id) pairs in the truth
-  int found = 0;            ///< detected with the right ID within the match radius
-  int wrong_id = 0;         ///< detections of an ID that is not within the radius of its truth
-  int duplicates = 0;       ///< the same (frame, id) reported more than once
+  int truth_markers = 0;  ///< (frame, id) pairs in the truth
+  int found = 0;          ///< detected with the right ID within the match radius
+  int wrong_id = 0;       ///< detections of an ID that is not within the radius of its truth
+  int duplicates = 0;     ///< the same (frame, id) reported more than once
   double centre_rms_px = 0.0, centre_max_px = 0.0;
   double heading_rms_deg = 0.0, heading_max_deg = 0.0;
-  int field_pairs = 0;      ///< found markers with field coordinates on both sides
+  int field_pairs = 0;  ///< found markers with field coordinates on both sides
   double field_rms_mm = 0.0, field_max_mm = 0.0;
   double theta_rms_deg = 0.0;
   double recall() const { return truth_markers ? static_cast<double>(found) / truth_markers : 0.0; }

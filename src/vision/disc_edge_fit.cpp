@@ -16,9 +16,10 @@ namespace {
 
 // Radii of the middle of the black ring and of the white ring, in units of the dark
 // disc's radius (the disc's outline is 1).
-constexpr double kBlackMid =
-    0.5 * (MarkerFamily::code_outer_radius + MarkerFamily::black_ring_outer_radius) / MarkerFamily::black_ring_outer_radius;
-constexpr double kWhiteMid = 0.5 * (1.0 + MarkerFamily::black_ring_outer_radius) / MarkerFamily::black_ring_outer_radius;
+constexpr double kBlackMid = 0.5 * (MarkerFamily::code_outer_radius + MarkerFamily::black_ring_outer_radius) /
+                             MarkerFamily::black_ring_outer_radius;
+constexpr double kWhiteMid =
+    0.5 * (1.0 + MarkerFamily::black_ring_outer_radius) / MarkerFamily::black_ring_outer_radius;
 constexpr int kMaxLines = 32;
 constexpr int kMaxPoints = 4 * kMaxLines;
 
@@ -30,8 +31,8 @@ constexpr int kMaxPoints = 4 * kMaxLines;
 // loop). Sets `offset` to the crossing's distance from `start` in pixels, outwards
 // (sub-pixel, linear between the two pixels around it); false when there is none.
 // Inline, with the pixels around the crossing kept from the walk's own reads.
-inline bool walk_to_edge(const std::uint8_t* start, std::ptrdiff_t step, int reach, double threshold,
-                         int bright_from, double& offset) {
+inline bool walk_to_edge(const std::uint8_t* start, std::ptrdiff_t step, int reach, double threshold, int bright_from,
+                         double& offset) {
   int dark_at = 0, dark = start[0], bright = 0;  // the dark pixel (offset outwards) and the bright one after it
   if (dark < bright_from) {
     // From dark, outwards to the first bright pixel.
@@ -199,8 +200,20 @@ template <class T>
 struct PointMoments {
   T x, y, xx, xy, yy, xxx, xxy, xyy, yyy, xxxx, xxxy, xxyy, xyyy, yyyy;
   explicit PointMoments(T zero)
-      : x(zero), y(zero), xx(zero), xy(zero), yy(zero), xxx(zero), xxy(zero), xyy(zero), yyy(zero), xxxx(zero),
-        xxxy(zero), xxyy(zero), xyyy(zero), yyyy(zero) {}
+      : x(zero),
+        y(zero),
+        xx(zero),
+        xy(zero),
+        yy(zero),
+        xxx(zero),
+        xxy(zero),
+        xyy(zero),
+        yyy(zero),
+        xxxx(zero),
+        xxxy(zero),
+        xxyy(zero),
+        xyyy(zero),
+        yyyy(zero) {}
   void add(const T& px, const T& py) {
     const T pxx = px * px, pxy = px * py, pyy = py * py;
     x += px;
@@ -332,7 +345,8 @@ std::optional<DiscEdgeFit> fit_centre_and_size(const Blob& predicted, double thr
   const double residual2 = residual_rms2(px, py, found, x0, y0, q00 * inv_k, q01 * inv_k, q11 * inv_k);
   // [[unlikely]]: a tracked disc's outline mostly fits, and without the hint GCC takes the
   // success path for cold and calls set_levels instead of inlining it.
-  if (residual2 > config.max_residual * config.max_residual) [[unlikely]] return std::nullopt;
+  if (residual2 > config.max_residual * config.max_residual) [[unlikely]]
+    return std::nullopt;
   // The area scales as k (the outline's radius as sqrt(k)).
   if (std::abs(k - 1.0) > config.max_area_change) return std::nullopt;
   DiscEdgeFit fit;
@@ -466,8 +480,8 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
   }
   if (levels < 4) return std::nullopt;
   if (config.keep_shape) {
-    return fit_centre_and_size(predicted, threshold_grey, config, q00 * det_s, q01 * det_s, q11 * det_s, radius_px,
-                               px, py, found, black, white, levels);
+    return fit_centre_and_size(predicted, threshold_grey, config, q00 * det_s, q01 * det_s, q11 * det_s, radius_px, px,
+                               py, found, black, white, levels);
   }
 
   // The normal equations need only the moments of the points up to the fourth order;
@@ -476,7 +490,8 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
   // one in each lane, then the odd one out: the same sums for both (PointMoments).
   PointMoments<v_float64x2> pairs(cv::v_setzero_f64());
   int first_single = 0;
-  for (; first_single + 1 < found; first_single += 2) pairs.add(cv::v_load(px + first_single), cv::v_load(py + first_single));
+  for (; first_single + 1 < found; first_single += 2)
+    pairs.add(cv::v_load(px + first_single), cv::v_load(py + first_single));
   PointMoments<double> m = pairs.map([](const v_float64x2& v) { return cv::v_reduce_sum(v); });
   for (int i = first_single; i < found; ++i) m.add(px[i], py[i]);
   const double sx = m.x, sy = m.y, sxx = m.xx, sxy = m.xy, syy = m.yy, sxxx = m.xxx, sxxy = m.xxy, sxyy = m.xyy,
@@ -507,7 +522,8 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
   // RMS of each crossing's distance from the ellipse, radially, as a fraction of the
   // ellipse's radius there (the same in every linearly related frame).
   const double residual2 = residual_rms2(px, py, found, x0, y0, m00, m01, m11);
-  if (residual2 > config.max_residual * config.max_residual) [[unlikely]] return std::nullopt;  // as above
+  if (residual2 > config.max_residual * config.max_residual) [[unlikely]]
+    return std::nullopt;  // as above
 
   // Back to pixels: the outline is centre + radius (x0 + m^-1/2 u), so the shape's
   // square is radius² m^-1.

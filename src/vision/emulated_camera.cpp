@@ -10,7 +10,8 @@ namespace rilbed::vision {
 namespace {
 
 CameraModel overhead_for(double width_m, double height_m, const EmulatedCameraConfig& c) {
-  if (!(width_m > 0.0) || !(height_m > 0.0)) throw std::invalid_argument("emulated camera: field size must be positive");
+  if (!(width_m > 0.0) || !(height_m > 0.0))
+    throw std::invalid_argument("emulated camera: field size must be positive");
   if (!(c.height_m > 0.0) || !(c.field_fill > 0.0) || !(c.fps > 0.0)) {
     throw std::invalid_argument("emulated camera: height, field fill and fps must be positive");
   }
@@ -30,6 +31,8 @@ EmulatedOverheadCamera::EmulatedOverheadCamera(double field_width_m, double fiel
       calibration_(camera_.camera().field_calibration(field_width_m, field_height_m)),
       rng_(config.seed) {}
 
-cv::Mat EmulatedOverheadCamera::render(const std::vector<SceneMarker>& markers) { return camera_.render(markers, rng_); }
+cv::Mat EmulatedOverheadCamera::render(const std::vector<SceneMarker>& markers) {
+  return camera_.render(markers, rng_);
+}
 
 }  // namespace rilbed::vision

@@ -162,8 +162,7 @@ cv::Mat estimate_homography(const std::vector<cv::Point2d>& undistorted_px, cons
 }
 
 FieldCalibrationResult fit(const std::vector<PointCorrespondence>& points, double width_m, double height_m,
-                           cv::Size image_size, const std::optional<LensModel>& lens,
-                           double ransac_threshold_m) {
+                           cv::Size image_size, const std::optional<LensModel>& lens, double ransac_threshold_m) {
   FieldCalibrationResult result;
   result.error = check_fit_inputs(points.size(), width_m, height_m, image_size, lens);
   if (!result.error.empty()) return result;
@@ -192,8 +191,7 @@ FieldCalibrationResult fit(const std::vector<PointCorrespondence>& points, doubl
 }
 
 // Reads a number that must be positive, naming the key when it is not.
-std::string read_positive(const cv::FileStorage& fs, const std::string& path, const std::string& key,
-                          double& out) {
+std::string read_positive(const cv::FileStorage& fs, const std::string& path, const std::string& key, double& out) {
   if (auto error = cvyaml::read_real(fs, path, key, out); !error.empty()) return error;
   return out > 0.0 ? std::string() : path + ": key '" + key + "' must be positive";
 }
@@ -205,11 +203,10 @@ std::string read_positive(const cv::FileStorage& fs, const std::string& path, co
 
 }  // namespace
 
-FieldCalibrationResult field_from_corners(const std::array<Vec2, 4>& corners_px, double width_m,
-                                          double height_m, cv::Size image_size,
-                                          const std::optional<LensModel>& lens) {
-  const std::array<Vec2, 4> field_corners_m = {Vec2{0.0, 0.0}, Vec2{width_m, 0.0},
-                                               Vec2{width_m, height_m}, Vec2{0.0, height_m}};
+FieldCalibrationResult field_from_corners(const std::array<Vec2, 4>& corners_px, double width_m, double height_m,
+                                          cv::Size image_size, const std::optional<LensModel>& lens) {
+  const std::array<Vec2, 4> field_corners_m = {Vec2{0.0, 0.0}, Vec2{width_m, 0.0}, Vec2{width_m, height_m},
+                                               Vec2{0.0, height_m}};
   std::vector<PointCorrespondence> points;
   for (int i = 0; i < 4; ++i) points.push_back({corners_px[i], field_corners_m[i], i + 1});
   if (!lens || validate_lens(*lens).empty()) {
@@ -226,10 +223,9 @@ FieldCalibrationResult field_from_corners(const std::array<Vec2, 4>& corners_px,
   return fit(points, width_m, height_m, image_size, lens, kDefaultRansacThresholdM);
 }
 
-FieldCalibrationResult field_from_correspondences(const std::vector<PointCorrespondence>& points,
-                                                  double width_m, double height_m, cv::Size image_size,
-                                                  const std::optional<LensModel>& lens,
-                                                  double ransac_threshold_m) {
+FieldCalibrationResult field_from_correspondences(const std::vector<PointCorrespondence>& points, double width_m,
+                                                  double height_m, cv::Size image_size,
+                                                  const std::optional<LensModel>& lens, double ransac_threshold_m) {
   return fit(points, width_m, height_m, image_size, lens, ransac_threshold_m);
 }
 
@@ -251,8 +247,7 @@ Vec2 field_to_pixel(const FieldCalibration& calibration, double x_m, double y_m)
   return {image[0].x, image[0].y};
 }
 
-double image_heading_to_field_deg(const FieldCalibration& calibration, double u_px, double v_px,
-                                  double heading_deg) {
+double image_heading_to_field_deg(const FieldCalibration& calibration, double u_px, double v_px, double heading_deg) {
   const double h_rad = deg_to_rad(heading_deg);
   // Screen heading counter-clockwise from +u with v down: the step is (cos, -sin).
   const double du = kHeadingStepPx * std::cos(h_rad);

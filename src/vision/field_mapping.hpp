@@ -79,9 +79,8 @@ struct FieldCalibrationFileResult {
 /// from above and going counter-clockwise (on a normal overhead image that is also
 /// counter-clockwise on screen). The corners must form a convex quadrilateral.
 /// `corners_px` are raw image pixels; they are undistorted with `lens` when given.
-FieldCalibrationResult field_from_corners(const std::array<Vec2, 4>& corners_px, double width_m,
-                                          double height_m, cv::Size image_size,
-                                          const std::optional<LensModel>& lens = std::nullopt);
+FieldCalibrationResult field_from_corners(const std::array<Vec2, 4>& corners_px, double width_m, double height_m,
+                                          cv::Size image_size, const std::optional<LensModel>& lens = std::nullopt);
 
 /// Default RANSAC threshold: a correspondence whose mapped image point lies further than
 /// this from its field point is an outlier. Markers are located to a few millimetres, so
@@ -92,9 +91,8 @@ inline constexpr double kDefaultRansacThresholdM = 0.02;
 /// field positions). Exactly 4 are fitted exactly; more are fitted with RANSAC and the
 /// inliers refined, and outliers are reported. Fails when fewer than 4 points are given,
 /// the size is not positive, or the points are degenerate (three or more on a line).
-FieldCalibrationResult field_from_correspondences(const std::vector<PointCorrespondence>& points,
-                                                  double width_m, double height_m,
-                                                  cv::Size image_size,
+FieldCalibrationResult field_from_correspondences(const std::vector<PointCorrespondence>& points, double width_m,
+                                                  double height_m, cv::Size image_size,
                                                   const std::optional<LensModel>& lens = std::nullopt,
                                                   double ransac_threshold_m = kDefaultRansacThresholdM);
 
@@ -110,8 +108,7 @@ Vec2 field_to_pixel(const FieldCalibration& calibration, double x_m, double y_m)
 /// counter-clockwise on screen from +u, i.e. atan2(-dv, du); the result is theta
 /// counter-clockwise from +x, degrees in [0, 360). Found by mapping two points a few
 /// pixels behind and ahead, so perspective and distortion are accounted for locally.
-double image_heading_to_field_deg(const FieldCalibration& calibration, double u_px, double v_px,
-                                  double heading_deg);
+double image_heading_to_field_deg(const FieldCalibration& calibration, double u_px, double v_px, double heading_deg);
 
 /// Checks a calibration's values: positive finite field size, finite invertible
 /// homography, positive image size, valid lens when present. Returns what is wrong, or
@@ -120,8 +117,7 @@ std::string validate_field_calibration(const FieldCalibration& calibration);
 
 /// Writes `calibration` to `path` as OpenCV YAML (keys in the header comment),
 /// replacing the file. Returns an error naming the file, or an empty string.
-[[nodiscard]] std::string save_field_calibration(const FieldCalibration& calibration,
-                                                 const std::string& path);
+[[nodiscard]] std::string save_field_calibration(const FieldCalibration& calibration, const std::string& path);
 
 /// Reads a field calibration file. A missing file, a file that is not OpenCV YAML, a
 /// missing key or a bad value gives an error naming the file and the key; never throws.

@@ -4,7 +4,8 @@
 
 namespace rilbed::vision {
 
-FieldTracker::FieldTracker(MarkerFamily family, std::vector<int> ids, FieldCalibration calibration, TrackerConfig config)
+FieldTracker::FieldTracker(MarkerFamily family, std::vector<int> ids, FieldCalibration calibration,
+                           TrackerConfig config)
     : tracker_(std::move(family), std::move(ids), config),
       calibration_(std::move(calibration)),
       settings_(vision_settings_of(config)) {
@@ -16,8 +17,9 @@ FieldTracker::FieldTracker(MarkerFamily family, std::vector<int> ids, FieldCalib
 std::vector<FieldObservation> FieldTracker::process(const cv::Mat& frame) {
   if (frame.size() != calibration_.image_size) {
     throw std::invalid_argument("frame of " + std::to_string(frame.cols) + "x" + std::to_string(frame.rows) +
-                                " pixels, but the field calibration is for " + std::to_string(calibration_.image_size.width) +
-                                "x" + std::to_string(calibration_.image_size.height));
+                                " pixels, but the field calibration is for " +
+                                std::to_string(calibration_.image_size.width) + "x" +
+                                std::to_string(calibration_.image_size.height));
   }
   seen_ = adjust_frame(frame, settings_, adjusted_);
   std::vector<FieldObservation> out;

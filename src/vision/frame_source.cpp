@@ -27,8 +27,8 @@ namespace {
 // without scanning the disk at random.
 constexpr int kSequenceMaxFirstIndex = 9;
 
-constexpr std::array<std::string_view, 10> kImageExtensions = {
-    ".png", ".jpg", ".jpeg", ".pgm", ".ppm", ".pbm", ".bmp", ".tif", ".tiff", ".webp"};
+constexpr std::array<std::string_view, 10> kImageExtensions = {".png", ".jpg", ".jpeg", ".pgm",  ".ppm",
+                                                               ".pbm", ".bmp", ".tif",  ".tiff", ".webp"};
 
 // ------------------------------------------------------------------ small helpers
 
@@ -37,16 +37,14 @@ OpenResult open_failed(std::string message) { return OpenResult{nullptr, std::mo
 FrameResult end_result() { return FrameResult{}; }
 
 FrameResult frame_result(cv::Mat image, int index, std::string name) {
-  return FrameResult{FrameResult::Kind::Frame, std::move(image), index, std::move(name), {}};
+  return FrameResult{FrameResult::Kind::kFrame, std::move(image), index, std::move(name), {}};
 }
 
 // Every per-frame error names the input, the frame index and the frame's own name so
 // that a user can find the bad file or the bad moment in a video.
-FrameResult frame_error(const std::string& input, int index, std::string name,
-                        const std::string& reason) {
-  std::string message =
-      input + ": frame " + std::to_string(index) + " (" + name + "): " + reason;
-  return FrameResult{FrameResult::Kind::Error, {}, index, std::move(name), std::move(message)};
+FrameResult frame_error(const std::string& input, int index, std::string name, const std::string& reason) {
+  std::string message = input + ": frame " + std::to_string(index) + " (" + name + "): " + reason;
+  return FrameResult{FrameResult::Kind::kError, {}, index, std::move(name), std::move(message)};
 }
 
 // "1 image", "3 images".
@@ -54,9 +52,7 @@ std::string count_text(std::size_t count, std::string_view one, std::string_view
   return std::to_string(count) + " " + std::string(count == 1 ? one : many);
 }
 
-std::string size_text(cv::Size size) {
-  return std::to_string(size.width) + "x" + std::to_string(size.height);
-}
+std::string size_text(cv::Size size) { return std::to_string(size.width) + "x" + std::to_string(size.height); }
 
 std::string lower(std::string text) {
   std::transform(text.begin(), text.end(), text.begin(),
@@ -66,8 +62,7 @@ std::string lower(std::string text) {
 
 bool has_image_extension(const fs::path& path) {
   const std::string ext = lower(path.extension().string());
-  return std::find(kImageExtensions.begin(), kImageExtensions.end(), ext) !=
-         kImageExtensions.end();
+  return std::find(kImageExtensions.begin(), kImageExtensions.end(), ext) != kImageExtensions.end();
 }
 
 std::string image_extension_list() {
@@ -156,8 +151,7 @@ PatternParse parse_sequence_pattern(const std::string& input) {
     } else if (i + 1 < input.size() && input[i + 1] == '%') {
       literal += '%';
       i += 2;
-    } else if (std::size_t end = parse_conversion(input, i, result.pattern);
-               end != std::string::npos) {
+    } else if (std::size_t end = parse_conversion(input, i, result.pattern); end != std::string::npos) {
       if (++conversions == 1) result.pattern.prefix = std::exchange(literal, {});
       i = end;
     } else {
@@ -180,9 +174,7 @@ PatternParse parse_sequence_pattern(const std::string& input) {
 class ImageListSource final : public FrameSource {
  public:
   ImageListSource(std::string input, std::vector<fs::path> files, std::string description)
-      : FrameSource(std::move(input)),
-        files_(std::move(files)),
-        description_(std::move(description)) {}
+      : FrameSource(std::move(input)), files_(std::move(files)), description_(std::move(description)) {}
 
   std::optional<int> frame_count() const override { return static_cast<int>(files_.size()); }
   std::string describe() const override { return description_; }
@@ -207,8 +199,7 @@ class ImageListSource final : public FrameSource {
 // One image, decoded when opened so that a bad file fails at open time.
 class SingleImageSource final : public FrameSource {
  public:
-  SingleImageSource(std::string input, cv::Mat image)
-      : FrameSource(std::move(input)), image_(std::move(image)) {}
+  SingleImageSource(std::string input, cv::Mat image) : FrameSource(std::move(input)), image_(std::move(image)) {}
 
   std::optional<int> frame_count() const override { return 1; }
   std::string describe() const override {
@@ -247,8 +238,7 @@ class VideoSource final : public FrameSource {
   // `capture` is open; `label` names frames ("run3.avi" gives "run3.avi#17").
   // The capture is held by unique_ptr because cv::VideoCapture has no move
   // constructor (its copies share one stream).
-  VideoSource(std::string input, std::unique_ptr<cv::VideoCapture> capture, std::string label,
-              bool live)
+  VideoSource(std::string input, std::unique_ptr<cv::VideoCapture> capture, std::string label, bool live)
       : FrameSource(std::move(input)),
         capture_(std::move(capture)),
         label_(std::move(label)),
@@ -292,12 +282,10 @@ class VideoSource final : public FrameSource {
   // at or past it (or with no count) it is the normal end of the video.
   FrameResult stop_result(int index, std::string name) {
     if (live_)
-      return frame_error(input(), index, std::move(name),
-                         "camera stopped delivering frames; the stream ends here");
+      return frame_error(input(), index, std::move(name), "camera stopped delivering frames; the stream ends here");
     if (count_ && index < *count_)
       return frame_error(input(), index, std::move(name),
-                         "reading stopped at frame " + std::to_string(index) + " of " +
-                             std::to_string(*count_) +
+                         "reading stopped at frame " + std::to_string(index) + " of " + std::to_string(*count_) +
                              " (file truncated or corrupt); the stream ends after the "
                              "last good frame");
     return end_result();
@@ -322,8 +310,7 @@ std::vector<cv::VideoCaptureAPIs> video_backends() {
   std::vector<cv::VideoCaptureAPIs> apis;
   for (cv::VideoCaptureAPIs api : cv::videoio_registry::getStreamBackends())
     if (api != cv::CAP_IMAGES && api != cv::CAP_GPHOTO2) apis.push_back(api);
-  std::stable_partition(apis.begin(), apis.end(),
-                        [](cv::VideoCaptureAPIs api) { return api == cv::CAP_FFMPEG; });
+  std::stable_partition(apis.begin(), apis.end(), [](cv::VideoCaptureAPIs api) { return api == cv::CAP_FFMPEG; });
   return apis;
 }
 
@@ -365,8 +352,7 @@ OpenResult open_video_file(const std::string& input) {
   }
   // An image with an extension we do not list (e.g. .jp2, .exr) is still an image.
   if (looks_like_image(input)) return open_single_image(input);
-  return open_failed("cannot open video file " + input +
-                     ": no OpenCV video backend could read it (tried " + tried +
+  return open_failed("cannot open video file " + input + ": no OpenCV video backend could read it (tried " + tried +
                      "); is it a video or image file?");
 }
 
@@ -383,8 +369,7 @@ struct DirectoryListing {
 bool is_listed_image(const fs::directory_entry& entry) {
   std::error_code ec;
   const fs::path& path = entry.path();
-  return !path.filename().string().starts_with(".") && entry.is_regular_file(ec) &&
-         has_image_extension(path);
+  return !path.filename().string().starts_with(".") && entry.is_regular_file(ec) && has_image_extension(path);
 }
 
 DirectoryListing list_directory(const std::string& input) {
@@ -406,15 +391,12 @@ OpenResult open_directory(const std::string& input) {
   std::vector<fs::path>& files = listing.images;
   if (files.empty())
     return open_failed("directory " + input + " has no image files (" +
-                       count_text(listing.entries, "entry", "entries") +
-                       ", none with extension " + image_extension_list() + ")");
-  std::sort(files.begin(), files.end(), [](const fs::path& a, const fs::path& b) {
-    return a.filename().string() < b.filename().string();
-  });
-  std::string description = "image directory " + input + " (" +
-                            count_text(files.size(), "image", "images") + ", " +
-                            files.front().filename().string() + " .. " +
-                            files.back().filename().string() + ")";
+                       count_text(listing.entries, "entry", "entries") + ", none with extension " +
+                       image_extension_list() + ")");
+  std::sort(files.begin(), files.end(),
+            [](const fs::path& a, const fs::path& b) { return a.filename().string() < b.filename().string(); });
+  std::string description = "image directory " + input + " (" + count_text(files.size(), "image", "images") + ", " +
+                            files.front().filename().string() + " .. " + files.back().filename().string() + ")";
   return OpenResult{std::make_unique<ImageListSource>(input, std::move(files), description), {}};
 }
 
@@ -427,15 +409,13 @@ OpenResult open_sequence(const std::string& input, const SequencePattern& patter
   int first = 0;
   while (first <= kSequenceMaxFirstIndex && !file_exists(pattern.format(first))) ++first;
   if (first > kSequenceMaxFirstIndex)
-    return open_failed("image sequence " + input + ": no first file (looked for " +
-                       pattern.format(0) + " .. " + pattern.format(kSequenceMaxFirstIndex) + ")");
+    return open_failed("image sequence " + input + ": no first file (looked for " + pattern.format(0) + " .. " +
+                       pattern.format(kSequenceMaxFirstIndex) + ")");
   std::vector<fs::path> files;
-  for (int i = first; i < INT_MAX && file_exists(pattern.format(i)); ++i)
-    files.emplace_back(pattern.format(i));
+  for (int i = first; i < INT_MAX && file_exists(pattern.format(i)); ++i) files.emplace_back(pattern.format(i));
   const int last = first + static_cast<int>(files.size()) - 1;
-  std::string description = "image sequence " + input + " (" +
-                            count_text(files.size(), "image", "images") + ", indices " +
-                            std::to_string(first) + ".." + std::to_string(last) + ")";
+  std::string description = "image sequence " + input + " (" + count_text(files.size(), "image", "images") +
+                            ", indices " + std::to_string(first) + ".." + std::to_string(last) + ")";
   return OpenResult{std::make_unique<ImageListSource>(input, std::move(files), description), {}};
 }
 
@@ -450,8 +430,7 @@ OpenResult open_path(const std::string& input) {
   if (fs::is_directory(status)) return open_directory(input);
   // Only plain files are probed with fopen: opening a device (/dev/video0) has effects.
   if (fs::is_regular_file(status))
-    if (std::string why = open_error(input); !why.empty())
-      return open_failed("cannot read " + input + ": " + why);
+    if (std::string why = open_error(input); !why.empty()) return open_failed("cannot read " + input + ": " + why);
   if (has_image_extension(input)) return open_single_image(input);
   return open_video_file(input);
 }
@@ -474,17 +453,18 @@ FrameResult FrameSource::check_size(FrameResult result) {
     return result;
   }
   if (size == first_size_) return result;
-  return frame_error(input_, result.index, std::move(result.name),
-                     "image is " + size_text(size) + " but the first frame was " +
-                         size_text(first_size_) + "; frame skipped");
+  return frame_error(
+      input_, result.index, std::move(result.name),
+      "image is " + size_text(size) + " but the first frame was " + size_text(first_size_) + "; frame skipped");
 }
 
 // ------------------------------------------------------------------ factories
 
 OpenResult open_frame_source(const std::string& input) {
   if (input.empty())
-    return open_failed("no input given: expected a video file, an image, a directory of "
-                       "images or a pattern such as frames/img_%04d.png");
+    return open_failed(
+        "no input given: expected a video file, an image, a directory of "
+        "images or a pattern such as frames/img_%04d.png");
   const PatternParse parsed = parse_sequence_pattern(input);
   if (!parsed.error.empty()) return open_failed(parsed.error);
   if (parsed.is_pattern) return open_sequence(input, parsed.pattern);
@@ -500,10 +480,8 @@ OpenResult open_camera(int index) {
   } catch (const cv::Exception&) {
     opened = false;
   }
-  if (!opened)
-    return open_failed("cannot open " + input + ": no such camera, or it is busy or not readable");
-  return OpenResult{std::make_unique<VideoSource>(input, std::move(capture),
-                                                  "camera" + std::to_string(index), true),
+  if (!opened) return open_failed("cannot open " + input + ": no such camera, or it is busy or not readable");
+  return OpenResult{std::make_unique<VideoSource>(input, std::move(capture), "camera" + std::to_string(index), true),
                     {}};
 }
 

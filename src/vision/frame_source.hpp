@@ -21,12 +21,12 @@ namespace rilbed::vision {
 /// What one call of FrameSource::next() produced.
 struct FrameResult {
   enum class Kind {
-    Frame,  ///< `image` holds a frame.
-    End,    ///< No more frames; every later next() call returns End too.
-    Error,  ///< This frame could not be used; `error` says why. Call next() again.
+    kFrame,  ///< `image` holds a frame.
+    kEnd,    ///< No more frames; every later next() call returns End too.
+    kError,  ///< This frame could not be used; `error` says why. Call next() again.
   };
 
-  Kind kind = Kind::End;
+  Kind kind = Kind::kEnd;
   /// The frame as read: CV_8UC3 (BGR) or CV_8UC1 (grey), owned by this result (no other
   /// reference is kept by the source). Empty unless kind == Frame.
   cv::Mat image;
@@ -39,9 +39,9 @@ struct FrameResult {
   /// Human-readable reason, naming the input and the frame index; set only for Error.
   std::string error;
 
-  bool is_frame() const { return kind == Kind::Frame; }
-  bool is_end() const { return kind == Kind::End; }
-  bool is_error() const { return kind == Kind::Error; }
+  bool is_frame() const { return kind == Kind::kFrame; }
+  bool is_end() const { return kind == Kind::kEnd; }
+  bool is_error() const { return kind == Kind::kError; }
 };
 
 /// A stream of frames in input order. Not thread-safe: one reader at a time.

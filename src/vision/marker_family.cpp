@@ -15,8 +15,7 @@ MarkerFamily MarkerFamily::six_ucp() { return MarkerFamily("6ucp", {85, 55, 55, 
 MarkerFamily MarkerFamily::k_ucp(int slice_count) {
   if (slice_count == 6) return six_ucp();
   if (slice_count < 6 || slice_count > 14) {
-    throw std::invalid_argument("kUCP families exist for k in 6..14, not " +
-                                std::to_string(slice_count));
+    throw std::invalid_argument("kUCP families exist for k in 6..14, not " + std::to_string(slice_count));
   }
   const double unit_deg = 360.0 / (slice_count - 1 + 1.5);
   std::vector<double> widths(slice_count, unit_deg);
@@ -29,8 +28,7 @@ MarkerFamily MarkerFamily::by_name(std::string_view name) {
   for (char c : name) lower.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
   if (lower.size() >= 4 && lower.substr(lower.size() - 3) == "ucp") {
     const std::string digits = lower.substr(0, lower.size() - 3);
-    if (!digits.empty() && digits.size() <= 2 &&
-        digits.find_first_not_of("0123456789") == std::string::npos) {
+    if (!digits.empty() && digits.size() <= 2 && digits.find_first_not_of("0123456789") == std::string::npos) {
       const int k = std::stoi(digits);
       if (k >= 6 && k <= 14) return k_ucp(k);
     }

@@ -56,8 +56,9 @@ DecoderConfig confirm_config(const TrackerConfig& config) {
 // A detection of `blob` as `match`; the blob's disc scaled to the marker's outer size.
 MarkerDetection make_detection(const Blob& blob, const CodeMatch& match, bool tracked, double threshold_grey) {
   const double disc_d = 2.0 * std::sqrt(std::abs(cv::determinant(blob.shape)));
-  MarkerDetection d{match.id, blob.u,  blob.v, match.heading_deg, match.score, disc_d / MarkerFamily::black_ring_outer_radius,
-                    tracked,  threshold_grey, blob.shape};
+  MarkerDetection d{match.id,          blob.u,         blob.v,
+                    match.heading_deg, match.score,    disc_d / MarkerFamily::black_ring_outer_radius,
+                    tracked,           threshold_grey, blob.shape};
   d.key_angle_rad = match.key_angle_rad;
   return d;
 }
@@ -122,8 +123,8 @@ cv::Mat MarkerTracker::to_grey(const cv::Mat& frame) {
   return grey_buffer_;
 }
 
-std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const std::vector<Blob>& blobs,
-                                                   bool use_tracks, const std::vector<int>& taken_ids) {
+std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const std::vector<Blob>& blobs, bool use_tracks,
+                                                   const std::vector<int>& taken_ids) {
   // Buffers kept from frame to frame: a frame of 64 markers made 130 allocations here.
   const std::size_t columns = ids_.size();
   similarity_.assign(blobs.size() * columns, -1.0);
@@ -303,9 +304,9 @@ std::optional<MarkerDetection> MarkerTracker::confirm_by_edges(const cv::Mat& gr
   // The heading from the key's edges, and every slice's colour: a spot check. The key's
   // angle predicted in the shape's frame is the track's while the shape is the one it
   // kept.
-  const double expected_key = same_shape ? track.predicted_key_angle_rad()
-                                         : confirm_decoder_.key_angle_of_heading(
-                                               fit->blob, track.predicted_heading_deg());
+  const double expected_key = same_shape
+                                  ? track.predicted_key_angle_rad()
+                                  : confirm_decoder_.key_angle_of_heading(fit->blob, track.predicted_heading_deg());
   const auto spot =
       confirm_decoder_.spot_check(grey, fit->blob, track.id, expected_key, fit->black_level, fit->white_level);
   if (spot && spot_check) {
@@ -445,8 +446,8 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
     // A spot check's angle is in the frame of the track's shape (its fit keeps it), so
     // the turn there is exact; after a fit of the whole outline the frame moved a little,
     // and the turn on screen stands in for it.
-    it->key_turn_rad = d.spot_checked ? wrap_rad_pi(d.key_angle_rad - it->key_angle_rad) / frames
-                                      : deg_to_rad(it->turn_deg);
+    it->key_turn_rad =
+        d.spot_checked ? wrap_rad_pi(d.key_angle_rad - it->key_angle_rad) / frames : deg_to_rad(it->turn_deg);
     it->key_angle_rad = d.key_angle_rad;
     it->heading_deg = d.heading_deg;
     it->shape = d.disc_shape;

@@ -11,11 +11,11 @@
 
 #include "core/geometry.hpp"
 #include "vision/blob_detector.hpp"
-#include "vision/marker_template.hpp"
 #include "vision/decoder.hpp"
 #include "vision/disc_edge_fit.hpp"
-#include "vision/ring_search.hpp"
 #include "vision/marker_family.hpp"
+#include "vision/marker_template.hpp"
+#include "vision/ring_search.hpp"
 
 namespace rilbed::vision {
 
@@ -164,7 +164,7 @@ struct FrameStats {
   int refits = 0;            ///< doubtful blobs (Blob::doubtful) whose outline was fitted again
   int refits_kept = 0;       ///< ...and that fitted a clean ellipse, so went on to decoding
   int ring_searches = 0;     ///< refits that failed and searched for the disc's rings (TrackerConfig::ring_search)
-  int declined = 0;          ///< decoded blobs left unnamed: two explanations too close (TrackerConfig::ambiguity_margin)
+  int declined = 0;  ///< decoded blobs left unnamed: two explanations too close (TrackerConfig::ambiguity_margin)
 };
 
 /// Runs the pipeline over a stream of frames of one size. Not thread-safe; one per
@@ -205,7 +205,7 @@ class MarkerTracker {
     double diameter_px = 0;
     double threshold_grey = 0;
     double score = 0;
-    double heading_deg = 0;  // on screen, as last seen
+    double heading_deg = 0;                  // on screen, as last seen
     cv::Matx22d shape = cv::Matx22d::eye();  // the disc's outline, as last seen
     int missed = 0;
     /// Frames since its code was last correlated (not only spot-checked).
@@ -262,10 +262,10 @@ class MarkerTracker {
   TrackerConfig config_;
   BlobDetector detector_;
   Decoder decoder_;
-  Decoder confirm_decoder_;  // the listed IDs only, at confirm_samples: the edge-fit confirmation
+  Decoder confirm_decoder_;    // the listed IDs only, at confirm_samples: the edge-fit confirmation
   MarkerTemplates templates_;  // the listed IDs
   std::vector<Track> tracks_;
-  std::vector<int> track_of_id_;  // per ID, its index in tracks_ or -1 (rebuilt per frame)
+  std::vector<int> track_of_id_;    // per ID, its index in tracks_ or -1 (rebuilt per frame)
   std::vector<int> confirmed_ids_;  // process()'s, kept between frames (no allocation per frame)
   std::vector<Blob> fragments_;     // a full search's doubtful blobs whose outline did not fit (settle_doubtful)
   FrameStats stats_;
@@ -276,7 +276,6 @@ class MarkerTracker {
 
 /// Convenience: one full-frame detection of `ids` in one image with default knobs.
 std::vector<MarkerDetection> detect_markers(const cv::Mat& image, const MarkerFamily& family,
-                                            const std::vector<int>& ids,
-                                            const TrackerConfig& config = {});
+                                            const std::vector<int>& ids, const TrackerConfig& config = {});
 
 }  // namespace rilbed::vision

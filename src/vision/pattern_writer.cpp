@@ -81,8 +81,8 @@ void draw_marker(cairo_t* cr, const MarkerFamily& family, int id, double radius)
   fill_disc(cr, radius * MarkerFamily::black_ring_outer_radius, 0.0);
   cairo_set_source_rgb(cr, 1.0, 1.0, 1.0);
   for (const MarkerSlice& run : white_runs(family, id)) {
-    fill_annular_sector(cr, radius * MarkerFamily::hole_radius,
-                        radius * MarkerFamily::code_outer_radius, run.start_deg, run.end_deg);
+    fill_annular_sector(cr, radius * MarkerFamily::hole_radius, radius * MarkerFamily::code_outer_radius, run.start_deg,
+                        run.end_deg);
   }
 }
 
@@ -213,8 +213,8 @@ void draw_cut_circle(cairo_t* cr, double radius_mm) {
 }
 
 /// Draws one marker with its cut circle and label in grid cell `index` (row-major).
-void draw_sheet_cell(cairo_t* cr, const MarkerFamily& family, int id, double diameter_mm,
-                     const SheetGrid& grid, int index) {
+void draw_sheet_cell(cairo_t* cr, const MarkerFamily& family, int id, double diameter_mm, const SheetGrid& grid,
+                     int index) {
   const int column = index % grid.columns;
   const int row = index / grid.columns;
   const double centre_x = grid.left_mm + column * (grid.cell_width_mm + sheet::gap_mm) + grid.cell_width_mm / 2.0;
@@ -292,17 +292,17 @@ PatternResult check_sheet_inputs(const MarkerFamily& family, const std::vector<i
 std::optional<PatternFormat> parse_pattern_format(std::string_view text) {
   std::string lower;
   for (char c : text) lower.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
-  if (lower == "svg") return PatternFormat::svg;
-  if (lower == "pdf") return PatternFormat::pdf;
-  if (lower == "png") return PatternFormat::png;
+  if (lower == "svg") return PatternFormat::kSvg;
+  if (lower == "pdf") return PatternFormat::kPdf;
+  if (lower == "png") return PatternFormat::kPng;
   return std::nullopt;
 }
 
 std::string_view pattern_extension(PatternFormat format) {
   switch (format) {
-    case PatternFormat::svg: return "svg";
-    case PatternFormat::pdf: return "pdf";
-    case PatternFormat::png: return "png";
+    case PatternFormat::kSvg: return "svg";
+    case PatternFormat::kPdf: return "pdf";
+    case PatternFormat::kPng: return "png";
   }
   return "";
 }
@@ -345,8 +345,8 @@ PatternResult write_marker_pdf(const MarkerFamily& family, int id, double diamet
   if (cairo_surface_status(surface.get()) != CAIRO_STATUS_SUCCESS) {
     return file_result(cairo_surface_status(surface.get()), path);
   }
-  set_pdf_metadata(surface.get(), family.name() + " marker ID " + std::to_string(id) + ", " +
-                                      format_mm(diameter_mm) + " mm");
+  set_pdf_metadata(surface.get(),
+                   family.name() + " marker ID " + std::to_string(id) + ", " + format_mm(diameter_mm) + " mm");
   ContextPtr cr(cairo_create(surface.get()));
   cairo_scale(cr.get(), kPtPerMm, kPtPerMm);  // user units are millimetres from here on
   cairo_translate(cr.get(), diameter_mm / 2.0, diameter_mm / 2.0);
@@ -354,8 +354,7 @@ PatternResult write_marker_pdf(const MarkerFamily& family, int id, double diamet
   return finish_vector(surface.get(), cr.get(), path);
 }
 
-PatternResult write_marker_png(const MarkerFamily& family, int id, int size_px,
-                               const std::filesystem::path& path) {
+PatternResult write_marker_png(const MarkerFamily& family, int id, int size_px, const std::filesystem::path& path) {
   if (PatternResult r = check_id(family, id); !r.ok()) return r;
   if (size_px < 1 || size_px > kMaxPngSizePx) {
     return failure("PNG size " + std::to_string(size_px) + " px is outside 1.." + std::to_string(kMaxPngSizePx));
@@ -363,7 +362,8 @@ PatternResult write_marker_png(const MarkerFamily& family, int id, int size_px,
   // A new ARGB32 image surface is all zeros, i.e. fully transparent outside the marker.
   SurfacePtr surface(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, size_px, size_px));
   if (cairo_surface_status(surface.get()) != CAIRO_STATUS_SUCCESS) {
-    return failure("cannot render " + quoted(path) + ": " + cairo_status_to_string(cairo_surface_status(surface.get())));
+    return failure("cannot render " + quoted(path) + ": " +
+                   cairo_status_to_string(cairo_surface_status(surface.get())));
   }
   ContextPtr cr(cairo_create(surface.get()));
   const double radius_px = size_px / 2.0;
@@ -374,8 +374,8 @@ PatternResult write_marker_png(const MarkerFamily& family, int id, int size_px,
   return file_result(cairo_surface_write_to_png(surface.get(), path.c_str()), path);
 }
 
-PatternResult write_marker_sheet_pdf(const MarkerFamily& family, const std::vector<int>& ids,
-                                     double diameter_mm, const std::filesystem::path& path) {
+PatternResult write_marker_sheet_pdf(const MarkerFamily& family, const std::vector<int>& ids, double diameter_mm,
+                                     const std::filesystem::path& path) {
   if (PatternResult r = check_sheet_inputs(family, ids, diameter_mm); !r.ok()) return r;
   SurfacePtr surface(cairo_pdf_surface_create(path.c_str(), kA4WidthMm * kPtPerMm, kA4HeightMm * kPtPerMm));
   if (cairo_surface_status(surface.get()) != CAIRO_STATUS_SUCCESS) {

@@ -23,7 +23,7 @@
 namespace rilbed::vision {
 
 /// File formats the pattern writer produces.
-enum class PatternFormat { svg, pdf, png };
+enum class PatternFormat { kSvg, kPdf, kPng };
 
 /// Parses "svg", "pdf" or "png" (case-insensitive); nullopt for anything else.
 std::optional<PatternFormat> parse_pattern_format(std::string_view text);
@@ -70,8 +70,7 @@ PatternResult write_marker_pdf(const MarkerFamily& family, int id, double diamet
 /// Writes marker `id` as a size_px x size_px ARGB PNG: centred, outer radius
 /// size_px / 2 so the white outer ring touches the four edges, corners outside the
 /// marker fully transparent, key slice pointing right. size_px in [1, kMaxPngSizePx].
-PatternResult write_marker_png(const MarkerFamily& family, int id, int size_px,
-                               const std::filesystem::path& path);
+PatternResult write_marker_png(const MarkerFamily& family, int id, int size_px, const std::filesystem::path& path);
 
 /// Writes markers `ids` (each a valid ID of `family`) at true size diameter_mm on
 /// A4 portrait pages: a title line (family, diameter), a grid of markers each with a
@@ -79,7 +78,7 @@ PatternResult write_marker_png(const MarkerFamily& family, int id, int size_px,
 /// with 10 mm ticks to check the printer's scaling. Uses as many pages as needed.
 /// Fails for an empty list, an invalid id, a diameter outside
 /// (0, max_sheet_diameter_mm()] or IO errors.
-PatternResult write_marker_sheet_pdf(const MarkerFamily& family, const std::vector<int>& ids,
-                                     double diameter_mm, const std::filesystem::path& path);
+PatternResult write_marker_sheet_pdf(const MarkerFamily& family, const std::vector<int>& ids, double diameter_mm,
+                                     const std::filesystem::path& path);
 
 }  // namespace rilbed::vision

@@ -14,9 +14,10 @@ namespace {
 
 constexpr int kRays = 16;
 // Middle of the black ring and of the white ring, in units of the dark disc's radius.
-constexpr double kBlackMid =
-    0.5 * (MarkerFamily::code_outer_radius + MarkerFamily::black_ring_outer_radius) / MarkerFamily::black_ring_outer_radius;
-constexpr double kWhiteMid = 0.5 * (1.0 + MarkerFamily::black_ring_outer_radius) / MarkerFamily::black_ring_outer_radius;
+constexpr double kBlackMid = 0.5 * (MarkerFamily::code_outer_radius + MarkerFamily::black_ring_outer_radius) /
+                             MarkerFamily::black_ring_outer_radius;
+constexpr double kWhiteMid =
+    0.5 * (1.0 + MarkerFamily::black_ring_outer_radius) / MarkerFamily::black_ring_outer_radius;
 // One ray's difference counts at most this much (grey levels), so that a bright speck
 // on the white ring or a dark one on the black cannot outweigh rays that show no ring.
 constexpr int kMaxRayContrast = 96;

@@ -21,12 +21,12 @@ namespace rilbed::vision {
 
 const char* floor_name(StressFloor floor) {
   switch (floor) {
-    case StressFloor::Plain: return "plain";
-    case StressFloor::Photo: return "photo";
-    case StressFloor::Wood: return "wood";
-    case StressFloor::Fabric: return "fabric";
-    case StressFloor::Carpet: return "carpet";
-    case StressFloor::Concrete: return "concrete";
+    case StressFloor::kPlain: return "plain";
+    case StressFloor::kPhoto: return "photo";
+    case StressFloor::kWood: return "wood";
+    case StressFloor::kFabric: return "fabric";
+    case StressFloor::kCarpet: return "carpet";
+    case StressFloor::kConcrete: return "concrete";
   }
   return "?";
 }
@@ -36,9 +36,10 @@ namespace {
 // opencv-doc's sample photographs that make plausible floors once tiled, greyed and
 // toned down: fur, foliage, brick, paper with print, clutter on a desk, paintings.
 constexpr std::array kFloorPhotos = {
-    "baboon.jpg", "board.jpg", "building.jpg", "fruits.jpg", "home.jpg", "starry_night.jpg", "graf1.png",
-    "stuff.jpg", "smarties.png", "sudoku.png", "text_defocus.jpg", "notes.png", "aero1.jpg", "leuvenA.jpg",
-    "orange.jpg", "butterfly.jpg", "HappyFish.jpg", "pic1.png", "imageTextN.png", "lena.jpg",
+    "baboon.jpg",       "board.jpg",     "building.jpg", "fruits.jpg",     "home.jpg",
+    "starry_night.jpg", "graf1.png",     "stuff.jpg",    "smarties.png",   "sudoku.png",
+    "text_defocus.jpg", "notes.png",     "aero1.jpg",    "leuvenA.jpg",    "orange.jpg",
+    "butterfly.jpg",    "HappyFish.jpg", "pic1.png",     "imageTextN.png", "lena.jpg",
 };
 
 // Draws from one scene's own random stream: scene (seed, index) is the same on every machine
@@ -46,7 +47,8 @@ constexpr std::array kFloorPhotos = {
 // rather than taken from <random>, whose results differ between standard libraries).
 class SceneRandom {
  public:
-  SceneRandom(std::uint64_t seed, int index) : engine_(mix(seed * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(index))) {}
+  SceneRandom(std::uint64_t seed, int index)
+      : engine_(mix(seed * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(index))) {}
   double uniform(double lo, double hi) { return lo + (hi - lo) * unit(); }
   int integer(int lo, int hi) { return lo + static_cast<int>(unit() * (hi - lo + 1)) % (hi - lo + 1); }  // [lo, hi]
   bool chance(double p) { return unit() < p; }
@@ -88,7 +90,7 @@ cv::Mat drawn_floor(StressFloor kind, SceneRandom& rnd) {
   constexpr int n = 512;
   cv::Mat t(n, n, CV_32F);
   switch (kind) {
-    case StressFloor::Wood: {  // long grain along x, bent by slow noise, with fine fibres
+    case StressFloor::kWood: {  // long grain along x, bent by slow noise, with fine fibres
       const cv::Mat bend = smooth_noise(rnd, n, 3, 8), fibre = smooth_noise(rnd, n, 256, 6);
       const double lines = rnd.uniform(10, 40);
       for (int y = 0; y < n; ++y)
@@ -97,7 +99,7 @@ cv::Mat drawn_floor(StressFloor kind, SceneRandom& rnd) {
                                                  0.35 * fibre.at<float>(y, x));
       break;
     }
-    case StressFloor::Fabric: {  // a weave: threads over and under, with slubs
+    case StressFloor::kFabric: {  // a weave: threads over and under, with slubs
       const double period = rnd.uniform(4, 12);
       const cv::Mat slub = smooth_noise(rnd, n, 64, 64);
       for (int y = 0; y < n; ++y)
@@ -108,7 +110,7 @@ cv::Mat drawn_floor(StressFloor kind, SceneRandom& rnd) {
         }
       break;
     }
-    case StressFloor::Carpet: {  // fine pile and slow patches
+    case StressFloor::kCarpet: {  // fine pile and slow patches
       cv::Mat pile(n, n, CV_32F);
       for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x) pile.at<float>(y, x) = static_cast<float>(rnd.normal());
@@ -116,7 +118,7 @@ cv::Mat drawn_floor(StressFloor kind, SceneRandom& rnd) {
       t = unit_contrast(pile) + 0.6 * smooth_noise(rnd, n, 6, 6);
       break;
     }
-    case StressFloor::Concrete: {  // octaves of blotches, and dark pores
+    case StressFloor::kConcrete: {  // octaves of blotches, and dark pores
       t = cv::Mat::zeros(n, n, CV_32F);
       for (int cells = 4, k = 0; k < 5; ++k, cells *= 2) t += smooth_noise(rnd, n, cells, cells) * (1.0 / (1 + k));
       const int pores = rnd.integer(50, 400);
@@ -125,10 +127,8 @@ cv::Mat drawn_floor(StressFloor kind, SceneRandom& rnd) {
                    cv::LINE_AA);
       break;
     }
-    case StressFloor::Plain:
-    case StressFloor::Photo:
-      t = cv::Mat::zeros(n, n, CV_32F);
-      break;
+    case StressFloor::kPlain:
+    case StressFloor::kPhoto: t = cv::Mat::zeros(n, n, CV_32F); break;
   }
   return unit_contrast(t);
 }
@@ -147,7 +147,9 @@ cv::Mat other_tag(SceneRandom& rnd) {
   cv::Mat cells;
   if (rnd.chance(0.5)) {
     const int which = rnd.integer(0, 2);
-    apriltag_family_t* family = which == 0 ? tag36h11_create() : which == 1 ? tag25h9_create() : tagStandard41h12_create();
+    apriltag_family_t* family = which == 0   ? tag36h11_create()
+                                : which == 1 ? tag25h9_create()
+                                             : tagStandard41h12_create();
     image_u8_t* image = apriltag_to_image(family, rnd.integer(0, static_cast<int>(family->ncodes) - 1));
     cells = cv::Mat(image->height, image->width, CV_8U);
     for (int y = 0; y < image->height; ++y)
@@ -155,12 +157,15 @@ cv::Mat other_tag(SceneRandom& rnd) {
     // image_u8_destroy is not exported by Debian's libapriltag; it frees these two.
     std::free(image->buf);
     std::free(image);
-    if (which == 0) tag36h11_destroy(family);
-    else if (which == 1) tag25h9_destroy(family);
-    else tagStandard41h12_destroy(family);
+    if (which == 0)
+      tag36h11_destroy(family);
+    else if (which == 1)
+      tag25h9_destroy(family);
+    else
+      tagStandard41h12_destroy(family);
   } else {
     const int bits = rnd.integer(4, 6);
-    const auto dictionary = cv::aruco::getPredefinedDictionary(bits == 4 ? cv::aruco::DICT_4X4_50
+    const auto dictionary = cv::aruco::getPredefinedDictionary(bits == 4   ? cv::aruco::DICT_4X4_50
                                                                : bits == 5 ? cv::aruco::DICT_5X5_100
                                                                            : cv::aruco::DICT_6X6_250);
     cv::Mat marker;
@@ -227,8 +232,10 @@ void lay_cable(Robot& robot, SceneRandom& rnd, double r, double fraction) {
   double lo = 0, hi = r + robot.cable_width_m;  // covered fraction falls from lo to hi
   for (int i = 0; i < 30; ++i) {
     const double mid = (lo + hi) / 2;
-    if (covered_fraction(cable_at(mid), robot.cable_width_m, r) > fraction) lo = mid;
-    else hi = mid;
+    if (covered_fraction(cable_at(mid), robot.cable_width_m, r) > fraction)
+      lo = mid;
+    else
+      hi = mid;
   }
   robot.cable_local = cable_at(hi);
   robot.occluded = covered_fraction(robot.cable_local, robot.cable_width_m, r);
@@ -236,11 +243,12 @@ void lay_cable(Robot& robot, SceneRandom& rnd, double r, double fraction) {
 
 Clutter cable_in_field(const Robot& robot, const Pose& pose) {
   Clutter c;
-  c.kind = Clutter::Kind::Cable;
+  c.kind = Clutter::Kind::kCable;
   c.size_m = robot.cable_width_m;
   c.grey = robot.cable_grey;
   const double cs = std::cos(pose.theta), sn = std::sin(pose.theta);
-  for (const auto& p : robot.cable_local) c.path_m.emplace_back(pose.x + cs * p.x - sn * p.y, pose.y + sn * p.x + cs * p.y);
+  for (const auto& p : robot.cable_local)
+    c.path_m.emplace_back(pose.x + cs * p.x - sn * p.y, pose.y + sn * p.x + cs * p.y);
   return c;
 }
 
@@ -260,15 +268,15 @@ StressConditions draw_conditions(SceneRandom& rnd, const StressOptions& options,
   c.k1 = rnd.uniform(-0.3, 0);
   const double f = rnd.uniform(0, 1);
   if (f < 0.2) {
-    c.floor = StressFloor::Plain;
+    c.floor = StressFloor::kPlain;
     c.floor_source = "light";
     c.floor_grey = rnd.uniform(150, 215);
   } else if (f < 0.3) {
-    c.floor = StressFloor::Plain;
+    c.floor = StressFloor::kPlain;
     c.floor_source = "dark";
     c.floor_grey = rnd.uniform(40, 100);
   } else if (f < 0.6 && !photos.empty()) {
-    c.floor = StressFloor::Photo;
+    c.floor = StressFloor::kPhoto;
     c.floor_source = photos[static_cast<std::size_t>(rnd.integer(0, static_cast<int>(photos.size()) - 1))];
     c.floor_grey = rnd.uniform(70, 200);
   } else {
@@ -283,16 +291,23 @@ StressConditions draw_conditions(SceneRandom& rnd, const StressOptions& options,
 
 // Clutter of one scene: kind, size (in marker diameters d_m) and place drawn at random.
 Clutter draw_clutter_item(SceneRandom& rnd, double d_m, cv::Point2d at) {
-  static const std::array<const char*, 8> kWords = {"rilbed", "KHEPERA", "lab 3", "0123", "CAUTION", "x=1.5", "ID 4", "robot"};
+  static const std::array<const char*, 8> kWords = {"rilbed",  "KHEPERA", "lab 3", "0123",
+                                                    "CAUTION", "x=1.5",   "ID 4",  "robot"};
   Clutter c;
   c.x_m = at.x;
   c.y_m = at.y;
   c.angle_rad = rnd.uniform(0, 2 * kPi);
   switch (rnd.integer(0, 8)) {
-    case 0: c.kind = Clutter::Kind::DarkDisc; c.size_m = d_m * rnd.uniform(0.5, 1.3); break;
-    case 1: c.kind = Clutter::Kind::Ring; c.size_m = d_m * rnd.uniform(0.7, 1.3); break;
+    case 0:
+      c.kind = Clutter::Kind::kDarkDisc;
+      c.size_m = d_m * rnd.uniform(0.5, 1.3);
+      break;
+    case 1:
+      c.kind = Clutter::Kind::kRing;
+      c.size_m = d_m * rnd.uniform(0.7, 1.3);
+      break;
     case 2: {
-      c.kind = Clutter::Kind::Tape;
+      c.kind = Clutter::Kind::kTape;
       c.size_m = d_m * rnd.uniform(0.1, 0.5);
       const double length = d_m * rnd.uniform(2, 8);
       c.x2_m = at.x + length * std::cos(c.angle_rad);
@@ -300,24 +315,24 @@ Clutter draw_clutter_item(SceneRandom& rnd, double d_m, cv::Point2d at) {
       break;
     }
     case 3:
-      c.kind = Clutter::Kind::Chessboard;
+      c.kind = Clutter::Kind::kChessboard;
       c.size_m = d_m * rnd.uniform(0.15, 0.4);
       c.cols = rnd.integer(3, 7);
       c.rows = rnd.integer(3, 7);
       break;
     case 4:
-      c.kind = Clutter::Kind::Text;
+      c.kind = Clutter::Kind::kText;
       c.size_m = d_m * rnd.uniform(0.3, 0.8);
       c.text = kWords[static_cast<std::size_t>(rnd.integer(0, static_cast<int>(kWords.size()) - 1))];
       break;
     case 5:
     case 6:
-      c.kind = Clutter::Kind::Pattern;
+      c.kind = Clutter::Kind::kPattern;
       c.size_m = d_m * rnd.uniform(0.8, 2.0);
       c.pattern = other_tag(rnd);
       break;
     default: {  // a cable wandering over the floor
-      c.kind = Clutter::Kind::Cable;
+      c.kind = Clutter::Kind::kCable;
       c.size_m = d_m * rnd.uniform(0.05, 0.2);
       c.grey = rnd.uniform(10, 230);
       double heading = c.angle_rad;
@@ -337,11 +352,11 @@ Clutter draw_clutter_item(SceneRandom& rnd, double d_m, cv::Point2d at) {
 // How far clutter reaches from its anchor point (for keeping it off the robots' paths).
 double clutter_reach(const Clutter& c) {
   switch (c.kind) {
-    case Clutter::Kind::Tape: return std::hypot(c.x2_m - c.x_m, c.y2_m - c.y_m) + c.size_m;
-    case Clutter::Kind::Chessboard: return c.size_m * (std::max(c.cols, c.rows) / 2.0 + 1.0) * 1.42;
-    case Clutter::Kind::Text: return c.size_m * c.text.size() * 0.9 + c.size_m;
-    case Clutter::Kind::Pattern: return c.size_m * 0.75;
-    case Clutter::Kind::Cable: {
+    case Clutter::Kind::kTape: return std::hypot(c.x2_m - c.x_m, c.y2_m - c.y_m) + c.size_m;
+    case Clutter::Kind::kChessboard: return c.size_m * (std::max(c.cols, c.rows) / 2.0 + 1.0) * 1.42;
+    case Clutter::Kind::kText: return c.size_m * c.text.size() * 0.9 + c.size_m;
+    case Clutter::Kind::kPattern: return c.size_m * 0.75;
+    case Clutter::Kind::kCable: {
       double reach = 0;
       for (const auto& p : c.path_m) reach = std::max(reach, std::hypot(p.x - c.x_m, p.y - c.y_m));
       return reach + c.size_m;
@@ -403,11 +418,12 @@ StressScene make_stress_scene(std::uint64_t seed, int index, const StressOptions
   // The camera: over the middle of a 4 x 3 m floor, 2.5 m up, tilted and distorting.
   const cv::Point2d target(2.0, 1.5);
   const double vfov_max = widest_vfov_deg(c.image_size, c.k1, 65.0);
-  const CameraModel camera =
-      CameraModel::overhead(c.image_size, rnd.uniform(std::min(45.0, 0.85 * vfov_max), vfov_max), target, 2.5, c.tilt_deg, c.k1);
+  const CameraModel camera = CameraModel::overhead(c.image_size, rnd.uniform(std::min(45.0, 0.85 * vfov_max), vfov_max),
+                                                   target, 2.5, c.tilt_deg, c.k1);
   scene.calibration = camera.field_calibration(4.0, 3.0);
   // Metres per pixel at the image centre set the markers' size.
-  const auto probe = camera.project({cv::Point3d(target.x - 0.01, target.y, 0), cv::Point3d(target.x + 0.01, target.y, 0)});
+  const auto probe =
+      camera.project({cv::Point3d(target.x - 0.01, target.y, 0), cv::Point3d(target.x + 0.01, target.y, 0)});
   const double px_per_m = std::hypot(probe[1].x - probe[0].x, probe[1].y - probe[0].y) / 0.02;
   const double d_m = c.marker_diameter_px / px_per_m, r_m = d_m / 2;
 
@@ -424,8 +440,8 @@ StressScene make_stress_scene(std::uint64_t seed, int index, const StressOptions
   imaging.motion_blur_px = c.motion_blur_px;
   imaging.motion_blur_angle_rad = deg_to_rad(c.motion_blur_angle_deg);
   imaging.clutter_supersample = 2;
-  if (c.floor != StressFloor::Plain) {
-    cv::Mat texture = c.floor == StressFloor::Photo
+  if (c.floor != StressFloor::kPlain) {
+    cv::Mat texture = c.floor == StressFloor::kPhoto
                           ? photo_floor((std::filesystem::path(options.photo_dir) / c.floor_source).string())
                           : drawn_floor(c.floor, rnd);
     const double contrast = rnd.uniform(6, 35);  // the texture's standard deviation, grey levels
@@ -446,14 +462,16 @@ StressScene make_stress_scene(std::uint64_t seed, int index, const StressOptions
     for (int i = 0; i < 24; ++i)
       rim.emplace_back(pose.x + r_m * std::cos(2 * kPi * i / 24), pose.y + r_m * std::sin(2 * kPi * i / 24), 0.0);
     for (const auto& p : camera.project(rim))
-      if (p.x < margin || p.y < margin || p.x > c.image_size.width - 1 - margin || p.y > c.image_size.height - 1 - margin)
+      if (p.x < margin || p.y < margin || p.x > c.image_size.width - 1 - margin ||
+          p.y > c.image_size.height - 1 - margin)
         return false;
     return true;
   };
 
   // Robots: IDs drawn from 1-8, some touching another, driving (or turning) through the clip.
   std::vector<int> ids = {1, 2, 3, 4, 5, 6, 7, 8};
-  for (int i = 7; i > 0; --i) std::swap(ids[static_cast<std::size_t>(i)], ids[static_cast<std::size_t>(rnd.integer(0, i))]);
+  for (int i = 7; i > 0; --i)
+    std::swap(ids[static_cast<std::size_t>(i)], ids[static_cast<std::size_t>(rnd.integer(0, i))]);
   const int frames = std::max(1, options.frames_per_scene);
   const double dt = 1.0 / options.fps;
   std::vector<Robot> robots;
@@ -519,7 +537,8 @@ StressScene make_stress_scene(std::uint64_t seed, int index, const StressOptions
       const double reach = clutter_reach(item);
       bool clear = true;
       for (const Robot& robot : robots)
-        for (const Pose& p : robot.poses) clear = clear && std::hypot(p.x - item.x_m, p.y - item.y_m) > reach + r_m + 0.1 * d_m;
+        for (const Pose& p : robot.poses)
+          clear = clear && std::hypot(p.x - item.x_m, p.y - item.y_m) > reach + r_m + 0.1 * d_m;
       if (!clear) continue;
       clutter.push_back(item);
       break;

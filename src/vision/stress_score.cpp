@@ -64,7 +64,7 @@ void StressTally::add(const StressScene& scene, int frame, const std::vector<Mar
       used[static_cast<std::size_t>(mine)] = true;
       const double e = signed_heading_error(found[static_cast<std::size_t>(mine)].heading_deg, t.heading_deg);
       if (std::abs(e) > kStressWrongHeadingDeg) {
-        mistakes_.push_back({StressMistake::Kind::WrongHeading, scene.index, frame, t.id, t.id,
+        mistakes_.push_back({StressMistake::Kind::kWrongHeading, scene.index, frame, t.id, t.id,
                              found[static_cast<std::size_t>(mine)].u, found[static_cast<std::size_t>(mine)].v, e});
       } else {
         o.found = true;
@@ -84,10 +84,10 @@ void StressTally::add(const StressScene& scene, int frame, const std::vector<Mar
     m.u = found[k].u;
     m.v = found[k].v;
     if (on < 0) {
-      m.kind = StressMistake::Kind::FalseDetection;
+      m.kind = StressMistake::Kind::kFalseDetection;
     } else {
       m.true_id = truth[static_cast<std::size_t>(on)].id;
-      m.kind = m.true_id == m.id ? StressMistake::Kind::Duplicate : StressMistake::Kind::WrongId;
+      m.kind = m.true_id == m.id ? StressMistake::Kind::kDuplicate : StressMistake::Kind::kWrongId;
     }
     mistakes_.push_back(m);
   }
@@ -99,7 +99,8 @@ int StressTally::count(StressMistake::Kind kind) const {
   return n;
 }
 
-StressStats summarise(const std::vector<StressOutcome>& outcomes, const std::function<bool(const StressOutcome&)>& keep) {
+StressStats summarise(const std::vector<StressOutcome>& outcomes,
+                      const std::function<bool(const StressOutcome&)>& keep) {
   StressStats s;
   double centre2 = 0, heading2 = 0;
   std::map<int, std::pair<double, int>> by_id;  // id -> (sum of heading errors, count)
@@ -132,10 +133,10 @@ StressStats summarise(const std::vector<StressOutcome>& outcomes, const std::fun
 
 const char* mistake_name(StressMistake::Kind kind) {
   switch (kind) {
-    case StressMistake::Kind::WrongId: return "wrong ID";
-    case StressMistake::Kind::FalseDetection: return "false detection";
-    case StressMistake::Kind::WrongHeading: return "heading > 10 deg off";
-    case StressMistake::Kind::Duplicate: return "duplicate";
+    case StressMistake::Kind::kWrongId: return "wrong ID";
+    case StressMistake::Kind::kFalseDetection: return "false detection";
+    case StressMistake::Kind::kWrongHeading: return "heading > 10 deg off";
+    case StressMistake::Kind::kDuplicate: return "duplicate";
   }
   return "?";
 }

@@ -21,11 +21,11 @@ inline constexpr double kStressWrongHeadingDeg = 10.0;
 /// What became of one marker in one frame.
 struct StressOutcome {
   int scene = 0, frame = 0, id = 0;
-  double diameter_px = 0;        ///< StressTruth::diameter_px
-  double occluded = 0;           ///< fraction of the disc covered
-  double blur_px = 0;            ///< the frame's blur as one Gaussian's sigma: sqrt(sigma^2 + smear^2 / 12)
+  double diameter_px = 0;  ///< StressTruth::diameter_px
+  double occluded = 0;     ///< fraction of the disc covered
+  double blur_px = 0;      ///< the frame's blur as one Gaussian's sigma: sqrt(sigma^2 + smear^2 / 12)
   bool touching = false;
-  StressFloor floor = StressFloor::Plain;
+  StressFloor floor = StressFloor::kPlain;
   bool found = false;            ///< its ID reported within half its diameter, heading within kStressWrongHeadingDeg
   double centre_error_px = 0;    ///< found: distance of the reported centre from the truth
   double heading_error_deg = 0;  ///< found: reported minus true, (-180, 180]
@@ -34,12 +34,12 @@ struct StressOutcome {
 /// A detection that is not a marker's own.
 struct StressMistake {
   enum class Kind {
-    WrongId,         ///< on a marker (within half its diameter) that has another ID
-    FalseDetection,  ///< on no marker: the floor or its clutter
-    WrongHeading,    ///< the right ID, but the heading more than kStressWrongHeadingDeg off
-    Duplicate,       ///< a second report of an ID already found on that marker
+    kWrongId,         ///< on a marker (within half its diameter) that has another ID
+    kFalseDetection,  ///< on no marker: the floor or its clutter
+    kWrongHeading,    ///< the right ID, but the heading more than kStressWrongHeadingDeg off
+    kDuplicate,       ///< a second report of an ID already found on that marker
   };
-  Kind kind = Kind::WrongId;
+  Kind kind = Kind::kWrongId;
   int scene = 0, frame = 0;
   int id = 0;                    ///< the ID reported
   int true_id = 0;               ///< the ID of the marker it lies on, 0 for none
@@ -82,7 +82,8 @@ struct StressStats {
 };
 
 /// Summarises the outcomes for which `keep` is true.
-StressStats summarise(const std::vector<StressOutcome>& outcomes, const std::function<bool(const StressOutcome&)>& keep);
+StressStats summarise(const std::vector<StressOutcome>& outcomes,
+                      const std::function<bool(const StressOutcome&)>& keep);
 
 /// The kind's name ("wrong ID", "false detection", ...).
 const char* mistake_name(StressMistake::Kind kind);

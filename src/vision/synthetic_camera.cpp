@@ -69,19 +69,18 @@ namespace {
 // Reflectance of clutter at a field point, or -1 where it does not cover the floor.
 double clutter_at(const Clutter& c, double x, double y, double black, double white) {
   switch (c.kind) {
-    case Clutter::Kind::DarkDisc:
-      return std::hypot(x - c.x_m, y - c.y_m) <= c.size_m / 2 ? black : -1.0;
-    case Clutter::Kind::Ring: {
+    case Clutter::Kind::kDarkDisc: return std::hypot(x - c.x_m, y - c.y_m) <= c.size_m / 2 ? black : -1.0;
+    case Clutter::Kind::kRing: {
       const double r = std::hypot(x - c.x_m, y - c.y_m);
       return (r <= c.size_m / 2 && r >= 0.3 * c.size_m) ? black : -1.0;
     }
-    case Clutter::Kind::Tape: {
+    case Clutter::Kind::kTape: {
       const Vec2 a{c.x_m, c.y_m}, b{c.x2_m, c.y2_m}, p{x, y};
       const Vec2 ab = b - a;
       const double t = std::clamp((p - a).dot(ab) / std::max(1e-12, ab.dot(ab)), 0.0, 1.0);
       return (p - (a + ab * t)).norm() <= c.size_m / 2 ? black + 10.0 : -1.0;
     }
-    case Clutter::Kind::Chessboard: {
+    case Clutter::Kind::kChessboard: {
       const double dx = x - c.x_m, dy = y - c.y_m;
       const double lx = std::cos(c.angle_rad) * dx + std::sin(c.angle_rad) * dy;
       const double ly = -std::sin(c.angle_rad) * dx + std::cos(c.angle_rad) * dy;
@@ -90,12 +89,12 @@ double clutter_at(const Clutter& c, double x, double y, double black, double whi
       if (gx < 0 || gy < 0 || gx >= c.cols || gy >= c.rows) return white;  // margin
       return ((static_cast<int>(gx) + static_cast<int>(gy)) % 2) ? white : black;
     }
-    case Clutter::Kind::Mat:
+    case Clutter::Kind::kMat:
       return (x >= std::min(c.x_m, c.x2_m) && x <= std::max(c.x_m, c.x2_m) && y >= std::min(c.y_m, c.y2_m) &&
               y <= std::max(c.y_m, c.y2_m))
                  ? c.grey
                  : -1.0;
-    case Clutter::Kind::Pattern: {
+    case Clutter::Kind::kPattern: {
       const double dx = x - c.x_m, dy = y - c.y_m;
       const double lx = std::cos(c.angle_rad) * dx + std::sin(c.angle_rad) * dy;
       const double ly = -std::sin(c.angle_rad) * dx + std::cos(c.angle_rad) * dy;
@@ -104,7 +103,7 @@ double clutter_at(const Clutter& c, double x, double y, double black, double whi
       const double cell = c.pattern.at<std::uint8_t>(static_cast<int>(gy), static_cast<int>(gx)) / 255.0;
       return black + cell * (white - black);
     }
-    case Clutter::Kind::Cable: {
+    case Clutter::Kind::kCable: {
       const Vec2 p{x, y};
       for (std::size_t i = 0; i + 1 < c.path_m.size(); ++i) {
         const Vec2 a{c.path_m[i].x, c.path_m[i].y}, b{c.path_m[i + 1].x, c.path_m[i + 1].y};
@@ -119,8 +118,7 @@ double clutter_at(const Clutter& c, double x, double y, double black, double whi
       }
       return -1.0;
     }
-    case Clutter::Kind::Text:
-      return -1.0;  // drawn with putText
+    case Clutter::Kind::kText: return -1.0;  // drawn with putText
   }
   return -1.0;
 }
@@ -175,7 +173,8 @@ std::vector<cv::Point2d> undistorted_pixels(const CameraModel& camera) {
     const auto w = catmull_rom(static_cast<double>(v - j * kStep) / kStep);
     for (int u = 0; u < size.width; ++u) {
       cv::Point2d p(0, 0);
-      for (int k = 0; k < 4; ++k) p += w[static_cast<std::size_t>(k)] * rows[static_cast<std::size_t>(j + k) * size.width + u];
+      for (int k = 0; k < 4; ++k)
+        p += w[static_cast<std::size_t>(k)] * rows[static_cast<std::size_t>(j + k) * size.width + u];
       out[static_cast<std::size_t>(v) * size.width + u] = p;
     }
   }
@@ -223,9 +222,9 @@ SyntheticCamera::SyntheticCamera(CameraModel camera, MarkerFamily family, Imagin
   light_.create(size, CV_32F);
   for (int v = 0; v < size.height; ++v) {
     for (int u = 0; u < size.width; ++u) {
-      light_.at<float>(v, u) = static_cast<float>(lighting_gain(std::max(1.0, conditions_.light_ratio),
-                                                                conditions_.light_direction_rad,
-                                                                field_x_.at<double>(v, u), field_y_.at<double>(v, u), lo, hi));
+      light_.at<float>(v, u) =
+          static_cast<float>(lighting_gain(std::max(1.0, conditions_.light_ratio), conditions_.light_direction_rad,
+                                           field_x_.at<double>(v, u), field_y_.at<double>(v, u), lo, hi));
     }
   }
   if (conditions_.vignetting > 0.0) {
@@ -279,7 +278,8 @@ void SyntheticCamera::add_floor_texture() {
       const int y0 = mirror(fy, texture.rows), y1 = mirror(fy + 1, texture.rows);
       const float* r0 = texture.ptr<float>(y0);
       const float* r1 = texture.ptr<float>(y1);
-      row[u] += static_cast<float>((r0[x0] * (1 - ax) + r0[x1] * ax) * (1 - ay) + (r1[x0] * (1 - ax) + r1[x1] * ax) * ay);
+      row[u] +=
+          static_cast<float>((r0[x0] * (1 - ax) + r0[x1] * ax) * (1 - ay) + (r1[x0] * (1 - ax) + r1[x1] * ax) * ay);
     }
   }
 }
@@ -308,8 +308,10 @@ cv::Rect projected_box(const CameraModel& cam, double x, double y, double half, 
   const auto px = cam.project(corners);
   double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
   for (const auto& p : px) {
-    u0 = std::min(u0, p.x); v0 = std::min(v0, p.y);
-    u1 = std::max(u1, p.x); v1 = std::max(v1, p.y);
+    u0 = std::min(u0, p.x);
+    v0 = std::min(v0, p.y);
+    u1 = std::max(u1, p.x);
+    v1 = std::max(v1, p.y);
   }
   const cv::Rect box(static_cast<int>(std::floor(u0)) - 2, static_cast<int>(std::floor(v0)) - 2,
                      static_cast<int>(std::ceil(u1 - u0)) + 5, static_cast<int>(std::ceil(v1 - v0)) + 5);
@@ -346,7 +348,7 @@ void SyntheticCamera::draw_marker(cv::Mat& reflectance, const SceneMarker& m) co
 }
 
 void SyntheticCamera::draw_clutter(cv::Mat& reflectance, const Clutter& c) const {
-  if (c.kind == Clutter::Kind::Text) {
+  if (c.kind == Clutter::Kind::kText) {
     const auto px = camera_.project({cv::Point3d(c.x_m, c.y_m, 0), cv::Point3d(c.x_m, c.y_m + c.size_m, 0)});
     const double height_px = std::abs(px[1].y - px[0].y);
     cv::putText(reflectance, c.text, px[0], cv::FONT_HERSHEY_SIMPLEX, std::max(0.2, height_px / 22.0),
@@ -354,27 +356,30 @@ void SyntheticCamera::draw_clutter(cv::Mat& reflectance, const Clutter& c) const
     return;
   }
   double cx = c.x_m, cy = c.y_m, half = c.size_m;
-  if (c.kind == Clutter::Kind::Cable) {
+  if (c.kind == Clutter::Kind::kCable) {
     if (c.path_m.empty()) return;
     double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
     for (const auto& p : c.path_m) {
-      x0 = std::min(x0, p.x); y0 = std::min(y0, p.y);
-      x1 = std::max(x1, p.x); y1 = std::max(y1, p.y);
+      x0 = std::min(x0, p.x);
+      y0 = std::min(y0, p.y);
+      x1 = std::max(x1, p.x);
+      y1 = std::max(y1, p.y);
     }
     cx = (x0 + x1) / 2;
     cy = (y0 + y1) / 2;
     half = std::max(x1 - x0, y1 - y0) / 2 + c.size_m;
-  } else if (c.kind == Clutter::Kind::Pattern) {
+  } else if (c.kind == Clutter::Kind::kPattern) {
     half = c.size_m * 0.75;
-  } else if (c.kind == Clutter::Kind::Tape || c.kind == Clutter::Kind::Mat) {
+  } else if (c.kind == Clutter::Kind::kTape || c.kind == Clutter::Kind::kMat) {
     cx = (c.x_m + c.x2_m) / 2;
     cy = (c.y_m + c.y2_m) / 2;
     half = std::hypot(c.x2_m - c.x_m, c.y2_m - c.y_m) / 2 + c.size_m;
-  } else if (c.kind == Clutter::Kind::Chessboard) {
+  } else if (c.kind == Clutter::Kind::kChessboard) {
     half = c.size_m * (std::max(c.cols, c.rows) / 2.0 + 1.0);
   }
   const cv::Rect box = projected_box(camera_, cx, cy, half, reflectance.size());
-  const int s = std::max(1, conditions_.clutter_supersample > 0 ? conditions_.clutter_supersample : conditions_.supersample);
+  const int s =
+      std::max(1, conditions_.clutter_supersample > 0 ? conditions_.clutter_supersample : conditions_.supersample);
   for (int v = box.y; v < box.y + box.height; ++v) {
     float* row = reflectance.ptr<float>(v);
     for (int u = box.x; u < box.x + box.width; ++u) {
@@ -424,8 +429,9 @@ cv::Mat SyntheticCamera::render(const std::vector<SceneMarker>& markers, cv::RNG
     cv::GaussianBlur(radiance, radiance, cv::Size(), conditions_.blur_sigma_px);
   }
   if (conditions_.motion_blur_px > 0.0) {
-    cv::filter2D(radiance, radiance, -1, motion_blur_kernel(conditions_.motion_blur_px, conditions_.motion_blur_angle_rad),
-                 cv::Point(-1, -1), 0.0, cv::BORDER_REFLECT);
+    cv::filter2D(radiance, radiance, -1,
+                 motion_blur_kernel(conditions_.motion_blur_px, conditions_.motion_blur_angle_rad), cv::Point(-1, -1),
+                 0.0, cv::BORDER_REFLECT);
   }
   if (conditions_.noise_sigma > 0.0) {
     cv::Mat noise(radiance.size(), CV_32F);
@@ -447,9 +453,9 @@ std::vector<MarkerTruth> SyntheticCamera::truth(const std::vector<SceneMarker>& 
   std::vector<MarkerTruth> out;
   constexpr double kAhead_m = 0.001;
   for (const SceneMarker& m : markers) {
-    const auto px = camera_.project({cv::Point3d(m.x_m, m.y_m, 0),
-                                     cv::Point3d(m.x_m + kAhead_m * std::cos(m.theta_rad),
-                                                 m.y_m + kAhead_m * std::sin(m.theta_rad), 0)});
+    const auto px =
+        camera_.project({cv::Point3d(m.x_m, m.y_m, 0), cv::Point3d(m.x_m + kAhead_m * std::cos(m.theta_rad),
+                                                                   m.y_m + kAhead_m * std::sin(m.theta_rad), 0)});
     MarkerTruth t;
     t.id = m.id;
     t.u = px[0].x;
@@ -477,8 +483,8 @@ cv::Mat render_marker_topdown(const MarkerFamily& family, int id, int size_px, d
       for (int j = 0; j < s; ++j) {
         for (int i = 0; i < s; ++i) {
           const double dx = u + (i + 0.5) / s - 0.5 - centre, dy = -(v + (j + 0.5) / s - 0.5 - centre);
-          const double colour = family.colour_at(id, std::hypot(dx, dy) / radius,
-                                                 rad_to_deg(std::atan2(dy, dx)) - heading_deg);
+          const double colour =
+              family.colour_at(id, std::hypot(dx, dy) / radius, rad_to_deg(std::atan2(dy, dx)) - heading_deg);
           acc += colour < 0.0 ? background_grey : 28.0 + colour * (240.0 - 28.0);
         }
       }

@@ -58,17 +58,17 @@ struct SceneMarker {
 struct Clutter {
   /// Pattern: a printed square of cells (another tag family: AprilTag, ArUco), `pattern`'s
   /// pixels as cells. Cable: a round cable of width size_m along `path_m`, grey `grey`.
-  enum class Kind { DarkDisc, Ring, Tape, Chessboard, Text, Mat, Pattern, Cable };
-  Kind kind = Kind::DarkDisc;
-  double x_m = 0.0, y_m = 0.0;   ///< centre (tape: start point; text: lower-left; mat: a corner)
+  enum class Kind { kDarkDisc, kRing, kTape, kChessboard, kText, kMat, kPattern, kCable };
+  Kind kind = Kind::kDarkDisc;
+  double x_m = 0.0, y_m = 0.0;  ///< centre (tape: start point; text: lower-left; mat: a corner)
   /// disc/ring outer diameter, tape and cable width, chessboard square, text height, the
   /// pattern's side
   double size_m = 0.05;
-  double x2_m = 0.0, y2_m = 0.0; ///< tape end point; mat: the opposite corner
-  double grey = 60.0;            ///< mat and cable reflectance, 0..255
-  int cols = 5, rows = 4;        ///< chessboard squares
-  double angle_rad = 0.0;        ///< chessboard and pattern rotation
-  std::string text;              ///< for Text
+  double x2_m = 0.0, y2_m = 0.0;  ///< tape end point; mat: the opposite corner
+  double grey = 60.0;             ///< mat and cable reflectance, 0..255
+  int cols = 5, rows = 4;         ///< chessboard squares
+  double angle_rad = 0.0;         ///< chessboard and pattern rotation
+  std::string text;               ///< for Text
   /// For Pattern: CV_8U cells, 0 printed black, 255 printed white (nearest cell, no
   /// interpolation: printed cells have sharp edges), row 0 at the pattern's top (+y).
   cv::Mat pattern;
@@ -78,15 +78,15 @@ struct Clutter {
 
 /// Imaging conditions.
 struct ImagingConditions {
-  double floor_grey = 185.0;        ///< floor level before lighting, 0..255
-  double white_grey = 240.0;        ///< printed white
-  double black_grey = 28.0;         ///< printed black
-  double light_ratio = 1.0;         ///< brightest to darkest lighting across the field (3 for 3:1)
-  double light_direction_rad = 0.3; ///< direction in the field of increasing light
-  double blur_sigma_px = 0.0;       ///< Gaussian defocus/motion blur
-  double noise_sigma = 0.0;         ///< Gaussian sensor noise, grey levels
-  int jpeg_quality = 0;             ///< 1..100 to pass frames through JPEG (MJPG), 0 for none
-  int supersample = 4;              ///< subpixels per pixel side for anti-aliasing
+  double floor_grey = 185.0;         ///< floor level before lighting, 0..255
+  double white_grey = 240.0;         ///< printed white
+  double black_grey = 28.0;          ///< printed black
+  double light_ratio = 1.0;          ///< brightest to darkest lighting across the field (3 for 3:1)
+  double light_direction_rad = 0.3;  ///< direction in the field of increasing light
+  double blur_sigma_px = 0.0;        ///< Gaussian defocus/motion blur
+  double noise_sigma = 0.0;          ///< Gaussian sensor noise, grey levels
+  int jpeg_quality = 0;              ///< 1..100 to pass frames through JPEG (MJPG), 0 for none
+  int supersample = 4;               ///< subpixels per pixel side for anti-aliasing
   /// Subpixels per pixel side for clutter (0: as `supersample`). Clutter's edges need no
   /// sub-pixel truth; 2 draws it four times faster than 4.
   int clutter_supersample = 0;
@@ -111,8 +111,8 @@ struct MarkerTruth {
   double u = 0.0, v = 0.0;   ///< projected centre, distorted pixels
   double heading_deg = 0.0;  ///< on screen, CCW from +u, atan2(-dv, du), [0, 360)
   double x_m = 0.0, y_m = 0.0;
-  double theta_deg = 0.0;    ///< field heading, CCW from +x, [0, 360)
-  bool visible = false;      ///< whole marker inside the image
+  double theta_deg = 0.0;  ///< field heading, CCW from +x, [0, 360)
+  bool visible = false;    ///< whole marker inside the image
 };
 
 /// Renders frames of one camera. The static floor (with its clutter and lighting) is
@@ -142,9 +142,9 @@ class SyntheticCamera {
   CameraModel camera_;
   MarkerFamily family_;
   ImagingConditions conditions_;
-  cv::Mat field_x_, field_y_;   // CV_64F, field coordinates of every pixel centre
-  cv::Mat floor_;               // CV_32F reflectance of the static floor, 0..255
-  cv::Mat light_;               // CV_32F lighting gain per pixel
+  cv::Mat field_x_, field_y_;  // CV_64F, field coordinates of every pixel centre
+  cv::Mat floor_;              // CV_32F reflectance of the static floor, 0..255
+  cv::Mat light_;              // CV_32F lighting gain per pixel
 };
 
 /// Renders a single marker top-down, as `size_px` square grey image on `background`

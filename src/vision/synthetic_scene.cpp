@@ -13,8 +13,8 @@ namespace {
 // The widest vertical field of view (degrees) at which the whole field, with a margin of
 // `margin` of the image on each side, stays inside the image: the camera then frames the
 // field as a lab sets it up.
-double fitting_vfov(cv::Size image_size, const ScenePreset& p, double height_m, double tilt_deg, double k1,
-                    double k2, double margin) {
+double fitting_vfov(cv::Size image_size, const ScenePreset& p, double height_m, double tilt_deg, double k1, double k2,
+                    double margin) {
   const cv::Point2d centre(p.field_width_m / 2, p.field_height_m / 2);
   double lo = 10.0, hi = 120.0;
   for (int it = 0; it < 40; ++it) {
@@ -48,7 +48,7 @@ Clutter make_clutter(Clutter::Kind kind, double x_m, double y_m, double size_m) 
 }
 
 Clutter tape(double x0, double y0, double x1, double y1, double width_m) {
-  Clutter c = make_clutter(Clutter::Kind::Tape, x0, y0, width_m);
+  Clutter c = make_clutter(Clutter::Kind::kTape, x0, y0, width_m);
   c.x2_m = x1;
   c.y2_m = y1;
   return c;
@@ -56,7 +56,8 @@ Clutter tape(double x0, double y0, double x1, double y1, double width_m) {
 
 void add_field_border(ScenePreset& p) {
   const double w = p.field_width_m, h = p.field_height_m;
-  for (const Clutter& c : {tape(0, 0, w, 0, 0.02), tape(0, h, w, h, 0.02), tape(0, 0, 0, h, 0.02), tape(w, 0, w, h, 0.02)}) {
+  for (const Clutter& c :
+       {tape(0, 0, w, 0, 0.02), tape(0, h, w, h, 0.02), tape(0, 0, 0, h, 0.02), tape(w, 0, w, h, 0.02)}) {
     p.clutter.push_back(c);
   }
 }
@@ -68,8 +69,8 @@ ScenePreset scene_preset(const std::string& name, cv::Size image_size) {
   p.name = name;
   const cv::Point2d centre(p.field_width_m / 2, p.field_height_m / 2);
   if (name == "nominal") {
-    p.camera = CameraModel::overhead(image_size, fitting_vfov(image_size, p, 1.5, 0.0, -0.05, 0.0, 0.03), centre,
-                                     1.5, 0.0, -0.05, 0.0);
+    p.camera = CameraModel::overhead(image_size, fitting_vfov(image_size, p, 1.5, 0.0, -0.05, 0.0, 0.03), centre, 1.5,
+                                     0.0, -0.05, 0.0);
     p.conditions.floor_grey = 185;
     p.conditions.blur_sigma_px = 0.6;
     p.conditions.noise_sigma = 2.0;
@@ -79,8 +80,8 @@ ScenePreset scene_preset(const std::string& name, cv::Size image_size) {
     return p;
   }
   if (name == "hard") {
-    p.camera = CameraModel::overhead(image_size, fitting_vfov(image_size, p, 1.5, 20.0, -0.22, 0.05, 0.02), centre,
-                                     1.5, 20.0, -0.22, 0.05);
+    p.camera = CameraModel::overhead(image_size, fitting_vfov(image_size, p, 1.5, 20.0, -0.22, 0.05, 0.02), centre, 1.5,
+                                     20.0, -0.22, 0.05);
     p.conditions.floor_grey = 150;
     p.conditions.blur_sigma_px = 1.0;
     p.conditions.noise_sigma = 5.0;
@@ -89,21 +90,21 @@ ScenePreset scene_preset(const std::string& name, cv::Size image_size) {
     p.conditions.jpeg_quality = 60;
     using K = Clutter::Kind;
     add_field_border(p);
-    Clutter mat = make_clutter(K::Mat, 0.02, 0.02, 0.0);  // a dark mat: markers on a dark floor
+    Clutter mat = make_clutter(K::kMat, 0.02, 0.02, 0.0);  // a dark mat: markers on a dark floor
     mat.x2_m = 0.55;
     mat.y2_m = 0.50;
     mat.grey = 55.0;
     p.clutter.push_back(mat);
-    p.clutter.push_back(tape(0.30, 0.55, 0.70, 0.62, 0.015));          // a stray strip of tape
-    p.clutter.push_back(make_clutter(K::DarkDisc, 0.12, 0.12, 0.05));  // a disc the size of a marker
-    p.clutter.push_back(make_clutter(K::DarkDisc, 1.40, 1.05, 0.04));
-    p.clutter.push_back(make_clutter(K::Ring, 1.38, 0.12, 0.05));      // a ring the size of a marker
-    p.clutter.push_back(make_clutter(K::Ring, 0.10, 1.08, 0.06));
-    Clutter board = make_clutter(K::Chessboard, 0.75, 0.08, 0.012);   // a calibration board left lying
+    p.clutter.push_back(tape(0.30, 0.55, 0.70, 0.62, 0.015));           // a stray strip of tape
+    p.clutter.push_back(make_clutter(K::kDarkDisc, 0.12, 0.12, 0.05));  // a disc the size of a marker
+    p.clutter.push_back(make_clutter(K::kDarkDisc, 1.40, 1.05, 0.04));
+    p.clutter.push_back(make_clutter(K::kRing, 1.38, 0.12, 0.05));  // a ring the size of a marker
+    p.clutter.push_back(make_clutter(K::kRing, 0.10, 1.08, 0.06));
+    Clutter board = make_clutter(K::kChessboard, 0.75, 0.08, 0.012);  // a calibration board left lying
     board.cols = 9;
     board.rows = 4;
     p.clutter.push_back(board);
-    Clutter text = make_clutter(K::Text, 0.95, 1.10, 0.04);
+    Clutter text = make_clutter(K::kText, 0.95, 1.10, 0.04);
     text.text = "RIL 6 lab";
     p.clutter.push_back(text);
     return p;

@@ -13,8 +13,8 @@ BehaviourInputs only(Behaviour b, double level = 1.0) {
   return in;
 }
 
-BehaviourNetworkState run(const BehaviourNetwork& net, BehaviourNetworkState s, const BehaviourInputs& in, double seconds,
-                          double dt = 0.1) {
+BehaviourNetworkState run(const BehaviourNetwork& net, BehaviourNetworkState s, const BehaviourInputs& in,
+                          double seconds, double dt = 0.1) {
   for (double t = 0; t < seconds - 1e-9; t += dt) s = net.update(s, in, dt);
   return s;
 }

@@ -47,7 +47,8 @@ TEST(ConvoyAgent, FollowsANearLeaderAndStopsAtTheStandoff) {
 
 TEST(ConvoyAgent, AvoidsWhatTheSensorsSee) {
   ConvoyAgent a(2);
-  const ControlOutput out = run(a, perceive({{0.2, 0.2}, 0.0}, Pose2{{1.0, 0.2}, 0.0}, {0, 0, 950, 950, 0, 0, 0, 0}), 10);
+  const ControlOutput out =
+      run(a, perceive({{0.2, 0.2}, 0.0}, Pose2{{1.0, 0.2}, 0.0}, {0, 0, 950, 950, 0, 0, 0, 0}), 10);
   EXPECT_EQ(out.behaviour, "avoid");
 }
 

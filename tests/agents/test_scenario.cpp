@@ -112,10 +112,11 @@ TEST(Scenario, ErrorsNameFileLineAndKey) {
 }
 
 TEST(Scenario, RealRobotsCarryTheirLink) {
-  const Scenario s = parse_scenario("camera: {emulate: true, fps: 25}\nsafety: {lost_timeout_ms: 300, geofence_margin_m: 0.03}\n"
-                                    "robots:\n  - id: 4\n    kind: real\n    link: {port: /dev/ttyUSB0, baud: 115200}\n"
-                                    "  - id: 5\n    kind: real\n    link: {emulate: true}\n",
-                                    "real.yaml");
+  const Scenario s = parse_scenario(
+      "camera: {emulate: true, fps: 25}\nsafety: {lost_timeout_ms: 300, geofence_margin_m: 0.03}\n"
+      "robots:\n  - id: 4\n    kind: real\n    link: {port: /dev/ttyUSB0, baud: 115200}\n"
+      "  - id: 5\n    kind: real\n    link: {emulate: true}\n",
+      "real.yaml");
   ASSERT_TRUE(s.camera.has_value());
   EXPECT_TRUE(s.camera->emulate);
   EXPECT_DOUBLE_EQ(s.camera->fps, 25.0);
@@ -125,7 +126,8 @@ TEST(Scenario, RealRobotsCarryTheirLink) {
   EXPECT_EQ(s.robots[0].link->port, "/dev/ttyUSB0");
   EXPECT_EQ(s.robots[0].link->baud, 115200);
   EXPECT_TRUE(s.robots[1].link->emulate);
-  EXPECT_NE(error_of("robots:\n  - id: 1\n    link: {emulate: true}\n").find("only a robot of kind real"), std::string::npos);
+  EXPECT_NE(error_of("robots:\n  - id: 1\n    link: {emulate: true}\n").find("only a robot of kind real"),
+            std::string::npos);
   const std::string blind = error_of("robots:\n  - id: 1\n    kind: real\n    link: {emulate: true}\n");
   EXPECT_NE(blind.find("camera: a scenario with real robots needs a `camera`"), std::string::npos) << blind;
   const std::string two = error_of("camera: {emulate: true, device: 0}\nrobots:\n  - id: 1\n");
@@ -137,7 +139,8 @@ TEST(Scenario, RealRobotsCarryTheirLink) {
 
 TEST(Scenario, TheCameraStartsWithTheVisionSettingsGiven) {
   const std::string real = "robots:\n  - id: 4\n    kind: real\n    link: {emulate: true}\n";
-  const Scenario s = parse_scenario("camera: {emulate: true, vision: {contrast: 1.5, threshold: 30, min_score: 0.7}}\n" + real, "v.yaml");
+  const Scenario s = parse_scenario(
+      "camera: {emulate: true, vision: {contrast: 1.5, threshold: 30, min_score: 0.7}}\n" + real, "v.yaml");
   ASSERT_TRUE(s.camera.has_value());
   vision::VisionSettings expected;
   expected.contrast = 1.5;
@@ -170,7 +173,8 @@ TEST(Scenario, RandomPosesAreFreeAndReproducible) {
     const Vec2 p = pa[i].position_m;
     EXPECT_GE(p.x, 0.0275 + 0.02 - 1e-12);
     EXPECT_LE(p.x, 1.0 - 0.0275 - 0.02 + 1e-12);
-    EXPECT_FALSE(p.x > 0.4 - 0.05 && p.x < 0.5 + 0.05 && p.y > 0.3 - 0.05 && p.y < 0.4 + 0.05) << "inside the box's margin";
+    EXPECT_FALSE(p.x > 0.4 - 0.05 && p.x < 0.5 + 0.05 && p.y > 0.3 - 0.05 && p.y < 0.4 + 0.05)
+        << "inside the box's margin";
     for (std::size_t j = 0; j < i; ++j) EXPECT_GE((p - pa[j].position_m).norm(), 0.075 - 1e-12);
   }
 }

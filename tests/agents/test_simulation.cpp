@@ -266,7 +266,7 @@ TEST(Simulation, ConvoyIdsMustBeOneToN) {
   s.robots.erase(s.robots.begin() + 2);  // no robot 3
   EXPECT_THROW(run_scenario(s, RunOptions{}), ScenarioError);
   Scenario real = shipped("convoy_sim");
-  real.robots[3].kind = environment::RobotKind::Real;
+  real.robots[3].kind = environment::RobotKind::kReal;
   EXPECT_THROW(run_scenario(real, RunOptions{}), ScenarioError);  // real robots need real time
   RunOptions realtime;
   realtime.realtime = true;
@@ -294,7 +294,8 @@ namespace rilbed::agents {
 namespace {
 
 TEST(StatusLine, ShowsEachRobotItsHealthAndTheFormation) {
-  const std::vector<PoseReport> poses = {{1, false, true, Pose2{}, "lead", "ok"}, {4, true, false, Pose2{}, "follow", "unseen"}};
+  const std::vector<PoseReport> poses = {{1, false, true, Pose2{}, "lead", "ok"},
+                                         {4, true, false, Pose2{}, "follow", "unseen"}};
   StatusReport s;
   s.t_us = 12'040'000;
   s.state = "running";

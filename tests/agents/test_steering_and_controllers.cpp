@@ -55,7 +55,7 @@ TEST(SteerAway, TurnsFromTheSideThatSeesMore) {
   EXPECT_GT(r.right, r.left);
   ProximityValues dead_ahead{0, 0, 900, 900, 0, 0, 0, 0};
   const WheelCommand d = steer_away(dead_ahead, c);
-  EXPECT_GT(d.right, d.left);  // breaks the tie to the left
+  EXPECT_GT(d.right, d.left);      // breaks the tie to the left
   EXPECT_LE(d.left + d.right, 0);  // does not push on
 }
 

@@ -17,7 +17,8 @@ TEST(WorkerPool, CoversEveryIndexOnceForAnyCountAndThreads) {
   for (const int threads : {1, 2, 3, 5}) {
     WorkerPool pool(threads);
     EXPECT_EQ(pool.threads(), threads);
-    for (const std::size_t count : {std::size_t{0}, std::size_t{1}, std::size_t{2}, std::size_t{7}, std::size_t{1000}}) {
+    for (const std::size_t count :
+         {std::size_t{0}, std::size_t{1}, std::size_t{2}, std::size_t{7}, std::size_t{1000}}) {
       std::vector<std::atomic<int>> hits(count);
       std::atomic<int> calls{0};
       pool.for_chunks(count, [&](std::size_t begin, std::size_t end) {

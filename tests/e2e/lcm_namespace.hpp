@@ -31,12 +31,14 @@ inline int in_namespace(const std::filesystem::path& dir, const std::string& bod
   out << "R='" << RILBED_BINARY << "'\nURL='udpm://239.255.76.67:7667?ttl=0'\ncd '" << dir.string() << "'\n"
       << "export XDG_RUNTIME_DIR=\"$PWD/xdg\"; mkdir -m 700 xdg\n"
       // Waits (polling) until N sockets are bound to LCM's port: listeners that have subscribed.
-      << "listening() { for i in $(seq 1 400); do [ \"$(ss -lun 2>/dev/null | grep -c ':7667 ')\" -ge \"$1\" ] && return 0; "
+      << "listening() { for i in $(seq 1 400); do [ \"$(ss -lun 2>/dev/null | grep -c ':7667 ')\" -ge \"$1\" ] && "
+         "return 0; "
          "sleep 0.05; done; echo \"fewer than $1 listeners\" >&2; return 1; }\n"
       << body;
   if (lossy) out << "\nnft list ruleset > nft.txt\n";
   out.close();
-  const int status = std::system(("unshare -n /bin/bash '" + script.string() + "' >'" + (dir / "ns.log").string() + "' 2>&1").c_str());
+  const int status =
+      std::system(("unshare -n /bin/bash '" + script.string() + "' >'" + (dir / "ns.log").string() + "' 2>&1").c_str());
   if (!WIFEXITED(status)) return -1;
   return WEXITSTATUS(status);
 }
@@ -46,10 +48,10 @@ inline bool namespaces_work() { return std::system("unshare -n true >/dev/null 2
 // nft can add a table inside a namespace (the package is installed and the kernel has nf_tables).
 inline bool nft_works() { return std::system("unshare -n nft add table inet probe >/dev/null 2>&1") == 0; }
 
-#define SKIP_WITHOUT_NAMESPACES()                                                                     \
+#define SKIP_WITHOUT_NAMESPACES() \
   if (!namespaces_work()) GTEST_SKIP() << "cannot make a network namespace here (unshare -n needs root)"
-#define SKIP_WITHOUT_NFT()                                                                              \
-  SKIP_WITHOUT_NAMESPACES();                                                                            \
+#define SKIP_WITHOUT_NFT()   \
+  SKIP_WITHOUT_NAMESPACES(); \
   if (!nft_works()) GTEST_SKIP() << "nft cannot add rules in a network namespace here (package nftables)"
 
 }  // namespace rilbed::e2e

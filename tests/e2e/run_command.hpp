@@ -50,8 +50,8 @@ inline CommandResult run_rilbed(const std::string& args) {
   const std::string tag = std::to_string(::getpid()) + "_" + std::to_string(counter++);
   const auto out_path = dir / ("rilbed_e2e_out_" + tag);
   const auto err_path = dir / ("rilbed_e2e_err_" + tag);
-  const std::string cmd = std::string("'") + RILBED_BINARY + "' " + args + " >'" + out_path.string() +
-                          "' 2>'" + err_path.string() + "' </dev/null";
+  const std::string cmd = std::string("'") + RILBED_BINARY + "' " + args + " >'" + out_path.string() + "' 2>'" +
+                          err_path.string() + "' </dev/null";
   const int status = std::system(cmd.c_str());
   CommandResult r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

@@ -29,7 +29,8 @@ namespace fs = std::filesystem;
 fs::path convoy_with_agents(const fs::path& dir, const std::string& agents_block) {
   const fs::path file = dir / "convoy_agents.yaml";
   std::ofstream out(file);
-  out << read_file(fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml") << "\nagents: " << agents_block << "\n";
+  out << read_file(fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml") << "\nagents: " << agents_block
+      << "\n";
   return file;
 }
 
@@ -60,14 +61,15 @@ TEST(AgentsCli, LockStepRunWithTwoAgentProcessesEqualsTheInProcessRun) {
   SKIP_WITHOUT_NAMESPACES();
   const fs::path dir = scratch_dir("agents_lockstep");
   const fs::path scenario = convoy_with_agents(dir, "{processes: 2}");
-  const int status = in_namespace(dir,
-                                  "\"$R\" run '" + (fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml").string() +
-                                      "' --fast --seed 5 --duration 40 --out local --quiet\n"
-                                      "\"$R\" run '" + scenario.string() +
-                                      "' --fast --seed 5 --duration 40 --out remote --lcm \"$URL\" > run.txt 2>&1\n");
+  const int status = in_namespace(
+      dir, "\"$R\" run '" + (fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml").string() +
+               "' --fast --seed 5 --duration 40 --out local --quiet\n"
+               "\"$R\" run '" +
+               scenario.string() + "' --fast --seed 5 --duration 40 --out remote --lcm \"$URL\" > run.txt 2>&1\n");
   ASSERT_EQ(status, 0) << read_file(dir / "ns.log") << read_file(dir / "run.txt");
   // 401 steps, each one message for both processes (it fits in a datagram), and the end three times.
-  EXPECT_NE(read_file(dir / "run.txt").find("agents: 404 quanta sent"), std::string::npos) << read_file(dir / "run.txt");
+  EXPECT_NE(read_file(dir / "run.txt").find("agents: 404 quanta sent"), std::string::npos)
+      << read_file(dir / "run.txt");
   expect_same_run_folder(dir / "local", dir / "remote");
 }
 
@@ -84,15 +86,17 @@ TEST(AgentsCli, RealRobotsWhoseAgentProcessDiesAreStoppedOverTheirLinks) {
   const std::string wait_for =
       "wait_for() { for i in $(seq 1 1200); do grep -q \"$2\" \"$1\" 2>/dev/null && return 0; sleep 0.05; done; "
       "echo \"timed out waiting for $2 in $1\" >&2; return 1; }\n";
-  const int status = in_namespace(
-      dir, wait_for + "\"$R\" agent --scenario " + s + " --ids 4-5 --lcm \"$URL\" > agent.txt 2>&1 &\nA=$!\n" +
-               "\"$R\" run " + s + " --realtime --seed 2 --duration 12 --no-place --out run --lcm \"$URL\" > run.txt 2>&1 &\n"
-               "RUN=$!\n"
-               "wait_for run/trajectories.csv '^4\\.[0-9]*,4,'\n"
-               "kill -9 $A\n"
-               "wait_for run/events.csv 'lost: process'\n"
-               "wait $RUN\n");
-  ASSERT_EQ(status, 0) << read_file(dir / "ns.log") << read_file(dir / "run.txt") << read_file(dir / "run" / "events.csv");
+  const int status =
+      in_namespace(dir, wait_for + "\"$R\" agent --scenario " + s +
+                            " --ids 4-5 --lcm \"$URL\" > agent.txt 2>&1 &\nA=$!\n" + "\"$R\" run " + s +
+                            " --realtime --seed 2 --duration 12 --no-place --out run --lcm \"$URL\" > run.txt 2>&1 &\n"
+                            "RUN=$!\n"
+                            "wait_for run/trajectories.csv '^4\\.[0-9]*,4,'\n"
+                            "kill -9 $A\n"
+                            "wait_for run/events.csv 'lost: process'\n"
+                            "wait $RUN\n");
+  ASSERT_EQ(status, 0) << read_file(dir / "ns.log") << read_file(dir / "run.txt")
+                       << read_file(dir / "run" / "events.csv");
   const std::string run = read_file(dir / "run.txt");
   EXPECT_NE(run.find("robot 4 (emulated): last speed 0 0"), std::string::npos) << run;
   EXPECT_NE(run.find("robot 5 (emulated): last speed 0 0"), std::string::npos) << run;
@@ -147,33 +151,38 @@ TEST(AgentsCli, ABatchWithACControllerInAgentProcessesEqualsTheInProcessBatch) {
   const fs::path wander = fs::path(RILBED_SOURCE_DIR) / "scenarios" / "wander.yaml";
   const fs::path scenario = dir / "wander_agents.yaml";
   std::ofstream(scenario) << read_file(wander) << "\nagents: {processes: 2}\n";
-  const int status = in_namespace(dir, "\"$R\" run '" + wander.string() +
-                                           "' --fast --seeds 3 --jobs 1 --duration 20 --out local --quiet\n"
-                                           "\"$R\" run '" + scenario.string() +
-                                           "' --fast --seeds 3 --jobs 1 --duration 20 --out remote --lcm \"$URL\" > run.txt 2>&1\n");
+  const int status =
+      in_namespace(dir, "\"$R\" run '" + wander.string() +
+                            "' --fast --seeds 3 --jobs 1 --duration 20 --out local --quiet\n"
+                            "\"$R\" run '" +
+                            scenario.string() +
+                            "' --fast --seeds 3 --jobs 1 --duration 20 --out remote --lcm \"$URL\" > run.txt 2>&1\n");
   ASSERT_EQ(status, 0) << read_file(dir / "ns.log") << read_file(dir / "run.txt");
   const std::string run = read_file(dir / "run.txt");
   // Three runs, each 201 steps and its end (sent three times).
   EXPECT_EQ(count_of(run, "agents: 204 quanta sent"), 3) << run;
-  for (const char* seed : {"seed_1", "seed_2", "seed_3"}) expect_same_run_folder(dir / "local" / seed, dir / "remote" / seed);
+  for (const char* seed : {"seed_1", "seed_2", "seed_3"})
+    expect_same_run_folder(dir / "local" / seed, dir / "remote" / seed);
 }
 
 TEST(AgentsCli, EightAgentProcessesFormTheConvoyUnderTenPercentLossAsInOneProcess) {
   SKIP_WITHOUT_NFT();
   const fs::path dir = scratch_dir("agents_loss");
   const fs::path scenario = convoy_with_agents(dir, "{processes: 8}");
-  const int status = in_namespace(dir,
-                                  "\"$R\" run '" + (fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml").string() +
-                                      "' --fast --seed 8 --stop-when-formed --out local --quiet\n"
-                                      "\"$R\" run '" + scenario.string() +
-                                      "' --fast --seed 8 --stop-when-formed --out remote --lcm \"$URL\" > run.txt 2>&1\n",
-                                  /*lossy=*/true);
+  const int status = in_namespace(
+      dir,
+      "\"$R\" run '" + (fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml").string() +
+          "' --fast --seed 8 --stop-when-formed --out local --quiet\n"
+          "\"$R\" run '" +
+          scenario.string() + "' --fast --seed 8 --stop-when-formed --out remote --lcm \"$URL\" > run.txt 2>&1\n",
+      /*lossy=*/true);
   ASSERT_EQ(status, 0) << read_file(dir / "ns.log") << read_file(dir / "run.txt");
   const std::string run = read_file(dir / "run.txt");
   EXPECT_NE(run.find("formed at"), std::string::npos) << run;
   // Quanta and answers were lost and sent again, and no process was given up on.
   std::smatch m;
-  ASSERT_TRUE(std::regex_search(run, m, std::regex(R"((\d+) sent again, \d+ duplicate answers, \d+ late, (\d+) processes lost)")))
+  ASSERT_TRUE(std::regex_search(
+      run, m, std::regex(R"((\d+) sent again, \d+ duplicate answers, \d+ late, (\d+) processes lost)")))
       << run;
   EXPECT_GT(std::stol(m[1]), 0) << run;
   EXPECT_EQ(m[2], "0") << run;
@@ -194,9 +203,13 @@ TEST(AgentsCli, AKilledAgentProcessIsLostTheRestGoOnAndARestartedOneRejoins) {
   const int status = in_namespace(
       dir, wait_for +
                "AGENTS=\nfor id in 1 2 3 4 5 6 7 8; do\n"
-               "  \"$R\" agent --scenario " + s + " --ids $id --lcm \"$URL\" > agent_$id.txt 2>&1 &\n"
+               "  \"$R\" agent --scenario " +
+               s +
+               " --ids $id --lcm \"$URL\" > agent_$id.txt 2>&1 &\n"
                "  [ $id = 5 ] && A5=$! || AGENTS=\"$AGENTS $!\"\ndone\n"
-               "\"$R\" run " + s + " --realtime --rt-factor 10 --seed 3 --duration 90 --out run --lcm \"$URL\" --quiet > run.txt 2>&1 &\n"
+               "\"$R\" run " +
+               s +
+               " --realtime --rt-factor 10 --seed 3 --duration 90 --out run --lcm \"$URL\" --quiet > run.txt 2>&1 &\n"
                "RUN=$!\n"
                // Three simulated seconds in, before the convoy forms (the trajectories are flushed
                // every 100 rows), robot 5's process dies.
@@ -204,14 +217,19 @@ TEST(AgentsCli, AKilledAgentProcessIsLostTheRestGoOnAndARestartedOneRejoins) {
                "kill -9 $A5; date +%s.%N > killed_at\n"
                "wait_for run/events.csv 'lost: process'\n"
                "date +%s.%N > lost_at\n"
-               "\"$R\" agent --scenario " + s + " --ids 5 --lcm \"$URL\" > agent_5_again.txt 2>&1 &\nAGENTS=\"$AGENTS $!\"\n"
+               "\"$R\" agent --scenario " +
+               s +
+               " --ids 5 --lcm \"$URL\" > agent_5_again.txt 2>&1 &\nAGENTS=\"$AGENTS $!\"\n"
                "wait_for run/events.csv 'rejoined'\n"
                "wait $RUN\n"
                "kill $AGENTS; wait $AGENTS || true\n");
-  ASSERT_EQ(status, 0) << read_file(dir / "ns.log") << read_file(dir / "run.txt") << read_file(dir / "run" / "events.csv");
+  ASSERT_EQ(status, 0) << read_file(dir / "ns.log") << read_file(dir / "run.txt")
+                       << read_file(dir / "run" / "events.csv");
   const double detection_s = std::stod(read_file(dir / "lost_at")) - std::stod(read_file(dir / "killed_at"));
-  std::printf("a killed agent process was reported lost %.2f s after it died (dead_after_ms 750, the default; polled every 50 ms)\n",
-              detection_s);
+  std::printf(
+      "a killed agent process was reported lost %.2f s after it died (dead_after_ms 750, the default; polled every 50 "
+      "ms)\n",
+      detection_s);
   const std::string events = read_file(dir / "run" / "events.csv");
   EXPECT_NE(events.find("(robots 5) stopped answering"), std::string::npos) << events;
   EXPECT_EQ(count_of(events, "lost: process"), 1) << events;
@@ -243,8 +261,9 @@ TEST(AgentsCli, ARunWhoseAgentsNeverComeNamesTheMissingRobots) {
   SKIP_WITHOUT_NAMESPACES();
   const fs::path dir = scratch_dir("agents_missing");
   const fs::path scenario = convoy_with_agents(dir, "{ids: 3-4, announce_timeout_s: 0.5}");
-  const int status = in_namespace(dir, "set +e\n\"$R\" run '" + scenario.string() +
-                                           "' --fast --seed 1 --duration 5 --lcm \"$URL\" > run.txt 2>&1\necho $? > rc\n");
+  const int status =
+      in_namespace(dir, "set +e\n\"$R\" run '" + scenario.string() +
+                            "' --fast --seed 1 --duration 5 --lcm \"$URL\" > run.txt 2>&1\necho $? > rc\n");
   ASSERT_EQ(status, 0) << read_file(dir / "ns.log");
   EXPECT_EQ(read_file(dir / "rc"), "1\n");
   EXPECT_NE(read_file(dir / "run.txt").find("no agent process announced robots 3,4"), std::string::npos)
@@ -260,7 +279,8 @@ std::string two_machines_script(const fs::path& dir) {
   std::ostringstream script;
   script << "set -e\nR='" << RILBED_BINARY << "'\ncd '" << dir.string() << "'\n"
          << "A=rilbed_a_$$; B=rilbed_b_$$; KEEP_PIDS=\n"
-         << "cleanup() { [ -n \"$KEEP_PIDS\" ] && kill $KEEP_PIDS 2>/dev/null; wait 2>/dev/null; ip netns del $A 2>/dev/null; "
+         << "cleanup() { [ -n \"$KEEP_PIDS\" ] && kill $KEEP_PIDS 2>/dev/null; wait 2>/dev/null; ip netns del $A "
+            "2>/dev/null; "
             "ip netns del $B 2>/dev/null; true; }\ntrap cleanup EXIT\n"
          << "ip netns add $A; ip netns add $B\n"
          << "ip link add veth_a netns $A type veth peer name veth_b netns $B\n"
@@ -272,10 +292,10 @@ std::string two_machines_script(const fs::path& dir) {
   return script.str();
 }
 
-#define SKIP_WITHOUT_NAMED_NAMESPACES()                                                                  \
-  SKIP_WITHOUT_NAMESPACES();                                                                           \
+#define SKIP_WITHOUT_NAMED_NAMESPACES()                                                                   \
+  SKIP_WITHOUT_NAMESPACES();                                                                              \
   if (std::system("ip netns add rilbed_probe_$$ >/dev/null 2>&1 && ip netns del rilbed_probe_$$") != 0) { \
-    GTEST_SKIP() << "cannot make named network namespaces here (ip netns add needs root)";             \
+    GTEST_SKIP() << "cannot make named network namespaces here (ip netns add needs root)";                \
   }
 
 // The run and robots 1-4's agent process are on one machine, robots 5-8's on the other.
@@ -285,16 +305,20 @@ TEST(AgentsCli, AgentsOnTwoMachinesJoinedByAVethPairGiveTheInProcessRun) {
   const fs::path scenario = convoy_with_agents(dir, "{processes: 0}");
   const std::string s = "'" + scenario.string() + "'";
   const fs::path script = dir / "machines.sh";
-  std::ofstream(script)
-      << two_machines_script(dir) << "\"$R\" run '"
-      << (fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml").string()
-      << "' --fast --seed 6 --duration 30 --out local --quiet\n"
-      << "ip netns exec $A \"$R\" agent --scenario " << s << " --ids 1-4 --lcm \"$URL\" > agent_a.txt 2>&1 &\nKEEP_PIDS=$!\n"
-      << "ip netns exec $B \"$R\" agent --scenario " << s << " --ids 5-8 --lcm \"$URL\" > agent_b.txt 2>&1 &\n"
-      << "KEEP_PIDS=\"$KEEP_PIDS $!\"\n"
-      << "ip netns exec $A \"$R\" run " << s << " --fast --seed 6 --duration 30 --out remote --lcm \"$URL\" > run.txt 2>&1\n";
-  const int status = std::system(("/bin/bash '" + script.string() + "' > '" + (dir / "machines.log").string() + "' 2>&1").c_str());
-  ASSERT_EQ(status, 0) << read_file(dir / "machines.log") << read_file(dir / "run.txt") << read_file(dir / "agent_b.txt");
+  std::ofstream(script) << two_machines_script(dir) << "\"$R\" run '"
+                        << (fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml").string()
+                        << "' --fast --seed 6 --duration 30 --out local --quiet\n"
+                        << "ip netns exec $A \"$R\" agent --scenario " << s
+                        << " --ids 1-4 --lcm \"$URL\" > agent_a.txt 2>&1 &\nKEEP_PIDS=$!\n"
+                        << "ip netns exec $B \"$R\" agent --scenario " << s
+                        << " --ids 5-8 --lcm \"$URL\" > agent_b.txt 2>&1 &\n"
+                        << "KEEP_PIDS=\"$KEEP_PIDS $!\"\n"
+                        << "ip netns exec $A \"$R\" run " << s
+                        << " --fast --seed 6 --duration 30 --out remote --lcm \"$URL\" > run.txt 2>&1\n";
+  const int status =
+      std::system(("/bin/bash '" + script.string() + "' > '" + (dir / "machines.log").string() + "' 2>&1").c_str());
+  ASSERT_EQ(status, 0) << read_file(dir / "machines.log") << read_file(dir / "run.txt")
+                       << read_file(dir / "agent_b.txt");
   EXPECT_NE(read_file(dir / "run.txt").find("0 processes lost"), std::string::npos) << read_file(dir / "run.txt");
   expect_same_run_folder(dir / "local", dir / "remote");
 }
@@ -307,7 +331,8 @@ TEST(AgentsCli, AgentsOnTwoMachinesJoinedByAVethPairGiveTheInProcessRun) {
 // named, not after the announce timeout.
 TEST(AgentsCli, HostsStartTheAgentsOnAnotherMachineOverSsh) {
   SKIP_WITHOUT_NAMED_NAMESPACES();
-  if (!fs::exists("/usr/sbin/sshd") || std::system("command -v ssh > /dev/null && command -v ssh-keygen > /dev/null") != 0) {
+  if (!fs::exists("/usr/sbin/sshd") ||
+      std::system("command -v ssh > /dev/null && command -v ssh-keygen > /dev/null") != 0) {
     GTEST_SKIP() << "OpenSSH (openssh-server, openssh-client) is not installed; ./run installs it";
   }
   const fs::path dir = scratch_dir("agents_ssh");
@@ -316,18 +341,20 @@ TEST(AgentsCli, HostsStartTheAgentsOnAnotherMachineOverSsh) {
            "', -o, StrictHostKeyChecking=no, -o, UserKnownHostsFile=/dev/null, -o, BatchMode=yes, -o, LogLevel=ERROR, "
            "-T, '{host}', '{command}']";
   };
-  const fs::path scenario = convoy_with_agents(dir, "{hosts: [10.203.0.2], processes: 2, launch: " + launch(2222) + "}");
+  const fs::path scenario =
+      convoy_with_agents(dir, "{hosts: [10.203.0.2], processes: 2, launch: " + launch(2222) + "}");
   // A port nothing listens on, and a timeout that would make the test wait a minute.
   std::ofstream(dir / "refused.yaml") << read_file(fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml")
-                                      << "\nagents: {hosts: [10.203.0.2], announce_timeout_s: 60, launch: " << launch(2223)
-                                      << "}\n";
+                                      << "\nagents: {hosts: [10.203.0.2], announce_timeout_s: 60, launch: "
+                                      << launch(2223) << "}\n";
   const fs::path script = dir / "ssh.sh";
   std::ofstream(script)
       << two_machines_script(dir) << "\"$R\" run '"
       << (fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml").string()
       << "' --fast --seed 6 --duration 30 --out local --quiet\n"
       << "ssh-keygen -q -t ed25519 -N '' -f host_key; ssh-keygen -q -t ed25519 -N '' -f id; cp id.pub authorized_keys\n"
-      << "printf '%s\\n' 'ListenAddress 10.203.0.2:2222' \"HostKey $PWD/host_key\" \"AuthorizedKeysFile $PWD/authorized_keys\" "
+      << "printf '%s\\n' 'ListenAddress 10.203.0.2:2222' \"HostKey $PWD/host_key\" \"AuthorizedKeysFile "
+         "$PWD/authorized_keys\" "
          "\"PidFile $PWD/sshd.pid\" 'UsePAM no' 'StrictModes no' 'PasswordAuthentication no' "
          "'KbdInteractiveAuthentication no' 'PermitRootLogin prohibit-password' > sshd_config\n"
       << "mkdir -p /run/sshd\n"  // sshd's privilege separation directory (systemd makes it)
@@ -340,7 +367,8 @@ TEST(AgentsCli, HostsStartTheAgentsOnAnotherMachineOverSsh) {
       << "ip netns pids $B | wc -l > left_on_b.txt\n"
       << "set +e\nip netns exec $A \"$R\" run '" << (dir / "refused.yaml").string()
       << "' --fast --seed 6 --duration 30 --lcm \"$URL\" > refused.txt 2>&1\necho $? > refused_rc.txt\n";
-  const int status = std::system(("/bin/bash '" + script.string() + "' > '" + (dir / "ssh_test.log").string() + "' 2>&1").c_str());
+  const int status =
+      std::system(("/bin/bash '" + script.string() + "' > '" + (dir / "ssh_test.log").string() + "' 2>&1").c_str());
   ASSERT_EQ(status, 0) << read_file(dir / "ssh_test.log") << read_file(dir / "run.txt") << read_file(dir / "sshd.log");
   const std::string run = read_file(dir / "run.txt");
   EXPECT_NE(run.find("0 processes lost"), std::string::npos) << run;
@@ -360,10 +388,11 @@ TEST(AgentsCli, HostsStartTheAgentsOnAnotherMachineOverSsh) {
 // shell's -c): every argument must arrive as it was, whatever it holds.
 TEST(AgentLaunch, TheCommandReachesTheRemoteShellWordForWord) {
   const std::vector<std::string> words = {"/opt/lab's rilbed/rilbed", "--lcm", "udpm://239.255.76.67:7667?ttl=1",
-                                          "$HOME `id` \"x\" \\ ;|&*", "", "a\nb"};
+                                          "$HOME `id` \"x\" \\ ;|&*", "",      "a\nb"};
   std::string command = "printf '<%s>'";
   for (const std::string& w : words) command.append(" ").append(app::shell_quote(w));
-  const std::vector<std::string> argv = app::launch_arguments({"ssh", "-p", "22", "{host}", "{command}"}, "pi@h{command}", command);
+  const std::vector<std::string> argv =
+      app::launch_arguments({"ssh", "-p", "22", "{host}", "{command}"}, "pi@h{command}", command);
   ASSERT_EQ(argv.size(), 5u);
   EXPECT_EQ(argv[3], "pi@h{command}");  // a host's text is put in, never searched again
   EXPECT_EQ(argv[4], command);
@@ -387,12 +416,14 @@ TEST(AgentLaunch, AScenarioOnStandardInputEndsAtItsDocumentEndAndTheAgentWithIts
   for (std::string line; std::getline(yaml, line);) crlf << line << "\r\n";
   crlf << "...  \r\n";
   crlf.close();
-  const std::string command = std::string("cd '") + dir.string() + "' && '" + RILBED_BINARY +
-                              "' agent --scenario-stdin=convoy_sim.yaml --ids 1,2 --lcm memq:// < crlf.yaml > out.txt 2>&1;"
-                              " echo $? > rc";
+  const std::string command =
+      std::string("cd '") + dir.string() + "' && '" + RILBED_BINARY +
+      "' agent --scenario-stdin=convoy_sim.yaml --ids 1,2 --lcm memq:// < crlf.yaml > out.txt 2>&1;"
+      " echo $? > rc";
   ASSERT_EQ(std::system(command.c_str()), 0);
   EXPECT_EQ(read_file(dir / "rc"), "0\n") << read_file(dir / "out.txt");
-  EXPECT_NE(read_file(dir / "out.txt").find("robots 1,2 of convoy_sim"), std::string::npos) << read_file(dir / "out.txt");
+  EXPECT_NE(read_file(dir / "out.txt").find("robots 1,2 of convoy_sim"), std::string::npos)
+      << read_file(dir / "out.txt");
 }
 
 TEST(AgentLaunch, ProcessesTakeTheHostsInTurn) {
@@ -424,7 +455,8 @@ TEST(AgentsCli, AgentsInOtherProcessesNeedABusTheyReach) {
                                        << "\nagents: {hosts: [lab-pc, -oProxyCommand=touch /tmp/x]}\n";
   const CommandResult host = run_rilbed("run '" + (dir / "bad_host.yaml").string() + "' --fast");
   EXPECT_EQ(host.exit_code, 1);
-  EXPECT_NE(host.err.find("agents.hosts: '-oProxyCommand=touch /tmp/x' is not a host name"), std::string::npos) << host.err;
+  EXPECT_NE(host.err.find("agents.hosts: '-oProxyCommand=touch /tmp/x' is not a host name"), std::string::npos)
+      << host.err;
   std::ofstream(dir / "bad_launch.yaml") << read_file(fs::path(RILBED_SOURCE_DIR) / "scenarios" / "convoy_sim.yaml")
                                          << "\nagents: {hosts: [lab-pc], launch: [ssh, '{host}']}\n";
   const CommandResult launch = run_rilbed("run '" + (dir / "bad_launch.yaml").string() + "' --fast");

@@ -44,8 +44,8 @@ bool contains(const std::string& text, const std::string& part) { return text.fi
 TEST(CalibrateIntrinsicsCli, LeftImagesMatchOpenCvSample) {
   const auto dir = scratch_dir("calib_intrinsics");
   const auto out = dir / "camera.yml";
-  const auto r = run_rilbed("calibrate intrinsics --images '" + kData + "/left*.jpg' --board 9x6 --square-mm 25 --out " +
-                            quoted(out));
+  const auto r = run_rilbed("calibrate intrinsics --images '" + kData +
+                            "/left*.jpg' --board 9x6 --square-mm 25 --out " + quoted(out));
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_TRUE(contains(r.out, "RMS reprojection error: 0.409")) << r.out;
   EXPECT_TRUE(contains(r.out, "used: " + kData + "/left01.jpg")) << r.out;
@@ -87,7 +87,8 @@ TEST(CalibrateIntrinsicsCli, FewerThanThreeUsableImagesFail) {
 TEST(CalibrateIntrinsicsCli, BadOptionsNameTheInput) {
   const auto dir = scratch_dir("calib_badopt");
   const auto out = quoted(dir / "camera.yml");
-  auto r = run_rilbed("calibrate intrinsics --images '" + kData + "/left*.jpg' --board 9by6 --square-mm 25 --out " + out);
+  auto r =
+      run_rilbed("calibrate intrinsics --images '" + kData + "/left*.jpg' --board 9by6 --square-mm 25 --out " + out);
   EXPECT_NE(r.exit_code, 0);
   EXPECT_TRUE(contains(r.err, "--board '9by6'")) << r.err;
   r = run_rilbed("calibrate intrinsics --images '" + kData + "/left*.jpg' --board 9x6 --square-mm -3 --out " + out);
@@ -185,8 +186,8 @@ TEST(CalibrateFieldCli, MarkersAtKnownPositions) {
                                   {0.75, 1.08}, {0.15, 1.05}, {0.60, 0.55}};
   std::string arg;
   for (std::size_t i = 0; i < at_m.size(); ++i) {
-    markers.push_back({static_cast<int>(i + 1), at_m[i].x, at_m[i].y, 0.3 * static_cast<double>(i),
-                       scene.preset.marker_diameter_m});
+    markers.push_back(
+        {static_cast<int>(i + 1), at_m[i].x, at_m[i].y, 0.3 * static_cast<double>(i), scene.preset.marker_diameter_m});
     if (!arg.empty()) arg += ';';
     arg += cv::format("%zu:%.3f,%.3f", i + 1, at_m[i].x, at_m[i].y);
   }

@@ -95,7 +95,8 @@ TEST(DetectCli, CsvColumnsFollowTheContract) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out.substr(0, r.out.find('\n')), "frame,id,u,v,heading_deg,score");
   EXPECT_EQ(data_rows(r.out), 16);
-  r = run_rilbed("detect '" + frames + "' --max-frames 1 --calib '" + (kDatasets / "nominal" / "calibration.yaml").string() + "' -q");
+  r = run_rilbed("detect '" + frames + "' --max-frames 1 --calib '" +
+                 (kDatasets / "nominal" / "calibration.yaml").string() + "' -q");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out.substr(0, r.out.find('\n')), "frame,id,u,v,heading_deg,score,x_m,y_m,theta_deg");
   EXPECT_NE(r.err.find("summary: 1 frames read"), std::string::npos) << r.err;
@@ -141,7 +142,8 @@ TEST(DetectCli, StressScenesAsTheContractSays) {
   auto r = run_rilbed("synth --preset stress --seed 11 --scene 3 --frames 4 --out '" + out.string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string truth_text = read_file(out / "ground_truth.csv");
-  EXPECT_EQ(truth_text.substr(0, truth_text.find('\n')), "frame,id,u,v,heading_deg,scene,diameter_px,occluded,touching");
+  EXPECT_EQ(truth_text.substr(0, truth_text.find('\n')),
+            "frame,id,u,v,heading_deg,scene,diameter_px,occluded,touching");
   const std::string scenes = read_file(out / "scenes.csv");
   EXPECT_EQ(scenes.rfind("scene,first_frame,frames,marker_diameter_px,", 0), 0u) << scenes;
   EXPECT_NE(scenes.find("\n3,0,4,"), std::string::npos) << scenes;
@@ -155,8 +157,9 @@ TEST(DetectCli, StressScenesAsTheContractSays) {
   r = run_rilbed("synth --preset stress --seed 11 --scene 3 --frames 1 --out '" + again.string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(read_file(again / "frames" / "frame_0000.png"), read_file(out / "frames" / "frame_0000.png"));
-  r = run_rilbed("detect '" + (out / "frames").string() + "' --calib '" + (out / "calibration" / "scene_0003.yaml").string() +
-                 "' --csv '" + (out / "found.csv").string() + "' -q");
+  r = run_rilbed("detect '" + (out / "frames").string() + "' --calib '" +
+                 (out / "calibration" / "scene_0003.yaml").string() + "' --csv '" + (out / "found.csv").string() +
+                 "' -q");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("  declined: "), std::string::npos) << r.err;  // the summary counts ambiguous markers
   const auto truth = vision::read_marker_csv((out / "ground_truth.csv").string());

@@ -25,8 +25,11 @@ namespace fs = std::filesystem;
 // codes.txt), then the console's exit, the run's and the gui's exit codes ("exit N", "run
 // N", "gui N").
 std::string gui_on_the_bus_script(const std::string& run_args, const std::string& body) {
-  return "P2='" RILBED_WS_PROBE "'\n"
-         "\"$R\" run " + run_args + " --lcm \"$URL\" --out run --quiet > run.txt 2> run.err &\n"
+  return "P2='" RILBED_WS_PROBE
+         "'\n"
+         "\"$R\" run " +
+         run_args +
+         " --lcm \"$URL\" --out run --quiet > run.txt 2> run.err &\n"
          "P=$!\n"
          "\"$R\" gui --lcm \"$URL\" --gui-port 0 > gui.txt 2> gui.err &\n"
          "G=$!\n"
@@ -43,10 +46,14 @@ std::string gui_on_the_bus_script(const std::string& run_args, const std::string
 TEST(GuiCli, ServesARunOnTheBusAndSendsItsConsoleCommands) {
   SKIP_WITHOUT_NAMESPACES();
   const auto dir = scratch_dir("gui_cli");
-  const int status = in_namespace(dir, gui_on_the_bus_script(shipped_scenario_arg("convoy_sim") + " --realtime --duration 120",
-      "\"$P2\" \"ws://$HOSTPORT/ws?token=wrong\" --topics /rilbed/poses --count 1 --timeout 5 > wrong.txt 2>&1; echo \"wrong $?\" >> codes.txt\n"
-      "\"$P2\" \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses,/rilbed/console_reply --count 1000 --until /rilbed/console_reply --timeout 60 "
-      "--send '/rilbed/console={\"command\":\"pause\"}' > probe.txt 2>&1; echo \"probe $?\" >> codes.txt\n"));
+  const int status = in_namespace(
+      dir, gui_on_the_bus_script(
+               shipped_scenario_arg("convoy_sim") + " --realtime --duration 120",
+               "\"$P2\" \"ws://$HOSTPORT/ws?token=wrong\" --topics /rilbed/poses --count 1 --timeout 5 > wrong.txt "
+               "2>&1; echo \"wrong $?\" >> codes.txt\n"
+               "\"$P2\" \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses,/rilbed/console_reply --count 1000 "
+               "--until /rilbed/console_reply --timeout 60 "
+               "--send '/rilbed/console={\"command\":\"pause\"}' > probe.txt 2>&1; echo \"probe $?\" >> codes.txt\n"));
   ASSERT_EQ(status, 0) << read_file(dir / "ns.log");
   const std::string codes = read_file(dir / "codes.txt");
   const std::string probe = read_file(dir / "probe.txt");
@@ -70,16 +77,24 @@ TEST(GuiCli, ServesARunOnTheBusAndSendsItsConsoleCommands) {
 TEST(GuiCli, VisionSettingsSetInTheBrowserReachARunOnTheBus) {
   SKIP_WITHOUT_NAMESPACES();
   const auto dir = scratch_dir("gui_cli_vision");
-  const int status = in_namespace(dir, gui_on_the_bus_script(shipped_scenario_arg("convoy_mixed") + " --duration 120",
-      // Once the run's poses come (it is running), one setParameters; its answer ends the probe.
-      "\"$P2\" \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses --count 100000 --until parameterValues --timeout 60 "
-      "--set-parameters '[{\"name\":\"vision.threshold\",\"value\":30},{\"name\":\"vision.contrast\",\"value\":1.25}]' "
-      "> probe.txt 2>&1; echo \"probe $?\" >> codes.txt\n"
-      "\"$P2\" \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses --count 100000 --until parameterValues --timeout 60 "
-      "--set-parameters '[{\"name\":\"vision.contrast\",\"value\":9}]' > refused.txt 2>&1; echo \"refused $?\" >> codes.txt\n"
-      // A viewer joining later: the settings as the run's status says (not only those set here).
-      "for i in $(seq 1 100); do \"$P2\" \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses --count 100000 "
-      "--until parameterValues --timeout 60 --get-parameters all > get.txt 2>&1; grep -q min_score get.txt && break; sleep 0.1; done\n"));
+  const int status = in_namespace(
+      dir,
+      gui_on_the_bus_script(
+          shipped_scenario_arg("convoy_mixed") + " --duration 120",
+          // Once the run's poses come (it is running), one setParameters; its answer ends the probe.
+          "\"$P2\" \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses --count 100000 --until parameterValues "
+          "--timeout 60 "
+          "--set-parameters "
+          "'[{\"name\":\"vision.threshold\",\"value\":30},{\"name\":\"vision.contrast\",\"value\":1.25}]' "
+          "> probe.txt 2>&1; echo \"probe $?\" >> codes.txt\n"
+          "\"$P2\" \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses --count 100000 --until parameterValues "
+          "--timeout 60 "
+          "--set-parameters '[{\"name\":\"vision.contrast\",\"value\":9}]' > refused.txt 2>&1; echo \"refused $?\" >> "
+          "codes.txt\n"
+          // A viewer joining later: the settings as the run's status says (not only those set here).
+          "for i in $(seq 1 100); do \"$P2\" \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses --count 100000 "
+          "--until parameterValues --timeout 60 --get-parameters all > get.txt 2>&1; grep -q min_score get.txt && "
+          "break; sleep 0.1; done\n"));
   ASSERT_EQ(status, 0) << read_file(dir / "ns.log");
   const std::string codes = read_file(dir / "codes.txt");
   const std::string probe = read_file(dir / "probe.txt");
@@ -99,7 +114,8 @@ TEST(GuiCli, VisionSettingsSetInTheBrowserReachARunOnTheBus) {
       << read_file(dir / "run" / "events.csv");
   // Refused by the run: said, and the values stay.
   const std::string refused = read_file(dir / "refused.txt");
-  EXPECT_NE(refused.find("status 2 vision settings refused: contrast 9 is outside 0.2..5"), std::string::npos) << refused;
+  EXPECT_NE(refused.find("status 2 vision settings refused: contrast 9 is outside 0.2..5"), std::string::npos)
+      << refused;
   EXPECT_NE(refused.find(R"("value":1.25)"), std::string::npos) << refused;
   const std::string got = read_file(dir / "get.txt");
   EXPECT_NE(got.find(R"({"name":"vision.min_score","value":0.75})"), std::string::npos) << got;
@@ -113,25 +129,35 @@ TEST(RunGui, ServesItsOwnRunAndADrivenRobotStopsWhenItsKeysStopAndItsDriverGoes)
   // stopped 300 ms later (the keys stopped), then handed back; a second client ends the run.
   const fs::path dir = scratch_dir("run_gui");
   const fs::path script = dir / "drive.sh";
-  std::ofstream(script) << "cd '" << dir.string() << "'\n"
-      "'" RILBED_BINARY "' run " << shipped_scenario_arg("convoy_mixed") << " --duration 120 --gui --gui-port 0 --out run --quiet > run.txt 2> run.err &\n"
-      "P=$!\n"
-      "for i in $(seq 1 400); do grep -q 'token=' run.txt && break; sleep 0.05; done\n"
-      "HOSTPORT=$(sed -n 's|.*http://\\([^/]*\\)/?token=.*|\\1|p' run.txt)\n"
-      "TOKEN=$(sed -n 's|.*?token=\\([0-9a-f]*\\).*|\\1|p' run.txt)\n"
-      "'" RILBED_WS_PROBE "' \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses --count 20 --timeout 60 "
-      "--send '/rilbed/drive={\"id\":4,\"left\":40,\"right\":40}' > drive.txt 2>&1; echo \"drive $?\" >> codes.txt\n"
-      // Wait for the hand drive's end in the run's events (a held stop, then given back).
-      "for i in $(seq 1 400); do grep -q 'robot 4 driven 0 0' run/events.csv 2>/dev/null && break; sleep 0.05; done\n"
-      "'" RILBED_WS_PROBE "' \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/status,/rilbed/console_reply --until /rilbed/console_reply "
-      "--count 1000 --timeout 60 --send '/rilbed/console={\"command\":\"exit\"}' > exit.txt 2>&1; echo \"exit $?\" >> codes.txt\n"
-      "wait $P; echo \"run $?\" >> codes.txt\n";
+  std::ofstream(script)
+      << "cd '" << dir.string()
+      << "'\n"
+         "'" RILBED_BINARY "' run "
+      << shipped_scenario_arg("convoy_mixed")
+      << " --duration 120 --gui --gui-port 0 --out run --quiet > run.txt 2> run.err &\n"
+         "P=$!\n"
+         "for i in $(seq 1 400); do grep -q 'token=' run.txt && break; sleep 0.05; done\n"
+         "HOSTPORT=$(sed -n 's|.*http://\\([^/]*\\)/?token=.*|\\1|p' run.txt)\n"
+         "TOKEN=$(sed -n 's|.*?token=\\([0-9a-f]*\\).*|\\1|p' run.txt)\n"
+         "'" RILBED_WS_PROBE
+         "' \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/poses --count 20 --timeout 60 "
+         "--send '/rilbed/drive={\"id\":4,\"left\":40,\"right\":40}' > drive.txt 2>&1; echo \"drive $?\" >> codes.txt\n"
+         // Wait for the hand drive's end in the run's events (a held stop, then given back).
+         "for i in $(seq 1 400); do grep -q 'robot 4 driven 0 0' run/events.csv 2>/dev/null && break; sleep 0.05; "
+         "done\n"
+         "'" RILBED_WS_PROBE
+         "' \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/status,/rilbed/console_reply --until "
+         "/rilbed/console_reply "
+         "--count 1000 --timeout 60 --send '/rilbed/console={\"command\":\"exit\"}' > exit.txt 2>&1; echo \"exit $?\" "
+         ">> codes.txt\n"
+         "wait $P; echo \"run $?\" >> codes.txt\n";
   ASSERT_EQ(std::system(("/bin/sh '" + script.string() + "'").c_str()), 0);
   const std::string codes = read_file(dir / "codes.txt");
   const std::string printed = read_file(dir / "run.txt") + read_file(dir / "run.err");
   for (const char* line : {"drive 0", "exit 0", "run 0"}) {
-    EXPECT_NE(codes.find(line), std::string::npos) << line << "\n" << codes << printed << read_file(dir / "exit.txt")
-                                                   << read_file(dir / "drive.txt");
+    EXPECT_NE(codes.find(line), std::string::npos)
+        << line << "\n"
+        << codes << printed << read_file(dir / "exit.txt") << read_file(dir / "drive.txt");
   }
   const std::string events = read_file(dir / "run" / "events.csv");
   const std::size_t driven = events.find("robot 4 driven 40 40 for ");
@@ -141,10 +167,13 @@ TEST(RunGui, ServesItsOwnRunAndADrivenRobotStopsWhenItsKeysStopAndItsDriverGoes)
   EXPECT_NE(stopped, std::string::npos) << events;
   // One event per change of speeds, not one per renewal of the hold.
   std::size_t holds = 0;
-  for (std::size_t at = events.find("robot 4 driven 0 0"); at != std::string::npos; at = events.find("robot 4 driven 0 0", at + 1)) ++holds;
+  for (std::size_t at = events.find("robot 4 driven 0 0"); at != std::string::npos;
+       at = events.find("robot 4 driven 0 0", at + 1))
+    ++holds;
   EXPECT_LE(holds, 2u) << events;
   EXPECT_NE(events.find("ended by gui 127.0.0.1:"), std::string::npos) << events;
-  EXPECT_NE(read_file(dir / "exit.txt").find(R"("accepted":true,"client")"), std::string::npos) << read_file(dir / "exit.txt");
+  EXPECT_NE(read_file(dir / "exit.txt").find(R"("accepted":true,"client")"), std::string::npos)
+      << read_file(dir / "exit.txt");
   EXPECT_NE(printed.find("robot 4 (emulated): last speed 0 0"), std::string::npos) << printed;
   fs::remove_all(dir);
 }

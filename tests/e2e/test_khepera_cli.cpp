@@ -79,8 +79,7 @@ class ChildProcess {
   // Everything it still writes to stdout until it closes it (or the timeout).
   std::string read_rest(std::chrono::milliseconds timeout) {
     const auto deadline = SteadyClock::now() + timeout;
-    while (read_some(deadline)) {
-    }
+    while (read_some(deadline)) {}
     return std::exchange(out_, {});
   }
   void send_signal(int signal) const {
@@ -135,11 +134,12 @@ class ChildProcess {
 
 // A `rilbed khepera-emu` child and the device it printed.
 struct Emulator {
-  explicit Emulator(std::vector<std::string> extra_args = {}) : process([&] {
-      std::vector<std::string> args = {"khepera-emu"};
-      args.insert(args.end(), extra_args.begin(), extra_args.end());
-      return args;
-    }()) {
+  explicit Emulator(std::vector<std::string> extra_args = {})
+      : process([&] {
+          std::vector<std::string> args = {"khepera-emu"};
+          args.insert(args.end(), extra_args.begin(), extra_args.end());
+          return args;
+        }()) {
     device = process.read_line(10s).value_or("");
   }
   // Ends it with SIGTERM and returns what it printed after the device path.

@@ -26,18 +26,22 @@ namespace fs = std::filesystem;
 TEST(LcmCli, WatchShowsARunOverMulticastAndItsEnd) {
   SKIP_WITHOUT_NAMESPACES();
   const fs::path dir = scratch_dir("lcm_watch");
-  const int status = in_namespace(dir,
-      "\"$R\" watch --lcm \"$URL\" --until-ended --for 60 > watch.txt 2>&1 &\n"
-      "W=$!\n"
-      // A second watcher on another prefix hears nothing of this run.
-      "\"$R\" watch --lcm \"$URL\" --channel-prefix OTHER_ --for 4 --silence 1 > other.txt 2>&1 &\n"
-      "O=$!\n"
-      "\"$R\" run " + shipped_scenario_arg("convoy_sim") + " --realtime --rt-factor 5 --stop-when-formed --lcm \"$URL\" --quiet > run.txt 2>&1\n"
-      "wait $W\n"
-      "set +e\nwait $O\necho \"other exit $?\" >> other.txt\n");
+  const int status =
+      in_namespace(dir,
+                   "\"$R\" watch --lcm \"$URL\" --until-ended --for 60 > watch.txt 2>&1 &\n"
+                   "W=$!\n"
+                   // A second watcher on another prefix hears nothing of this run.
+                   "\"$R\" watch --lcm \"$URL\" --channel-prefix OTHER_ --for 4 --silence 1 > other.txt 2>&1 &\n"
+                   "O=$!\n"
+                   "\"$R\" run " +
+                       shipped_scenario_arg("convoy_sim") +
+                       " --realtime --rt-factor 5 --stop-when-formed --lcm \"$URL\" --quiet > run.txt 2>&1\n"
+                       "wait $W\n"
+                       "set +e\nwait $O\necho \"other exit $?\" >> other.txt\n");
   ASSERT_EQ(status, 0) << read_file(dir / "ns.log") << read_file(dir / "run.txt") << read_file(dir / "watch.txt");
   const std::string watch = read_file(dir / "watch.txt");
-  EXPECT_NE(watch.find("watching convoy_sim on udpm://239.255.76.67:7667?ttl=0: 8 robots (0 real)"), std::string::npos) << watch;
+  EXPECT_NE(watch.find("watching convoy_sim on udpm://239.255.76.67:7667?ttl=0: 8 robots (0 real)"), std::string::npos)
+      << watch;
   // It may join a moment after the run began: any second's status line will do.
   EXPECT_NE(watch.find("s running x5.0  1:wait"), std::string::npos) << watch;
   EXPECT_NE(watch.find("formed: convoy formed"), std::string::npos) << watch;
@@ -45,7 +49,8 @@ TEST(LcmCli, WatchShowsARunOverMulticastAndItsEnd) {
   EXPECT_NE(read_file(dir / "run.txt").find("formed at"), std::string::npos);
   const std::string other = read_file(dir / "other.txt");
   EXPECT_NE(other.find("no rilbed run heard on udpm://239.255.76.67:7667?ttl=0 for 1 s (channels OTHER_RILBED_*)"),
-            std::string::npos) << other;
+            std::string::npos)
+      << other;
   EXPECT_NE(other.find("other exit 1"), std::string::npos) << other;
   fs::remove_all(dir);
 }
@@ -76,8 +81,9 @@ namespace {
 TEST(LcmCli, RecordThenReplayGivesTheSameRunFolder) {
   const fs::path dir = scratch_dir("lcm_record");
   const std::string log = (dir / "run.lcm").string();
-  CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_mixed") + " --all-virtual --stop-when-formed --seed 9 --out '" +
-                               (dir / "live").string() + "' --record '" + log + "'");
+  CommandResult r =
+      run_rilbed("run " + shipped_scenario_arg("convoy_mixed") + " --all-virtual --stop-when-formed --seed 9 --out '" +
+                 (dir / "live").string() + "' --record '" + log + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   r = run_rilbed("replay '" + log + "' --out '" + (dir / "replayed").string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -95,7 +101,8 @@ TEST(LcmCli, RecordThenReplayGivesTheSameRunFolder) {
   EXPECT_NE(r.err.find("ends before the run did"), std::string::npos) << r.err;
   const std::string rows = read_file(dir / "cut" / "trajectories.csv");
   EXPECT_GT(rows.size(), 1000u);
-  EXPECT_EQ(read_file(dir / "live" / "trajectories.csv").rfind(rows.substr(0, rows.rfind('\n', rows.size() - 2)), 0), 0u);
+  EXPECT_EQ(read_file(dir / "live" / "trajectories.csv").rfind(rows.substr(0, rows.rfind('\n', rows.size() - 2)), 0),
+            0u);
   // Not a log at all.
   std::ofstream(dir / "junk.lcm") << "this is not an LCM log\n";
   r = run_rilbed("replay '" + (dir / "junk.lcm").string() + "' --out '" + (dir / "junk").string() + "'");
@@ -113,23 +120,27 @@ TEST(LcmCli, RecordThenReplayGivesTheSameRunFolder) {
 TEST(LcmCli, LcmsOwnToolsPlayAndRecordARun) {
   SKIP_WITHOUT_NAMESPACES();
   const fs::path dir = scratch_dir("lcm_tools");
-  const int status = in_namespace(dir,
+  const int status = in_namespace(
+      dir,
       // Recorded in (scaled) real time, so that the player paces it as it was: a burst of a
       // whole run at once would overflow the watcher's socket buffer, as UDP does.
-      "\"$R\" run " + shipped_scenario_arg("convoy_sim") + " --realtime --rt-factor 5 --stop-when-formed --seed 4 --record run.lcm --quiet > run.txt\n"
-      "\"$R\" watch --lcm \"$URL\" --until-ended --for 60 > watch.txt 2>&1 &\n"
-      "W=$!\n"
-      // The watcher must be listening before the player starts: wait until it has subscribed
-      // (it says nothing until it hears), by polling its socket.
-      "for i in $(seq 1 100); do ss -lun 2>/dev/null | grep -q 7667 && break; sleep 0.05; done\n"
-      "lcm-logplayer --lcm-url=\"$URL\" run.lcm > player.txt 2>&1\n"
-      "wait $W\n"
-      "lcm-logger --lcm-url=\"$URL\" logged.lcm > logger.txt 2>&1 &\n"
-      "L=$!\n"
-      "for i in $(seq 1 100); do ss -lun 2>/dev/null | grep -q 7667 && break; sleep 0.05; done\n"
-      "\"$R\" run " + shipped_scenario_arg("convoy_sim") + " --realtime --rt-factor 20 --stop-when-formed --seed 4 --lcm \"$URL\" --out live --quiet > run2.txt\n"
-      "kill -INT $L; wait $L || true\n"
-      "\"$R\" replay logged.lcm --out from_logger > replay.txt 2>&1\n");
+      "\"$R\" run " + shipped_scenario_arg("convoy_sim") +
+          " --realtime --rt-factor 5 --stop-when-formed --seed 4 --record run.lcm --quiet > run.txt\n"
+          "\"$R\" watch --lcm \"$URL\" --until-ended --for 60 > watch.txt 2>&1 &\n"
+          "W=$!\n"
+          // The watcher must be listening before the player starts: wait until it has subscribed
+          // (it says nothing until it hears), by polling its socket.
+          "for i in $(seq 1 100); do ss -lun 2>/dev/null | grep -q 7667 && break; sleep 0.05; done\n"
+          "lcm-logplayer --lcm-url=\"$URL\" run.lcm > player.txt 2>&1\n"
+          "wait $W\n"
+          "lcm-logger --lcm-url=\"$URL\" logged.lcm > logger.txt 2>&1 &\n"
+          "L=$!\n"
+          "for i in $(seq 1 100); do ss -lun 2>/dev/null | grep -q 7667 && break; sleep 0.05; done\n"
+          "\"$R\" run " +
+          shipped_scenario_arg("convoy_sim") +
+          " --realtime --rt-factor 20 --stop-when-formed --seed 4 --lcm \"$URL\" --out live --quiet > run2.txt\n"
+          "kill -INT $L; wait $L || true\n"
+          "\"$R\" replay logged.lcm --out from_logger > replay.txt 2>&1\n");
   ASSERT_EQ(status, 0) << read_file(dir / "ns.log") << read_file(dir / "watch.txt") << read_file(dir / "replay.txt");
   const std::string watch = read_file(dir / "watch.txt");
   EXPECT_NE(watch.find("watching convoy_sim"), std::string::npos) << watch;
@@ -156,8 +167,8 @@ namespace {
 TEST(LcmCli, ARecordingsFramesGoThroughTheVisionPipelineAgain) {
   const fs::path dir = scratch_dir("lcm_frames");
   const std::string rec = (dir / "rec.lcm").string();
-  CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_mixed") + " --duration 3 --quiet --record '" + rec +
-                               "' --record-frames --out '" + (dir / "run").string() + "'");
+  CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_mixed") + " --duration 3 --quiet --record '" +
+                               rec + "' --record-frames --out '" + (dir / "run").string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   r = run_rilbed("detect '" + rec + "' --ids 4-5 -q --csv '" + (dir / "again.csv").string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -202,7 +213,8 @@ TEST(LcmCli, ARecordingsFramesGoThroughTheVisionPipelineAgain) {
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_LT(read_file(dir / "strict.csv").size(), read_file(dir / "again.csv").size() / 2);
   // A recording without frames says how to make one.
-  r = run_rilbed("run " + shipped_scenario_arg("convoy_mixed") + " --duration 1 --quiet --record '" + (dir / "plain.lcm").string() + "'");
+  r = run_rilbed("run " + shipped_scenario_arg("convoy_mixed") + " --duration 1 --quiet --record '" +
+                 (dir / "plain.lcm").string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   r = run_rilbed("detect '" + (dir / "plain.lcm").string() + "'");
   EXPECT_EQ(r.exit_code, 1);
@@ -211,7 +223,8 @@ TEST(LcmCli, ARecordingsFramesGoThroughTheVisionPipelineAgain) {
   // --record-frames needs a recording, and a camera.
   r = run_rilbed("run " + shipped_scenario_arg("convoy_sim") + " --duration 1 --record-frames");
   EXPECT_EQ(r.exit_code, 2);
-  r = run_rilbed("run " + shipped_scenario_arg("convoy_sim") + " --duration 1 --record-frames --record '" + (dir / "x.lcm").string() + "'");
+  r = run_rilbed("run " + shipped_scenario_arg("convoy_sim") + " --duration 1 --record-frames --record '" +
+                 (dir / "x.lcm").string() + "'");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("has no camera"), std::string::npos) << r.err;
   fs::remove_all(dir);
@@ -220,41 +233,47 @@ TEST(LcmCli, ARecordingsFramesGoThroughTheVisionPipelineAgain) {
 TEST(LcmCli, TheConsoleDrivesARobotSwitchesTheModeAndResetsTheRun) {
   SKIP_WITHOUT_NAMESPACES();
   const fs::path dir = scratch_dir("lcm_console_more");
-  const int status = in_namespace(dir,
-      "\"$R\" run " + shipped_scenario_arg("convoy_mixed") + " --duration 120 --lcm \"$URL\" --out run --record rec.lcm --quiet > run.txt 2> run.err &\n"
-      "P=$!\n"
-      "set +e\n"
-      "for i in $(seq 1 100); do \"$R\" console --lcm \"$URL\" --timeout-ms 200 --token x pause 2>/dev/null; "
-      "grep -q 'refused' run.err && break; sleep 0.1; done\n"
-      // A real (emulated) robot driven by hand, backwards on one wheel. The console answers
-      // before the run has placed its robots and started: ask until the run itself answers.
-      "for i in $(seq 1 300); do \"$R\" console --lcm \"$URL\" drive 4 30 -30 --for 1 > d1.txt 2>&1; c=$?; "
-      "grep -q 'no run is running' d1.txt || break; sleep 0.1; done\n"
-      "echo \"drive $c\" >> codes.txt\n"
-      "\"$R\" console --lcm \"$URL\" drive 42 30 30 --for 1 > d2.txt 2>&1; echo \"drive-none $?\" >> codes.txt\n"
-      "\"$R\" console --lcm \"$URL\" drive 4 30 30 > d3.txt 2>&1; echo \"drive-nofor $?\" >> codes.txt\n"
-      "\"$R\" console --lcm \"$URL\" mode central > m1.txt 2>&1; echo \"central $?\" >> codes.txt\n"
-      "\"$R\" console --lcm \"$URL\" mode central > m2.txt 2>&1; echo \"central-again $?\" >> codes.txt\n"
-      "\"$R\" console --lcm \"$URL\" mode distributed > m3.txt 2>&1; echo \"distributed $?\" >> codes.txt\n"
-      "\"$R\" console --lcm \"$URL\" vision threshold 30 contrast 1.2 > v1.txt 2>&1; echo \"vision $?\" >> codes.txt\n"
-      "\"$R\" console --lcm \"$URL\" vision contrast 9 > v2.txt 2>&1; echo \"vision-bad $?\" >> codes.txt\n"
-      "\"$R\" console --lcm \"$URL\" reset > r1.txt 2>&1; echo \"reset $?\" >> codes.txt\n"
-      // The run starts over (its real robots placed again): ask until the new one answers.
-      "for i in $(seq 1 300); do \"$R\" console --lcm \"$URL\" --timeout-ms 300 exit > e1.txt 2>&1 && break; sleep 0.1; done\n"
-      "echo \"exit $?\" >> codes.txt\n"
-      "wait $P; echo \"run $?\" >> codes.txt\n"
-      "\"$R\" replay rec.lcm --out replayed > replay.txt 2>&1; echo \"replay $?\" >> codes.txt\n");
+  const int status = in_namespace(
+      dir,
+      "\"$R\" run " + shipped_scenario_arg("convoy_mixed") +
+          " --duration 120 --lcm \"$URL\" --out run --record rec.lcm --quiet > run.txt 2> run.err &\n"
+          "P=$!\n"
+          "set +e\n"
+          "for i in $(seq 1 100); do \"$R\" console --lcm \"$URL\" --timeout-ms 200 --token x pause 2>/dev/null; "
+          "grep -q 'refused' run.err && break; sleep 0.1; done\n"
+          // A real (emulated) robot driven by hand, backwards on one wheel. The console answers
+          // before the run has placed its robots and started: ask until the run itself answers.
+          "for i in $(seq 1 300); do \"$R\" console --lcm \"$URL\" drive 4 30 -30 --for 1 > d1.txt 2>&1; c=$?; "
+          "grep -q 'no run is running' d1.txt || break; sleep 0.1; done\n"
+          "echo \"drive $c\" >> codes.txt\n"
+          "\"$R\" console --lcm \"$URL\" drive 42 30 30 --for 1 > d2.txt 2>&1; echo \"drive-none $?\" >> codes.txt\n"
+          "\"$R\" console --lcm \"$URL\" drive 4 30 30 > d3.txt 2>&1; echo \"drive-nofor $?\" >> codes.txt\n"
+          "\"$R\" console --lcm \"$URL\" mode central > m1.txt 2>&1; echo \"central $?\" >> codes.txt\n"
+          "\"$R\" console --lcm \"$URL\" mode central > m2.txt 2>&1; echo \"central-again $?\" >> codes.txt\n"
+          "\"$R\" console --lcm \"$URL\" mode distributed > m3.txt 2>&1; echo \"distributed $?\" >> codes.txt\n"
+          "\"$R\" console --lcm \"$URL\" vision threshold 30 contrast 1.2 > v1.txt 2>&1; echo \"vision $?\" >> "
+          "codes.txt\n"
+          "\"$R\" console --lcm \"$URL\" vision contrast 9 > v2.txt 2>&1; echo \"vision-bad $?\" >> codes.txt\n"
+          "\"$R\" console --lcm \"$URL\" reset > r1.txt 2>&1; echo \"reset $?\" >> codes.txt\n"
+          // The run starts over (its real robots placed again): ask until the new one answers.
+          "for i in $(seq 1 300); do \"$R\" console --lcm \"$URL\" --timeout-ms 300 exit > e1.txt 2>&1 && break; sleep "
+          "0.1; done\n"
+          "echo \"exit $?\" >> codes.txt\n"
+          "wait $P; echo \"run $?\" >> codes.txt\n"
+          "\"$R\" replay rec.lcm --out replayed > replay.txt 2>&1; echo \"replay $?\" >> codes.txt\n");
   ASSERT_EQ(status, 0) << read_file(dir / "ns.log");
   const std::string codes = read_file(dir / "codes.txt");
   for (const char* line : {"drive 0", "drive-none 1", "drive-nofor 2", "central 0", "central-again 1", "distributed 0",
                            "vision 0", "vision-bad 1", "reset 0", "exit 0", "run 0", "replay 0"}) {
     EXPECT_NE(codes.find(line), std::string::npos) << line << "\n" << codes << read_file(dir / "run.err");
   }
-  EXPECT_NE(read_file(dir / "d1.txt").find("accepted: drive 4 30 -30 1"), std::string::npos) << read_file(dir / "d1.txt");
+  EXPECT_NE(read_file(dir / "d1.txt").find("accepted: drive 4 30 -30 1"), std::string::npos)
+      << read_file(dir / "d1.txt");
   EXPECT_NE(read_file(dir / "d2.txt").find("refused: this run has no robot 42"), std::string::npos);
   EXPECT_NE(read_file(dir / "d3.txt").find("drive takes ID LEFT RIGHT and --for SECONDS"), std::string::npos);
   EXPECT_NE(read_file(dir / "m2.txt").find("refused: the convoy is in central mode already"), std::string::npos);
-  EXPECT_NE(read_file(dir / "v2.txt").find("refused: contrast 9 is outside 0.2..5"), std::string::npos) << read_file(dir / "v2.txt");
+  EXPECT_NE(read_file(dir / "v2.txt").find("refused: contrast 9 is outside 0.2..5"), std::string::npos)
+      << read_file(dir / "v2.txt");
   const std::string err = read_file(dir / "run.err");
   EXPECT_NE(err.find("reset from the console: the run starts over"), std::string::npos) << err;
   // The folder holds the run that went on to its end; the recording holds both.
@@ -277,25 +296,26 @@ TEST(LcmCli, TheConsoleDrivesARobotSwitchesTheModeAndResetsTheRun) {
 TEST(LcmCli, TheConsoleSteersARunAndPauseStopsItsRealRobots) {
   SKIP_WITHOUT_NAMESPACES();
   const fs::path dir = scratch_dir("lcm_console");
-  const int status = in_namespace(dir,
-      "\"$R\" run " + shipped_scenario_arg("convoy_mixed") + " --duration 60 --lcm \"$URL\" --out run --quiet > run.txt 2> run.err &\n"
-      "P=$!\n"
-      "set +e\n"
-      // The run answers once it is up: ask until it does (a refused command proves it is there).
-      "for i in $(seq 1 100); do \"$R\" console --lcm \"$URL\" --timeout-ms 200 --token x pause 2>/dev/null; "
-      "grep -q 'refused' run.err && break; sleep 0.1; done\n"
-      // The console answers before the run has placed its robots: pause once the run itself answers.
-      "for i in $(seq 1 300); do \"$R\" console --lcm \"$URL\" pause > c1.txt 2>&1; c=$?; "
-      "grep -q 'no run is running' c1.txt || break; sleep 0.1; done\n"
-      "echo \"pause $c\" >> codes.txt\n"
-      "sleep 1.5\n"
-      "\"$R\" console --lcm \"$URL\" resume > c2.txt 2>&1; echo \"resume $?\" >> codes.txt\n"
-      "\"$R\" console --lcm \"$URL\" rt-factor 2 > c3.txt 2>&1; echo \"rt $?\" >> codes.txt\n"
-      "\"$R\" console --lcm \"$URL\" --token 00 exit > c4.txt 2>&1; echo \"badtoken $?\" >> codes.txt\n"
-      "sleep 1\n"
-      "\"$R\" console --lcm \"$URL\" exit > c5.txt 2>&1; echo \"exit $?\" >> codes.txt\n"
-      "wait $P; echo \"run $?\" >> codes.txt\n"
-      "\"$R\" console --lcm \"$URL\" --timeout-ms 300 pause > c6.txt 2>&1; echo \"gone $?\" >> codes.txt\n");
+  const int status = in_namespace(
+      dir, "\"$R\" run " + shipped_scenario_arg("convoy_mixed") +
+               " --duration 60 --lcm \"$URL\" --out run --quiet > run.txt 2> run.err &\n"
+               "P=$!\n"
+               "set +e\n"
+               // The run answers once it is up: ask until it does (a refused command proves it is there).
+               "for i in $(seq 1 100); do \"$R\" console --lcm \"$URL\" --timeout-ms 200 --token x pause 2>/dev/null; "
+               "grep -q 'refused' run.err && break; sleep 0.1; done\n"
+               // The console answers before the run has placed its robots: pause once the run itself answers.
+               "for i in $(seq 1 300); do \"$R\" console --lcm \"$URL\" pause > c1.txt 2>&1; c=$?; "
+               "grep -q 'no run is running' c1.txt || break; sleep 0.1; done\n"
+               "echo \"pause $c\" >> codes.txt\n"
+               "sleep 1.5\n"
+               "\"$R\" console --lcm \"$URL\" resume > c2.txt 2>&1; echo \"resume $?\" >> codes.txt\n"
+               "\"$R\" console --lcm \"$URL\" rt-factor 2 > c3.txt 2>&1; echo \"rt $?\" >> codes.txt\n"
+               "\"$R\" console --lcm \"$URL\" --token 00 exit > c4.txt 2>&1; echo \"badtoken $?\" >> codes.txt\n"
+               "sleep 1\n"
+               "\"$R\" console --lcm \"$URL\" exit > c5.txt 2>&1; echo \"exit $?\" >> codes.txt\n"
+               "wait $P; echo \"run $?\" >> codes.txt\n"
+               "\"$R\" console --lcm \"$URL\" --timeout-ms 300 pause > c6.txt 2>&1; echo \"gone $?\" >> codes.txt\n");
   ASSERT_EQ(status, 0) << read_file(dir / "ns.log");
   const std::string codes = read_file(dir / "codes.txt");
   for (const char* line : {"pause 0", "resume 0", "rt 1", "badtoken 1", "exit 0", "run 0", "gone 1"}) {
@@ -332,11 +352,14 @@ TEST(LcmCli, TheConsoleSteersARunAndPauseStopsItsRealRobots) {
     std::getline(f, y, ',');
     if (id == "4" || id == "5") real[std::stoi(id)].push_back({std::stod(t), {std::stod(x), std::stod(y)}});
   }
-  auto distance = [](const auto& a, const auto& b) { return std::hypot(b.second.first - a.second.first, b.second.second - a.second.second); };
+  auto distance = [](const auto& a, const auto& b) {
+    return std::hypot(b.second.first - a.second.first, b.second.second - a.second.second);
+  };
   for (const auto& [id, samples] : real) {
     for (std::size_t k = 2; k < samples.size(); ++k) {
       if (samples[k - 1].first <= t_pause && samples[k].first > t_pause) {
-        const double speed_mps = distance(samples[k - 2], samples[k - 1]) / (samples[k - 1].first - samples[k - 2].first);
+        const double speed_mps =
+            distance(samples[k - 2], samples[k - 1]) / (samples[k - 1].first - samples[k - 2].first);
         const double moved = distance(samples[k - 1], samples[k]);
         EXPECT_LT(moved, 0.5 * speed_mps + 0.005)
             << "robot " << id << " moved " << moved << " m across the pause, at " << speed_mps << " m/s before it";

@@ -125,10 +125,10 @@ std::vector<std::string> statuses_in_log(const std::vector<LogEvent>& log) {
     if (e.channel != "RILBED_STATUS") continue;
     Fields f(e.data);
     const std::int64_t utime = f.int64();
-    f.int64();   // wall_utime
-    f.string();  // scenario
-    f.int64();   // seed
-    f.string();  // mode
+    f.int64();    // wall_utime
+    f.string();   // scenario
+    f.int64();    // seed
+    f.string();   // mode
     f.boolean();  // realtime
     f.float64();  // rt_factor
     std::string status = "t=" + one_decimal_seconds(utime) + "s " + f.string();
@@ -200,24 +200,28 @@ std::size_t count_of(const std::string& text, const std::string& what) {
 TEST(LcmLoss, TheWatcherShowsEveryMessageThatCameThroughATenPercentLoss) {
   SKIP_WITHOUT_NFT();
   const fs::path dir = scratch_dir("lcm_loss_watch");
-  const int status = in_namespace(dir,
-      "lcm-logger --lcm-url=\"$URL\" heard.lcm > logger.txt 2>&1 &\n"
-      "L=$!\n"
-      "\"$R\" watch --lcm \"$URL\" --until-ended --silence 1 --for 120 > watch.txt 2>&1 &\n"
-      "W=$!\n"
-      "listening 2\n"
-      "set +e\n"
-      "\"$R\" run " + shipped_scenario_arg("convoy_sim") + " --realtime --rt-factor 4 --stop-when-formed --seed 1 --lcm \"$URL\" "
-      "--record sent.lcm --out run --quiet > run.txt 2> run.err\n"
-      "echo \"run $?\" >> codes.txt\n"
-      // The watcher ends by itself once it has shown the run's end; if that was lost, it says
-      // the bus went silent (then it is stopped here).
-      "for i in $(seq 1 400); do kill -0 $W 2>/dev/null || break; tail -n 1 watch.txt | grep -q 'no rilbed run heard' && break; "
-      "sleep 0.05; done\n"
-      "if kill -0 $W 2>/dev/null; then echo 'watch stopped' >> codes.txt; kill -INT $W; wait $W; "
-      "else wait $W; echo \"watch $?\" >> codes.txt; fi\n"
-      "kill -INT $L; wait $L\n",
-      true);
+  const int status =
+      in_namespace(dir,
+                   "lcm-logger --lcm-url=\"$URL\" heard.lcm > logger.txt 2>&1 &\n"
+                   "L=$!\n"
+                   "\"$R\" watch --lcm \"$URL\" --until-ended --silence 1 --for 120 > watch.txt 2>&1 &\n"
+                   "W=$!\n"
+                   "listening 2\n"
+                   "set +e\n"
+                   "\"$R\" run " +
+                       shipped_scenario_arg("convoy_sim") +
+                       " --realtime --rt-factor 4 --stop-when-formed --seed 1 --lcm \"$URL\" "
+                       "--record sent.lcm --out run --quiet > run.txt 2> run.err\n"
+                       "echo \"run $?\" >> codes.txt\n"
+                       // The watcher ends by itself once it has shown the run's end; if that was lost, it says
+                       // the bus went silent (then it is stopped here).
+                       "for i in $(seq 1 400); do kill -0 $W 2>/dev/null || break; tail -n 1 watch.txt | grep -q 'no "
+                       "rilbed run heard' && break; "
+                       "sleep 0.05; done\n"
+                       "if kill -0 $W 2>/dev/null; then echo 'watch stopped' >> codes.txt; kill -INT $W; wait $W; "
+                       "else wait $W; echo \"watch $?\" >> codes.txt; fi\n"
+                       "kill -INT $L; wait $L\n",
+                   true);
   ASSERT_EQ(status, 0) << read_file(dir / "ns.log");
   const std::string codes = read_file(dir / "codes.txt");
   const std::string watch = read_file(dir / "watch.txt");
@@ -236,7 +240,8 @@ TEST(LcmLoss, TheWatcherShowsEveryMessageThatCameThroughATenPercentLoss) {
   std::printf("[ loss     ] %ld of %ld packets dropped (%.1f %%); lcm-logger heard %zu of %zu messages\n", loss.dropped,
               loss.packets, 100.0 * loss.rate(), heard.size(), sent.size());
 
-  EXPECT_NE(watch.find("watching convoy_sim on udpm://239.255.76.67:7667?ttl=0: 8 robots (0 real)"), std::string::npos) << watch;
+  EXPECT_NE(watch.find("watching convoy_sim on udpm://239.255.76.67:7667?ttl=0: 8 robots (0 real)"), std::string::npos)
+      << watch;
   // Every status and event that came through, in order, none twice.
   const std::vector<std::string> statuses = statuses_in_log(heard);
   ASSERT_GT(statuses.size(), 5u);
@@ -245,7 +250,8 @@ TEST(LcmLoss, TheWatcherShowsEveryMessageThatCameThroughATenPercentLoss) {
 
   // The end: its status and summary go out three times each, so a watcher hears of it
   // unless all six were lost.
-  const bool summary_heard = std::any_of(heard.begin(), heard.end(), [](const LogEvent& e) { return e.channel == "RILBED_SUMMARY"; });
+  const bool summary_heard =
+      std::any_of(heard.begin(), heard.end(), [](const LogEvent& e) { return e.channel == "RILBED_SUMMARY"; });
   if (statuses.back().find(" ended") != std::string::npos) {
     EXPECT_NE(watch.find("(ended by formed)"), std::string::npos) << watch;
     EXPECT_NE(codes.find("watch 0"), std::string::npos) << codes << watch;
@@ -282,22 +288,26 @@ TEST(LcmLoss, ConsoleCommandsAreAnsweredThroughATenPercentLoss) {
     factors += " " + factor_list.back();
   }
   const int status = in_namespace(dir,
-      "\"$R\" run " + shipped_scenario_arg("convoy_sim") + " --realtime --duration 600 --lcm \"$URL\" --out run --quiet "
-      "> run.txt 2> run.err &\n"
-      "P=$!\n"
-      "for i in $(seq 1 400); do [ -s xdg/rilbed/token ] && break; sleep 0.05; done\n"
-      "set +e\n"
-      "n=0\n"
-      "c() { name=$1; shift; n=$((n+1)); \"$R\" console --lcm \"$URL\" --timeout-ms 10000 \"$@\" > c_$name.txt 2>&1; "
-      "echo \"$name $?\" >> codes.txt; }\n"
-      "c pause pause\n"
-      "c pause_again pause\n"
-      "c resume resume\n"
-      "for f in" + factors + "; do c rt_$f rt-factor $f; done\n"
-      "c badtoken --token 0123456789abcdef pause\n"
-      "c exit exit\n"
-      "wait $P; echo \"run $?\" >> codes.txt\n",
-      true);
+                                  "\"$R\" run " + shipped_scenario_arg("convoy_sim") +
+                                      " --realtime --duration 600 --lcm \"$URL\" --out run --quiet "
+                                      "> run.txt 2> run.err &\n"
+                                      "P=$!\n"
+                                      "for i in $(seq 1 400); do [ -s xdg/rilbed/token ] && break; sleep 0.05; done\n"
+                                      "set +e\n"
+                                      "n=0\n"
+                                      "c() { name=$1; shift; n=$((n+1)); \"$R\" console --lcm \"$URL\" --timeout-ms "
+                                      "10000 \"$@\" > c_$name.txt 2>&1; "
+                                      "echo \"$name $?\" >> codes.txt; }\n"
+                                      "c pause pause\n"
+                                      "c pause_again pause\n"
+                                      "c resume resume\n"
+                                      "for f in" +
+                                      factors +
+                                      "; do c rt_$f rt-factor $f; done\n"
+                                      "c badtoken --token 0123456789abcdef pause\n"
+                                      "c exit exit\n"
+                                      "wait $P; echo \"run $?\" >> codes.txt\n",
+                                  true);
   ASSERT_EQ(status, 0) << read_file(dir / "ns.log");
   const std::string codes = read_file(dir / "codes.txt");
   const std::string run_err = read_file(dir / "run.err");
@@ -312,11 +322,13 @@ TEST(LcmLoss, ConsoleCommandsAreAnsweredThroughATenPercentLoss) {
   for (const char* line : {"pause 0", "pause_again 1", "resume 0", "badtoken 1", "exit 0", "run 0"}) {
     EXPECT_NE(codes.find(std::string(line) + "\n"), std::string::npos) << line << "\n" << codes << run_err;
   }
-  EXPECT_NE(read_file(dir / "c_pause.txt").find("accepted: pause"), std::string::npos) << read_file(dir / "c_pause.txt");
+  EXPECT_NE(read_file(dir / "c_pause.txt").find("accepted: pause"), std::string::npos)
+      << read_file(dir / "c_pause.txt");
   EXPECT_NE(read_file(dir / "c_pause_again.txt").find("refused: the run is paused already"), std::string::npos)
       << read_file(dir / "c_pause_again.txt");
   EXPECT_NE(read_file(dir / "c_resume.txt").find("accepted: resume"), std::string::npos);
-  EXPECT_NE(read_file(dir / "c_badtoken.txt").find("refused: wrong token"), std::string::npos) << read_file(dir / "c_badtoken.txt");
+  EXPECT_NE(read_file(dir / "c_badtoken.txt").find("refused: wrong token"), std::string::npos)
+      << read_file(dir / "c_badtoken.txt");
   EXPECT_NE(read_file(dir / "c_exit.txt").find("accepted: exit"), std::string::npos);
   for (const std::string& f : factor_list) {
     EXPECT_NE(codes.find("rt_" + f + " 0\n"), std::string::npos) << f << "\n" << codes;
@@ -340,24 +352,29 @@ TEST(LcmLoss, ConsoleCommandsAreAnsweredThroughATenPercentLoss) {
 TEST(LcmLoss, AStalledWatcherNeverHoldsUpTheRun) {
   SKIP_WITHOUT_NAMESPACES();
   const fs::path dir = scratch_dir("lcm_loss_stall");
-  const int status = in_namespace(dir,
+  const int status = in_namespace(
+      dir,
       "\"$R\" watch --lcm \"$URL\" --until-ended --silence 1 --for 120 > watch.txt 2>&1 &\n"
       "W=$!\n"
       "listening 1\n"
       "kill -STOP $W\n"
       "set +e\n"
       // A safety bound only: a run held up by its watcher would hang, and fail here instead.
-      "timeout -k 5 120 \"$R\" run " + shipped_scenario_arg("convoy_sim") +
-      " --realtime --rt-factor 4 --stop-when-formed --seed 1 --lcm \"$URL\" --out run > run.txt 2> run.err\n"
-      "echo \"run $?\" >> codes.txt\n"
-      "ss -lunm > sockets.txt\n"
-      "kill -CONT $W\n"
-      "for i in $(seq 1 400); do kill -0 $W 2>/dev/null || break; tail -n 1 watch.txt | grep -q 'no rilbed run heard' && break; "
-      "sleep 0.05; done\n"
-      "if kill -0 $W 2>/dev/null; then echo 'missed the end' >> codes.txt; "
-      "\"$R\" run " + shipped_scenario_arg("wander") + " --realtime --rt-factor 4 --duration 2 --lcm \"$URL\" --quiet > run2.txt 2>&1; "
-      "echo \"run2 $?\" >> codes.txt; fi\n"
-      "wait $W; echo \"watch $?\" >> codes.txt\n",
+      "timeout -k 5 120 \"$R\" run " +
+          shipped_scenario_arg("convoy_sim") +
+          " --realtime --rt-factor 4 --stop-when-formed --seed 1 --lcm \"$URL\" --out run > run.txt 2> run.err\n"
+          "echo \"run $?\" >> codes.txt\n"
+          "ss -lunm > sockets.txt\n"
+          "kill -CONT $W\n"
+          "for i in $(seq 1 400); do kill -0 $W 2>/dev/null || break; tail -n 1 watch.txt | grep -q 'no rilbed run "
+          "heard' && break; "
+          "sleep 0.05; done\n"
+          "if kill -0 $W 2>/dev/null; then echo 'missed the end' >> codes.txt; "
+          "\"$R\" run " +
+          shipped_scenario_arg("wander") +
+          " --realtime --rt-factor 4 --duration 2 --lcm \"$URL\" --quiet > run2.txt 2>&1; "
+          "echo \"run2 $?\" >> codes.txt; fi\n"
+          "wait $W; echo \"watch $?\" >> codes.txt\n",
       false);
   ASSERT_EQ(status, 0) << read_file(dir / "ns.log");
   const std::string codes = read_file(dir / "codes.txt");
@@ -378,12 +395,12 @@ TEST(LcmLoss, AStalledWatcherNeverHoldsUpTheRun) {
   }
   // The watcher, continued, went on and ended by itself on a run's end.
   EXPECT_NE(codes.find("watch 0\n"), std::string::npos) << codes << watch;
-  EXPECT_NE(watch.find("watching convoy_sim on udpm://239.255.76.67:7667?ttl=0: 8 robots (0 real)"), std::string::npos) << watch;
+  EXPECT_NE(watch.find("watching convoy_sim on udpm://239.255.76.67:7667?ttl=0: 8 robots (0 real)"), std::string::npos)
+      << watch;
   if (codes.find("missed the end") == std::string::npos) {
     EXPECT_NE(watch.find("(ended by formed)"), std::string::npos) << watch;
   } else {
-    std::printf("[ stall    ] the stalled watcher's socket overflowed: %s\n",
-                read_file(dir / "sockets.txt").c_str());
+    std::printf("[ stall    ] the stalled watcher's socket overflowed: %s\n", read_file(dir / "sockets.txt").c_str());
     EXPECT_EQ(watch.find("(ended by formed)"), std::string::npos) << watch;
     const std::size_t silent = watch.find("no rilbed run heard on udpm://239.255.76.67:7667?ttl=0 for 1 s");
     EXPECT_NE(silent, std::string::npos) << watch;

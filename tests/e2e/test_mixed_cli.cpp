@@ -17,7 +17,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-
 // Without --realtime: a run with real robots is real time by itself.
 void expect_forms_and_stops(const std::string& name, int real_robots) {
   const fs::path dir = scratch_dir(name);
@@ -47,7 +46,8 @@ void expect_forms_and_stops(const std::string& name, int real_robots) {
   // The picture marks the real robots apart, with a legend.
   const std::string svg = read_file(dir / "run" / "trajectories.svg");
   std::size_t squares = 0;
-  for (std::size_t at = svg.find("class=\"real\""); at != std::string::npos; at = svg.find("class=\"real\"", at + 1)) ++squares;
+  for (std::size_t at = svg.find("class=\"real\""); at != std::string::npos; at = svg.find("class=\"real\"", at + 1))
+    ++squares;
   EXPECT_EQ(squares, static_cast<std::size_t>(real_robots)) << svg;
   EXPECT_NE(svg.find("real robot (as the camera saw it)"), std::string::npos);
   fs::remove_all(dir);
@@ -65,7 +65,8 @@ void expect_signal_stops_every_robot(const std::string& signal) {
   const fs::path script = dir / "interrupt.sh";
   std::ofstream(script) << "'" << RILBED_BINARY << "' run " << shipped_scenario_arg("convoy_mixed")
                         << " --realtime --duration 60 >'" << out << "' 2>&1 &\npid=$!\n"
-                        << "i=0\nuntil grep -q '^t=[1-9]' '" << out << "' || [ $i -ge 1200 ]; do sleep 0.1; i=$((i+1)); done\n"
+                        << "i=0\nuntil grep -q '^t=[1-9]' '" << out
+                        << "' || [ $i -ge 1200 ]; do sleep 0.1; i=$((i+1)); done\n"
                         << "kill -" << signal << " $pid\nwait $pid\n";
   const int status = std::system(("/bin/sh '" + script.string() + "'").c_str());
   EXPECT_TRUE(WIFEXITED(status));
@@ -94,7 +95,8 @@ TEST(MixedRun, FaultsNeverStopTheRun) {
                "    link: {emulate: true, faults: {disconnect_after_s: 3, replug_after_s: 2}}\n");
   const fs::path scenario = dir / "faults.yaml";
   std::ofstream(scenario) << text;
-  const CommandResult r = run_rilbed("run '" + scenario.string() + "' --realtime --duration 12 --out '" + (dir / "run").string() + "'");
+  const CommandResult r =
+      run_rilbed("run '" + scenario.string() + "' --realtime --duration 12 --out '" + (dir / "run").string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("robot 4 (emulated): last speed 0 0"), std::string::npos) << r.out << r.err;
   EXPECT_NE(r.out.find("robot 5 (emulated): last speed 0 0"), std::string::npos) << r.out << r.err;
@@ -118,14 +120,17 @@ TEST(MixedRun, SimToRealComparison) {
   // time); `rilbed compare` reports per-robot RMS distances and the formation times.
   const fs::path dir = scratch_dir("sim2real");
   const std::string common = " --stop-when-formed --duration 60 --seed 4 --out '";
-  const CommandResult sim = run_rilbed("run " + shipped_scenario_arg("convoy_real") + " --all-virtual --fast" + common + (dir / "sim").string() + "'");
+  const CommandResult sim = run_rilbed("run " + shipped_scenario_arg("convoy_real") + " --all-virtual --fast" + common +
+                                       (dir / "sim").string() + "'");
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
-  const CommandResult real = run_rilbed("run " + shipped_scenario_arg("convoy_real") + " --realtime" + common + (dir / "real").string() + "'");
+  const CommandResult real =
+      run_rilbed("run " + shipped_scenario_arg("convoy_real") + " --realtime" + common + (dir / "real").string() + "'");
   ASSERT_EQ(real.exit_code, 0) << real.err;
   const CommandResult cmp = run_rilbed("compare '" + (dir / "sim").string() + "' '" + (dir / "real").string() + "'");
   ASSERT_EQ(cmp.exit_code, 0) << cmp.err;
   EXPECT_NE(cmp.out.find("| robot | samples | RMS distance m | max distance m |"), std::string::npos) << cmp.out;
-  for (int id = 1; id <= 4; ++id) EXPECT_NE(cmp.out.find("| " + std::to_string(id) + " | "), std::string::npos) << cmp.out;
+  for (int id = 1; id <= 4; ++id)
+    EXPECT_NE(cmp.out.find("| " + std::to_string(id) + " | "), std::string::npos) << cmp.out;
   EXPECT_NE(cmp.out.find("formation time: "), std::string::npos) << cmp.out;
   EXPECT_EQ(cmp.out.find("not formed"), std::string::npos) << cmp.out;
   // Emulated robots follow the virtual ones closely: same controller, same start.
@@ -145,10 +150,11 @@ TEST(MixedRun, SimToRealOverABatchOfSeeds) {
   // folders prints per seed and in summary each real robot's RMS and the formation times.
   const fs::path dir = scratch_dir("sim2real_batch");
   const std::string common = " --seeds 3 --seed 11 --duration 8 --out '";
-  const CommandResult sim =
-      run_rilbed("run " + shipped_scenario_arg("convoy_mixed") + " --all-virtual --quiet" + common + (dir / "sim").string() + "'");
+  const CommandResult sim = run_rilbed("run " + shipped_scenario_arg("convoy_mixed") + " --all-virtual --quiet" +
+                                       common + (dir / "sim").string() + "'");
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
-  const CommandResult mixed = run_rilbed("run " + shipped_scenario_arg("convoy_mixed") + common + (dir / "mixed").string() + "'");
+  const CommandResult mixed =
+      run_rilbed("run " + shipped_scenario_arg("convoy_mixed") + common + (dir / "mixed").string() + "'");
   ASSERT_EQ(mixed.exit_code, 0) << mixed.out << mixed.err;
   for (int seed = 11; seed <= 13; ++seed) {
     EXPECT_NE(mixed.out.find("seed " + std::to_string(seed) + ": "), std::string::npos) << mixed.out;
@@ -197,7 +203,8 @@ TEST(MixedRun, TheOperatorIsAskedWhenRobotsCannotBePlaced) {
                           "' --seeds 2 --seed 5 --duration 3 --place-timeout 0.3 --quiet --out '";
   // With an operator who presses Enter: both seeds run.
   const fs::path answered = dir / "answered.txt";
-  int status = std::system(("printf '\\n' | " + run + (dir / "a").string() + "' >'" + answered.string() + "' 2>&1").c_str());
+  int status =
+      std::system(("printf '\\n' | " + run + (dir / "a").string() + "' >'" + answered.string() + "' 2>&1").c_str());
   const std::string a = read_file(answered);
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << a;
   EXPECT_NE(a.find("robots 4, 5 did not reach their start poses within"), std::string::npos) << a;
@@ -227,7 +234,8 @@ TEST(LoopBenchCli, PrintsItsTableAndStopsTheRobots) {
 TEST(MixedRun, FastWithRealRobotsIsAnErrorThatSaysWhy) {
   const CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_mixed") + " --fast");
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("robots 4, 5 are real and move in wall-clock time, so --fast cannot run them"), std::string::npos)
+  EXPECT_NE(r.err.find("robots 4, 5 are real and move in wall-clock time, so --fast cannot run them"),
+            std::string::npos)
       << r.err;
   EXPECT_NE(r.err.find("--all-virtual"), std::string::npos) << r.err;
   // All virtual, the same scenario keeps --fast.

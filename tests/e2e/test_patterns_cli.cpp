@@ -75,8 +75,8 @@ TEST(PatternsCli, PngWritesOneFilePerId) {
   EXPECT_EQ(image.cols, 256);
   EXPECT_EQ(image.rows, 256);
   EXPECT_EQ(image.channels(), 4);
-  EXPECT_EQ(image.at<cv::Vec4b>(0, 0)[3], 0);         // transparent corner
-  EXPECT_EQ(image.at<cv::Vec4b>(128, 128)[0], 0);     // black hole at the centre
+  EXPECT_EQ(image.at<cv::Vec4b>(0, 0)[3], 0);             // transparent corner
+  EXPECT_EQ(image.at<cv::Vec4b>(128, 128)[0], 0);         // black hole at the centre
   EXPECT_EQ(image.at<cv::Vec4b>(128, 128 + 51)[0], 255);  // key slice to the right, r = 0.4 R
   fs::remove_all(dir);
 }

@@ -4,8 +4,8 @@
 #include <nlohmann/json.hpp>
 
 #include <csignal>
-#include <fstream>
 #include <filesystem>
+#include <fstream>
 #include <regex>
 #include <string>
 #include <thread>
@@ -17,11 +17,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-
 TEST(RunCli, OneRunWritesItsFolder) {
   const fs::path dir = scratch_dir("run_one");
-  const CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_sim") + " --fast --stop-when-formed --seed 5 --out '" +
-                                     (dir / "run").string() + "'");
+  const CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_sim") +
+                                     " --fast --stop-when-formed --seed 5 --out '" + (dir / "run").string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("seed 5: formed at"), std::string::npos) << r.out;
   for (const char* f : {"trajectories.csv", "events.csv", "summary.json", "trajectories.svg"}) {
@@ -36,10 +35,11 @@ TEST(RunCli, OneRunWritesItsFolder) {
 
 TEST(RunCli, ABatchWritesOneFolderPerSeedAndATable) {
   const fs::path dir = scratch_dir("run_batch");
-  const CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_sim") + " --fast --stop-when-formed --seed 10 --seeds 4 --out '" +
-                                     dir.string() + "'");
+  const CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_sim") +
+                                     " --fast --stop-when-formed --seed 10 --seeds 4 --out '" + dir.string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  for (int seed = 10; seed < 14; ++seed) EXPECT_TRUE(fs::exists(dir / ("seed_" + std::to_string(seed)) / "summary.json"));
+  for (int seed = 10; seed < 14; ++seed)
+    EXPECT_TRUE(fs::exists(dir / ("seed_" + std::to_string(seed)) / "summary.json"));
   const auto batch = nlohmann::json::parse(read_file(dir / "batch.json"));
   EXPECT_EQ(batch["runs"], 4);
   EXPECT_EQ(batch["per_run"].size(), 4u);
@@ -50,7 +50,8 @@ TEST(RunCli, ABatchWritesOneFolderPerSeedAndATable) {
 TEST(RunCli, SameSeedTwiceGivesIdenticalFiles) {
   const fs::path dir = scratch_dir("run_twice");
   for (const char* run : {"a", "b"}) {
-    const CommandResult r = run_rilbed("run " + shipped_scenario_arg("wander") + " --duration 10 --seed 3 --out '" + (dir / run).string() + "'");
+    const CommandResult r = run_rilbed("run " + shipped_scenario_arg("wander") + " --duration 10 --seed 3 --out '" +
+                                       (dir / run).string() + "'");
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   EXPECT_EQ(read_file(dir / "a" / "trajectories.csv"), read_file(dir / "b" / "trajectories.csv"));
@@ -82,10 +83,12 @@ TEST(RunCli, RealTimeRunPrintsBehavioursAndStopsOnSigint) {
   // start). --duration bounds the run should the signal be missed.
   const std::string out = (dir / "out.txt").string();
   const fs::path script = dir / "interrupt.sh";
-  std::ofstream(script) << "'" << RILBED_BINARY << "' run " << shipped_scenario_arg("convoy_sim") << " --realtime --duration 20 --out '"
-                        << (dir / "run").string() << "' >'" << out << "' 2>&1 &\n"
+  std::ofstream(script) << "'" << RILBED_BINARY << "' run " << shipped_scenario_arg("convoy_sim")
+                        << " --realtime --duration 20 --out '" << (dir / "run").string() << "' >'" << out
+                        << "' 2>&1 &\n"
                         << "pid=$!\n"
-                        << "i=0; while [ $i -lt 1200 ] && ! grep -q 't=1.0s' '" << out << "' 2>/dev/null; do sleep 0.05; i=$((i+1)); done\n"
+                        << "i=0; while [ $i -lt 1200 ] && ! grep -q 't=1.0s' '" << out
+                        << "' 2>/dev/null; do sleep 0.05; i=$((i+1)); done\n"
                         << "kill -INT $pid\nwait $pid\n";
   const int status = std::system(("/bin/sh '" + script.string() + "'").c_str());
   EXPECT_TRUE(WIFEXITED(status));
@@ -124,8 +127,9 @@ void expect_same_folders(const fs::path& a, const fs::path& b) {
 TEST(RunCli, AnyNumberOfThreadsGivesTheSameRunFolderForTheConvoy) {
   const fs::path dir = scratch_dir("run_threads_convoy");
   for (const char* threads : {"1", "2", "3"}) {
-    const CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_sim") + " --duration 30 --seed 7 --threads " +
-                                       threads + " --out '" + (dir / threads).string() + "'");
+    const CommandResult r =
+        run_rilbed("run " + shipped_scenario_arg("convoy_sim") + " --duration 30 --seed 7 --threads " + threads +
+                   " --out '" + (dir / threads).string() + "'");
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   expect_same_folders(dir / "1", dir / "2");
@@ -160,22 +164,26 @@ TEST(RunCli, ThreadsMustBeAPositiveCount) {
 TEST(SimBenchCli, PrintsItsTable) {
   const CommandResult r = run_rilbed("sim-bench --robots 50,100 --seconds 2 --threads 1,2");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("| robots | threads | field m | simulated s | start-up s | wall s (median of 3) | CPU s (median) | "
-                       "wall ms per simulated s |"),
-            std::string::npos)
+  EXPECT_NE(
+      r.out.find("| robots | threads | field m | simulated s | start-up s | wall s (median of 3) | CPU s (median) | "
+                 "wall ms per simulated s |"),
+      std::string::npos)
       << r.out;
   EXPECT_NE(r.out.find("| 100 | 1 |"), std::string::npos) << r.out;
   // Two threads give the same trajectories as one (the "same" column).
   EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(\| 100 \| 2 \|[^\n]*\| yes \|)"))) << r.out;
   EXPECT_EQ(r.out.find("| NO |"), std::string::npos) << r.out;
   // Where the time went, one row per count and thread count, the parts' shares adding up to the run.
-  EXPECT_NE(r.out.find("| robots | threads | sensing | behaviours | integration | collisions | recording | DEVS kernel and the rest |"),
+  EXPECT_NE(r.out.find("| robots | threads | sensing | behaviours | integration | collisions | recording | DEVS kernel "
+                       "and the rest |"),
             std::string::npos)
       << r.out;
   std::smatch m;
   const std::string out = r.out;
-  ASSERT_TRUE(std::regex_search(out, m, std::regex(R"(\| 100 \| 1 \| [0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \| )"
-                                                  R"([0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \|)")))
+  ASSERT_TRUE(std::regex_search(
+      out, m,
+      std::regex(R"(\| 100 \| 1 \| [0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \| )"
+                 R"([0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \| [0-9.]+ \((\d+) %\) \|)")))
       << out;
   int total = 0;
   for (int i = 1; i <= 6; ++i) total += std::stoi(m[i]);

@@ -63,9 +63,11 @@ int main(int argc, char** argv) {
   try {
     boost::asio::io_context io;
     websocket::stream<beast::tcp_stream> ws(io);
-    beast::get_lowest_layer(ws).connect(tcp::endpoint(boost::asio::ip::make_address(host), static_cast<unsigned short>(std::stoi(port))));
-    ws.set_option(websocket::stream_base::decorator(
-        [](websocket::request_type& r) { r.set(beast::http::field::sec_websocket_protocol, "foxglove.websocket.v1"); }));
+    beast::get_lowest_layer(ws).connect(
+        tcp::endpoint(boost::asio::ip::make_address(host), static_cast<unsigned short>(std::stoi(port))));
+    ws.set_option(websocket::stream_base::decorator([](websocket::request_type& r) {
+      r.set(beast::http::field::sec_websocket_protocol, "foxglove.websocket.v1");
+    }));
     ws.handshake(hostport, target);
     beast::get_lowest_layer(ws).expires_after(std::chrono::seconds(timeout_s));
     std::map<std::uint32_t, std::string> sub_topic;
@@ -101,7 +103,8 @@ int main(int argc, char** argv) {
       }
       if (bytes.size() < 13 || bytes[0] != 0x01) continue;
       const std::uint32_t sub = static_cast<unsigned char>(bytes[1]) | static_cast<unsigned char>(bytes[2]) << 8 |
-                                static_cast<unsigned char>(bytes[3]) << 16 | static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[4])) << 24;
+                                static_cast<unsigned char>(bytes[3]) << 16 |
+                                static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[4])) << 24;
       std::printf("%s %s\n", sub_topic[sub].c_str(), bytes.substr(13).c_str());
       std::fflush(stdout);
       ++got;
@@ -109,19 +112,25 @@ int main(int argc, char** argv) {
       if (get_parameters && !sent) {
         sent = true;
         ws.text(true);
-        ws.write(boost::asio::buffer(json{{"op", "getParameters"}, {"parameterNames", json::array()}, {"id", "probe"}}.dump()));
+        ws.write(boost::asio::buffer(
+            json{{"op", "getParameters"}, {"parameterNames", json::array()}, {"id", "probe"}}.dump()));
       }
       if (!set_parameters.empty() && !sent) {
         sent = true;
         ws.text(true);
-        ws.write(boost::asio::buffer(json{{"op", "setParameters"}, {"parameters", json::parse(set_parameters)}, {"id", "probe"}}.dump()));
+        ws.write(boost::asio::buffer(
+            json{{"op", "setParameters"}, {"parameters", json::parse(set_parameters)}, {"id", "probe"}}.dump()));
       }
       if (!send.empty() && !sent) {
         sent = true;
         const std::string topic = send.substr(0, send.find('='));
         const std::string payload = send.substr(send.find('=') + 1);
         ws.text(true);
-        ws.write(boost::asio::buffer(json{{"op", "advertise"}, {"channels", {{{"id", 1}, {"topic", topic}, {"encoding", "json"}, {"schemaName", "rilbed.console_command"}}}}}.dump()));
+        ws.write(boost::asio::buffer(
+            json{{"op", "advertise"},
+                 {"channels",
+                  {{{"id", 1}, {"topic", topic}, {"encoding", "json"}, {"schemaName", "rilbed.console_command"}}}}}
+                .dump()));
         ws.binary(true);
         ws.write(boost::asio::buffer(std::string("\x01\x01\x00\x00\x00", 5) + payload));
       }

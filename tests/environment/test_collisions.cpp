@@ -23,8 +23,8 @@ TEST(Collisions, RobotDrivingIntoAWallStopsFlushAtItsRadius) {
   int wall_events = 0;
   for (int i = 0; i < 20; ++i) {
     for (const CollisionEvent& e : world.step(kTick)) {
-      EXPECT_EQ(e.first, (BodyRef{BodyKind::Robot, 1}));
-      EXPECT_EQ(e.second, (BodyRef{BodyKind::Wall, kWallRight}));
+      EXPECT_EQ(e.first, (BodyRef{BodyKind::kRobot, 1}));
+      EXPECT_EQ(e.second, (BodyRef{BodyKind::kWall, kWallRight}));
       ++wall_events;
     }
   }
@@ -64,8 +64,8 @@ TEST(Collisions, HeadOnRobotsSeparateToExactlyTouching) {
   EXPECT_NEAR(b.x, 0.5 + kR, 1e-9);
   EXPECT_NEAR(a.y, 0.5, 1e-12);
   ASSERT_EQ(events.size(), 1u);
-  EXPECT_EQ(events[0].first, (BodyRef{BodyKind::Robot, 1}));
-  EXPECT_EQ(events[0].second, (BodyRef{BodyKind::Robot, 2}));
+  EXPECT_EQ(events[0].first, (BodyRef{BodyKind::kRobot, 1}));
+  EXPECT_EQ(events[0].second, (BodyRef{BodyKind::kRobot, 2}));
   // They meet after (0.4 - 2R) / (2 * 0.4 m/s) = 0.43125 s, in the step ending at 0.5 s.
   EXPECT_GT(events[0].t_us, 400'000);
   EXPECT_LE(events[0].t_us, 500'000);
@@ -82,7 +82,7 @@ TEST(Collisions, RobotAgainstAPolygonCorner) {
   bool saw_event = false;
   for (int i = 0; i < 15; ++i) {
     for (const CollisionEvent& e : world.step(kTick)) {
-      EXPECT_EQ(e.second, (BodyRef{BodyKind::Obstacle, 0}));
+      EXPECT_EQ(e.second, (BodyRef{BodyKind::kObstacle, 0}));
       saw_event = true;
     }
     EXPECT_GE((world.robot(1).pose.position_m - Vec2{0.6, 0.6}).norm(), kR - 1e-9);
@@ -126,7 +126,7 @@ TEST(Collisions, FastRobotDoesNotTunnelThroughAThinWall) {
 TEST(Collisions, RealRobotIsNeverPushed) {
   World world(empty_field(1, 1));
   RobotConfig real = quiet_robot(7, 0.5, 0.5, 0.0);
-  real.kind = RobotKind::Real;
+  real.kind = RobotKind::kReal;
   world.add_robot(real);
   world.add_robot(quiet_robot(1, 0.3, 0.5, 0.0));
   world.set_wheel_speeds(1, 60, 60);
@@ -162,8 +162,8 @@ TEST(Collisions, MovingDiscBouncesOffAWall) {
   EXPECT_NEAR(m.position_m().y, 0.5, 1e-12);
   EXPECT_NEAR(m.velocity_mps().x, -1.0, 1e-12);
   ASSERT_EQ(events.size(), 1u);
-  EXPECT_EQ(events[0].first, (BodyRef{BodyKind::MovingObstacle, 0}));
-  EXPECT_EQ(events[0].second, (BodyRef{BodyKind::Wall, kWallRight}));
+  EXPECT_EQ(events[0].first, (BodyRef{BodyKind::kMovingObstacle, 0}));
+  EXPECT_EQ(events[0].second, (BodyRef{BodyKind::kWall, kWallRight}));
 }
 
 TEST(Collisions, MovingPolygonBouncesOffAnObstacleAtAnAngle) {
@@ -171,7 +171,7 @@ TEST(Collisions, MovingPolygonBouncesOffAnObstacleAtAnAngle) {
   map.obstacles.push_back(rectangle(1.5, 0.0, 2.0, 2.0));  // a block along the right side
   World world(map);
   MovingObstacleConfig box;
-  box.shape = MovingShape::Polygon;
+  box.shape = MovingShape::kPolygon;
   box.vertices_m = {{-0.05, -0.05}, {0.05, -0.05}, {0.05, 0.05}, {-0.05, 0.05}};
   box.position_m = {1.0, 0.5};
   box.velocity_mps = {0.5, 0.5};
@@ -200,7 +200,7 @@ TEST(Collisions, MovingObstaclePushesVirtualRobotsAndBouncesOffRealOnes) {
 
   World with_real(empty_field(2, 1));
   RobotConfig real = quiet_robot(2, 1.0, 0.5, 0.0);
-  real.kind = RobotKind::Real;
+  real.kind = RobotKind::kReal;
   with_real.add_robot(real);
   with_real.add_moving_obstacle(disc);
   run(with_real, 30, kTick);

@@ -21,7 +21,7 @@ TEST(Kinematics, StraightLineAndOdometryPulses) {
   World world(empty_field(2, 2));
   world.add_robot(quiet_robot(1, 0.5, 1.0, 0.0));
   world.set_wheel_speeds(1, 10, 10);  // 80 mm/s
-  run(world, 10, 100'000);       // 1 s
+  run(world, 10, 100'000);            // 1 s
   const RobotState& r = world.robot(1);
   EXPECT_NEAR(r.pose.position_m.x, 0.58, 1e-12);
   EXPECT_NEAR(r.pose.position_m.y, 1.0, 1e-12);
@@ -116,10 +116,10 @@ TEST(Kinematics, SlipNoiseIsSeededAndCanHideFromTheCounters) {
   EXPECT_EQ(a.pose.position_m, b.pose.position_m);
   EXPECT_EQ(a.pose.heading_rad, b.pose.heading_rad);
   EXPECT_NE(a.pose.position_m, other.pose.position_m);
-  EXPECT_NE(a.pose.heading_rad, 0.0);                // it wandered
-  EXPECT_NE(a.odometer().left_pulses, 10000);        // 0.8 m commanded; the counters saw the slip
+  EXPECT_NE(a.pose.heading_rad, 0.0);          // it wandered
+  EXPECT_NE(a.odometer().left_pulses, 10000);  // 0.8 m commanded; the counters saw the slip
   const RobotState hidden = drive(5, false);
-  EXPECT_EQ(hidden.odometer().left_pulses, 10000);   // counters see only the command...
+  EXPECT_EQ(hidden.odometer().left_pulses, 10000);  // counters see only the command...
   EXPECT_EQ(hidden.odometer().right_pulses, 10000);
   EXPECT_EQ(hidden.pose.position_m, a.pose.position_m);  // ...while the body slips the same way
 }

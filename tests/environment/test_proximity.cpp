@@ -84,7 +84,8 @@ TEST(Proximity, LeftAndRightAreMirrorImages) {
   const ProximityValues l = readings(true), r = readings(false);
   EXPECT_GT(l[0], 100);  // the left sensor is 12.5 mm from the block
   EXPECT_EQ(r[0], 0);
-  for (int i = 0; i < 6; ++i) EXPECT_EQ(l[static_cast<std::size_t>(i)], r[static_cast<std::size_t>(5 - i)]) << "sensor " << i;
+  for (int i = 0; i < 6; ++i)
+    EXPECT_EQ(l[static_cast<std::size_t>(i)], r[static_cast<std::size_t>(5 - i)]) << "sensor " << i;
   EXPECT_EQ(l[6], r[7]);
   EXPECT_EQ(l[7], r[6]);
 }
@@ -132,7 +133,7 @@ TEST(Proximity, NoiseHasTheConfiguredSpread) {
 }
 
 TEST(Proximity, SeesOtherRobotsRealOrVirtual) {
-  for (const RobotKind kind : {RobotKind::Virtual, RobotKind::Real}) {
+  for (const RobotKind kind : {RobotKind::kVirtual, RobotKind::kReal}) {
     World world(empty_field(1, 1));
     world.add_robot(quiet_robot(1, 0.5, 0.5, 0.0));
     RobotConfig other = quiet_robot(2, 0.5 + 2 * kR, 0.5, kPi);  // touching, in front

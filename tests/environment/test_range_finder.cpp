@@ -107,7 +107,8 @@ TEST(RangeFinder, SeesRobotsAndReportsNoisyDistances) {
 TEST(RangeFinder, BadConfigurationIsRejected) {
   World world(empty_field(3, 3));
   EXPECT_THROW(world.add_robot(with_range_finders(quiet_robot(1, 1, 1, 0), {finder(0, 180)})), std::invalid_argument);
-  EXPECT_THROW(world.add_robot(with_range_finders(quiet_robot(1, 1, 1, 0), {finder(0, 30, -1)})), std::invalid_argument);
+  EXPECT_THROW(world.add_robot(with_range_finders(quiet_robot(1, 1, 1, 0), {finder(0, 30, -1)})),
+               std::invalid_argument);
   try {
     world.add_robot(with_range_finders(quiet_robot(4, 1, 1, 0), {finder(0), finder(0, 30, NAN)}));
     FAIL();

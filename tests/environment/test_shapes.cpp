@@ -60,7 +60,7 @@ TEST(Segments, PathCrossingAndSightBlocking) {
   EXPECT_FALSE(path_crosses_segment({1, 0}, {2, 0}, {1, -1}, {1, 1}));  // starts on it: does not
 
   EXPECT_TRUE(segment_blocks_sight({0, 0}, {2, 0}, {1, -1}, {1, 1}));
-  EXPECT_FALSE(segment_blocks_sight({1, 0}, {2, 0}, {1, -1}, {1, 1}));  // viewer mounted on it
+  EXPECT_FALSE(segment_blocks_sight({1, 0}, {2, 0}, {1, -1}, {1, 1}));     // viewer mounted on it
   EXPECT_FALSE(segment_blocks_sight({0, 0}, {2, 0}, {0, 0.5}, {2, 0.5}));  // parallel
 }
 

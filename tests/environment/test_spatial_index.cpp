@@ -107,7 +107,7 @@ TEST(SegmentIndex, NearQueriesTrackLookupsAndSightLinesMatchBruteForce) {
   for (int i = 0; i < 60; ++i) {
     const Vec2 a = random_point(rng, 0, 3);
     const Vec2 b = a + Vec2{uniform01(rng) - 0.5, uniform01(rng) - 0.5} * (i % 5 == 0 ? 2.5 : 0.4);
-    segments.push_back({a, b, {BodyKind::Obstacle, i}, 0.02 * uniform01(rng)});
+    segments.push_back({a, b, {BodyKind::kObstacle, i}, 0.02 * uniform01(rng)});
   }
   const SegmentIndex index(g, segments);
   for (int q = 0; q < 400; ++q) {
@@ -140,10 +140,10 @@ TEST(SegmentIndex, SegmentsOnCellBordersAreFoundFromBothSides) {
   int id = 0;
   for (int k = 0; k <= 12; ++k) {
     const double v = k * 0.1;
-    segments.push_back({{v, 0.0}, {v, 1.2}, {BodyKind::Obstacle, id++}, 0.0});  // vertical borders
-    segments.push_back({{0.0, v}, {1.5, v}, {BodyKind::Obstacle, id++}, 0.0});  // horizontal borders
+    segments.push_back({{v, 0.0}, {v, 1.2}, {BodyKind::kObstacle, id++}, 0.0});  // vertical borders
+    segments.push_back({{0.0, v}, {1.5, v}, {BodyKind::kObstacle, id++}, 0.0});  // horizontal borders
   }
-  segments.push_back({{0.0, 0.0}, {1.2, 1.2}, {BodyKind::Obstacle, id++}, 0.0});  // through cell corners
+  segments.push_back({{0.0, 0.0}, {1.2, 1.2}, {BodyKind::kObstacle, id++}, 0.0});  // through cell corners
   const SegmentIndex index(g, segments);
   std::mt19937_64 rng(5);
   for (int q = 0; q < 3000; ++q) {
@@ -153,7 +153,8 @@ TEST(SegmentIndex, SegmentsOnCellBordersAreFoundFromBothSides) {
     index.for_each_in_box(box_around(p, reach), [&](const IndexedSegment& s) { near.insert(s.owner.id); });
     for (const IndexedSegment& s : segments) {
       if (distance_sq_to_segment(p, s.a_m, s.b_m) <= reach * reach) {
-        EXPECT_TRUE(near.contains(s.owner.id)) << "segment " << s.owner.id << " missed from (" << p.x << ", " << p.y << ")";
+        EXPECT_TRUE(near.contains(s.owner.id))
+            << "segment " << s.owner.id << " missed from (" << p.x << ", " << p.y << ")";
       }
     }
   }

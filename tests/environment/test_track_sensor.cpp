@@ -71,8 +71,20 @@ TEST(TrackFootprint, VerticalElementHasEqualSolidAngleRings) {
   EXPECT_EQ(inner, 4);
   EXPECT_EQ(outer, 12);
   EXPECT_NEAR(centroid_x(f), 0.0, 1e-15);
-  EXPECT_EQ(track_footprint([] { auto c = element(0); c.precision = 1; return c; }()).points_m.size(), 1u);
-  EXPECT_EQ(track_footprint([] { auto c = element(0); c.precision = 100; return c; }()).points_m.size(), 100u);
+  EXPECT_EQ(track_footprint([] {
+              auto c = element(0);
+              c.precision = 1;
+              return c;
+            }())
+                .points_m.size(),
+            1u);
+  EXPECT_EQ(track_footprint([] {
+              auto c = element(0);
+              c.precision = 100;
+              return c;
+            }())
+                .points_m.size(),
+            100u);
 }
 
 TEST(TrackFootprint, InclinationShiftsTheEllipseAndCrowdsItsNearEnd) {

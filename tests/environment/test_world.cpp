@@ -4,8 +4,8 @@
 #include <memory>
 #include <string>
 
-#include "environment/random.hpp"
 #include "core/worker_pool.hpp"
+#include "environment/random.hpp"
 #include "environment/world.hpp"
 #include "world_fixtures.hpp"
 
@@ -140,13 +140,21 @@ TEST(WorldValidation, BadRobotsAreRejectedNamingTheRobot) {
   expect_invalid([&] { world.add_robot(quiet_robot(3, 0.1, 0.1, 0.0)); }, "robot 3: another robot has this id");
   expect_invalid([&] { world.add_robot(quiet_robot(4, 0.33, 0.3, 0.0)); }, "robot 4: placed overlapping robot 3");
   expect_invalid([&] { world.robot(99); }, "no robot with id 99");
-  expect_invalid([&] { world.set_observed_pose(3, {{0.5, 0.5}, 0.0}, 0); }, "robot 3: set_observed_pose is for real robots");
+  expect_invalid(
+      [&] {
+        world.set_observed_pose(3, {{0.5, 0.5}, 0.0}, 0);
+      },
+      "robot 3: set_observed_pose is for real robots");
   expect_invalid([&] { world.step(-1); }, "dt_us");
   // A real robot may be seen anywhere, even overlapping a virtual one.
   RobotConfig real = quiet_robot(5, 0.32, 0.3, 0.0);
-  real.kind = RobotKind::Real;
+  real.kind = RobotKind::kReal;
   world.add_robot(real);
-  expect_invalid([&] { world.set_observed_pose(5, {{INFINITY, 0.5}, 0.0}, 0); }, "robot 5: observed pose is not finite");
+  expect_invalid(
+      [&] {
+        world.set_observed_pose(5, {{INFINITY, 0.5}, 0.0}, 0);
+      },
+      "robot 5: observed pose is not finite");
   EXPECT_EQ(world.robots().size(), 2u);
 }
 
@@ -159,7 +167,7 @@ TEST(WorldValidation, BadMovingObstaclesAreRejected) {
   m.position_m = {0.05, 0.5};
   expect_invalid([&] { world.add_moving_obstacle(m); }, "moving obstacle 0: placed overlapping wall 3 (left)");
   MovingObstacleConfig ell;
-  ell.shape = MovingShape::Polygon;
+  ell.shape = MovingShape::kPolygon;
   ell.position_m = {0.5, 0.5};
   ell.vertices_m = {{-0.1, -0.1}, {0.1, -0.1}, {0.1, 0.0}, {0.0, 0.0}, {0.0, 0.1}, {-0.1, 0.1}};
   expect_invalid([&] { world.add_moving_obstacle(ell); }, "must be convex");
@@ -217,11 +225,13 @@ TEST(World, SameSeedSameWorldDifferentSeedDifferentWorld) {
     for (int step = 0; step < 100; ++step) {
       if (step % 10 == 0)
         for (const RobotState& r : world.robots())
-          world.set_wheel_speeds(r.id, static_cast<int>(uniform01(rng) * 120) - 40, static_cast<int>(uniform01(rng) * 120) - 40);
+          world.set_wheel_speeds(r.id, static_cast<int>(uniform01(rng) * 120) - 40,
+                                 static_cast<int>(uniform01(rng) * 120) - 40);
       world.step(kTick);
       world.sense_all(world.time_us(), readings);
       int sum = 0;
-      for (const SensorReadings& s : readings) for (const int v : *s.proximity) sum += v;
+      for (const SensorReadings& s : readings)
+        for (const int v : *s.proximity) sum += v;
       proximity_sums.push_back(sum);
     }
     std::vector<Pose2> poses;
@@ -260,7 +270,7 @@ TEST(World, SenseAllMatchesSenseOneByOne) {
 TEST(World, RealRobotsGetVirtualSensorsButNoVirtualOdometry) {
   World world(empty_field(1, 1));
   RobotConfig real = quiet_robot(1, 0.5, 0.5, 0.0);
-  real.kind = RobotKind::Real;
+  real.kind = RobotKind::kReal;
   world.add_robot(real);
   world.set_observed_pose(1, {{1.0 - kR - 0.01, 0.5}, 0.0}, 5);
   EXPECT_EQ(world.robot(1).pose_t_us, 5);
@@ -347,12 +357,14 @@ TEST(World, ThreadsChangeNothing) {
     }
     events += static_cast<int>(e3.size());
     for (std::size_t i = 0; i < one.robots().size(); ++i) {
-      ASSERT_EQ(one.robots()[i].pose.position_m, three.robots()[i].pose.position_m) << "robot " << i << " at step " << step;
+      ASSERT_EQ(one.robots()[i].pose.position_m, three.robots()[i].pose.position_m)
+          << "robot " << i << " at step " << step;
       ASSERT_EQ(one.robots()[i].pose.heading_rad, three.robots()[i].pose.heading_rad);
     }
     one.sense_all(one.time_us(), readings_one);
     three.sense_all(three.time_us(), readings_three);
-    for (std::size_t i = 0; i < readings_one.size(); ++i) ASSERT_EQ(*readings_one[i].proximity, *readings_three[i].proximity);
+    for (std::size_t i = 0; i < readings_one.size(); ++i)
+      ASSERT_EQ(*readings_one[i].proximity, *readings_three[i].proximity);
   }
   EXPECT_GT(events, 100) << "crowded enough to collide";
 }
@@ -404,7 +416,7 @@ TEST(World, TheSensorSweepGivesTheReadingsOfOneByOne) {
     }
     // A robot moved by hand (a real robot's observed pose) is read where it now is.
     RobotConfig real = quiet_robot(9999, 0.3, 0.3, 0.0);
-    real.kind = RobotKind::Real;
+    real.kind = RobotKind::kReal;
     world.add_robot(real);
     world.sense_ahead(world.time_us());
     world.set_observed_pose(9999, {{1.2, 0.2}, 1.0}, world.time_us());
@@ -475,8 +487,7 @@ TEST(World, TheSensorSweepKeepsEveryKindOfReading) {
           world.add_robot(c);
           EXPECT_EQ(world.sensor_config(c.id), c.sensors);
           ++id;
-        } catch (const std::invalid_argument&) {
-        }
+        } catch (const std::invalid_argument&) {}
       }
     }
     ASSERT_GT(id, 40);
@@ -526,7 +537,8 @@ TEST(World, SearchingContactsAheadChangesNoCollision) {
       const std::vector<CollisionEvent> events_a(ea.begin(), ea.end());
       const auto eb = b.step(kTick);
       ASSERT_EQ(events_a.size(), eb.size()) << "seed " << seed << " step " << step;
-      for (std::size_t k = 0; k < eb.size(); ++k) ASSERT_TRUE(events_a[k] == eb[k]) << "seed " << seed << " step " << step;
+      for (std::size_t k = 0; k < eb.size(); ++k)
+        ASSERT_TRUE(events_a[k] == eb[k]) << "seed " << seed << " step " << step;
       events += static_cast<int>(eb.size());
       for (std::size_t i = 0; i < a.robots().size(); ++i)
         ASSERT_EQ(a.robots()[i].pose.position_m, b.robots()[i].pose.position_m) << "seed " << seed << " step " << step;
@@ -546,7 +558,8 @@ TEST(World, NeitherRenumberingTheSlotsNorTheCellSizeChangesAnything) {
   };
   for (const std::uint64_t seed : {11ULL, 4242ULL}) {
     std::vector<std::unique_ptr<World>> worlds;
-    for (const Setting setting : {Setting{1, 0.0}, Setting{0, 0.0}, Setting{7, 0.0}, Setting{20, 0.1}, Setting{20, 0.45}}) {
+    for (const Setting setting :
+         {Setting{1, 0.0}, Setting{0, 0.0}, Setting{7, 0.0}, Setting{20, 0.1}, Setting{20, 0.45}}) {
       WorldConfig config;
       config.noise_seed = seed;
       config.reorder_every_steps = setting.reorder_every_steps;
@@ -578,7 +591,8 @@ TEST(World, NeitherRenumberingTheSlotsNorTheCellSizeChangesAnything) {
       }
       for (std::size_t k = 1; k < worlds.size(); ++k) {
         ASSERT_EQ(stepped[0].size(), stepped[k].size()) << "seed " << seed << " step " << step;
-        for (std::size_t e = 0; e < stepped[0].size(); ++e) ASSERT_TRUE(stepped[0][e] == stepped[k][e]) << "world " << k << " step " << step << " event " << e;
+        for (std::size_t e = 0; e < stepped[0].size(); ++e)
+          ASSERT_TRUE(stepped[0][e] == stepped[k][e]) << "world " << k << " step " << step << " event " << e;
         for (std::size_t i = 0; i < ids.size(); ++i)
           slots_differed |= worlds[0]->robots()[i].id != worlds[k]->robots()[i].id;
         for (const int id : ids) {

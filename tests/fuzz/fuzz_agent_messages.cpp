@@ -35,8 +35,8 @@ using namespace rilbed;
   std::fprintf(stderr, "\nfuzz_agent_messages: invariant broken: %s\n", what);
   std::abort();
 }
-#define FUZZ_CHECK(condition) \
-  do {                        \
+#define FUZZ_CHECK(condition)             \
+  do {                                    \
     if (!(condition)) broken(#condition); \
   } while (false)
 
@@ -82,8 +82,7 @@ lcm::LCM& memq() {
     if (!made) broken("memq:// did not open");
     return made;
   }();
-  while (lcm->handleTimeout(0) > 0) {
-  }
+  while (lcm->handleTimeout(0) > 0) {}
   return *lcm;
 }
 
@@ -147,8 +146,7 @@ void fuzz_run(const std::uint8_t* data, std::size_t size, bool hello) {
   links::publish_encoded(*lcm, config.channels.agent_hello, h);
   if (run.wait_for_agents(std::chrono::milliseconds(50))) broken("the known process was not taken");
   lcm->publish(hello ? config.channels.agent_hello : config.channels.quantum_reply, data, static_cast<unsigned>(size));
-  while (lcm->handleTimeout(0) > 0) {
-  }
+  while (lcm->handleTimeout(0) > 0) {}
   if (hello) {
     rilbed::agent_hello_t m{};
     const bool refused = !links::decode_checked(data, size, m) || m.session.empty() || m.scenario != "fuzz";

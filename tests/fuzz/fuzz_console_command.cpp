@@ -34,8 +34,8 @@ using namespace rilbed;
   std::fprintf(stderr, "\nfuzz_console_command: invariant broken: %s\n", what);
   std::abort();
 }
-#define FUZZ_CHECK(condition) \
-  do {                        \
+#define FUZZ_CHECK(condition)             \
+  do {                                    \
     if (!(condition)) broken(#condition); \
   } while (false)
 
@@ -57,15 +57,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                  [&taken](const agents::ControlAction& a) { taken.push_back(a); });
   links::LcmConsoleServer server(bus, channels, kToken, control, {}, false);
   Replies replies;
-  links::LcmSubscription subscription(bus, channels.console_reply, [&replies](const std::string&, const void* d, std::size_t n) {
-    rilbed::console_reply_t r;
-    if (links::decode_checked(d, n, r)) replies.got.push_back(r);
-  });
+  links::LcmSubscription subscription(bus, channels.console_reply,
+                                      [&replies](const std::string&, const void* d, std::size_t n) {
+                                        rilbed::console_reply_t r;
+                                        if (links::decode_checked(d, n, r)) replies.got.push_back(r);
+                                      });
 
   for (int send = 0; send < 2; ++send) {
     bus.publish(channels.console, data, static_cast<unsigned>(size));
-    while (bus.handleTimeout(0) > 0) {
-    }
+    while (bus.handleTimeout(0) > 0) {}
   }
 
   rilbed::console_command_t c;

@@ -24,8 +24,8 @@ using namespace rilbed::gui_web::foxglove;
   std::fprintf(stderr, "\nfuzz_foxglove_messages: invariant broken: %s\n", what);
   std::abort();
 }
-#define FUZZ_CHECK(condition) \
-  do {                        \
+#define FUZZ_CHECK(condition)             \
+  do {                                    \
     if (!(condition)) broken(#condition); \
   } while (false)
 

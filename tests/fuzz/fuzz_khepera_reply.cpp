@@ -30,9 +30,9 @@ namespace {
 
 using namespace rilbed::links;
 
-constexpr CommandKind kKinds[] = {CommandKind::kReadVersions,  CommandKind::kSetSpeeds,    CommandKind::kReadSpeeds,
-                                  CommandKind::kSetCounters,   CommandKind::kReadCounters, CommandKind::kReadProximity,
-                                  CommandKind::kReadAmbient,   CommandKind::kSetLed};
+constexpr CommandKind kKinds[] = {CommandKind::kReadVersions, CommandKind::kSetSpeeds,    CommandKind::kReadSpeeds,
+                                  CommandKind::kSetCounters,  CommandKind::kReadCounters, CommandKind::kReadProximity,
+                                  CommandKind::kReadAmbient,  CommandKind::kSetLed};
 static_assert(sizeof kKinds / sizeof kKinds[0] == kCommandKindCount);
 
 // An invariant broken: say which and on what, then abort so that libFuzzer saves the input.
@@ -40,8 +40,8 @@ static_assert(sizeof kKinds / sizeof kKinds[0] == kCommandKindCount);
   std::fprintf(stderr, "\nfuzz_khepera_reply: invariant broken: %s\n  on %s\n", what, printable(detail, 400).c_str());
   std::abort();
 }
-#define FUZZ_CHECK(condition, detail) \
-  do {                                \
+#define FUZZ_CHECK(condition, detail)               \
+  do {                                              \
     if (!(condition)) broken(#condition, (detail)); \
   } while (false)
 
@@ -84,7 +84,9 @@ void check_reply(const RobotModel& model, CommandKind kind, std::string_view lin
   FUZZ_CHECK(encoded.size() >= 2 && encoded.compare(encoded.size() - 2, 2, "\r\n") == 0, encoded);
   FUZZ_CHECK(looks_like_reply_to(model, kind, encoded), encoded);
   const Result<Reply> again = decode_reply(model, kind, encoded);
-  if (!again.ok()) broken("encode_reply of a decoded reply decodes again", std::string(line) + " -> " + encoded + " -> " + again.error());
+  if (!again.ok())
+    broken("encode_reply of a decoded reply decodes again",
+           std::string(line) + " -> " + encoded + " -> " + again.error());
   FUZZ_CHECK(again->kind == kind, encoded);
   // The values rilbed computes with survive the round trip. (Versions are text kept for
   // display: one that is not a bios,protocol pair may read back differently, e.g. "B" has
@@ -104,10 +106,12 @@ void check_command(const RobotModel& model, std::string_view line) {
   }
   // What the link would send for this command is that command again.
   const Result<EncodedCommand> encoded = encode_command(model, command.value());
-  if (!encoded.ok()) broken("encode_command of a decoded command succeeds", std::string(line) + " -> " + encoded.error());
+  if (!encoded.ok())
+    broken("encode_command of a decoded command succeeds", std::string(line) + " -> " + encoded.error());
   const Result<Command> again = decode_command(model, encoded->bytes);
   if (!again.ok()) broken("encode_command of a decoded command decodes again", encoded->bytes + " -> " + again.error());
-  if (!(again.value() == command.value())) broken("decode_command(encode_command(c)) == c", std::string(line) + " -> " + encoded->bytes);
+  if (!(again.value() == command.value()))
+    broken("decode_command(encode_command(c)) == c", std::string(line) + " -> " + encoded->bytes);
 }
 
 void check_line(std::string_view line) {

@@ -44,8 +44,8 @@ using namespace rilbed;
   std::fprintf(stderr, "\nfuzz_lcm_log: %s\n", what.c_str());
   std::abort();
 }
-#define FUZZ_CHECK(condition) \
-  do {                        \
+#define FUZZ_CHECK(condition)                                  \
+  do {                                                         \
     if (!(condition)) broken("invariant broken: " #condition); \
   } while (false)
 

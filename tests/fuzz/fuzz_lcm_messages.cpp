@@ -47,8 +47,8 @@ std::string g_channel;  // the channel of the input being checked, for the repor
   std::fprintf(stderr, "\nfuzz_lcm_messages: invariant broken on channel %s: %s\n", g_channel.c_str(), what);
   std::abort();
 }
-#define FUZZ_CHECK(condition) \
-  do {                        \
+#define FUZZ_CHECK(condition)             \
+  do {                                    \
     if (!(condition)) broken(#condition); \
   } while (false)
 
@@ -56,12 +56,28 @@ std::string g_channel;  // the channel of the input being checked, for the repor
 const std::vector<std::string>& channel_names() {
   static const std::vector<std::string> names = [] {
     const links::Channels c = links::Channels::with_prefix("");
-    return std::vector<std::string>{c.poses,   c.events,     c.status, c.world,         c.summary,
-                                    c.wheels,  c.sensors,    c.detections, c.frames, c.camera, c.sensor_layout, c.vision, "RILBED_UNKNOWN"};
+    return std::vector<std::string>{c.poses,         c.events,  c.status,        c.world,  c.summary,
+                                    c.wheels,        c.sensors, c.detections,    c.frames, c.camera,
+                                    c.sensor_layout, c.vision,  "RILBED_UNKNOWN"};
   }();
   return names;
 }
-enum Pick { kPoses, kEvents, kStatus, kWorld, kSummary, kWheels, kSensors, kDetections, kFrames, kCamera, kSensorLayout, kVision, kUnknown, kPicks };
+enum Pick {
+  kPoses,
+  kEvents,
+  kStatus,
+  kWorld,
+  kSummary,
+  kWheels,
+  kSensors,
+  kDetections,
+  kFrames,
+  kCamera,
+  kSensorLayout,
+  kVision,
+  kUnknown,
+  kPicks
+};
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
@@ -210,7 +226,8 @@ void check_wheels(const rilbed_fuzz::TouchingObserver& seen, const rilbed::wheel
   FUZZ_CHECK(seen.calls.wheels == 1 && seen.last_wheels.size() == m.robots.size());
   for (std::size_t i = 0; i < m.robots.size(); ++i) {
     const auto& w = seen.last_wheels[i];
-    FUZZ_CHECK(w.id == m.robots[i].id && w.wheels.left == m.robots[i].left_units && w.wheels.right == m.robots[i].right_units);
+    FUZZ_CHECK(w.id == m.robots[i].id && w.wheels.left == m.robots[i].left_units &&
+               w.wheels.right == m.robots[i].right_units);
   }
 }
 
@@ -307,7 +324,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     FUZZ_CHECK(problem->rfind(g_channel + ": ", 0) == 0);
   } else {
     // A camera is kept for the next world (which carries it): no call of its own.
-    FUZZ_CHECK(seen.calls.total() == (pick == kUnknown || pick == kCamera || pick == kSensorLayout || pick == kVision ? 0 : 1));
+    FUZZ_CHECK(seen.calls.total() ==
+               (pick == kUnknown || pick == kCamera || pick == kSensorLayout || pick == kVision ? 0 : 1));
   }
   FUZZ_CHECK(decoder.summary_seen() == (seen.calls.summary == 1));
   FUZZ_CHECK(decoder.last_status().has_value() == (seen.calls.status == 1));
@@ -344,10 +362,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       break;
     }
     case kWheels:
-      check_channel<rilbed::wheels_t>(problem, message, length, [&](const rilbed::wheels_t& m) { check_wheels(seen, m); });
+      check_channel<rilbed::wheels_t>(problem, message, length,
+                                      [&](const rilbed::wheels_t& m) { check_wheels(seen, m); });
       break;
     case kSensors:
-      check_channel<rilbed::sensors_t>(problem, message, length, [&](const rilbed::sensors_t& m) { check_sensors(seen, m); });
+      check_channel<rilbed::sensors_t>(problem, message, length,
+                                       [&](const rilbed::sensors_t& m) { check_sensors(seen, m); });
       break;
     case kDetections:
       check_channel<rilbed::detections_t>(problem, message, length,
@@ -386,8 +406,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       FUZZ_CHECK(!decoder.decode(links::Channels::with_prefix("").world, bytes.data(), bytes.size()));
       FUZZ_CHECK(seen.calls.world == 1 && seen.last_world.camera.has_value());
       const agents::CameraReport& c = *seen.last_world.camera;
-      FUZZ_CHECK(c.width_px == m.width_px && c.height_px == m.height_px && c.lens_distortion == (m.lens_distortion != 0));
-      for (int i = 0; i < 9; ++i) FUZZ_CHECK(same_bits(c.image_to_field[static_cast<std::size_t>(i)], m.image_to_field[i]));
+      FUZZ_CHECK(c.width_px == m.width_px && c.height_px == m.height_px &&
+                 c.lens_distortion == (m.lens_distortion != 0));
+      for (int i = 0; i < 9; ++i)
+        FUZZ_CHECK(same_bits(c.image_to_field[static_cast<std::size_t>(i)], m.image_to_field[i]));
       FUZZ_CHECK(c.source == m.source);
       break;
     }
@@ -425,8 +447,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       for (const auto& g : m.geometries) {
         std::int32_t next = 0;
         for (const std::int32_t e : g.track_sensor) {
-          if (e == next) ++next;
-          else if (e != next - 1) consistent = false;
+          if (e == next)
+            ++next;
+          else if (e != next - 1)
+            consistent = false;
         }
       }
       if (problem) {
@@ -455,9 +479,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       break;
     }
     case kUnknown:
-    case kPicks:
-      FUZZ_CHECK(!problem);
-      break;
+    case kPicks: FUZZ_CHECK(!problem); break;
   }
   // Keep the observer's reads.
   if (seen.sink == 0x5eed5eed5eed5eedULL) std::fputc('\0', stderr);

@@ -27,8 +27,8 @@ constexpr const char* kSource = "fuzz.yaml";
   std::fprintf(stderr, "\nfuzz_scenario: %s\n", what.c_str());
   std::abort();
 }
-#define FUZZ_CHECK(condition) \
-  do {                        \
+#define FUZZ_CHECK(condition)                                  \
+  do {                                                         \
     if (!(condition)) broken("invariant broken: " #condition); \
   } while (false)
 
@@ -63,7 +63,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } catch (const ScenarioError& e) {
     // "FILE:LINE: KEY: problem" (or "FILE: problem").
     const std::string message = e.what();
-    if (message.rfind(std::string(kSource) + ":", 0) != 0) broken("a ScenarioError that does not name the file: " + message);
+    if (message.rfind(std::string(kSource) + ":", 0) != 0)
+      broken("a ScenarioError that does not name the file: " + message);
   } catch (const std::exception& e) {
     broken("parse_scenario let " + type_name(typeid(e)) + " escape (only ScenarioError may): " + e.what());
   } catch (...) {

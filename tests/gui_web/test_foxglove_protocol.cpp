@@ -17,7 +17,8 @@ using nlohmann::json;
 template <typename T>
 T parsed(const std::string& text) {
   auto r = parse_client_text(text);
-  EXPECT_TRUE(std::holds_alternative<ClientText>(r)) << text << ": " << (std::holds_alternative<std::string>(r) ? std::get<std::string>(r) : "");
+  EXPECT_TRUE(std::holds_alternative<ClientText>(r))
+      << text << ": " << (std::holds_alternative<std::string>(r) ? std::get<std::string>(r) : "");
   return std::get<T>(std::get<ClientText>(r));
 }
 
@@ -29,26 +30,32 @@ std::string refused(const std::string& text) {
 
 TEST(FoxgloveProtocol, ParsesWhatFoxgloveClientSends) {
   // Exactly as FoxgloveClient writes them (JSON.stringify), subscription ids from 0.
-  const auto s = parsed<Subscribe>(R"({"op":"subscribe","subscriptions":[{"id":0,"channelId":1},{"id":1,"channelId":4294967295}]})");
+  const auto s = parsed<Subscribe>(
+      R"({"op":"subscribe","subscriptions":[{"id":0,"channelId":1},{"id":1,"channelId":4294967295}]})");
   ASSERT_EQ(s.subscriptions.size(), 2u);
   EXPECT_EQ(s.subscriptions[0].id, 0u);
   EXPECT_EQ(s.subscriptions[1].channel_id, 4294967295u);
-  EXPECT_EQ(parsed<Unsubscribe>(R"({"op":"unsubscribe","subscriptionIds":[0,7]})").subscription_ids, (std::vector<std::uint32_t>{0, 7}));
-  const auto a = parsed<ClientAdvertise>(R"({"op":"advertise","channels":[{"id":1,"topic":"/rilbed/console","encoding":"json","schemaName":"rilbed.console_command"}]})");
+  EXPECT_EQ(parsed<Unsubscribe>(R"({"op":"unsubscribe","subscriptionIds":[0,7]})").subscription_ids,
+            (std::vector<std::uint32_t>{0, 7}));
+  const auto a = parsed<ClientAdvertise>(
+      R"({"op":"advertise","channels":[{"id":1,"topic":"/rilbed/console","encoding":"json","schemaName":"rilbed.console_command"}]})");
   ASSERT_EQ(a.channels.size(), 1u);
   EXPECT_EQ(a.channels[0].topic, "/rilbed/console");
   EXPECT_EQ(a.channels[0].encoding, "json");
-  EXPECT_EQ(parsed<ClientUnadvertise>(R"({"op":"unadvertise","channelIds":[1]})").channel_ids, (std::vector<std::uint32_t>{1}));
+  EXPECT_EQ(parsed<ClientUnadvertise>(R"({"op":"unadvertise","channelIds":[1]})").channel_ids,
+            (std::vector<std::uint32_t>{1}));
   const auto g = parsed<GetParameters>(R"({"op":"getParameters","parameterNames":[],"id":"req-1"})");
   EXPECT_TRUE(g.names.empty());
   EXPECT_EQ(g.id, "req-1");
   EXPECT_EQ(parsed<GetParameters>(R"({"op":"getParameters","parameterNames":["a"]})").id, std::nullopt);
-  const auto p = parsed<SetParameters>(R"({"op":"setParameters","parameters":[{"name":"/vision/min_score","value":0.8},{"name":"/x"}],"id":"abc"})");
+  const auto p = parsed<SetParameters>(
+      R"({"op":"setParameters","parameters":[{"name":"/vision/min_score","value":0.8},{"name":"/x"}],"id":"abc"})");
   ASSERT_EQ(p.parameters.size(), 2u);
   EXPECT_EQ(p.parameters[0].value, json(0.8));
   EXPECT_TRUE(p.parameters[1].value.is_null());  // unset
   // Fields the protocol may add later are ignored.
-  EXPECT_EQ(parsed<Unsubscribe>(R"({"op":"unsubscribe","subscriptionIds":[3],"future":true})").subscription_ids.size(), 1u);
+  EXPECT_EQ(parsed<Unsubscribe>(R"({"op":"unsubscribe","subscriptionIds":[3],"future":true})").subscription_ids.size(),
+            1u);
 }
 
 TEST(FoxgloveProtocol, RefusesMalformedMessagesWithAReason) {
@@ -58,7 +65,8 @@ TEST(FoxgloveProtocol, RefusesMalformedMessagesWithAReason) {
   EXPECT_EQ(refused(R"({"op":7})"), "no string \"op\"");
   EXPECT_EQ(refused(R"({"op":"fly"})"), "unknown op 'fly'");
   EXPECT_EQ(refused("{\"op\":\"a\\u0001b\"}"), "unknown op 'a?b'");
-  EXPECT_EQ(refused(std::string(R"({"op":")") + std::string(500, 'x') + "\"}"), "unknown op '" + std::string(64, 'x') + "'");
+  EXPECT_EQ(refused(std::string(R"({"op":")") + std::string(500, 'x') + "\"}"),
+            "unknown op '" + std::string(64, 'x') + "'");
   EXPECT_EQ(refused(R"({"op":"subscribe"})"), "subscribe: subscriptions is missing");
   EXPECT_EQ(refused(R"({"op":"subscribe","subscriptions":{}})"), "subscribe: subscriptions is not an array");
   EXPECT_EQ(refused(R"({"op":"subscribe","subscriptions":[{"id":0,"channelId":1},{"id":1}]})"),
@@ -75,7 +83,8 @@ TEST(FoxgloveProtocol, RefusesMalformedMessagesWithAReason) {
   EXPECT_EQ(refused(R"({"op":"advertise","channels":[{"id":1,"topic":5,"encoding":"json","schemaName":"x"}]})"),
             "advertise: channels[0].topic is not a string");
   EXPECT_EQ(refused(R"({"op":"getParameters","parameterNames":[],"id":5})"), "getParameters: id is not a string");
-  EXPECT_EQ(refused(R"({"op":"setParameters","parameters":[{"value":1}]})"), "setParameters: parameters[0].name is missing");
+  EXPECT_EQ(refused(R"({"op":"setParameters","parameters":[{"value":1}]})"),
+            "setParameters: parameters[0].name is missing");
   // No list longer than kMaxItems.
   std::string many = R"({"op":"unsubscribe","subscriptionIds":[)";
   for (std::size_t i = 0; i <= kMaxItems; ++i) many += (i ? ",1" : "1");
@@ -90,12 +99,14 @@ TEST(FoxgloveProtocol, BinaryFramesBothWays) {
   EXPECT_EQ(std::string(m.payload.begin(), m.payload.end()), "{}");
   EXPECT_EQ(std::get<ClientMessage>(parse_client_binary(std::vector<std::uint8_t>{1, 0, 0, 0, 0})).payload.size(), 0u);
   EXPECT_EQ(std::get<std::string>(parse_client_binary({})), "empty binary message");
-  EXPECT_EQ(std::get<std::string>(parse_client_binary(std::vector<std::uint8_t>{7, 0, 0, 0, 0})), "unknown binary opcode 7");
+  EXPECT_EQ(std::get<std::string>(parse_client_binary(std::vector<std::uint8_t>{7, 0, 0, 0, 0})),
+            "unknown binary opcode 7");
   EXPECT_EQ(std::get<std::string>(parse_client_binary(std::vector<std::uint8_t>{1, 0, 0})),
             "message of 3 bytes is shorter than its 5-byte header");
   // Message Data header: the spec's example (subscription 7, 1700000000123456789 ns).
   const auto h = message_data_header(7, 1700000000123456789ULL);
-  const std::array<std::uint8_t, 13> expected = {0x01, 0x07, 0x00, 0x00, 0x00, 0x15, 0xcd, 0x85, 0x3d, 0xfe, 0x9c, 0x97, 0x17};
+  const std::array<std::uint8_t, 13> expected = {0x01, 0x07, 0x00, 0x00, 0x00, 0x15, 0xcd,
+                                                 0x85, 0x3d, 0xfe, 0x9c, 0x97, 0x17};
   EXPECT_EQ(h, expected);
 }
 
@@ -106,7 +117,8 @@ TEST(FoxgloveProtocol, ServerMessagesHaveTheSpecsShape) {
   EXPECT_EQ(info["supportedEncodings"], json::array({"json"}));
   EXPECT_TRUE(info["metadata"].is_object());
   EXPECT_EQ(info["sessionId"], "run-1");
-  const std::vector<Channel> channels = {{3, "/rilbed/poses", "json", "rilbed.poses", R"({"type":"object"})", "jsonschema"}};
+  const std::vector<Channel> channels = {
+      {3, "/rilbed/poses", "json", "rilbed.poses", R"({"type":"object"})", "jsonschema"}};
   const json adv = json::parse(advertise(channels));
   ASSERT_EQ(adv["channels"].size(), 1u);
   EXPECT_EQ(adv["channels"][0]["id"], 3);

@@ -39,7 +39,8 @@ struct RecordingSink {
       if (r.command == "pause") return ConsoleAnswer{true, "pause"};
       if (r.command == "drive" && r.args.at(0) == "99") return ConsoleAnswer{false, "this run has no robot 99"};
       if (r.command == "drive") return ConsoleAnswer{true, "drive"};
-      if (r.command == "vision" && r.args.size() >= 2 && r.args[1] == "9") return ConsoleAnswer{false, "contrast 9 is outside 0.2..5"};
+      if (r.command == "vision" && r.args.size() >= 2 && r.args[1] == "9")
+        return ConsoleAnswer{false, "contrast 9 is outside 0.2..5"};
       if (r.command == "vision") return ConsoleAnswer{true, "vision"};
       return ConsoleAnswer{false, "unknown command '" + r.command + "'"};
     };
@@ -77,8 +78,9 @@ struct PanelClient : Client {
     next_json();  // serverInfo
     advertised = next_json();
     send_text({{"op", "advertise"},
-               {"channels", {{{"id", 1}, {"topic", "/rilbed/console"}, {"encoding", "json"}, {"schemaName", ""}},
-                             {{"id", 2}, {"topic", "/rilbed/drive"}, {"encoding", "json"}, {"schemaName", ""}}}}});
+               {"channels",
+                {{{"id", 1}, {"topic", "/rilbed/console"}, {"encoding", "json"}, {"schemaName", ""}},
+                 {{"id", 2}, {"topic", "/rilbed/drive"}, {"encoding", "json"}, {"schemaName", ""}}}}});
   }
   void publish(std::uint32_t channel, const json& message) {
     std::string frame(5, '\0');
@@ -99,7 +101,8 @@ struct PanelClient : Client {
   json next_reply() {
     for (;;) {
       const auto m = next();
-      if (std::holds_alternative<std::string>(m) && std::get<std::string>(m).size() > 13 && std::get<std::string>(m)[1] == 7) {
+      if (std::holds_alternative<std::string>(m) && std::get<std::string>(m).size() > 13 &&
+          std::get<std::string>(m)[1] == 7) {
         return json::parse(std::get<std::string>(m).substr(13));
       }
     }
@@ -158,7 +161,10 @@ TEST(GuiService, ARobotDrivenByHandStopsWhenTheKeysStopComing) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
   const auto keys_until = Clock::now();
-  ASSERT_TRUE(eventually([&] { const auto d = run.drives(4); return !d.empty() && d.back() == "0 0"; }));
+  ASSERT_TRUE(eventually([&] {
+    const auto d = run.drives(4);
+    return !d.empty() && d.back() == "0 0";
+  }));
   const auto calls = run.snapshot();
   ASSERT_FALSE(calls.empty());
   EXPECT_EQ(calls.front().request.args, (std::vector<std::string>{"4", "30", "30", "0.6"}));
@@ -215,7 +221,10 @@ TEST(GuiService, AnotherClientTakesTheRobotOverAndTheFirstIsToldSo) {
   const std::string first_name = run.snapshot().back().request.client;
   (void)first_name;
   second.drive(6, -10, 10);
-  ASSERT_TRUE(eventually([&] { const auto d = run.drives(6); return !d.empty() && d.back() == "-10 10"; }));
+  ASSERT_TRUE(eventually([&] {
+    const auto d = run.drives(6);
+    return !d.empty() && d.back() == "-10 10";
+  }));
   const std::string second_name = run.snapshot().back().request.client;
   EXPECT_NE(first_name, second_name);
   // The first driver alone is told, on its own socket.
@@ -284,7 +293,8 @@ json next_op(Client& c, const std::string& op) {
 // parameterValues' list as name -> value.
 std::map<std::string, json> values_of(const json& parameter_values) {
   std::map<std::string, json> out;
-  for (const auto& p : parameter_values["parameters"]) out[p["name"].get<std::string>()] = p.contains("value") ? p["value"] : json();
+  for (const auto& p : parameter_values["parameters"])
+    out[p["name"].get<std::string>()] = p.contains("value") ? p["value"] : json();
   return out;
 }
 
@@ -302,7 +312,8 @@ TEST(GuiService, VisionSettingsAreParametersTheRunSetsAndReports) {
   ASSERT_EQ(viewer.connect(gui.server().port(), "/ws?token=" + kToken), 101);
   const json info = viewer.next_json();
   for (const char* capability : {"parameters", "parametersSubscribe", "clientPublish"}) {
-    EXPECT_NE(std::find(info["capabilities"].begin(), info["capabilities"].end(), capability), info["capabilities"].end())
+    EXPECT_NE(std::find(info["capabilities"].begin(), info["capabilities"].end(), capability),
+              info["capabilities"].end())
         << capability << " " << info.dump();
   }
   // No camera yet: no parameters. (The answer also says the subscription has been read.)
@@ -325,9 +336,10 @@ TEST(GuiService, VisionSettingsAreParametersTheRunSetsAndReports) {
   EXPECT_EQ(values["vision.min_score"], 0.75);
 
   // Setting two at once is one console command; the answer carries the request's id.
-  viewer.send_text({{"op", "setParameters"},
-                    {"parameters", {{{"name", "vision.contrast"}, {"value", 1.5}}, {{"name", "vision.threshold"}, {"value", 30}}}},
-                    {"id", "c"}});
+  viewer.send_text(
+      {{"op", "setParameters"},
+       {"parameters", {{{"name", "vision.contrast"}, {"value", 1.5}}, {{"name", "vision.threshold"}, {"value", 30}}}},
+       {"id", "c"}});
   update = next_op(viewer, "parameterValues");
   EXPECT_FALSE(update.contains("id"));  // the subscribed change first
   EXPECT_EQ(values_of(update)["vision.contrast"], 1.5);
@@ -340,19 +352,23 @@ TEST(GuiService, VisionSettingsAreParametersTheRunSetsAndReports) {
   EXPECT_EQ(calls[0].request.args, (std::vector<std::string>{"contrast", "1.5", "threshold", "30"}));
 
   // Refused by the run: an error status, and the values as they are.
-  viewer.send_text({{"op", "setParameters"}, {"parameters", {{{"name", "vision.contrast"}, {"value", 9}}}}, {"id", "d"}});
+  viewer.send_text(
+      {{"op", "setParameters"}, {"parameters", {{{"name", "vision.contrast"}, {"value", 9}}}}, {"id", "d"}});
   const json refusal = next_op(viewer, "status");
   EXPECT_EQ(refusal["level"], 2);
-  EXPECT_NE(refusal["message"].get<std::string>().find("contrast 9 is outside 0.2..5"), std::string::npos) << refusal.dump();
+  EXPECT_NE(refusal["message"].get<std::string>().find("contrast 9 is outside 0.2..5"), std::string::npos)
+      << refusal.dump();
   answer = next_op(viewer, "parameterValues");
   EXPECT_EQ(answer["id"], "d");
   EXPECT_EQ(values_of(answer)["vision.contrast"], 1.5);
 
   // Not a vision setting, or not a number: refused here, the run never hears of it.
   viewer.send_text({{"op", "setParameters"}, {"parameters", {{{"name", "gamma"}, {"value", 2}}}}, {"id", "e"}});
-  EXPECT_NE(next_op(viewer, "status")["message"].get<std::string>().find("unknown parameter 'gamma'"), std::string::npos);
+  EXPECT_NE(next_op(viewer, "status")["message"].get<std::string>().find("unknown parameter 'gamma'"),
+            std::string::npos);
   EXPECT_EQ(next_op(viewer, "parameterValues")["id"], "e");
-  viewer.send_text({{"op", "setParameters"}, {"parameters", {{{"name", "vision.contrast"}, {"value", "high"}}}}, {"id", "f"}});
+  viewer.send_text(
+      {{"op", "setParameters"}, {"parameters", {{{"name", "vision.contrast"}, {"value", "high"}}}}, {"id", "f"}});
   EXPECT_NE(next_op(viewer, "status")["message"].get<std::string>().find("must be a number"), std::string::npos);
   EXPECT_EQ(next_op(viewer, "parameterValues")["id"], "f");
   EXPECT_EQ(run.snapshot().size(), 2u);
@@ -384,8 +400,9 @@ TEST(GuiService, AViewerJoiningLaterGetsTheLatestPosesAndSceneThoughNobodyWatche
   viewer.next_json();
   const json advertised = viewer.next_json();
   viewer.send_text({{"op", "subscribe"},
-                    {"subscriptions", {{{"id", 1}, {"channelId", channel_id(advertised, "/rilbed/poses")}},
-                                       {{"id", 2}, {"channelId", channel_id(advertised, "/rilbed/scene")}}}}});
+                    {"subscriptions",
+                     {{{"id", 1}, {"channelId", channel_id(advertised, "/rilbed/poses")}},
+                      {{"id", 2}, {"channelId", channel_id(advertised, "/rilbed/scene")}}}}});
   std::map<int, json> got;
   while (got.size() < 2) {
     const auto m = viewer.next();

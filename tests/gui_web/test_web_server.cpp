@@ -44,7 +44,8 @@ TEST(WebServer, TheTokenOpensEverythingAndNothingOpensWithoutIt) {
   WebServerConfig c = config();
   c.web_root = root;
   WebServer server(c, {});
-  EXPECT_EQ(get(server.port(), "/?token=" + kToken), (std::pair<int, std::string>{200, "<!doctype html><title>rilbed</title>"}));
+  EXPECT_EQ(get(server.port(), "/?token=" + kToken),
+            (std::pair<int, std::string>{200, "<!doctype html><title>rilbed</title>"}));
   EXPECT_EQ(get(server.port(), "/").first, 401);
   EXPECT_EQ(get(server.port(), "/?token=" + kToken.substr(1)).first, 401);
   EXPECT_EQ(get(server.port(), "/?token=" + kToken + "0").first, 401);
@@ -56,12 +57,14 @@ TEST(WebServer, TheTokenOpensEverythingAndNothingOpensWithoutIt) {
   EXPECT_EQ(upgrade_status(server.port(), "/ws?token=" + kToken, ""), 400);
   EXPECT_EQ(upgrade_status(server.port(), "/ws?token=" + kToken, "foxglove.websocket.v1", "http://evil.example"), 403);
   EXPECT_EQ(upgrade_status(server.port(), "/ws?token=" + kToken, "foxglove.websocket.v1",
-                           "http://127.0.0.1:" + std::to_string(server.port())), 101);
+                           "http://127.0.0.1:" + std::to_string(server.port())),
+            101);
   EXPECT_EQ(upgrade_status(server.port(), "/ws?token=" + kToken, "other, foxglove.websocket.v1"), 101);
   // A page loaded from this server under another name (the lab machine's, on the LAN) is its own.
   const std::string lan = "rilbed-lab.local:" + std::to_string(server.port());
   EXPECT_EQ(upgrade_status(server.port(), "/ws?token=" + kToken, "foxglove.websocket.v1", "http://" + lan, lan), 101);
-  EXPECT_EQ(upgrade_status(server.port(), "/ws?token=" + kToken, "foxglove.websocket.v1", "http://evil.example", lan), 403);
+  EXPECT_EQ(upgrade_status(server.port(), "/ws?token=" + kToken, "foxglove.websocket.v1", "http://evil.example", lan),
+            403);
   EXPECT_EQ(Client().connect(server.port(), "/ws?token=" + kToken), 101);
   EXPECT_EQ(server.counters().refused, 8u);  // 3 pages, 5 WebSockets
   std::filesystem::remove_all(root);
@@ -139,7 +142,8 @@ TEST(WebServer, ALatchedChannelsLastMessageGreetsEachNewSubscriber) {
   ASSERT_EQ(client.connect(server.port(), "/ws?token=" + kToken), 101);
   client.next_json();
   client.next_json();
-  client.send_text({{"op", "subscribe"}, {"subscriptions", {{{"id", 1}, {"channelId", plain}}, {{"id", 2}, {"channelId", latched}}}}});
+  client.send_text({{"op", "subscribe"},
+                    {"subscriptions", {{{"id", 1}, {"channelId", plain}}, {{"id", 2}, {"channelId", latched}}}}});
   const auto m = client.next();
   ASSERT_TRUE(std::holds_alternative<std::string>(m));
   const std::string& bytes = std::get<std::string>(m);
@@ -169,7 +173,8 @@ TEST(WebServer, GreetsSubscribesAndSendsData) {
   // Subscription id 0 is the client's first.
   client.send_text({{"op", "subscribe"}, {"subscriptions", {{{"id", 0}, {"channelId", poses}}}}});
   for (int i = 0; i < 200 && server.counters().messages_sent == 0; ++i) {
-    server.publish(poses, 1'000'000'000ULL + i, std::make_shared<const std::string>(R"({"n":)" + std::to_string(i) + "}"));
+    server.publish(poses, 1'000'000'000ULL + i,
+                   std::make_shared<const std::string>(R"({"n":)" + std::to_string(i) + "}"));
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   const auto data = std::get<std::string>(client.next());
@@ -178,7 +183,8 @@ TEST(WebServer, GreetsSubscribesAndSendsData) {
   EXPECT_EQ(data.substr(1, 4), std::string("\0\0\0\0", 4));  // subscription 0
   EXPECT_EQ(data.substr(13, 5), R"({"n":)");
   // A channel added later is advertised to the client.
-  const std::uint32_t world = server.add_channel({0, "/rilbed/world", "json", "rilbed.world", R"({"type":"object"})", "jsonschema"});
+  const std::uint32_t world =
+      server.add_channel({0, "/rilbed/world", "json", "rilbed.world", R"({"type":"object"})", "jsonschema"});
   for (;;) {
     auto m = client.next();
     if (std::holds_alternative<json>(m) && std::get<json>(m)["op"] == "advertise") {
@@ -227,8 +233,8 @@ TEST(WebServer, ClientMessagesReachTheOwnerAndBadOnesGetAStatus) {
   std::mutex mutex;
   std::vector<std::string> heard;
   WebServer::Handlers h;
-  h.on_client_message = [&](const std::string&, const std::string& topic, const std::string&, std::string_view payload)
-      -> std::optional<std::string> {
+  h.on_client_message = [&](const std::string&, const std::string& topic, const std::string&,
+                            std::string_view payload) -> std::optional<std::string> {
     std::lock_guard lock(mutex);
     heard.push_back(topic + " " + std::string(payload));
     if (payload == "refuse") return std::string("not a command");
@@ -245,7 +251,9 @@ TEST(WebServer, ClientMessagesReachTheOwnerAndBadOnesGetAStatus) {
     EXPECT_EQ(st["level"], level);
     EXPECT_NE(st["message"].get<std::string>().find(text), std::string::npos) << st.dump();
   };
-  client.send_text({{"op", "advertise"}, {"channels", {{{"id", 1}, {"topic", "/rilbed/console"}, {"encoding", "json"}, {"schemaName", "c"}}}}});
+  client.send_text(
+      {{"op", "advertise"},
+       {"channels", {{{"id", 1}, {"topic", "/rilbed/console"}, {"encoding", "json"}, {"schemaName", "c"}}}}});
   client.send_binary(std::string("\x01\x01\x00\x00\x00", 5) + R"({"command":"pause"})");
   client.send_binary(std::string("\x01\x01\x00\x00\x00", 5) + "refuse");
   expect_status(2, "not a command");
@@ -260,7 +268,8 @@ TEST(WebServer, ClientMessagesReachTheOwnerAndBadOnesGetAStatus) {
   expect_status(2, "unknown binary opcode 7");
   client.send_text({{"op", "subscribe"}, {"subscriptions", {{{"id", 0}, {"channelId", 42}}}}});
   expect_status(1, "Channel 42 is not available");
-  client.send_text({{"op", "advertise"}, {"channels", {{{"id", 2}, {"topic", "/x"}, {"encoding", "cdr"}, {"schemaName", "c"}}}}});
+  client.send_text(
+      {{"op", "advertise"}, {"channels", {{{"id", 2}, {"topic", "/x"}, {"encoding", "cdr"}, {"schemaName", "c"}}}}});
   expect_status(2, "encoding 'cdr' is not supported");
   {
     std::lock_guard lock(mutex);
@@ -278,7 +287,10 @@ TEST(WebServer, ClientMessagesReachTheOwnerAndBadOnesGetAStatus) {
   beast::error_code ec;
   big.ws.text(true);
   // The server may close before the whole message is written (then the write fails).
-  big.ws.write(asio::buffer(json{{"op", "unsubscribe"}, {"subscriptionIds", json::array()}, {"pad", std::string(4096, 'x')}}.dump()), ec);
+  big.ws.write(
+      asio::buffer(
+          json{{"op", "unsubscribe"}, {"subscriptionIds", json::array()}, {"pad", std::string(4096, 'x')}}.dump()),
+      ec);
   if (!ec) {
     big.buffer.consume(big.buffer.size());
     big.ws.read(big.buffer, ec);
@@ -359,8 +371,9 @@ TEST(WebServer, FiftyClientsAndOneThatNeverReadsHoldsUpNobody) {
   for (auto& t : readers) t.join();
   // The stalled client lost messages; publishing never waited for it.
   EXPECT_GT(server.counters().messages_dropped, 0u);
-  std::printf("[ web      ] 2,000 x 16 kB to 50 clients (one stalled): queued in %.3f s, %llu dropped for slow clients\n",
-              queued_s, static_cast<unsigned long long>(server.counters().messages_dropped));
+  std::printf(
+      "[ web      ] 2,000 x 16 kB to 50 clients (one stalled): queued in %.3f s, %llu dropped for slow clients\n",
+      queued_s, static_cast<unsigned long long>(server.counters().messages_dropped));
 }
 
 }  // namespace

@@ -57,8 +57,9 @@ inline std::pair<int, std::string> get(std::uint16_t port, const std::string& ta
 
 // The status of a WebSocket upgrade request (101 when accepted), as a browser would send
 // it. (Beast 1.74's client does not keep the response of a declined handshake.)
-inline int upgrade_status(std::uint16_t port, const std::string& target, const std::string& subprotocol = "foxglove.websocket.v1",
-                   const std::string& origin = "", const std::string& host = "") {
+inline int upgrade_status(std::uint16_t port, const std::string& target,
+                          const std::string& subprotocol = "foxglove.websocket.v1", const std::string& origin = "",
+                          const std::string& host = "") {
   asio::io_context io;
   beast::tcp_stream stream(io);
   stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));

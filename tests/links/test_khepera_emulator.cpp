@@ -41,7 +41,9 @@ class RawClient {
   RawClient& operator=(const RawClient&) = delete;
   bool ok() const { return fd_ >= 0; }
 
-  void send(const std::string& bytes) { ASSERT_EQ(::write(fd_, bytes.data(), bytes.size()), static_cast<ssize_t>(bytes.size())); }
+  void send(const std::string& bytes) {
+    ASSERT_EQ(::write(fd_, bytes.data(), bytes.size()), static_cast<ssize_t>(bytes.size()));
+  }
 
   // Bytes up to and including the next LF, or nullopt if none within `timeout`.
   std::optional<std::string> line(std::chrono::milliseconds timeout = 2000ms) {
@@ -53,7 +55,8 @@ class RawClient {
         pending_.erase(0, lf + 1);
         return line;
       }
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+      const auto left =
+          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
       if (left.count() <= 0) return std::nullopt;
       pollfd p{fd_, POLLIN, 0};
       if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) continue;

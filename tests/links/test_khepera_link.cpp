@@ -13,9 +13,9 @@
 #include <thread>
 #include <vector>
 
+#include "link_test_support.hpp"
 #include "links/khepera_emulator.hpp"
 #include "links/khepera_link.hpp"
-#include "link_test_support.hpp"
 
 using namespace rilbed::links;
 using namespace std::chrono_literals;
@@ -489,8 +489,5 @@ INSTANTIATE_TEST_SUITE_P(
         PeerCase{"UpperCase", style_with([](ReplyStyle& s) { s.upper_case_letter = true; }), kKTeam},
         PeerCase{"SpacesAfterCommas", style_with([](ReplyStyle& s) { s.spaces_after_commas = true; }), kKTeam},
         PeerCase{"Echo", style_with([](ReplyStyle& s) { s.echo = true; }), kKTeam},
-        PeerCase{"AllAtOnce", style_with([](ReplyStyle& s) {
-                   s = {true, "\n", ",9,x", 2, true, true};
-                 }),
-                 kDotted}),
+        PeerCase{"AllAtOnce", style_with([](ReplyStyle& s) { s = {true, "\n", ",9,x", 2, true, true}; }), kDotted}),
     [](const ::testing::TestParamInfo<PeerCase>& info) { return std::string(info.param.name); });

@@ -143,15 +143,15 @@ TEST(KheperaProtocol, AcceptsRepliesOfOtherFirmware) {
   struct VersionCase {
     std::string line, bios, protocol, text;
   };
-  for (const VersionCase& c : std::vector<VersionCase>{
-           {"b,5.02,5.01\r\n", "5.02", "5.01", "bios 5.02, protocol 5.01"},
-           {"B,5.02,5.01\n", "5.02", "5.01", "bios 5.02, protocol 5.01"},
-           {"b, 5 , 4  ", "5", "4", "bios 5, protocol 4"},
-           {"b,K2 BIOS v5", "K2 BIOS v5", "", "K2 BIOS v5"},
-           {"b,,4", "", "4", ",4"},
-           {"b,5,4,2019-03, rev C", "5", "4", "bios 5, protocol 4 (2019-03, rev C)"},
-           {"b", "", "", ""},
-           {"b,-1,x", "-1", "x", "bios -1, protocol x"}}) {
+  for (const VersionCase& c :
+       std::vector<VersionCase>{{"b,5.02,5.01\r\n", "5.02", "5.01", "bios 5.02, protocol 5.01"},
+                                {"B,5.02,5.01\n", "5.02", "5.01", "bios 5.02, protocol 5.01"},
+                                {"b, 5 , 4  ", "5", "4", "bios 5, protocol 4"},
+                                {"b,K2 BIOS v5", "K2 BIOS v5", "", "K2 BIOS v5"},
+                                {"b,,4", "", "4", ",4"},
+                                {"b,5,4,2019-03, rev C", "5", "4", "bios 5, protocol 4 (2019-03, rev C)"},
+                                {"b", "", "", ""},
+                                {"b,-1,x", "-1", "x", "bios -1, protocol x"}}) {
     const Result<Reply> r = decode_reply(k, CommandKind::kReadVersions, c.line);
     ASSERT_TRUE(r.ok()) << printable(c.line) << ": " << r.error();
     EXPECT_EQ(r->versions.bios, c.bios) << printable(c.line);

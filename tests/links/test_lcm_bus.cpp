@@ -118,7 +118,8 @@ TEST(LcmBus, ARunOnTheInProcessBusIsWhatItsFolderHolds) {
     ASSERT_LT(k, got.events.size()) << line;
     const auto& e = got.events[k++];
     std::snprintf(row, sizeof row, "%.3f,", static_cast<double>(e.utime) * 1e-6);
-    EXPECT_EQ(line.rfind(std::string(row) + e.kind + "," + std::to_string(e.id) + "," + std::to_string(e.other) + ",", 0), 0u)
+    EXPECT_EQ(
+        line.rfind(std::string(row) + e.kind + "," + std::to_string(e.id) + "," + std::to_string(e.other) + ",", 0), 0u)
         << line;
   }
   EXPECT_EQ(k, got.events.size());
@@ -220,7 +221,8 @@ namespace {
 
 std::vector<std::uint8_t> from_hex(const std::string& hex) {
   std::vector<std::uint8_t> bytes;
-  for (std::size_t i = 0; i + 1 < hex.size(); i += 2) bytes.push_back(static_cast<std::uint8_t>(std::stoi(hex.substr(i, 2), nullptr, 16)));
+  for (std::size_t i = 0; i + 1 < hex.size(); i += 2)
+    bytes.push_back(static_cast<std::uint8_t>(std::stoi(hex.substr(i, 2), nullptr, 16)));
   return bytes;
 }
 
@@ -241,8 +243,8 @@ TEST(LcmBus, HostileMessagesAndLogsAreRefusedNotDecoded) {
       "00000001800000006e6f7465000000000100000000000000027800");
   const auto dir = std::filesystem::temp_directory_path() / ("rilbed_hostile_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
-  std::ofstream(dir / "event.lcm", std::ios::binary).write(reinterpret_cast<const char*>(log_bytes.data()),
-                                                           static_cast<std::streamsize>(log_bytes.size()));
+  std::ofstream(dir / "event.lcm", std::ios::binary)
+      .write(reinterpret_cast<const char*>(log_bytes.data()), static_cast<std::streamsize>(log_bytes.size()));
   LcmLogReader reader((dir / "event.lcm").string());
   ASSERT_TRUE(reader.good());
   const auto event = reader.next();
@@ -251,9 +253,10 @@ TEST(LcmBus, HostileMessagesAndLogsAreRefusedNotDecoded) {
   EXPECT_TRUE(decoder.decode(event->channel, event->data.data(), event->data.size()).has_value());
   EXPECT_FALSE(reader.next().has_value());
   // A log event that claims 2 GB of data (liblcm's reader wrote through a null pointer).
-  const auto huge = from_hex("eda1da01000000000000000000000000000000010000000d7fffffff52494c4245445f4556454e5453736f6d652064617461");
-  std::ofstream(dir / "huge.lcm", std::ios::binary).write(reinterpret_cast<const char*>(huge.data()),
-                                                          static_cast<std::streamsize>(huge.size()));
+  const auto huge =
+      from_hex("eda1da01000000000000000000000000000000010000000d7fffffff52494c4245445f4556454e5453736f6d652064617461");
+  std::ofstream(dir / "huge.lcm", std::ios::binary)
+      .write(reinterpret_cast<const char*>(huge.data()), static_cast<std::streamsize>(huge.size()));
   LcmLogReader cut((dir / "huge.lcm").string());
   EXPECT_FALSE(cut.next().has_value());
   EXPECT_TRUE(cut.truncated());

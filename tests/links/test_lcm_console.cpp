@@ -29,7 +29,9 @@ rilbed::console_command_t command(std::string name, std::vector<std::string> arg
 
 TEST(LcmConsole, ParsesEveryCommandAndRefusesTheRest) {
   using Kind = agents::ControlAction::Kind;
-  auto kind = [](const rilbed::console_command_t& c) { return std::get<agents::ControlAction>(parse_console_command(c)).kind; };
+  auto kind = [](const rilbed::console_command_t& c) {
+    return std::get<agents::ControlAction>(parse_console_command(c)).kind;
+  };
   EXPECT_EQ(kind(command("pause")), Kind::kPause);
   EXPECT_EQ(kind(command("resume")), Kind::kResume);
   EXPECT_EQ(kind(command("exit")), Kind::kExit);
@@ -42,19 +44,22 @@ TEST(LcmConsole, ParsesEveryCommandAndRefusesTheRest) {
   EXPECT_EQ(mode.kind, Kind::kMode);
   EXPECT_TRUE(mode.central);
   EXPECT_FALSE(std::get<agents::ControlAction>(parse_console_command(command("mode", {"distributed"}))).central);
-  const auto drive = std::get<agents::ControlAction>(parse_console_command(command("drive", {"3", "-40", "127", "2.5"})));
+  const auto drive =
+      std::get<agents::ControlAction>(parse_console_command(command("drive", {"3", "-40", "127", "2.5"})));
   EXPECT_EQ(drive.kind, Kind::kDrive);
   EXPECT_EQ(drive.robot_id, 3);
   EXPECT_EQ(drive.left, -40);
   EXPECT_EQ(drive.right, 127);
   EXPECT_EQ(drive.duration_s, 2.5);
-  for (const auto& bad : {command("mode"), command("mode", {"fast"}), command("mode", {"central", "x"}), command("reset", {"1"}),
-                          command("drive", {"3", "40", "40"}), command("drive", {"3", "128", "0", "1"}),
-                          command("drive", {"3", "0", "-128", "1"}), command("drive", {"x", "0", "0", "1"}),
-                          command("drive", {"3", "1.5", "0", "1"}), command("drive", {"3", "0", "0", "0"}),
-                          command("drive", {"3", "0", "0", "nan"}), command("drive", {"3", "0", "0", "601"}),
-                          command("drive", {"99999999999", "0", "0", "1"}), command("drive", {"-1", "0", "0", "1"})}) {
-    EXPECT_TRUE(std::holds_alternative<std::string>(parse_console_command(bad))) << bad.command << " " << bad.args.size();
+  for (const auto& bad :
+       {command("mode"), command("mode", {"fast"}), command("mode", {"central", "x"}), command("reset", {"1"}),
+        command("drive", {"3", "40", "40"}), command("drive", {"3", "128", "0", "1"}),
+        command("drive", {"3", "0", "-128", "1"}), command("drive", {"x", "0", "0", "1"}),
+        command("drive", {"3", "1.5", "0", "1"}), command("drive", {"3", "0", "0", "0"}),
+        command("drive", {"3", "0", "0", "nan"}), command("drive", {"3", "0", "0", "601"}),
+        command("drive", {"99999999999", "0", "0", "1"}), command("drive", {"-1", "0", "0", "1"})}) {
+    EXPECT_TRUE(std::holds_alternative<std::string>(parse_console_command(bad)))
+        << bad.command << " " << bad.args.size();
   }
   for (const auto& bad : {command("rt-factor"), command("rt-factor", {"0"}), command("rt-factor", {"x"}),
                           command("rt-factor", {"inf"}), command("pause", {"now"}), command("fly"), command("")}) {
@@ -64,7 +69,8 @@ TEST(LcmConsole, ParsesEveryCommandAndRefusesTheRest) {
 
 TEST(LcmConsole, VisionTakesNameValuePairsInRange) {
   using Kind = agents::ControlAction::Kind;
-  const auto v = std::get<agents::ControlAction>(parse_console_command(command("vision", {"contrast", "1.5", "threshold", "30"})));
+  const auto v =
+      std::get<agents::ControlAction>(parse_console_command(command("vision", {"contrast", "1.5", "threshold", "30"})));
   EXPECT_EQ(v.kind, Kind::kVision);
   EXPECT_EQ(v.vision, (std::vector<std::pair<std::string, double>>{{"contrast", 1.5}, {"threshold", 30.0}}));
   const auto reason = [](const rilbed::console_command_t& c) {
@@ -163,8 +169,9 @@ TEST(LcmConsole, AnswersEveryCommandOnceAndAppliesItOnce) {
   EXPECT_NE(run.applied[1].what.find("'exit'"), std::string::npos);
   // The same command three times (a client retrying after a loss): three answers, one action.
   Replies replies;
-  LcmSubscription subscription(server_bus, channels.console_reply,
-                               [&replies](const std::string& c, const void* data, std::size_t size) { replies.on(c, data, size); });
+  LcmSubscription subscription(
+      server_bus, channels.console_reply,
+      [&replies](const std::string& c, const void* data, std::size_t size) { replies.on(c, data, size); });
   const rilbed::console_command_t resume = command("resume");
   for (int i = 0; i < 3; ++i) server_bus.publish(channels.console, &resume);
   for (int i = 0; i < 200 && replies.got.size() < 3; ++i) server_bus.handleTimeout(10);

@@ -24,12 +24,14 @@ agents::Scenario two_real_robots(const std::string& placement) {
       "robots:\n"
       "  - ids: 1-2\n"
       "    kind: real\n"
-      "    link: {emulate: true, placement: " + placement + "}\n"
-      "    pose: random\n"
-      "    controller: none\n"
-      "  - id: 3\n"
-      "    pose: [0.75, 0.6, 0]\n"
-      "    controller: none\n",
+      "    link: {emulate: true, placement: " +
+          placement +
+          "}\n"
+          "    pose: random\n"
+          "    controller: none\n"
+          "  - id: 3\n"
+          "    pose: [0.75, 0.6, 0]\n"
+          "    controller: none\n",
       "placing.yaml");
 }
 
@@ -89,7 +91,8 @@ TEST(Placement, AsksTheOperatorByNameWhenDrivingRunsOutOfTime) {
   options.ask_operator = [](const std::string&) { return false; };
   r = place_real_robots(robots, {{1, Pose2{{0.3, 0.3}, 0.0}}, {2, Pose2{{1.2, 0.9}, 0.0}}}, options);
   EXPECT_FALSE(r.ok);
-  EXPECT_NE(r.error.find("robots 1, 2 are not at their start poses and nobody placed them"), std::string::npos) << r.error;
+  EXPECT_NE(r.error.find("robots 1, 2 are not at their start poses and nobody placed them"), std::string::npos)
+      << r.error;
   // With nobody to ask, it fails too. (Towards poses nearly a metre from where the robots
   // stand: the call above drove them towards these for at most 0.5 s, so a slow machine
   // cannot leave them already in place.)
@@ -119,7 +122,7 @@ TEST(Placement, TheStartPosesAreTheRunsOwn) {
   for (std::uint64_t seed : {1u, 7u, 42u}) {
     agents::Scenario all_virtual = scenario;
     for (auto& r : all_virtual.robots) {
-      r.kind = environment::RobotKind::Virtual;
+      r.kind = environment::RobotKind::kVirtual;
       r.link.reset();
     }
     all_virtual.camera.reset();

@@ -20,9 +20,9 @@
 #include <vector>
 
 #include "environment/world.hpp"
+#include "link_test_support.hpp"
 #include "links/khepera_emulator.hpp"
 #include "links/khepera_link.hpp"
-#include "link_test_support.hpp"
 #include "links/real_body.hpp"
 
 using namespace rilbed;
@@ -56,7 +56,7 @@ class RealBodyTest : public ::testing::Test {
   void SetUp() override {
     environment::RobotConfig rc;
     rc.id = kRealId;
-    rc.kind = environment::RobotKind::Real;
+    rc.kind = environment::RobotKind::kReal;
     rc.pose = {{0.75, 0.6}, 0.0};
     world_.add_robot(rc);
     // Observations are made at the world's current time; start it off zero so that a
@@ -224,7 +224,7 @@ TEST_F(RealBodyTest, TheGeofenceStopsOnlyMovesOutward) {
   // In a corner both edges count: facing out of either is refused, into both is allowed.
   observe(0.02, 0.02, -kPi / 2);
   ASSERT_TRUE(drive_obeyed(-24, -24));  // backwards: up, inwards
-  ASSERT_TRUE(drive_stopped(24, 24));    // forwards: down, out
+  ASSERT_TRUE(drive_stopped(24, 24));   // forwards: down, out
   observe(0.02, 0.02, kPi / 4);
   ASSERT_TRUE(drive_obeyed(26, 26));  // into the field
   observe(0.02, 0.02, kPi);
@@ -271,8 +271,8 @@ TEST_F(RealBodySenseTest, CombinesTheRobotsOwnProximityWithVirtualWallsPerSensor
   for (int i = 0; i < environment::kProximityCount; ++i) {
     EXPECT_EQ((*r.proximity)[i], std::max(v[i], own[i])) << "sensor " << i;
   }
-  EXPECT_EQ((*r.proximity)[0], 1000);   // the robot's own
-  EXPECT_EQ((*r.proximity)[3], v[3]);   // the virtual wall beats the robot's 100
+  EXPECT_EQ((*r.proximity)[0], 1000);  // the robot's own
+  EXPECT_EQ((*r.proximity)[3], v[3]);  // the virtual wall beats the robot's 100
   EXPECT_GT((*r.proximity)[3], own[3]);
   ASSERT_TRUE(r.odometry.has_value());  // the robot's counters (a real robot's are not virtual)
   const auto counters = body_->link().latest_counters();
@@ -305,7 +305,7 @@ TEST_F(RealBodyTest, DestroyingTheBodyStopsTheRobot) {
 TEST_F(RealBodyTest, RejectsARobotThatIsNotARealOneOfTheWorld) {
   environment::RobotConfig rc;
   rc.id = 3;
-  rc.kind = environment::RobotKind::Virtual;
+  rc.kind = environment::RobotKind::kVirtual;
   rc.pose = {{0.3, 0.3}, 0.0};
   world_.add_robot(rc);
   RealBodyConfig body;
@@ -318,7 +318,8 @@ class RealBodyReplugTest : public RealBodyTest {
  protected:
   static EmulatorConfig with_stable_path() {
     EmulatorConfig emulated;
-    emulated.stable_path = (fs::temp_directory_path() / ("rilbed_test_real_body_" + std::to_string(::getpid()))).string();
+    emulated.stable_path =
+        (fs::temp_directory_path() / ("rilbed_test_real_body_" + std::to_string(::getpid()))).string();
     return emulated;
   }
   RealBodyReplugTest() : RealBodyTest(with_stable_path()) {}
@@ -357,12 +358,13 @@ TEST_F(RealBodyReplugTest, HealthShowsTheLinkLostAndRecovered) {
 // 0..4095: a controller's Khepera units and the world's 0..1023 scale are converted.
 class EpuckBodyTest : public RealBodyTest {
  protected:
-  EpuckBodyTest() : RealBodyTest([] {
-      EmulatorConfig e;
-      e.model = epuck_model();
-      e.proximity = {4095, 0, 2048, 0, 0, 0, 0, 0};
-      return e;
-    }()) {}
+  EpuckBodyTest()
+      : RealBodyTest([] {
+          EmulatorConfig e;
+          e.model = epuck_model();
+          e.proximity = {4095, 0, 2048, 0, 0, 0, 0, 0};
+          return e;
+        }()) {}
 };
 
 TEST_F(EpuckBodyTest, ConvertsSpeedsAndProximityToTheModelsUnits) {

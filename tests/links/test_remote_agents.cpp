@@ -264,7 +264,7 @@ TEST(RemoteAgents, InRealTimeAnAnswerPastItsDeadlineIsCountedLateAndAppliedAtThe
   EXPECT_EQ(remote.counters().late, 1);
   ASSERT_EQ(second.size(), 2 * rc.robot_ids.size());
   for (std::size_t i = 0; i < rc.robot_ids.size(); ++i) {
-    EXPECT_EQ(second[i].robot_id, rc.robot_ids[i]);  // the late answers first ...
+    EXPECT_EQ(second[i].robot_id, rc.robot_ids[i]);                        // the late answers first ...
     EXPECT_EQ(second[rc.robot_ids.size() + i].robot_id, rc.robot_ids[i]);  // ... then this instant's
     EXPECT_NE(second[i].output.behaviour, "lost");
   }

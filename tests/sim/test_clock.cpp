@@ -17,14 +17,14 @@ using WallClock = std::chrono::steady_clock;
 TEST(FastClock, JumpsToEachDeadline) {
   FastClock clock;
   EXPECT_EQ(clock.now_us(), 0);
-  EXPECT_EQ(clock.wait_until(1'000'000'000), WaitResult::reached);
+  EXPECT_EQ(clock.wait_until(1'000'000'000), WaitResult::kReached);
   EXPECT_EQ(clock.now_us(), 1'000'000'000);
-  EXPECT_EQ(clock.wait_until(kInfinity), WaitResult::reached);
+  EXPECT_EQ(clock.wait_until(kInfinity), WaitResult::kReached);
   EXPECT_EQ(clock.now_us(), 1'000'000'000);  // "never" is not a time
   clock.start(5);
   EXPECT_EQ(clock.now_us(), 5);
   clock.stop();
-  EXPECT_EQ(clock.wait_until(10), WaitResult::stopped);
+  EXPECT_EQ(clock.wait_until(10), WaitResult::kStopped);
   EXPECT_EQ(clock.now_us(), 5);
 }
 
@@ -41,7 +41,7 @@ TEST(RealTimeClock, FactorTenTakesATenthOfTheWallTime) {
   RealTimeClock clock(10.0);
   const auto wall_start = WallClock::now();
   clock.start(0);
-  EXPECT_EQ(clock.wait_until(200'000), WaitResult::reached);
+  EXPECT_EQ(clock.wait_until(200'000), WaitResult::kReached);
   const auto wall_elapsed = WallClock::now() - wall_start;
   EXPECT_GE(wall_elapsed, 20ms);
   EXPECT_LT(wall_elapsed, 2s);
@@ -55,7 +55,7 @@ TEST(RealTimeClock, ManySmallWaitsDoNotLoseTime) {
   const auto wall_start = WallClock::now();
   clock.start(1'000);
   for (TimeUs t_us = 3'000; t_us <= 101'000; t_us += 2'000) {
-    ASSERT_EQ(clock.wait_until(t_us), WaitResult::reached);
+    ASSERT_EQ(clock.wait_until(t_us), WaitResult::kReached);
     ASSERT_GE(clock.now_us(), t_us);
   }
   EXPECT_GE(WallClock::now() - wall_start, 100ms);
@@ -65,8 +65,8 @@ TEST(RealTimeClock, PastDeadlinesAreReachedAtOnce) {
   RealTimeClock clock(1.0);
   clock.start(1'000'000);
   const auto wall_start = WallClock::now();
-  EXPECT_EQ(clock.wait_until(500'000), WaitResult::reached);
-  EXPECT_EQ(clock.wait_until(1'000'000), WaitResult::reached);
+  EXPECT_EQ(clock.wait_until(500'000), WaitResult::kReached);
+  EXPECT_EQ(clock.wait_until(1'000'000), WaitResult::kReached);
   EXPECT_LT(WallClock::now() - wall_start, 2s);
 }
 
@@ -78,7 +78,7 @@ TEST(RealTimeClock, SetFactorWhileWaitingTakesEffect) {
   auto waiting = std::async(std::launch::async, [&] { return clock.wait_until(20'000'000); });
   std::this_thread::sleep_for(20ms);
   clock.set_factor(1000.0);  // the rest takes about 20 ms
-  EXPECT_EQ(waiting.get(), WaitResult::reached);
+  EXPECT_EQ(waiting.get(), WaitResult::kReached);
   EXPECT_LT(WallClock::now() - wall_start, 10s);
   EXPECT_GE(clock.now_us(), 20'000'000);
 }
@@ -117,7 +117,7 @@ TEST(RealTimeClock, PauseFreezesTimeAndWaits) {
   EXPECT_EQ(clock.now_us(), frozen_us);
   clock.resume();
   EXPECT_FALSE(clock.paused());
-  EXPECT_EQ(waiting.get(), WaitResult::reached);
+  EXPECT_EQ(waiting.get(), WaitResult::kReached);
   EXPECT_GE(clock.now_us(), frozen_us + 1'000);
 }
 
@@ -128,7 +128,7 @@ TEST(RealTimeClock, NotifyWakesAWaitEarly) {
   auto waiting = std::async(std::launch::async, [&] { return clock.wait_until(100'000'000); });
   std::this_thread::sleep_for(20ms);
   clock.notify();
-  EXPECT_EQ(waiting.get(), WaitResult::woken);
+  EXPECT_EQ(waiting.get(), WaitResult::kWoken);
   EXPECT_LT(WallClock::now() - wall_start, 10s);
   EXPECT_LT(clock.now_us(), 100'000'000);
 }
@@ -137,9 +137,9 @@ TEST(RealTimeClock, NotifyBeforeWaitIsNotLost) {
   RealTimeClock clock(1.0);
   clock.start(0);
   clock.notify();
-  EXPECT_EQ(clock.wait_until(kInfinity), WaitResult::woken);
+  EXPECT_EQ(clock.wait_until(kInfinity), WaitResult::kWoken);
   // Consumed: the next wait runs to its deadline.
-  EXPECT_EQ(clock.wait_until(clock.now_us() + 1'000), WaitResult::reached);
+  EXPECT_EQ(clock.wait_until(clock.now_us() + 1'000), WaitResult::kReached);
 }
 
 TEST(RealTimeClock, StopEndsEveryWait) {
@@ -149,7 +149,7 @@ TEST(RealTimeClock, StopEndsEveryWait) {
   auto second = std::async(std::launch::async, [&] { return clock.wait_until(50'000'000); });
   std::this_thread::sleep_for(20ms);
   clock.stop();
-  EXPECT_EQ(first.get(), WaitResult::stopped);
-  EXPECT_EQ(second.get(), WaitResult::stopped);
-  EXPECT_EQ(clock.wait_until(1), WaitResult::stopped);
+  EXPECT_EQ(first.get(), WaitResult::kStopped);
+  EXPECT_EQ(second.get(), WaitResult::kStopped);
+  EXPECT_EQ(clock.wait_until(1), WaitResult::kStopped);
 }

@@ -35,9 +35,7 @@ struct Chain {
   }
   /// Marks the end of every step in the log with "@<t_us>".
   void mark_steps(Coordinator& coordinator) {
-    coordinator.on_step([log = log](const StepReport& report) {
-      log->push_back("@" + std::to_string(report.t_us));
-    });
+    coordinator.on_step([log = log](const StepReport& report) { log->push_back("@" + std::to_string(report.t_us)); });
   }
 };
 
@@ -63,10 +61,10 @@ TEST(Coordinator, ChainEventTimesMatchHandComputation) {
   coordinator.run_until(1000 * kMs);
   EXPECT_EQ(chain.sink->state().received, (Received{{250 * kMs, 1}, {400 * kMs, 2}, {550 * kMs, 3}}));
   EXPECT_EQ(*chain.log, (EventLog{
-                            "gen:out 1", "gen:int", "proc:ext e=100000 [1]", "@100000",
-                            "gen:out 2", "gen:int", "proc:ext e=100000 [2]", "@200000",
+                            "gen:out 1",  "gen:int",  "proc:ext e=100000 [1]", "@100000",
+                            "gen:out 2",  "gen:int",  "proc:ext e=100000 [2]", "@200000",
                             "proc:out 1", "proc:int", "sink:ext e=250000 [1]", "@250000",
-                            "gen:out 3", "gen:int", "proc:ext e=50000 [3]", "@300000",
+                            "gen:out 3",  "gen:int",  "proc:ext e=50000 [3]",  "@300000",
                             "proc:out 2", "proc:int", "sink:ext e=150000 [2]", "@400000",
                             "proc:out 3", "proc:int", "sink:ext e=150000 [3]", "@550000",
                         }));
@@ -86,12 +84,30 @@ TEST(Coordinator, ConfluentWhenInputArrivesAsTimeAdvanceRunsOut) {
   // All outputs of an instant come before its transitions; confluent gets the elapsed
   // time (= time advance) and by default runs internal, then external with 0.
   EXPECT_EQ(*chain.log, (EventLog{
-                            "gen:out 1", "gen:int", "proc:ext e=100000 [1]", "@100000",
-                            "gen:out 2", "proc:out 1", "gen:int", "proc:conf e=100000", "proc:int",
-                            "proc:ext e=0 [2]", "sink:ext e=200000 [1]", "@200000",
-                            "gen:out 3", "proc:out 2", "gen:int", "proc:conf e=100000", "proc:int",
-                            "proc:ext e=0 [3]", "sink:ext e=100000 [2]", "@300000",
-                            "proc:out 3", "proc:int", "sink:ext e=100000 [3]", "@400000",
+                            "gen:out 1",
+                            "gen:int",
+                            "proc:ext e=100000 [1]",
+                            "@100000",
+                            "gen:out 2",
+                            "proc:out 1",
+                            "gen:int",
+                            "proc:conf e=100000",
+                            "proc:int",
+                            "proc:ext e=0 [2]",
+                            "sink:ext e=200000 [1]",
+                            "@200000",
+                            "gen:out 3",
+                            "proc:out 2",
+                            "gen:int",
+                            "proc:conf e=100000",
+                            "proc:int",
+                            "proc:ext e=0 [3]",
+                            "sink:ext e=100000 [2]",
+                            "@300000",
+                            "proc:out 3",
+                            "proc:int",
+                            "sink:ext e=100000 [3]",
+                            "@400000",
                         }));
 }
 
@@ -163,11 +179,9 @@ TEST(Coordinator, AtomicRootTakesInjectionsAndReportsOutputs) {
   FastClock clock;
   Coordinator coordinator(proc, clock);
   std::vector<std::pair<TimeUs, std::vector<int>>> outputs;
-  coordinator.on_output<int>(proc->out, [&](TimeUs t_us, const std::vector<int>& messages) {
-    outputs.emplace_back(t_us, messages);
-  });
-  EXPECT_THROW(coordinator.on_output<int>(proc->in, [](TimeUs, const std::vector<int>&) {}),
-               std::invalid_argument);
+  coordinator.on_output<int>(
+      proc->out, [&](TimeUs t_us, const std::vector<int>& messages) { outputs.emplace_back(t_us, messages); });
+  EXPECT_THROW(coordinator.on_output<int>(proc->in, [](TimeUs, const std::vector<int>&) {}), std::invalid_argument);
   coordinator.run_until(10);
   coordinator.inject(proc->in, 5);
   coordinator.run_until(100);
@@ -210,8 +224,7 @@ TEST(Coordinator, ModelExceptionsCarryTheModelPath) {
   } catch (const ModelError& error) {
     EXPECT_EQ(error.model_path(), "top/mid/bad");
     const std::string what = error.what();
-    EXPECT_NE(what.find("'top/mid/bad' failed in internal_transition at t=30 us: boom"), std::string::npos)
-        << what;
+    EXPECT_NE(what.find("'top/mid/bad' failed in internal_transition at t=30 us: boom"), std::string::npos) << what;
   }
   EXPECT_EQ(coordinator.now_us(), 20);  // the last complete step
   EXPECT_THROW(coordinator.run_until(2000), std::logic_error);
@@ -415,7 +428,7 @@ class Watcher final : public AtomicModel<int> {
   TimeUs time_advance() const override { return period_us_; }
   void internal_transition() override {
     ++state_;
-    for (const Ticker* t : before_) ok_ = ok_ && t->state() == state_;   // already stepped
+    for (const Ticker* t : before_) ok_ = ok_ && t->state() == state_;     // already stepped
     for (const Ticker* t : after_) ok_ = ok_ && t->state() == state_ - 1;  // not yet
   }
   void external_transition(TimeUs) override {}
@@ -436,12 +449,14 @@ struct TickerWorld {
   explicit TickerWorld(int failing = -1, int second_failing = -1) {
     std::vector<const Ticker*> before, after;
     for (int i = 0; i < 20; ++i) {
-      tickers.push_back(&top->emplace<Ticker>("t" + std::to_string(i), 10 * kMs, i == failing || i == second_failing ? 3 : 0));
+      tickers.push_back(
+          &top->emplace<Ticker>("t" + std::to_string(i), 10 * kMs, i == failing || i == second_failing ? 3 : 0));
       before.push_back(tickers.back());
     }
     watcher = &top->emplace<Watcher>(10 * kMs);
     for (int i = 20; i < 40; ++i) {
-      tickers.push_back(&top->emplace<Ticker>("t" + std::to_string(i), 10 * kMs, i == failing || i == second_failing ? 3 : 0));
+      tickers.push_back(
+          &top->emplace<Ticker>("t" + std::to_string(i), 10 * kMs, i == failing || i == second_failing ? 3 : 0));
       after.push_back(tickers.back());
     }
     watcher->watch(before, after);

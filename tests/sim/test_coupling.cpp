@@ -64,14 +64,14 @@ TEST(Coupling, RejectsDirectionsThatFitNoKind) {
   auto& top_out = top.add_output<int>("out");
   auto& a = top.emplace<Processor>("a", 10);
   auto& b = top.emplace<Processor>("b", 10);
-  EXPECT_THROW(top.couple(a.out, b.out), std::invalid_argument);    // out -> out of siblings
-  EXPECT_THROW(top.couple(a.in, b.in), std::invalid_argument);      // in -> in of siblings
-  EXPECT_THROW(top.couple(top_in, top_out), std::invalid_argument); // own in -> own out
-  EXPECT_THROW(top.couple(top_out, a.in), std::invalid_argument);   // own out -> child
-  EXPECT_THROW(top.couple(a.in, top_out), std::invalid_argument);   // child in -> own out
-  EXPECT_NO_THROW(top.couple(top_in, a.in));                        // EIC
-  EXPECT_NO_THROW(top.couple(a.out, b.in));                         // IC
-  EXPECT_NO_THROW(top.couple(b.out, top_out));                      // EOC
+  EXPECT_THROW(top.couple(a.out, b.out), std::invalid_argument);     // out -> out of siblings
+  EXPECT_THROW(top.couple(a.in, b.in), std::invalid_argument);       // in -> in of siblings
+  EXPECT_THROW(top.couple(top_in, top_out), std::invalid_argument);  // own in -> own out
+  EXPECT_THROW(top.couple(top_out, a.in), std::invalid_argument);    // own out -> child
+  EXPECT_THROW(top.couple(a.in, top_out), std::invalid_argument);    // child in -> own out
+  EXPECT_NO_THROW(top.couple(top_in, a.in));                         // EIC
+  EXPECT_NO_THROW(top.couple(a.out, b.in));                          // IC
+  EXPECT_NO_THROW(top.couple(b.out, top_out));                       // EOC
   EXPECT_NE(what_of([&] { top.couple(a.out, b.in); }).find("exists already"), std::string::npos);
   EXPECT_EQ(top.couplings().size(), 3u);
 }
@@ -88,7 +88,7 @@ TEST(Coupling, ChecksNamesAndParents) {
   EXPECT_THROW(top.add(std::shared_ptr<Sink>()), std::invalid_argument);
   EXPECT_THROW(Sink(""), std::invalid_argument);
   EXPECT_THROW(gen->add_output<double>("out"), std::invalid_argument);  // port name taken
-  EXPECT_NO_THROW(gen->add_input<double>("out"));  // inputs and outputs are separate
+  EXPECT_NO_THROW(gen->add_input<double>("out"));                       // inputs and outputs are separate
   EXPECT_EQ(&gen->output_port<int>("out"), &gen->out);
   EXPECT_THROW(gen->output_port<double>("out"), std::invalid_argument);
   EXPECT_THROW(gen->input_port<int>("missing"), std::invalid_argument);
@@ -134,9 +134,8 @@ TEST(Coupling, RoutesThroughNestedCoupledModels) {
   EXPECT_EQ(coordinator.atomics()[1], &proc);
   EXPECT_EQ(coordinator.atomics()[2], &sink);
   std::vector<std::pair<rilbed::TimeUs, std::vector<int>>> at_top;
-  coordinator.on_output<int>(top_out, [&](rilbed::TimeUs t_us, const std::vector<int>& messages) {
-    at_top.emplace_back(t_us, messages);
-  });
+  coordinator.on_output<int>(
+      top_out, [&](rilbed::TimeUs t_us, const std::vector<int>& messages) { at_top.emplace_back(t_us, messages); });
   coordinator.run_until(1000);
   EXPECT_EQ(sink.state().received, (std::vector<std::pair<rilbed::TimeUs, int>>{{130, 1}, {230, 2}}));
   EXPECT_EQ(at_top, (std::vector<std::pair<rilbed::TimeUs, std::vector<int>>>{{130, {1}}, {230, {2}}}));

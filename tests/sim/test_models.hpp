@@ -32,10 +32,13 @@ struct GeneratorState {
 /// period_us).
 class Generator : public AtomicModel<GeneratorState> {
  public:
-  Generator(std::string id, TimeUs period_us, int count, std::shared_ptr<EventLog> log = nullptr,
-            int base = 0)
-      : AtomicModel(std::move(id), {}), out(add_output<int>("out")), period_us_(period_us),
-        count_(count), base_(base), log_(std::move(log)) {}
+  Generator(std::string id, TimeUs period_us, int count, std::shared_ptr<EventLog> log = nullptr, int base = 0)
+      : AtomicModel(std::move(id), {}),
+        out(add_output<int>("out")),
+        period_us_(period_us),
+        count_(count),
+        base_(base),
+        log_(std::move(log)) {}
 
   Port<int>& out;
 
@@ -69,8 +72,11 @@ struct ProcessorState {
 class Processor : public AtomicModel<ProcessorState> {
  public:
   Processor(std::string id, TimeUs service_us, std::shared_ptr<EventLog> log = nullptr)
-      : AtomicModel(std::move(id), {}), in(add_input<int>("in")), out(add_output<int>("out")),
-        service_us_(service_us), log_(std::move(log)) {}
+      : AtomicModel(std::move(id), {}),
+        in(add_input<int>("in")),
+        out(add_output<int>("out")),
+        service_us_(service_us),
+        log_(std::move(log)) {}
 
   Port<int>& in;
   Port<int>& out;

@@ -8,10 +8,11 @@ using rilbed::vision::assign_max_similarity;
 
 // The paper's Table 1: 5 objects, IDs {1, 3, 6}.
 TEST(Assignment, PapersTableOne) {
-  const std::vector<std::vector<double>> table = {
-      {0.27433464, 0.3336813, 0.40391427}, {0.6221739, 0.93153024, 0.16337222},
-      {0.5072501, 0.19723846, 0.9139368},  {0.3381496, 0.47814554, 0.36910614},
-      {0.9299889, 0.65918684, 0.51369625}};
+  const std::vector<std::vector<double>> table = {{0.27433464, 0.3336813, 0.40391427},
+                                                  {0.6221739, 0.93153024, 0.16337222},
+                                                  {0.5072501, 0.19723846, 0.9139368},
+                                                  {0.3381496, 0.47814554, 0.36910614},
+                                                  {0.9299889, 0.65918684, 0.51369625}};
   const auto a = assign_max_similarity(table, 0.0);
   EXPECT_EQ(a, (std::vector<int>{-1, 1, 2, -1, 0}));
 }

@@ -36,9 +36,9 @@ TEST(BlobDetector, SubPixelCentroid) {
 
 TEST(BlobDetector, RejectsSquaresAndLines) {
   cv::Mat img(200, 200, CV_8UC1, cv::Scalar(185));
-  cv::rectangle(img, {20, 20, 30, 30}, cv::Scalar(28), cv::FILLED);       // square
-  cv::line(img, {100, 20}, {180, 60}, cv::Scalar(28), 4);                // tape
-  cv::rectangle(img, {20, 120, 60, 20}, cv::Scalar(28), cv::FILLED);      // bar
+  cv::rectangle(img, {20, 20, 30, 30}, cv::Scalar(28), cv::FILLED);   // square
+  cv::line(img, {100, 20}, {180, 60}, cv::Scalar(28), 4);             // tape
+  cv::rectangle(img, {20, 120, 60, 20}, cv::Scalar(28), cv::FILLED);  // bar
   // The square's outline strays from an ellipse by a chord error of about 0.2: doubtful
   // at most, for the tracker's edge fit to turn down (MarkerTracker test below).
   BlobDetector detector;
@@ -137,8 +137,7 @@ TEST(BlobDetector, CircularTrackAroundMarkersDoesNotHideThem) {
   BlobDetector detector;
   const auto blobs = detector.detect(img);
   auto found_at = [&](double u, double v) {
-    return std::any_of(blobs.begin(), blobs.end(),
-                       [&](const Blob& b) { return std::hypot(b.u - u, b.v - v) < 0.5; });
+    return std::any_of(blobs.begin(), blobs.end(), [&](const Blob& b) { return std::hypot(b.u - u, b.v - v) < 0.5; });
   };
   EXPECT_TRUE(found_at(120 + 15.5, 150 + 15.5));
   EXPECT_TRUE(found_at(200 + 19.5, 190 + 19.5));
@@ -154,8 +153,8 @@ TEST(BlobDetector, ThickRingAroundAMarkerDoesNotHideIt) {
   render_marker_topdown(f, 3, 32, 40.0, 190.0).copyTo(img(cv::Rect(98, 70, 32, 32)));
   BlobDetector detector;
   const auto blobs = detector.detect(img);
-  EXPECT_TRUE(std::any_of(blobs.begin(), blobs.end(),
-                          [](const Blob& b) { return std::hypot(b.u - 113.5, b.v - 85.5) < 0.5; }));
+  EXPECT_TRUE(
+      std::any_of(blobs.begin(), blobs.end(), [](const Blob& b) { return std::hypot(b.u - 113.5, b.v - 85.5) < 0.5; }));
 }
 
 // The extent sweep and the run-by-run fill agree on a marker's disc wherever the seed

@@ -42,7 +42,8 @@ std::vector<std::string> left_images() {
 
 // A scratch directory unique to this process, emptied on creation.
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("rilbed_test_calibration_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("rilbed_test_calibration_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -88,9 +89,13 @@ TEST(Intrinsics, ReportsUnusableImagesAndSkipsOtherSizes) {
   cv::Mat small;
   cv::resize(cv::imread(paths[0]), small, cv::Size(320, 240), 0, 0, cv::INTER_AREA);
   cv::imwrite((dir / "small.png").string(), small);
-  const std::vector<std::string> input = {paths[0], (dir / "text.jpg").string(), paths[1],
-                                          (dir / "missing.jpg").string(), (dir / "blank.png").string(),
-                                          (dir / "small.png").string(), paths[2]};
+  const std::vector<std::string> input = {paths[0],
+                                          (dir / "text.jpg").string(),
+                                          paths[1],
+                                          (dir / "missing.jpg").string(),
+                                          (dir / "blank.png").string(),
+                                          (dir / "small.png").string(),
+                                          paths[2]};
   const auto result = calibrate_intrinsics(input, {9, 6, 25.0});
   ASSERT_TRUE(result.ok()) << result.error;
   ASSERT_EQ(result.images.size(), input.size());
@@ -349,8 +354,8 @@ TEST(FieldMapping, RejectsDegenerateInput) {
 
 TEST(FieldMapping, FlagsAMirroredCornerOrder) {
   // The corners given clockwise on screen: still convex, but a mirror image of the field.
-  const auto r = field_from_corners({Vec2{100, 400}, Vec2{100, 100}, Vec2{500, 100}, Vec2{500, 400}}, 2, 1.5,
-                                    cv::Size(640, 480));
+  const auto r =
+      field_from_corners({Vec2{100, 400}, Vec2{100, 100}, Vec2{500, 100}, Vec2{500, 400}}, 2, 1.5, cv::Size(640, 480));
   ASSERT_TRUE(r.ok()) << r.error;
   EXPECT_TRUE(r.mirrored);
 }

@@ -142,8 +142,8 @@ TEST(Decoder, MatchOneFindsThePeakFromTheHeadingLastSeen) {
         EXPECT_NEAR(wrap_deg_180(everywhere.heading_deg - heading), 0.0, 1.5) << family << " " << samples;
         for (double turned : {0.0, 4.0, -4.0, 9.0, -9.0, 13.0, -13.0, 40.0, -90.0, 180.0}) {
           const CodeMatch near = decoder.match_one(signal, blobs[0], id, wrap_deg_360(heading - turned));
-          const std::string where = std::string(family) + " samples " + std::to_string(samples) + " turned " +
-                                    std::to_string(turned);
+          const std::string where =
+              std::string(family) + " samples " + std::to_string(samples) + " turned " + std::to_string(turned);
           if (std::abs(turned) < 15.0 || near.score >= min_assign_score) {
             EXPECT_NEAR(near.score, everywhere.score, 1e-9) << where;
             EXPECT_NEAR(wrap_deg_180(near.heading_deg - everywhere.heading_deg), 0.0, 1e-6) << where;
@@ -178,9 +178,9 @@ TEST(Decoder, SpotCheckFindsTheHeadingFromTheKeyEdges) {
           ASSERT_TRUE(signal.usable);
           // A correlation's key angle is its heading's in the blob's frame too.
           const CodeMatch correlated = decoder.match_one(signal, blobs[0], id);
-          EXPECT_NEAR(wrap_rad_pi(correlated.key_angle_rad -
-                                  decoder.key_angle_of_heading(blobs[0], correlated.heading_deg)),
-                      0.0, 1e-9);
+          EXPECT_NEAR(
+              wrap_rad_pi(correlated.key_angle_rad - decoder.key_angle_of_heading(blobs[0], correlated.heading_deg)),
+              0.0, 1e-9);
           for (double turned : {0.0, 4.0, -4.0, 8.0, -8.0}) {
             const std::string where = std::string(family) + " size " + std::to_string(size) + " id " +
                                       std::to_string(id) + " heading " + std::to_string(heading) + " turned " +
@@ -225,8 +225,9 @@ TEST(Decoder, SpotCheckRefusesOtherIdsAndNonMarkers) {
         }
       }
       for (double turned : {30.0, -45.0, 90.0, 180.0}) {
-        const auto found = decoder.spot_check(img, blobs[0], id, decoder.key_angle_of_heading(blobs[0], heading - turned),
-                                              signal.black_level, signal.white_level);
+        const auto found =
+            decoder.spot_check(img, blobs[0], id, decoder.key_angle_of_heading(blobs[0], heading - turned),
+                               signal.black_level, signal.white_level);
         if (found) {
           EXPECT_NEAR(wrap_deg_180(found->heading_deg - heading), 0.0, 1.0) << "id " << id << " turned " << turned;
         }
@@ -239,8 +240,8 @@ TEST(Decoder, SpotCheckRefusesOtherIdsAndNonMarkers) {
   ASSERT_EQ(blobs.size(), 1u);
   for (int id : ids) {
     for (double heading : {0.0, 120.0, 240.0}) {
-      EXPECT_FALSE(
-          decoder.spot_check(disc, blobs[0], id, decoder.key_angle_of_heading(blobs[0], heading), 28.0, 185.0).has_value())
+      EXPECT_FALSE(decoder.spot_check(disc, blobs[0], id, decoder.key_angle_of_heading(blobs[0], heading), 28.0, 185.0)
+                       .has_value())
           << id;
     }
   }

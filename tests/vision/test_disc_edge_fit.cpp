@@ -81,7 +81,8 @@ TEST(DiscEdgeFit, RecoversTheCentreFromAnOffPrediction) {
 TEST(DiscEdgeFit, FollowsADiscBeyondItsReach) {
   cv::Point2d truth;
   const cv::Mat img = marker_image(0.375, 200.0, truth);
-  for (cv::Point2d error : {cv::Point2d(4.0, 1.0), cv::Point2d(4.5, 0.5), cv::Point2d(3.0, 3.0), cv::Point2d(0.5, -5.0), cv::Point2d(-5.0, -1.0)}) {
+  for (cv::Point2d error : {cv::Point2d(4.0, 1.0), cv::Point2d(4.5, 0.5), cv::Point2d(3.0, 3.0), cv::Point2d(0.5, -5.0),
+                            cv::Point2d(-5.0, -1.0)}) {
     const auto fit = fit_disc_edges(img, disc_at(truth + error, 12.0), 110.0);
     EXPECT_TRUE(fit.has_value()) << "error " << error;
     if (!fit) continue;
@@ -124,7 +125,7 @@ TEST(DiscEdgeFit, LoadDiscAreaReadsTheAreaOnly) {
   cv::Mat img(120, 200, CV_8UC1, cv::Scalar(0));
   EXPECT_EQ(load_disc_area(img, disc_at({100, 60}, 12.0)), 0);
   img(cv::Rect(50, 47, 41, 27)).setTo(0x40);  // the rows of the disc at (70, 60), as wide as the fit reads
-  img.at<std::uint8_t>(60, 150) = 0x01;        // a pixel far from it
+  img.at<std::uint8_t>(60, 150) = 0x01;       // a pixel far from it
   EXPECT_EQ(load_disc_area(img, disc_at({70, 60}, 12.0)), 0x40);
   EXPECT_EQ(load_disc_area(img, disc_at({100, 100}, 12.0)), 0);  // beside both
   // A marker wider than a cache line reads every line of its rows.

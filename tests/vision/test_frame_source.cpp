@@ -87,9 +87,7 @@ std::vector<FrameResult> frames_of(const std::vector<FrameResult>& results) {
   return frames;
 }
 
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 OpenResult open_ok(const std::string& input) {
   OpenResult opened = open_frame_source(input);
@@ -121,8 +119,7 @@ TEST(FrameSourceDirectory, ImagesComeSortedByNameAndOtherFilesAreIgnored) {
 
   const std::vector<FrameResult> results = drain(source);
   ASSERT_EQ(results.size(), 6u);
-  const std::vector<std::string> names = {"img_00.png", "img_01.BMP", "img_02.PNG", "img_03.png",
-                                          "img_04.tiff"};
+  const std::vector<std::string> names = {"img_00.png", "img_01.BMP", "img_02.PNG", "img_03.png", "img_04.tiff"};
   for (int i = 0; i < 5; ++i) {
     const FrameResult& r = results[static_cast<std::size_t>(i)];
     ASSERT_TRUE(r.is_frame()) << i << ": " << r.error;
@@ -385,8 +382,7 @@ TEST(FrameSourceVideo, TruncatedAviEndsCleanlyAfterTheLastGoodFrame) {
   ASSERT_TRUE(stop.is_error());
   EXPECT_EQ(stop.index, static_cast<int>(frames.size()));
   EXPECT_TRUE(contains(stop.error, path)) << stop.error;
-  EXPECT_TRUE(contains(stop.error, "stopped at frame " + std::to_string(frames.size())))
-      << stop.error;
+  EXPECT_TRUE(contains(stop.error, "stopped at frame " + std::to_string(frames.size()))) << stop.error;
   EXPECT_TRUE(results.back().is_end());
   EXPECT_TRUE(opened.source->next().is_end());
 }

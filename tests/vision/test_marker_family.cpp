@@ -30,14 +30,14 @@ TEST(MarkerFamily, SlicesFollowTheTemplate) {
 
 TEST(MarkerFamily, ColourAtMatchesRingsAndSlices) {
   const auto f = MarkerFamily::six_ucp();
-  EXPECT_EQ(f.colour_at(1, 0.05, 0), 0.0);    // hole
-  EXPECT_EQ(f.colour_at(1, 0.4, 0), 1.0);     // key slice
-  EXPECT_EQ(f.colour_at(1, 0.4, 70), 0.0);    // guard slice
-  EXPECT_EQ(f.colour_at(8, 0.4, 180), 1.0);   // x2 of ID 8
+  EXPECT_EQ(f.colour_at(1, 0.05, 0), 0.0);   // hole
+  EXPECT_EQ(f.colour_at(1, 0.4, 0), 1.0);    // key slice
+  EXPECT_EQ(f.colour_at(1, 0.4, 70), 0.0);   // guard slice
+  EXPECT_EQ(f.colour_at(8, 0.4, 180), 1.0);  // x2 of ID 8
   EXPECT_EQ(f.colour_at(1, 0.4, 180), 0.0);
-  EXPECT_EQ(f.colour_at(1, 0.7, 0), 0.0);     // black ring
-  EXPECT_EQ(f.colour_at(1, 0.9, 0), 1.0);     // white ring
-  EXPECT_EQ(f.colour_at(1, 1.1, 0), -1.0);    // outside
+  EXPECT_EQ(f.colour_at(1, 0.7, 0), 0.0);   // black ring
+  EXPECT_EQ(f.colour_at(1, 0.9, 0), 1.0);   // white ring
+  EXPECT_EQ(f.colour_at(1, 1.1, 0), -1.0);  // outside
 }
 
 // Codes must be unique under rotation, or two robots could not be told apart.

@@ -18,7 +18,8 @@ const std::vector<int> kIds = {1, 2, 3, 4, 5, 6, 7, 8};
 // One marker of `size_px` on a light floor, blurred by `blur_px` (0: sharp).
 cv::Mat one_marker(int id, int size_px, double heading_deg, double blur_px) {
   cv::Mat img(120, 120, CV_8UC1, cv::Scalar(185));
-  render_marker_topdown(MarkerFamily::six_ucp(), id, size_px, heading_deg).copyTo(img(cv::Rect(37, 41, size_px, size_px)));
+  render_marker_topdown(MarkerFamily::six_ucp(), id, size_px, heading_deg)
+      .copyTo(img(cv::Rect(37, 41, size_px, size_px)));
   if (blur_px > 0) cv::GaussianBlur(img, img, cv::Size(), blur_px);
   return img;
 }
@@ -85,7 +86,8 @@ TEST(MarkerTemplates, PrintedLettersAndDigitsDoNotMatchAnywhere) {
           disc.v = box.y + box.height / 2.0 - 0.5 + dv;
           disc.shape = cv::Matx22d::eye() * (scale * std::max(box.width, box.height) / 2.0);
           for (int id : kIds) {
-            for (int k = 0; k < 48; ++k) best = std::max(best, templates.correlation(img, disc, id, k * 3.14159265 / 24));
+            for (int k = 0; k < 48; ++k)
+              best = std::max(best, templates.correlation(img, disc, id, k * 3.14159265 / 24));
           }
         }
       }
@@ -100,7 +102,8 @@ TEST(MarkerTemplates, AMarkerCutByTheFrameEdgeIsComparedOnWhatIsInside) {
   cv::Mat img(80, 80, CV_8UC1, cv::Scalar(185));
   // Two columns of its white ring fall beyond the frame: centre (13.5, 35.5), R = 16 px,
   // heading 45 degrees.
-  render_marker_topdown(MarkerFamily::six_ucp(), 3, 32, 45.0)(cv::Rect(2, 0, 30, 32)).copyTo(img(cv::Rect(0, 20, 30, 32)));
+  render_marker_topdown(MarkerFamily::six_ucp(), 3, 32, 45.0)(cv::Rect(2, 0, 30, 32))
+      .copyTo(img(cv::Rect(0, 20, 30, 32)));
   Blob disc;
   disc.u = 13.5;
   disc.v = 35.5;

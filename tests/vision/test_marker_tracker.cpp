@@ -31,7 +31,8 @@ Errors run_scene(const std::string& preset_name, int frames, bool tracked, unsig
     const cv::Mat img = camera.render(robots, rng);
     const auto found = tracked ? tracker.process(img) : tracker.detect_full_frame(img);
     std::map<int, MarkerTruth> truth;
-    for (const auto& t : camera.truth(robots)) if (t.visible) truth[t.id] = t;
+    for (const auto& t : camera.truth(robots))
+      if (t.visible) truth[t.id] = t;
     e.expected += static_cast<int>(truth.size());
     for (const auto& d : found) {
       auto it = truth.find(d.id);
@@ -188,7 +189,8 @@ TEST(MarkerTracker, SmallMarkersUnderBlurAndNoise) {
       const double heading = rng.uniform(0.0, 360.0);
       constexpr int kScale = 8;
       cv::Mat big(64 * kScale, 64 * kScale, CV_8UC1, cv::Scalar(185));
-      render_marker_topdown(f, id, 24 * kScale, heading, 185.0, 1).copyTo(big(cv::Rect(150, 170, 24 * kScale, 24 * kScale)));
+      render_marker_topdown(f, id, 24 * kScale, heading, 185.0, 1)
+          .copyTo(big(cv::Rect(150, 170, 24 * kScale, 24 * kScale)));
       cv::Mat img, noise(64, 64, CV_16SC1);
       cv::resize(big, img, {64, 64}, 0, 0, cv::INTER_AREA);
       cv::GaussianBlur(img, img, {}, 0.7);
@@ -339,8 +341,10 @@ TEST(MarkerTracker, TheShapeFollowsAStretchingMarker) {
   constexpr int kScale = 4;
   auto frame_with = [&](double stretch) {
     cv::Mat big(240 * kScale, 320 * kScale, CV_8UC1, cv::Scalar(185));
-    render_marker_topdown(f, 3, 32 * kScale, 30.0, 185.0, 1).copyTo(big(cv::Rect(100 * kScale, 80 * kScale, 32 * kScale, 32 * kScale)));
-    render_marker_topdown(f, 6, 32 * kScale, 200.0, 185.0, 1).copyTo(big(cv::Rect(220 * kScale, 150 * kScale, 32 * kScale, 32 * kScale)));
+    render_marker_topdown(f, 3, 32 * kScale, 30.0, 185.0, 1)
+        .copyTo(big(cv::Rect(100 * kScale, 80 * kScale, 32 * kScale, 32 * kScale)));
+    render_marker_topdown(f, 6, 32 * kScale, 200.0, 185.0, 1)
+        .copyTo(big(cv::Rect(220 * kScale, 150 * kScale, 32 * kScale, 32 * kScale)));
     // Stretched along u about marker 3's centre.
     const double cx = (116.0) * kScale;
     const cv::Matx23d warp(stretch, 0, cx * (1.0 - stretch), 0, 1, 0);

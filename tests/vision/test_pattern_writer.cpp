@@ -5,12 +5,12 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <yaml-cpp/yaml.h>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <yaml-cpp/yaml.h>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -42,7 +42,7 @@ std::string read_text(const fs::path& path) {
 
 /// Writes marker `id` as a PNG and reads it back unchanged (BGRA).
 cv::Mat render_png(const MarkerFamily& family, int id, int size_px, const fs::path& dir) {
-  const fs::path path = dir / marker_file_name(family, id, PatternFormat::png);
+  const fs::path path = dir / marker_file_name(family, id, PatternFormat::kPng);
   const PatternResult result = write_marker_png(family, id, size_px, path);
   EXPECT_TRUE(result.ok()) << result.error;
   return cv::imread(path.string(), cv::IMREAD_UNCHANGED);
@@ -67,10 +67,9 @@ bool is_opaque_black(const cv::Vec4b& p) { return p[3] == 255 && p[0] < 55 && p[
 
 /// True when the polar point is within margin_px of a ring or slice boundary, where
 /// antialiasing and pixel quantisation make the colour legitimately uncertain.
-bool near_boundary(const MarkerFamily& family, int id, double r, double angle_deg, double radius_px,
-                   double margin_px) {
-  for (double ring : {MarkerFamily::hole_radius, MarkerFamily::code_outer_radius,
-                      MarkerFamily::black_ring_outer_radius, 1.0}) {
+bool near_boundary(const MarkerFamily& family, int id, double r, double angle_deg, double radius_px, double margin_px) {
+  for (double ring :
+       {MarkerFamily::hole_radius, MarkerFamily::code_outer_radius, MarkerFamily::black_ring_outer_radius, 1.0}) {
     if (std::abs(r - ring) * radius_px < margin_px) return true;
   }
   if (r <= MarkerFamily::hole_radius || r >= MarkerFamily::code_outer_radius) return false;
@@ -142,16 +141,16 @@ std::pair<double, std::string> svg_length(const std::string& svg, const std::str
 
 TEST(PatternWriter, FileNamesFollowTheContract) {
   const MarkerFamily six = MarkerFamily::six_ucp();
-  EXPECT_EQ(marker_file_name(six, 3, PatternFormat::pdf), "6ucp_id3.pdf");
-  EXPECT_EQ(marker_file_name(six, 8, PatternFormat::png), "6ucp_id8.png");
-  EXPECT_EQ(marker_file_name(MarkerFamily::k_ucp(9), 64, PatternFormat::svg), "9ucp_id64.svg");
+  EXPECT_EQ(marker_file_name(six, 3, PatternFormat::kPdf), "6ucp_id3.pdf");
+  EXPECT_EQ(marker_file_name(six, 8, PatternFormat::kPng), "6ucp_id8.png");
+  EXPECT_EQ(marker_file_name(MarkerFamily::k_ucp(9), 64, PatternFormat::kSvg), "9ucp_id64.svg");
   EXPECT_EQ(sheet_file_name(six), "6ucp_sheet.pdf");
 }
 
 TEST(PatternWriter, ParsesFormatsCaseInsensitively) {
-  EXPECT_EQ(parse_pattern_format("svg"), PatternFormat::svg);
-  EXPECT_EQ(parse_pattern_format("PDF"), PatternFormat::pdf);
-  EXPECT_EQ(parse_pattern_format("Png"), PatternFormat::png);
+  EXPECT_EQ(parse_pattern_format("svg"), PatternFormat::kSvg);
+  EXPECT_EQ(parse_pattern_format("PDF"), PatternFormat::kPdf);
+  EXPECT_EQ(parse_pattern_format("Png"), PatternFormat::kPng);
   EXPECT_FALSE(parse_pattern_format("jpg").has_value());
   EXPECT_FALSE(parse_pattern_format("").has_value());
 }
@@ -304,8 +303,7 @@ TEST(PatternWriter, MarkerPdfPageIsTheMarkerAtTrueSize) {
 TEST(PatternWriter, SheetIsOneA4PageForSixUcp) {
   const fs::path dir = scratch_dir("sheet");
   const fs::path path = dir / "6ucp_sheet.pdf";
-  const PatternResult result =
-      write_marker_sheet_pdf(MarkerFamily::six_ucp(), {1, 2, 3, 4, 5, 6, 7, 8}, 50.0, path);
+  const PatternResult result = write_marker_sheet_pdf(MarkerFamily::six_ucp(), {1, 2, 3, 4, 5, 6, 7, 8}, 50.0, path);
   ASSERT_TRUE(result.ok()) << result.error;
   const std::string pdf = read_text(path);
   EXPECT_EQ(pdf.rfind("%PDF-", 0), 0u);

@@ -77,7 +77,8 @@ TEST(SyntheticCamera, InterpolatedUndistortionMatchesTheExactOne) {
   std::vector<cv::Point2d> pixels, exact;
   cv::RNG rng(3);
   for (int i = 0; i < 4000; ++i) pixels.emplace_back(rng.uniform(0, 1280), rng.uniform(0, 960));
-  for (const cv::Point2d corner : {cv::Point2d(0, 0), cv::Point2d(1279, 0), cv::Point2d(0, 959), cv::Point2d(1279, 959)})
+  for (const cv::Point2d corner :
+       {cv::Point2d(0, 0), cv::Point2d(1279, 0), cv::Point2d(0, 959), cv::Point2d(1279, 959)})
     pixels.push_back(corner);
   cv::undistortPoints(pixels, exact, cam.camera_matrix, cam.distortion, cv::noArray(), cv::noArray(),
                       cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 40, 1e-10));

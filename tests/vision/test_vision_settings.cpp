@@ -66,8 +66,8 @@ TEST(VisionSettings, ContrastIsAGainAboutMidGreyAndBrightnessAnOffset) {
   s.contrast = 2.0;
   s.brightness = 10.0;
   const cv::Mat out = adjust_frame(frame, s, buffer);
-  EXPECT_EQ(out.at<std::uint8_t>(0, 0), 0);    // saturated
-  EXPECT_EQ(out.at<std::uint8_t>(0, 1), 82);   // 2 * (100 - 128) + 128 + 10
+  EXPECT_EQ(out.at<std::uint8_t>(0, 0), 0);   // saturated
+  EXPECT_EQ(out.at<std::uint8_t>(0, 1), 82);  // 2 * (100 - 128) + 128 + 10
   EXPECT_EQ(out.at<std::uint8_t>(0, 2), 138);
   EXPECT_EQ(out.at<std::uint8_t>(0, 3), 255);  // saturated
   const cv::Mat bgr(2, 2, CV_8UC3, cv::Scalar(100, 128, 0));
