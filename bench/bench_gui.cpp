@@ -42,13 +42,13 @@
 #include <thread>
 #include <vector>
 
-#include "agents/scenario.hpp"
-#include "agents/simulation.hpp"
+#include "bus/lcm_bus.hpp"
 #include "core/id_list.hpp"
 #include "core/statistics.hpp"
 #include "gui_web/gui_service.hpp"
-#include "links/lcm_bus.hpp"
 #include "machine.hpp"
+#include "run/scenario.hpp"
+#include "run/simulation.hpp"
 
 namespace {
 
@@ -148,13 +148,13 @@ struct Measured {
 };
 
 // One run with `viewers` viewers (nullopt: no panel at all).
-void run_once(const agents::Scenario& scenario, std::optional<int> viewers, double seconds, Measured& out) {
+void run_once(const run::Scenario& scenario, std::optional<int> viewers, double seconds, Measured& out) {
   std::string error;
-  auto lcm = links::open_lcm("memq://", error);
+  auto lcm = bus::open_lcm("memq://", error);
   if (!lcm) throw std::runtime_error(error);
-  links::LcmRunPublisher::Options po;
+  bus::LcmRunPublisher::Options po;
   po.in_process = true;
-  links::LcmRunPublisher publisher(*lcm, links::Channels{}, po);
+  bus::LcmRunPublisher publisher(*lcm, bus::Channels{}, po);
   std::unique_ptr<gui_web::GuiService> gui;
   asio::io_context io;
   std::vector<std::shared_ptr<Viewer>> clients;
@@ -182,14 +182,14 @@ void run_once(const agents::Scenario& scenario, std::optional<int> viewers, doub
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
   }
-  agents::RunOptions o;
+  run::RunOptions o;
   o.seed = 1;
   o.duration_s = seconds;
   o.realtime = true;
   o.rt_factor = 1.0;
   o.observer = &publisher;
   const double cpu0 = process_cpu_s();
-  const agents::RunResult r = agents::run_scenario(scenario, o);
+  const run::RunResult r = run::run_scenario(scenario, o);
   const double cpu = process_cpu_s() - cpu0;
   out.cpu_per_wall.push_back(cpu / r.run_wall_s);
   out.latency_ms.insert(out.latency_ms.end(), r.loop_latency_ms.begin(), r.loop_latency_ms.end());
@@ -229,7 +229,7 @@ int main(int argc, char** argv) {
   std::vector<std::optional<int>> configs{std::nullopt};
   for (int v : counts.ids) configs.emplace_back(v);
 
-  const agents::Scenario scenario = agents::wandering_scenario(robots, seconds);
+  const run::Scenario scenario = run::wandering_scenario(robots, seconds);
   std::printf("# rilbed web panel benchmark\n\n");
   std::printf("- CPU: %s; `nproc`: %d; load average at start: %s\n", cpu_model().c_str(), bench::usable_cpus(),
               first_line("/proc/loadavg").c_str());

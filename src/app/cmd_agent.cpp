@@ -19,12 +19,12 @@
 #include <thread>
 #include <vector>
 
-#include "agents/scenario.hpp"
-#include "agents/simulation.hpp"
 #include "app/commands.hpp"
+#include "bus/agent_server.hpp"
+#include "bus/lcm_bus.hpp"
 #include "core/id_list.hpp"
-#include "links/agent_server.hpp"
-#include "links/lcm_bus.hpp"
+#include "run/scenario.hpp"
+#include "run/simulation.hpp"
 
 namespace rilbed::app {
 
@@ -86,7 +86,7 @@ void watch_lifeline() {
 }
 
 int agent_command(const AgentArgs& args) {
-  if (const auto problem = links::check_channel_prefix(args.prefix)) {
+  if (const auto problem = bus::check_channel_prefix(args.prefix)) {
     spdlog::error("agent: {}", *problem);
     return kExitUsage;
   }
@@ -94,7 +94,7 @@ int agent_command(const AgentArgs& args) {
     spdlog::error("agent: give either --scenario FILE or --scenario-stdin NAME");
     return kExitUsage;
   }
-  agents::Scenario scenario;
+  run::Scenario scenario;
   bool lifeline = false;
   try {
     if (!args.scenario_stdin.empty()) {
@@ -103,10 +103,10 @@ int agent_command(const AgentArgs& args) {
         spdlog::error("agent: cannot read the scenario from standard input");
         return kExitFailure;
       }
-      scenario = agents::parse_scenario(*text, args.scenario_stdin);
+      scenario = run::parse_scenario(*text, args.scenario_stdin);
       scenario.source = args.scenario_stdin;
     } else {
-      scenario = agents::load_scenario(args.scenario);
+      scenario = run::load_scenario(args.scenario);
     }
   } catch (const std::exception& e) {
     spdlog::error("agent: {}", e.what());
@@ -128,7 +128,7 @@ int agent_command(const AgentArgs& args) {
       return kExitUsage;
     }
     try {
-      if (!agents::make_controller(scenario, *spec)) {
+      if (!run::make_controller(scenario, *spec)) {
         spdlog::error("agent: robot {} of {} has no controller (controller: none)", id, scenario.source.string());
         return kExitUsage;
       }
@@ -139,21 +139,21 @@ int agent_command(const AgentArgs& args) {
   }
   std::string error;
   // Quanta come on the URL; answers and announcements go on the answer bus (the next port).
-  std::unique_ptr<lcm::LCM> lcm = links::open_lcm(args.url, error);
-  std::unique_ptr<lcm::LCM> answers = lcm ? links::open_lcm(links::agent_reply_url(args.url), error) : nullptr;
+  std::unique_ptr<lcm::LCM> lcm = bus::open_lcm(args.url, error);
+  std::unique_ptr<lcm::LCM> answers = lcm ? bus::open_lcm(bus::agent_reply_url(args.url), error) : nullptr;
   if (!lcm || !answers) {
     spdlog::error("agent: {}", error);
     return kExitFailure;
   }
-  links::AgentServerConfig config;
-  config.channels = links::Channels::with_prefix(args.prefix);
+  bus::AgentServerConfig config;
+  config.channels = bus::Channels::with_prefix(args.prefix);
   config.scenario_name = scenario.name;
   config.robot_ids = ids;
   config.once = args.once;
-  links::AgentServer server(*lcm, *answers, config, [&scenario](int id) {
+  bus::AgentServer server(*lcm, *answers, config, [&scenario](int id) {
     const auto spec =
         std::find_if(scenario.robots.begin(), scenario.robots.end(), [&](const auto& r) { return r.id == id; });
-    return agents::make_controller(scenario, *spec);
+    return run::make_controller(scenario, *spec);
   });
   std::signal(SIGINT, on_agent_signal);
   std::signal(SIGTERM, on_agent_signal);

@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "agents/run_comparison.hpp"
 #include "app/commands.hpp"
 #include "core/id_list.hpp"
 #include "core/statistics.hpp"
+#include "run/run_comparison.hpp"
 
 namespace rilbed::app {
 
@@ -34,7 +34,7 @@ std::string cell(const char* format, const std::optional<double>& value) {
 }
 
 int compare_two_runs(const std::string& a, const std::string& b) {
-  const agents::RunComparison c = agents::compare_runs(a, b);
+  const run::RunComparison c = run::compare_runs(a, b);
   if (!c.ok()) {
     spdlog::error("{}", c.error);
     return kExitFailure;
@@ -59,7 +59,7 @@ int compare_two_runs(const std::string& a, const std::string& b) {
 // Per seed: each compared robot's trajectory RMS and the formation times; then the median
 // and the 95th percentile of every column (of the difference's size for the difference).
 int compare_two_batches(const std::string& a, const std::string& b) {
-  const agents::BatchComparison c = agents::compare_batches(a, b);
+  const run::BatchComparison c = run::compare_batches(a, b);
   if (!c.ok()) {
     spdlog::error("{}", c.error);
     return kExitFailure;
@@ -136,7 +136,7 @@ void add_compare_command(CLI::App& app) {
       ->check(CLI::ExistingDirectory);
   cmd->add_option("run_b", *b, "Second run or batch folder")->required()->check(CLI::ExistingDirectory);
   cmd->callback([a, b] {
-    const bool batch_a = agents::is_batch_folder(*a), batch_b = agents::is_batch_folder(*b);
+    const bool batch_a = run::is_batch_folder(*a), batch_b = run::is_batch_folder(*b);
     if (batch_a != batch_b) {
       spdlog::error("{} is a {} folder and {} a {} folder: compare two runs or two batches", *a,
                     batch_a ? "batch" : "run", *b, batch_b ? "batch" : "run");

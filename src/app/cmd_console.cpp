@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "app/commands.hpp"
-#include "links/lcm_bus.hpp"
-#include "links/lcm_console.hpp"
+#include "bus/lcm_bus.hpp"
+#include "bus/lcm_console.hpp"
 
 namespace rilbed::app {
 
@@ -31,17 +31,17 @@ struct ConsoleArgs {
 };
 
 int console_command(const ConsoleArgs& args) {
-  if (const auto problem = links::check_channel_prefix(args.prefix)) {
+  if (const auto problem = bus::check_channel_prefix(args.prefix)) {
     spdlog::error("console: {}", *problem);
     return kExitUsage;
   }
   std::string token = args.token;
   if (token.empty()) {
-    const auto path = links::token_path(args.prefix);
-    if (const auto from_file = links::read_token(path)) token = *from_file;
+    const auto path = bus::token_path(args.prefix);
+    if (const auto from_file = bus::read_token(path)) token = *from_file;
   }
   std::string error;
-  std::unique_ptr<lcm::LCM> lcm = links::open_lcm(args.url, error);
+  std::unique_ptr<lcm::LCM> lcm = bus::open_lcm(args.url, error);
   if (!lcm) {
     spdlog::error("console: {}", error);
     return kExitFailure;
@@ -58,8 +58,8 @@ int console_command(const ConsoleArgs& args) {
     spdlog::error("console: --for goes with drive only");
     return kExitUsage;
   }
-  const auto reply = links::send_console_command(*lcm, links::Channels::with_prefix(args.prefix), token,
-                                                 args.words.front(), rest, args.timeout_ms);
+  const auto reply = bus::send_console_command(*lcm, bus::Channels::with_prefix(args.prefix), token, args.words.front(),
+                                               rest, args.timeout_ms);
   if (!reply) {
     std::fprintf(stderr, "rilbed console: no run answered on %s within %d ms (channel %sRILBED_CONSOLE)\n",
                  args.url.c_str(), args.timeout_ms, args.prefix.c_str());

@@ -14,9 +14,9 @@
 #include <optional>
 
 #include "app/commands.hpp"
+#include "bus/lcm_frame_source.hpp"
 #include "core/geometry.hpp"
 #include "core/id_list.hpp"
-#include "links/lcm_frame_source.hpp"
 #include "vision/field_mapping.hpp"
 #include "vision/frame_source.hpp"
 #include "vision/marker_tracker.hpp"
@@ -102,9 +102,9 @@ int run_detect(const DetectOptions& opt) {
   }
 
   // A run's recording (--record-frames) is footage too: its frames go through the pipeline again.
-  vision::OpenResult opened = opt.camera >= 0                     ? vision::open_camera(opt.camera)
-                              : links::is_lcm_log_path(opt.input) ? links::open_lcm_frames(opt.input)
-                                                                  : vision::open_frame_source(opt.input);
+  vision::OpenResult opened = opt.camera >= 0                   ? vision::open_camera(opt.camera)
+                              : bus::is_lcm_log_path(opt.input) ? bus::open_lcm_frames(opt.input)
+                                                                : vision::open_frame_source(opt.input);
   if (!opened.ok()) {
     spdlog::error("{}", opened.error);
     return kExitFailure;

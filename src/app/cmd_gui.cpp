@@ -20,9 +20,9 @@
 
 #include "app/commands.hpp"
 #include "app/panel_options.hpp"
+#include "bus/lcm_bus.hpp"
+#include "bus/lcm_console.hpp"
 #include "gui_web/gui_service.hpp"
-#include "links/lcm_bus.hpp"
-#include "links/lcm_console.hpp"
 
 namespace rilbed::app {
 
@@ -45,19 +45,19 @@ gui_web::ConsoleSink lcm_console_sink(const GuiArgs& args) {
   auto lcm = std::shared_ptr<lcm::LCM>();
   return [&args, lcm](const gui_web::ConsoleRequest& request) mutable -> gui_web::ConsoleAnswer {
     std::string error;
-    if (!lcm) lcm = links::open_lcm(args.url, error);
+    if (!lcm) lcm = bus::open_lcm(args.url, error);
     if (!lcm) return {false, "cannot reach the bus " + args.url + ": " + error};
     std::string token = args.run_token;
-    if (token.empty()) token = links::read_token(links::token_path(args.prefix)).value_or("");
-    const auto reply = links::send_console_command(*lcm, links::Channels::with_prefix(args.prefix), token,
-                                                   request.command, request.args, 1000, 200, request.client);
+    if (token.empty()) token = bus::read_token(bus::token_path(args.prefix)).value_or("");
+    const auto reply = bus::send_console_command(*lcm, bus::Channels::with_prefix(args.prefix), token, request.command,
+                                                 request.args, 1000, 200, request.client);
     if (!reply) return {false, "no run answered on " + args.url + " within a second"};
     return {reply->accepted != 0, reply->reason};
   };
 }
 
 int gui_command(const GuiArgs& args) {
-  if (const auto problem = links::check_channel_prefix(args.prefix)) {
+  if (const auto problem = bus::check_channel_prefix(args.prefix)) {
     spdlog::error("gui: {}", *problem);
     return kExitUsage;
   }
@@ -72,7 +72,7 @@ int gui_command(const GuiArgs& args) {
     return kExitUsage;
   }
   std::string error;
-  std::unique_ptr<lcm::LCM> lcm = links::open_lcm(args.url, error);
+  std::unique_ptr<lcm::LCM> lcm = bus::open_lcm(args.url, error);
   if (!lcm) {
     spdlog::error("gui: {}", error);
     return kExitFailure;
@@ -80,16 +80,16 @@ int gui_command(const GuiArgs& args) {
   // The panel's own token: the run's stays with the run (it goes only into console commands).
   std::unique_ptr<gui_web::GuiService> gui = start_panel(args.panel, "", lcm_console_sink(args));
   if (!gui) return kExitFailure;
-  const links::Channels run_channels = links::Channels::with_prefix(args.prefix);
-  links::RunReportDecoder decoder(run_channels, *gui);
-  std::vector<std::unique_ptr<links::LcmSubscription>> subscriptions;
+  const bus::Channels run_channels = bus::Channels::with_prefix(args.prefix);
+  bus::RunReportDecoder decoder(run_channels, *gui);
+  std::vector<std::unique_ptr<bus::LcmSubscription>> subscriptions;
   long bad = 0;
   for (const std::string* c :
        {&run_channels.world, &run_channels.poses, &run_channels.events, &run_channels.status, &run_channels.summary,
         &run_channels.wheels, &run_channels.sensors, &run_channels.detections, &run_channels.camera,
         &run_channels.frames, &run_channels.sensor_layout, &run_channels.vision}) {
     subscriptions.push_back(
-        std::make_unique<links::LcmSubscription>(*lcm, *c, [&](const std::string& ch, const void* d, std::size_t n) {
+        std::make_unique<bus::LcmSubscription>(*lcm, *c, [&](const std::string& ch, const void* d, std::size_t n) {
           if (const auto problem = decoder.decode(ch, d, n)) {
             if (++bad <= 5) spdlog::warn("gui: {} (skipped)", *problem);
           }

@@ -15,7 +15,7 @@
 #include <thread>
 
 #include "app/commands.hpp"
-#include "links/khepera_link.hpp"
+#include "serial/khepera_link.hpp"
 
 namespace rilbed::app {
 
@@ -36,8 +36,8 @@ struct KheperaArgs {
 /// Exit status when a drive was interrupted by SIGINT/SIGTERM (the robot was stopped).
 constexpr int kExitInterrupted = 130;
 
-links::LinkConfig link_config(const KheperaArgs& args, const links::RobotModel& model) {
-  links::LinkConfig config;
+serial::LinkConfig link_config(const KheperaArgs& args, const serial::RobotModel& model) {
+  serial::LinkConfig config;
   config.port = args.port;
   config.baud = args.baud;
   config.model = model;
@@ -47,8 +47,8 @@ links::LinkConfig link_config(const KheperaArgs& args, const links::RobotModel& 
   // Retries and clamps are worth a warning; a failure is reported once, by the command
   // itself (with what it means for the robot), so the link's own error line is only shown
   // with --verbose, as is the chatter.
-  config.log = [verbose](links::LogLevel level, const std::string& message) {
-    if (level == links::LogLevel::kWarning) {
+  config.log = [verbose](serial::LogLevel level, const std::string& message) {
+    if (level == serial::LogLevel::kWarning) {
       spdlog::warn("{}", message);
     } else if (verbose) {
       spdlog::info("{}", message);
@@ -85,41 +85,41 @@ std::string join_values(const environment::ProximityValues& values) {
 }
 
 // How long a query may wait: its own budget, after a safety stop's that may be ahead of it.
-std::chrono::milliseconds query_timeout(const links::KheperaLink& link) {
+std::chrono::milliseconds query_timeout(const serial::KheperaLink& link) {
   return std::chrono::milliseconds(2 * link.command_budget_ms() + 200);
 }
 
 // Waits for the link's handshake (it reads the versions on opening): true once the robot
 // answered; false, with the reason logged, when it could not.
-bool wait_for_handshake(const links::KheperaLink& link) {
+bool wait_for_handshake(const serial::KheperaLink& link) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(link.command_budget_ms() + 500);
   while (std::chrono::steady_clock::now() < deadline) {
-    const links::LinkState state = link.state();
-    if (state == links::LinkState::kOk && link.versions()) return true;
-    if (state == links::LinkState::kUnresponsive || state == links::LinkState::kLost) break;
+    const serial::LinkState state = link.state();
+    if (state == serial::LinkState::kOk && link.versions()) return true;
+    if (state == serial::LinkState::kUnresponsive || state == serial::LinkState::kLost) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  const links::LinkStatus status = link.status();
+  const serial::LinkStatus status = link.status();
   spdlog::error(
       "{}", status.last_error.empty() ? "khepera " + link.port() + ": no reply to the handshake" : status.last_error);
   return false;
 }
 
-int info_command(links::KheperaLink& link) {
+int info_command(serial::KheperaLink& link) {
   const auto budget = query_timeout(link);
   if (!wait_for_handshake(link)) return kExitFailure;
-  const links::FirmwareVersions versions = *link.versions();
-  const auto proximity = link.query(links::Command::read_proximity(), budget);
+  const serial::FirmwareVersions versions = *link.versions();
+  const auto proximity = link.query(serial::Command::read_proximity(), budget);
   if (!proximity) {
     spdlog::error("{}", proximity.error());
     return kExitFailure;
   }
-  const auto counters = link.query(links::Command::read_counters(), budget);
+  const auto counters = link.query(serial::Command::read_counters(), budget);
   if (!counters) {
     spdlog::error("{}", counters.error());
     return kExitFailure;
   }
-  const links::LinkConfig& config = link.config();
+  const serial::LinkConfig& config = link.config();
   std::printf("port %s: %s at %u baud\n", config.port.c_str(), std::string(config.model.name).c_str(), config.baud);
   std::printf("versions: %s\n", versions.text.c_str());
   std::printf("proximity: %s\n", join_values(proximity->sensors).c_str());
@@ -128,10 +128,10 @@ int info_command(links::KheperaLink& link) {
   return 0;
 }
 
-int drive_command(links::KheperaLink& link, const KheperaArgs& args) {
+int drive_command(serial::KheperaLink& link, const KheperaArgs& args) {
   const auto budget = query_timeout(link);
   if (!wait_for_handshake(link)) return kExitFailure;
-  const auto go = link.query(links::Command::set_speeds(args.left_units, args.right_units), budget);
+  const auto go = link.query(serial::Command::set_speeds(args.left_units, args.right_units), budget);
   if (!go) {
     spdlog::error("{}", go.error());
     return kExitFailure;
@@ -147,7 +147,7 @@ int drive_command(links::KheperaLink& link, const KheperaArgs& args) {
     const auto left = std::chrono::ceil<std::chrono::milliseconds>(end - std::chrono::steady_clock::now());
     signal = wait_for_signal(std::min(left, std::chrono::milliseconds(100)));
     if (signal != 0) break;
-    if (link.state() == links::LinkState::kLost) {
+    if (link.state() == serial::LinkState::kLost) {
       lost = true;
       break;
     }
@@ -158,12 +158,12 @@ int drive_command(links::KheperaLink& link, const KheperaArgs& args) {
     return kExitFailure;
   }
   // The stop, confirmed, then the counters; stop() sends D,0,0 once more on the way out.
-  const auto stop = link.query(links::Command::set_speeds(0, 0), budget);
+  const auto stop = link.query(serial::Command::set_speeds(0, 0), budget);
   if (!stop) {
     spdlog::error("{} (the robot may still be moving)", stop.error());
     return kExitFailure;
   }
-  const auto counters = link.query(links::Command::read_counters(), budget);
+  const auto counters = link.query(serial::Command::read_counters(), budget);
   if (signal != 0) {
     std::printf("interrupted after %.2f s; stopped\n", drove_s);
   } else {
@@ -181,14 +181,14 @@ int drive_command(links::KheperaLink& link, const KheperaArgs& args) {
 enum class Action { kInfo, kDrive };
 
 int khepera_command(const KheperaArgs& args, Action action) {
-  const links::RobotModel* model = links::find_robot_model(args.model);
+  const serial::RobotModel* model = serial::find_robot_model(args.model);
   if (model == nullptr) {
     spdlog::error("khepera {}: unknown robot model '{}'", args.port, args.model);
     return kExitUsage;
   }
-  std::unique_ptr<links::KheperaLink> link;
+  std::unique_ptr<serial::KheperaLink> link;
   try {
-    link = std::make_unique<links::KheperaLink>(link_config(args, *model));
+    link = std::make_unique<serial::KheperaLink>(link_config(args, *model));
   } catch (const std::invalid_argument& e) {
     spdlog::error("{}", e.what());
     return kExitUsage;

@@ -14,7 +14,7 @@
 #include <system_error>
 
 #include "app/commands.hpp"
-#include "links/khepera_emulator.hpp"
+#include "serial/khepera_emulator.hpp"
 
 namespace rilbed::app {
 
@@ -44,10 +44,10 @@ struct EmulatorArgs {
 // `--versions TEXT`: for a Khepera the text after "b," (its first field the BIOS, the
 // second the protocol version), for an e-puck the text after "v,"; read as the link reads
 // the reply that carries it.
-links::FirmwareVersions versions_from_text(const links::RobotModel& model, const std::string& text) {
-  const std::string reply = std::string(1, model.reply_letter(links::CommandKind::kReadVersions)) + "," + text;
-  const links::Result<links::Reply> decoded = links::decode_reply(model, links::CommandKind::kReadVersions, reply);
-  return decoded.ok() ? decoded->versions : links::FirmwareVersions{text, "", text};
+serial::FirmwareVersions versions_from_text(const serial::RobotModel& model, const std::string& text) {
+  const std::string reply = std::string(1, model.reply_letter(serial::CommandKind::kReadVersions)) + "," + text;
+  const serial::Result<serial::Reply> decoded = serial::decode_reply(model, serial::CommandKind::kReadVersions, reply);
+  return decoded.ok() ? decoded->versions : serial::FirmwareVersions{text, "", text};
 }
 
 // "x,y,theta_deg" (metres, metres, degrees).
@@ -62,14 +62,14 @@ std::optional<Pose2> parse_pose(const std::string& text) {
 }
 
 int emulator_command(const EmulatorArgs& args) {
-  const links::RobotModel* model = links::find_robot_model(args.model);
+  const serial::RobotModel* model = serial::find_robot_model(args.model);
   const std::optional<Pose2> pose = parse_pose(args.pose);
   if (model == nullptr || !pose) {
     spdlog::error("khepera-emu: {}", model == nullptr ? "unknown model '" + args.model + "'"
                                                       : "--pose '" + args.pose + "' is not x,y,theta_deg");
     return kExitUsage;
   }
-  links::EmulatorConfig config;
+  serial::EmulatorConfig config;
   config.model = *model;
   config.initial_pose = *pose;
   config.seed = args.seed;
@@ -96,9 +96,9 @@ int emulator_command(const EmulatorArgs& args) {
   sigaddset(&signals, SIGTERM);
   ::pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
-  std::unique_ptr<links::KheperaEmulator> emulator;
+  std::unique_ptr<serial::KheperaEmulator> emulator;
   try {
-    emulator = std::make_unique<links::KheperaEmulator>(config);
+    emulator = std::make_unique<serial::KheperaEmulator>(config);
   } catch (const std::invalid_argument& e) {
     spdlog::error("{}", e.what());
     return kExitUsage;
@@ -112,7 +112,7 @@ int emulator_command(const EmulatorArgs& args) {
 
   int signal = 0;
   while (::sigwait(&signals, &signal) != 0) {}
-  const links::WheelSpeeds last = emulator->last_speeds();
+  const serial::WheelSpeeds last = emulator->last_speeds();
   const Pose2 final_pose = emulator->true_pose();
   const environment::OdometryReading counters = emulator->counters();
   std::printf("last speed %d %d\n", last.left_units, last.right_units);
@@ -121,7 +121,7 @@ int emulator_command(const EmulatorArgs& args) {
   std::printf("counters %lld %lld\n", static_cast<long long>(counters.left_pulses),
               static_cast<long long>(counters.right_pulses));
   std::printf("commands %llu speeds, %llu bad\n",
-              static_cast<unsigned long long>(emulator->commands_received(links::CommandKind::kSetSpeeds)),
+              static_cast<unsigned long long>(emulator->commands_received(serial::CommandKind::kSetSpeeds)),
               static_cast<unsigned long long>(emulator->bad_commands()));
   std::fflush(stdout);
   return 0;

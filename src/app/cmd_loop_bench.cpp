@@ -12,13 +12,13 @@
 #include <vector>
 
 #include "agents/basic_controllers.hpp"
-#include "agents/scenario.hpp"
 #include "app/commands.hpp"
 #include "core/statistics.hpp"
 #include "environment/world.hpp"
-#include "links/khepera_emulator.hpp"
-#include "links/khepera_link.hpp"
-#include "links/real_body.hpp"
+#include "run/real_body.hpp"
+#include "run/scenario.hpp"
+#include "serial/khepera_emulator.hpp"
+#include "serial/khepera_link.hpp"
 #include "vision/emulated_camera.hpp"
 #include "vision/field_tracker.hpp"
 
@@ -61,15 +61,15 @@ int loop_bench(const LoopArgs& args) {
     rc.pose = real_poses.back();
     world.add_robot(rc);
   }
-  agents::Scenario layout;
+  run::Scenario layout;
   layout.map = map;
   for (int i = 0; i < args.real + args.virtual_robots; ++i) {
-    agents::RobotSpec spec;
+    run::RobotSpec spec;
     spec.id = i + 1;
     if (i < args.real) spec.pose = real_poses[i];
     layout.robots.push_back(spec);
   }
-  const std::vector<Pose2> poses = agents::draw_initial_poses(layout, rng);
+  const std::vector<Pose2> poses = run::draw_initial_poses(layout, rng);
   for (int i = args.real; i < args.real + args.virtual_robots; ++i) {
     environment::RobotConfig rc;
     rc.id = i + 1;
@@ -78,30 +78,30 @@ int loop_bench(const LoopArgs& args) {
   }
 
   // The real robots: emulated Kheperas on pseudo-terminals, each reached over a link.
-  std::vector<std::unique_ptr<links::KheperaEmulator>> emulators;
+  std::vector<std::unique_ptr<serial::KheperaEmulator>> emulators;
   std::vector<std::unique_ptr<WriteStamp>> stamps;
-  std::vector<std::unique_ptr<links::RealBody>> bodies;
+  std::vector<std::unique_ptr<run::RealBody>> bodies;
   std::vector<agents::WanderController> controllers(args.real + args.virtual_robots);
   for (int i = 0; i < args.real; ++i) {
-    links::EmulatorConfig emu;
+    serial::EmulatorConfig emu;
     emu.initial_pose = real_poses[i];
-    emulators.push_back(std::make_unique<links::KheperaEmulator>(emu));
+    emulators.push_back(std::make_unique<serial::KheperaEmulator>(emu));
     stamps.push_back(std::make_unique<WriteStamp>());
-    links::LinkConfig lc;
+    serial::LinkConfig lc;
     lc.port = emulators.back()->device_path();
     WriteStamp* stamp = stamps.back().get();
-    lc.on_speeds_written = [stamp](const links::Command&, Clock::time_point at) {
+    lc.on_speeds_written = [stamp](const serial::Command&, Clock::time_point at) {
       stamp->last_ns.store(at.time_since_epoch().count());
       stamp->count.fetch_add(1);
     };
-    auto link = std::make_unique<links::KheperaLink>(lc);
+    auto link = std::make_unique<serial::KheperaLink>(lc);
     if (const auto error = link->start()) {
       spdlog::error("{}", *error);
       return kExitFailure;
     }
-    links::RealBodyConfig bc;
+    run::RealBodyConfig bc;
     bc.lost_timeout_ms = 1000;
-    bodies.push_back(std::make_unique<links::RealBody>(i + 1, world, std::move(link), bc));
+    bodies.push_back(std::make_unique<run::RealBody>(i + 1, world, std::move(link), bc));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // handshakes
 
@@ -169,7 +169,7 @@ int loop_bench(const LoopArgs& args) {
   }
   bodies.clear();  // every robot stopped
   int stopped = 0;
-  for (const auto& e : emulators) stopped += e->last_speeds() == links::WheelSpeeds{0, 0};
+  for (const auto& e : emulators) stopped += e->last_speeds() == serial::WheelSpeeds{0, 0};
 
   std::printf("## Loop latency (rilbed loop-bench)\n\n");
   std::printf(

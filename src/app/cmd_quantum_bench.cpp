@@ -19,14 +19,14 @@
 
 #include <unistd.h>
 
-#include "agents/scenario.hpp"
-#include "agents/simulation.hpp"
-#include "app/agent_processes.hpp"
 #include "app/commands.hpp"
+#include "bus/lcm_bus.hpp"
+#include "bus/remote_agents.hpp"
 #include "core/id_list.hpp"
 #include "core/statistics.hpp"
-#include "links/lcm_bus.hpp"
-#include "links/remote_agents.hpp"
+#include "run/scenario.hpp"
+#include "run/simulation.hpp"
+#include "session/agent_processes.hpp"
 
 namespace rilbed::app {
 
@@ -75,39 +75,40 @@ struct Row {
 
 // Runs `scenario` with its controllers in the processes of `remote` (or in this process),
 // timing the DEVS run alone.
-agents::RunResult run_once(const agents::Scenario& scenario, std::uint64_t seed, agents::AgentExchange* remote) {
-  agents::RunOptions o;
+run::RunResult run_once(const run::Scenario& scenario, std::uint64_t seed, run::AgentExchange* remote) {
+  run::RunOptions o;
   o.seed = seed;
   o.keep_in_memory = true;
   o.remote_agents = remote;
-  return agents::run_scenario(scenario, o);
+  return run::run_scenario(scenario, o);
 }
 
 std::optional<Row> bench_one(const QuantumBenchArgs& args, lcm::LCM& lcm, lcm::LCM& answers,
                              const std::filesystem::path& dir, int robots, int processes, int quanta) {
   const std::filesystem::path file = write_scenario(dir, robots, quanta);
-  agents::Scenario scenario = agents::load_scenario(file);
-  const agents::RunResult local = run_once(scenario, args.seed, nullptr);
+  run::Scenario scenario = run::load_scenario(file);
+  const run::RunResult local = run_once(scenario, args.seed, nullptr);
   std::vector<int> ids;
   for (int id = 1; id <= robots; ++id) ids.push_back(id);
-  AgentProcesses agents_here;
+  session::AgentProcesses agents_here;
   std::string error;
-  if (!agents_here.start({file.string(), args.url, args.prefix, {}, {}}, place_agents(ids, processes, {}), error)) {
+  if (!agents_here.start({file.string(), args.url, args.prefix, {}, {}}, session::place_agents(ids, processes, {}),
+                         error)) {
     spdlog::error("quantum-bench: {}", error);
     return std::nullopt;
   }
-  links::RemoteAgentsConfig config;
-  config.channels = links::Channels::with_prefix(args.prefix);
+  bus::RemoteAgentsConfig config;
+  config.channels = bus::Channels::with_prefix(args.prefix);
   config.scenario_name = scenario.name;
   config.robot_ids = ids;
   config.record_exchange_times = true;
-  links::RemoteAgents remote(lcm, answers, config);
+  bus::RemoteAgents remote(lcm, answers, config);
   if (const auto missing =
           remote.wait_for_agents(std::chrono::seconds(20), [&] { return agents_here.ended_early(); })) {
     spdlog::error("quantum-bench: {}", *missing);
     return std::nullopt;
   }
-  const agents::RunResult r = run_once(scenario, args.seed, &remote);
+  const run::RunResult r = run_once(scenario, args.seed, &remote);
   Row row;
   row.robots = robots;
   row.processes = processes;
@@ -168,8 +169,8 @@ int quantum_bench_command(const QuantumBenchArgs& args) {
     }
   }
   std::string error;
-  std::unique_ptr<lcm::LCM> lcm = links::open_lcm(args.url, error);
-  std::unique_ptr<lcm::LCM> answers = lcm ? links::open_lcm(links::agent_reply_url(args.url), error) : nullptr;
+  std::unique_ptr<lcm::LCM> lcm = bus::open_lcm(args.url, error);
+  std::unique_ptr<lcm::LCM> answers = lcm ? bus::open_lcm(bus::agent_reply_url(args.url), error) : nullptr;
   if (!lcm || !answers || args.url.rfind("memq://", 0) == 0) {
     spdlog::error("quantum-bench: {}",
                   lcm ? "the agents run in other processes: give a bus they reach, not memq://" : error);

@@ -12,9 +12,9 @@
 #include <string>
 #include <thread>
 
-#include "agents/run_folder_writer.hpp"
 #include "app/commands.hpp"
-#include "links/lcm_bus.hpp"
+#include "bus/lcm_bus.hpp"
+#include "run/run_folder_writer.hpp"
 
 namespace rilbed::app {
 
@@ -34,13 +34,13 @@ struct ReplayArgs {
 };
 
 int write_folder(const ReplayArgs& args) {
-  links::LcmLogReader log(args.log);
+  bus::LcmLogReader log(args.log);
   if (!log.good()) {
     spdlog::error("replay: cannot read {}", args.log);
     return kExitFailure;
   }
-  agents::RunFolderWriter writer(args.out);
-  links::RunReportDecoder decoder(links::Channels::with_prefix(args.prefix), writer);
+  run::RunFolderWriter writer(args.out);
+  bus::RunReportDecoder decoder(bus::Channels::with_prefix(args.prefix), writer);
   long events = 0, bad = 0;
   bool cut_short = false;
   try {
@@ -76,13 +76,13 @@ int write_folder(const ReplayArgs& args) {
 }
 
 int publish(const ReplayArgs& args) {
-  links::LcmLogReader log(args.log);
+  bus::LcmLogReader log(args.log);
   if (!log.good()) {
     spdlog::error("replay: cannot read {}", args.log);
     return kExitFailure;
   }
   std::string error;
-  std::unique_ptr<lcm::LCM> lcm = links::open_lcm(args.lcm_url, error);
+  std::unique_ptr<lcm::LCM> lcm = bus::open_lcm(args.lcm_url, error);
   if (!lcm) {
     spdlog::error("replay: {}", error);
     return kExitFailure;

@@ -21,21 +21,21 @@
 
 #include <nlohmann/json.hpp>
 
-#include "agents/run_folder_writer.hpp"
-#include "agents/scenario.hpp"
-#include "agents/simulation.hpp"
-#include "agents/status_line.hpp"
-#include "app/agent_processes.hpp"
 #include "app/commands.hpp"
 #include "app/panel_options.hpp"
+#include "bus/lcm_bus.hpp"
+#include "bus/lcm_console.hpp"
+#include "bus/remote_agents.hpp"
 #include "core/id_list.hpp"
 #include "core/statistics.hpp"
 #include "gui_web/gui_service.hpp"
-#include "links/lcm_bus.hpp"
-#include "links/lcm_console.hpp"
-#include "links/placement.hpp"
-#include "links/real_robots.hpp"
-#include "links/remote_agents.hpp"
+#include "run/placement.hpp"
+#include "run/real_robots.hpp"
+#include "run/run_folder_writer.hpp"
+#include "run/scenario.hpp"
+#include "run/simulation.hpp"
+#include "run/status_line.hpp"
+#include "session/agent_processes.hpp"
 
 namespace rilbed::app {
 
@@ -52,16 +52,16 @@ extern "C" void on_signal(int) { interrupted.store(true); }
 // not run.
 std::atomic<bool> batch_aborted{false};
 
-void log_to_spdlog(links::LogLevel level, const std::string& message) {
-  if (level == links::LogLevel::kError)
+void log_to_spdlog(serial::LogLevel level, const std::string& message) {
+  if (level == serial::LogLevel::kError)
     spdlog::error("{}", message);
-  else if (level == links::LogLevel::kWarning)
+  else if (level == serial::LogLevel::kWarning)
     spdlog::warn("{}", message);
-  else if (level == links::LogLevel::kInfo)
+  else if (level == serial::LogLevel::kInfo)
     spdlog::info("{}", message);
 }
 
-void print_emulated_last_speeds(const links::RealRobots& real) {
+void print_emulated_last_speeds(const run::RealRobots& real) {
   for (const auto& [id, emulator] : real.emulators()) {
     const auto speeds = emulator->last_speeds();
     std::printf("robot %d (emulated): last speed %d %d\n", id, speeds.left_units, speeds.right_units);
@@ -110,16 +110,16 @@ struct RunArgs {
 // The console sink of `rilbed run --gui`: a browser's command acts on this run's own
 // RunControl, checked as a console's command over LCM is (the web server has checked the
 // token already).
-gui_web::ConsoleSink run_control_sink(agents::RunControl& control) {
+gui_web::ConsoleSink run_control_sink(run::RunControl& control) {
   return [&control](const gui_web::ConsoleRequest& request) -> gui_web::ConsoleAnswer {
     rilbed::console_command_t c;
     c.client = "gui " + request.client;
     c.command = request.command;
     c.args = request.args;
     c.num_args = static_cast<std::int32_t>(c.args.size());
-    auto parsed = links::parse_console_command(c);
+    auto parsed = bus::parse_console_command(c);
     if (auto* why = std::get_if<std::string>(&parsed)) return {false, *why};
-    if (auto refusal = control.act(std::get<agents::ControlAction>(parsed))) return {false, *refusal};
+    if (auto refusal = control.act(std::get<run::ControlAction>(parsed))) return {false, *refusal};
     std::string done = request.command;
     for (const std::string& arg : request.args) done += " " + arg;
     return {true, done};
@@ -128,19 +128,18 @@ gui_web::ConsoleSink run_control_sink(agents::RunControl& control) {
 
 // Puts the real robots at the start poses of `seed` (links::place_real_robots), reports
 // what it did, and throws when they could not be placed (the batch then ends).
-void place_or_throw(links::RealRobots& real, const agents::Scenario& scenario, std::uint64_t seed,
-                    const RunArgs& args) {
-  const std::vector<Pose2> poses = agents::start_poses(scenario, seed);
+void place_or_throw(run::RealRobots& real, const run::Scenario& scenario, std::uint64_t seed, const RunArgs& args) {
+  const std::vector<Pose2> poses = run::start_poses(scenario, seed);
   std::map<int, Pose2> targets;
   for (std::size_t i = 0; i < scenario.robots.size(); ++i) {
     if (scenario.robots[i].kind == environment::RobotKind::kReal) targets[scenario.robots[i].id] = poses[i];
   }
-  links::PlacementOptions o;
+  run::PlacementOptions o;
   o.timeout_s = args.place_timeout_s;
   o.ask_operator = ask_operator_on_stdin;
   o.interrupt = &interrupted;
   o.log = log_to_spdlog;
-  const links::PlacementResult r = links::place_real_robots(real, targets, o);
+  const run::PlacementResult r = run::place_real_robots(real, targets, o);
   if (!r.ok) {
     batch_aborted.store(true);
     throw std::runtime_error("seed " + std::to_string(seed) + ": " + r.error);
@@ -157,7 +156,7 @@ void place_or_throw(links::RealRobots& real, const agents::Scenario& scenario, s
   }
 }
 
-void print_result(const agents::RunResult& r) {
+void print_result(const run::RunResult& r) {
   char formed[64] = "no convoy";
   if (r.convoy_size > 0) std::snprintf(formed, sizeof formed, "convoy not formed");
   if (r.formation_time_s) std::snprintf(formed, sizeof formed, "formed at %.1f s", *r.formation_time_s);
@@ -168,19 +167,19 @@ void print_result(const agents::RunResult& r) {
 }
 
 // Runs one seed of a batch (its options already hold the seed and out_dir).
-using SeedRunner = std::function<agents::RunResult(const agents::RunOptions&)>;
+using SeedRunner = std::function<run::RunResult(const run::RunOptions&)>;
 
-int run_batch(const agents::Scenario& scenario, const RunArgs& args, agents::RunOptions base,
-              const SeedRunner& run_seed, int max_jobs) {
+int run_batch(const run::Scenario& scenario, const RunArgs& args, run::RunOptions base, const SeedRunner& run_seed,
+              int max_jobs) {
   const int n = args.seeds;
-  std::vector<agents::RunResult> results(n);
+  std::vector<run::RunResult> results(n);
   std::vector<std::string> errors(n);
   std::atomic<int> next{0};
   std::mutex print_mutex;
   const auto wall_start = std::chrono::steady_clock::now();
   auto worker = [&] {
     for (int i = next++; i < n && !interrupted.load() && !batch_aborted.load(); i = next++) {
-      agents::RunOptions o = base;
+      run::RunOptions o = base;
       o.seed = args.seed + static_cast<std::uint64_t>(i);
       if (!args.out.empty()) o.out_dir = std::filesystem::path(args.out) / ("seed_" + std::to_string(o.seed));
       try {
@@ -233,7 +232,7 @@ int run_batch(const agents::Scenario& scenario, const RunArgs& args, agents::Run
   }
   nlohmann::json batch;
   batch["scenario"] = scenario.name;
-  batch["mode"] = scenario.mode == agents::ConvoyMode::kCentral ? "central" : "distributed";
+  batch["mode"] = scenario.mode == run::ConvoyMode::kCentral ? "central" : "distributed";
   batch["runs"] = done;
   batch["formed"] = formed;
   batch["failed"] = failed;
@@ -267,10 +266,10 @@ int run_batch(const agents::Scenario& scenario, const RunArgs& args, agents::Run
 }
 
 int run_command(const RunArgs& args) {
-  agents::Scenario scenario;
+  run::Scenario scenario;
   try {
-    scenario = agents::load_scenario(args.scenario);
-  } catch (const agents::ScenarioError& e) {
+    scenario = run::load_scenario(args.scenario);
+  } catch (const run::ScenarioError& e) {
     spdlog::error("{}", e.what());
     return kExitFailure;
   }
@@ -278,14 +277,14 @@ int run_command(const RunArgs& args) {
   if (args.all_virtual) {
     // The same robots, poses and controllers, every one virtual: the simulation half of a
     // sim-to-real comparison (`rilbed compare`).
-    for (agents::RobotSpec& r : scenario.robots) {
+    for (run::RobotSpec& r : scenario.robots) {
       if (r.kind == environment::RobotKind::kReal) stand_ins.push_back(r.id);
       r.kind = environment::RobotKind::kVirtual;
       r.link.reset();
     }
     scenario.camera.reset();
   }
-  const std::vector<int> real_ids = agents::real_robot_ids(scenario);
+  const std::vector<int> real_ids = run::real_robot_ids(scenario);
   if (!real_ids.empty() && args.fast) {
     // Safe default: real robots move in wall-clock time, whatever the simulation's clock.
     spdlog::error(
@@ -294,9 +293,9 @@ int run_command(const RunArgs& args) {
         args.scenario, id_list_text(real_ids));
     return kExitUsage;
   }
-  if (args.mode == "central") scenario.mode = agents::ConvoyMode::kCentral;
-  if (args.mode == "distributed") scenario.mode = agents::ConvoyMode::kDistributed;
-  agents::RunOptions options;
+  if (args.mode == "central") scenario.mode = run::ConvoyMode::kCentral;
+  if (args.mode == "distributed") scenario.mode = run::ConvoyMode::kDistributed;
+  run::RunOptions options;
   options.realtime = args.realtime || !real_ids.empty();
   options.virtual_stand_ins = stand_ins;
   options.rt_factor = args.rt_factor;
@@ -307,11 +306,11 @@ int run_command(const RunArgs& args) {
   options.interrupt = &interrupted;
   // The LCM bus: everything the run reports goes out on it while it runs, and the run's
   // own outputs (its folder, its status line) are subscribers of the same messages.
-  if (const auto problem = links::check_channel_prefix(args.channel_prefix)) {
+  if (const auto problem = bus::check_channel_prefix(args.channel_prefix)) {
     spdlog::error("{}", *problem);
     return kExitUsage;
   }
-  const links::Channels channels = links::Channels::with_prefix(args.channel_prefix);
+  const bus::Channels channels = bus::Channels::with_prefix(args.channel_prefix);
   std::unique_ptr<lcm::LogFile> recording;
   if (!args.record.empty()) {
     if (args.seeds > 0) {
@@ -338,7 +337,7 @@ int run_command(const RunArgs& args) {
   std::unique_ptr<lcm::LCM> network_lcm;
   if (network_bus) {
     std::string error;
-    network_lcm = links::open_lcm(args.lcm_url, error);
+    network_lcm = bus::open_lcm(args.lcm_url, error);
     if (!network_lcm) {
       spdlog::error("{}", error);
       return kExitFailure;
@@ -353,42 +352,42 @@ int run_command(const RunArgs& args) {
     }
   }
   // Steering the run (the console on the bus, the web panel).
-  agents::RunControl control;
+  run::RunControl control;
   // The web panel (--gui), made below; declared here for the runs' buses to feed it. It
   // outlives every run (a reset starts a new one; its viewers stay) and goes before the
   // control its commands act on.
   std::unique_ptr<gui_web::GuiService> gui;
   // The publisher of the run now going (a paused run re-publishes its world and status).
   std::mutex current_mutex;
-  links::LcmRunPublisher* current_publisher = nullptr;
+  bus::LcmRunPublisher* current_publisher = nullptr;
   const bool status_line = options.realtime && !args.quiet && args.seeds == 0;
   // Runs one seed with `run` on its bus: its folder (options.out_dir) written by a
   // subscriber, not by the run.
   auto on_bus = [&](const SeedRunner& run) -> SeedRunner {
-    return [&, run](const agents::RunOptions& given) {
-      agents::RunOptions o = given;
+    return [&, run](const run::RunOptions& given) {
+      run::RunOptions o = given;
       std::unique_ptr<lcm::LCM> own_lcm;
       lcm::LCM* bus = network_lcm.get();
       if (!bus) {
         std::string error;
-        own_lcm = links::open_lcm("memq://", error);
+        own_lcm = bus::open_lcm("memq://", error);
         if (!own_lcm) throw std::runtime_error(error);
         bus = own_lcm.get();
       }
-      links::LcmRunPublisher::Options po;
+      bus::LcmRunPublisher::Options po;
       po.in_process = !network_bus;
       po.log = recording.get();
       po.frames = args.record_frames;
       // The panel shows the camera at most 10 frames a second; they go to it alone.
       if (gui) po.local_frame_period_ms = static_cast<int>(1000.0 / gui_web::kMaxCameraFps);
-      links::LcmRunPublisher publisher(*bus, channels, po);
-      std::unique_ptr<agents::RunFolderWriter> folder;
+      bus::LcmRunPublisher publisher(*bus, channels, po);
+      std::unique_ptr<run::RunFolderWriter> folder;
       if (o.out_dir) {
-        folder = std::make_unique<agents::RunFolderWriter>(*o.out_dir);
+        folder = std::make_unique<run::RunFolderWriter>(*o.out_dir);
         publisher.add_local_subscriber(*folder);
         o.out_dir.reset();
       }
-      agents::StatusLine line([](const std::string& text) {
+      run::StatusLine line([](const std::string& text) {
         std::printf("%s\n", text.c_str());
         std::fflush(stdout);
       });
@@ -401,13 +400,13 @@ int run_command(const RunArgs& args) {
       }
       struct Forget {
         std::mutex& m;
-        links::LcmRunPublisher*& p;
+        bus::LcmRunPublisher*& p;
         ~Forget() {
           std::lock_guard lock(m);
           p = nullptr;
         }
       } forget{current_mutex, current_publisher};
-      agents::RunResult r = run(o);
+      run::RunResult r = run(o);
       if (network_bus) {
         // The end goes out twice more: a watcher that lost it would wait for it forever.
         for (int k = 0; k < 2; ++k) {
@@ -426,7 +425,7 @@ int run_command(const RunArgs& args) {
     };
   };
   // The console: commands on the bus, each with this run's token.
-  std::unique_ptr<links::LcmConsoleServer> console;
+  std::unique_ptr<bus::LcmConsoleServer> console;
   std::filesystem::path token_file;
   std::string token;
   // A finished run's token opens nothing: its file goes with the run (unless a newer run
@@ -435,19 +434,19 @@ int run_command(const RunArgs& args) {
     const std::filesystem::path& file;
     const std::string& token;
     ~TokenFileRemover() {
-      if (!file.empty() && links::read_token(file) == token) std::filesystem::remove(file);
+      if (!file.empty() && bus::read_token(file) == token) std::filesystem::remove(file);
     }
   } remove_token_at_exit{token_file, token};
   // Only on a bus other processes reach: memq:// is this process alone (and liblcm's
   // memq provider is not safe with a second thread handling it).
   if (network_bus) {
-    token = links::make_run_token();
-    token_file = links::token_path(args.channel_prefix);
-    const auto problem = links::write_token(token_file, token);
+    token = bus::make_run_token();
+    token_file = bus::token_path(args.channel_prefix);
+    const auto problem = bus::write_token(token_file, token);
     std::fprintf(stderr, "rilbed: run token %s%s%s\n", token.c_str(), problem ? "" : " (in ",
                  problem ? "" : (token_file.string() + ", readable by you only)").c_str());
     if (problem) spdlog::warn("the token is not in a file ({}): give it to rilbed console with --token", *problem);
-    console = std::make_unique<links::LcmConsoleServer>(
+    console = std::make_unique<bus::LcmConsoleServer>(
         *network_lcm, channels, token, control, [](const std::string& m) { spdlog::info("{}", m); }, true,
         [&] {
           // While paused the run reports nothing: its last world and status go out again
@@ -479,27 +478,26 @@ int run_command(const RunArgs& args) {
   if (!args.out.empty()) options.out_dir = args.out;  // a batch puts each seed in a folder of its own
   // Real robots: their links (and emulators) stay open from run to run of a batch, and
   // live until every run has stopped them.
-  std::unique_ptr<links::RealRobots> real;
-  agents::RealBodyFactory real_bodies;
-  SeedRunner run_seed =
-      on_bus([&](const agents::RunOptions& o) { return agents::run_scenario(scenario, o, real_bodies); });
+  std::unique_ptr<run::RealRobots> real;
+  run::RealBodyFactory real_bodies;
+  SeedRunner run_seed = on_bus([&](const run::RunOptions& o) { return run::run_scenario(scenario, o, real_bodies); });
   if (!real_ids.empty()) {
-    real = std::make_unique<links::RealRobots>(scenario, log_to_spdlog);
+    real = std::make_unique<run::RealRobots>(scenario, log_to_spdlog);
     real_bodies = real->body_factory();
     options.emulated_markers = [&real] { return real->emulated_markers(); };
     // Before each run, every real robot goes to the run's start pose (as its all-virtual
     // twin starts): emulated ones are put there, physical ones driven there.
-    run_seed = on_bus([&](const agents::RunOptions& o) {
+    run_seed = on_bus([&](const run::RunOptions& o) {
       if (!args.no_place) place_or_throw(*real, scenario, o.seed, args);
-      return agents::run_scenario(scenario, o, real_bodies);
+      return run::run_scenario(scenario, o, real_bodies);
     });
   }
   // Controllers in other processes (issue 18): each run waits for every remote robot's
   // process to announce itself, then steps them one quantum per control instant.
   std::unique_ptr<lcm::LCM> agents_lcm, agents_answers_lcm;
-  AgentProcesses agent_processes;
+  session::AgentProcesses agent_processes;
   if (scenario.agents) {
-    const agents::AgentsSpec& spec = *scenario.agents;
+    const run::AgentsSpec& spec = *scenario.agents;
     if (!network_bus) {
       spdlog::error(
           "{}: its agents run in other processes, which need a bus they reach: give --lcm URL "
@@ -508,42 +506,42 @@ int run_command(const RunArgs& args) {
       return kExitUsage;
     }
     std::string error;
-    agents_lcm = links::open_lcm(args.lcm_url, error);
-    if (agents_lcm) agents_answers_lcm = links::open_lcm(links::agent_reply_url(args.lcm_url), error);
+    agents_lcm = bus::open_lcm(args.lcm_url, error);
+    if (agents_lcm) agents_answers_lcm = bus::open_lcm(bus::agent_reply_url(args.lcm_url), error);
     if (!agents_lcm || !agents_answers_lcm) {
       spdlog::error("{}", error);
       return kExitFailure;
     }
-    const AgentLaunchConfig launch{args.scenario, args.lcm_url, args.channel_prefix, spec.launch, spec.remote_rilbed};
+    const session::AgentLaunchConfig launch{args.scenario, args.lcm_url, args.channel_prefix, spec.launch,
+                                            spec.remote_rilbed};
     if (spec.processes > 0 &&
-        !agent_processes.start(launch, place_agents(spec.ids, spec.processes, spec.hosts), error)) {
+        !agent_processes.start(launch, session::place_agents(spec.ids, spec.processes, spec.hosts), error)) {
       spdlog::error("{}", error);
       return kExitFailure;
     }
-    links::RemoteAgentsConfig config;
+    bus::RemoteAgentsConfig config;
     config.channels = channels;
     config.scenario_name = scenario.name;
     config.robot_ids = spec.ids;
     for (const int id : spec.ids) {
       const auto robot =
           std::find_if(scenario.robots.begin(), scenario.robots.end(), [&](const auto& r) { return r.id == id; });
-      if (const auto c = agents::make_controller(scenario, *robot); c && c->wants_team())
-        config.team_readers.insert(id);
+      if (const auto c = run::make_controller(scenario, *robot); c && c->wants_team()) config.team_readers.insert(id);
     }
     config.realtime = options.realtime;
     config.resend_ms = spec.resend_ms;
     config.dead_after_ms = spec.dead_after_ms;
     config.deadline_ms = spec.deadline_ms;
     const auto timeout = std::chrono::milliseconds(static_cast<std::int64_t>(spec.announce_timeout_s * 1000.0));
-    run_seed = [&, config, timeout, inner = run_seed](const agents::RunOptions& given) {
-      agents::RunOptions o = given;
-      links::RemoteAgents remote(*agents_lcm, *agents_answers_lcm, config);
+    run_seed = [&, config, timeout, inner = run_seed](const run::RunOptions& given) {
+      run::RunOptions o = given;
+      bus::RemoteAgents remote(*agents_lcm, *agents_answers_lcm, config);
       if (const auto missing = remote.wait_for_agents(timeout, [&] { return agent_processes.ended_early(); })) {
-        throw agents::ScenarioError(args.scenario + ": " + *missing);
+        throw run::ScenarioError(args.scenario + ": " + *missing);
       }
       o.remote_agents = &remote;
-      agents::RunResult r = inner(o);
-      const links::RemoteAgentsCounters& c = remote.counters();
+      run::RunResult r = inner(o);
+      const bus::RemoteAgentsCounters& c = remote.counters();
       if (!args.quiet) {
         std::printf(
             "agents: %lld quanta sent, %lld sent again, %lld duplicate answers, %lld late, %lld processes lost, "
@@ -558,9 +556,9 @@ int run_command(const RunArgs& args) {
   }
   // The console's reset ends a run to start it over (its folder too), as it began: real
   // robots are placed again.
-  run_seed = [run_seed](const agents::RunOptions& o) {
+  run_seed = [run_seed](const run::RunOptions& o) {
     for (;;) {
-      agents::RunResult r = run_seed(o);
+      run::RunResult r = run_seed(o);
       if (r.ended_by != "reset" || interrupted.load()) return r;
       spdlog::info("seed {}: reset from the console: the run starts over", o.seed);
     }
@@ -575,14 +573,14 @@ int run_command(const RunArgs& args) {
     return status;
   }
   try {
-    const agents::RunResult r = run_seed(options);
+    const run::RunResult r = run_seed(options);
     print_result(r);
     if (real) print_emulated_last_speeds(*real);
     if (!args.out.empty()) std::printf("run folder: %s\n", args.out.c_str());
     // The page's viewers get the run's end (its last status and summary) before the
     // server goes; their page then says the run ended, not that the server vanished.
     if (gui) gui->flush(std::chrono::seconds(2));
-  } catch (const agents::ScenarioError& e) {
+  } catch (const run::ScenarioError& e) {
     spdlog::error("{}", e.what());
     return kExitFailure;
   } catch (const std::exception& e) {

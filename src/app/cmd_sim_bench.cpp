@@ -12,11 +12,11 @@
 #include <utility>
 #include <vector>
 
-#include "agents/scenario.hpp"
-#include "agents/simulation.hpp"
 #include "app/commands.hpp"
+#include "bus/lcm_bus.hpp"
 #include "core/id_list.hpp"
-#include "links/lcm_bus.hpp"
+#include "run/scenario.hpp"
+#include "run/simulation.hpp"
 
 namespace rilbed::app {
 
@@ -42,8 +42,8 @@ double peak_rss_mb() {
 }
 
 // N wandering Kheperas with their eight IR sensors in a field of constant density.
-agents::Scenario bench_scenario(int robots, const BenchArgs& args) {
-  agents::Scenario s = agents::wandering_scenario(robots, args.seconds, args.physics_step_ms, args.density_per_m2);
+run::Scenario bench_scenario(int robots, const BenchArgs& args) {
+  run::Scenario s = run::wandering_scenario(robots, args.seconds, args.physics_step_ms, args.density_per_m2);
   s.name = "sim-bench-" + std::to_string(robots);
   s.source = "(sim-bench)";
   return s;
@@ -65,7 +65,7 @@ void print_splits(const std::vector<Split>& splits) {
       "timed run slower by |\n"
       "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
   for (const Split& s : splits) {
-    agents::RunProfile p = s.profile;
+    run::RunProfile p = s.profile;
     p.sensing_s /= s.threads;
     p.behaviours_s /= s.threads;
     const double parts[] = {
@@ -125,7 +125,7 @@ int bench_command(const BenchArgs& args) {
     int threads = 1;
     double run_s = 0.0, simulated_s = 0.0;
     double plain_wall_per_simulated_s = 0.0;  // the untimed runs' median
-    agents::RunProfile profile;
+    run::RunProfile profile;
   };
   std::vector<Split> splits;
   bool any_differs = false;
@@ -135,7 +135,7 @@ int bench_command(const BenchArgs& args) {
   struct Bus {
     std::string url;
     std::unique_ptr<lcm::LCM> lcm;
-    std::unique_ptr<links::LcmRunPublisher> publisher;
+    std::unique_ptr<bus::LcmRunPublisher> publisher;
     std::vector<std::pair<int, double>> costs;  // robots, CPU cost in per cent
     std::vector<double> core_shares;            // extra CPU per simulated second: the share of a core at real time
   };
@@ -144,20 +144,20 @@ int bench_command(const BenchArgs& args) {
     Bus bus;
     bus.url = url;
     std::string error;
-    bus.lcm = links::open_lcm(url, error);
+    bus.lcm = bus::open_lcm(url, error);
     if (!bus.lcm) {
       spdlog::error("sim-bench: {}", error);
       return kExitFailure;
     }
-    bus.publisher = std::make_unique<links::LcmRunPublisher>(*bus.lcm, links::Channels{}, url.rfind("memq://", 0) == 0);
+    bus.publisher = std::make_unique<bus::LcmRunPublisher>(*bus.lcm, bus::Channels{}, url.rfind("memq://", 0) == 0);
     buses.push_back(std::move(bus));
   }
   struct Timing {
     std::vector<double> walls, cpus, startups;
-    agents::RunResult r;
+    run::RunResult r;
   };
   for (int n : counts.ids) {
-    const agents::Scenario s = bench_scenario(n, args);
+    const run::Scenario s = bench_scenario(n, args);
     std::optional<std::uint64_t> first_digest;
     const std::size_t thread_rows = thread_counts.ids.size();
     // Per thread count: the plain runs and each bus's.
@@ -176,7 +176,7 @@ int bench_command(const BenchArgs& args) {
           if (split_run && k > 0) break;
           Timing scratch;
           Timing& t = split_run ? scratch : k == 0 ? plain[ti] : bused[ti][k - 1];
-          agents::RunOptions o;
+          run::RunOptions o;
           o.seed = args.seed;
           o.duration_s = args.seconds;
           o.threads = thread_counts.ids[ti];
@@ -184,7 +184,7 @@ int bench_command(const BenchArgs& args) {
           if (k > 0) o.observer = buses[k - 1].publisher.get();
           o.profile = split_run;
           try {
-            t.r = agents::run_scenario(s, o);
+            t.r = run::run_scenario(s, o);
           } catch (const std::exception& e) {
             spdlog::error("{} robots: {}", n, e.what());
             return kExitFailure;
@@ -200,7 +200,7 @@ int bench_command(const BenchArgs& args) {
             split.threads = thread_counts.ids[ti];
             split.run_s += t.r.run_wall_s;
             split.simulated_s += t.r.simulated_s;
-            const agents::RunProfile& p = *t.r.profile;
+            const run::RunProfile& p = *t.r.profile;
             split.profile.sensing_s += p.sensing_s;
             split.profile.behaviours_s += p.behaviours_s;
             split.profile.integration_s += p.integration_s;
@@ -221,7 +221,7 @@ int bench_command(const BenchArgs& args) {
         const double wall_s = std::max(1e-9, t.walls[t.walls.size() / 2]);
         const double cpu_s = std::max(1e-9, t.cpus[t.cpus.size() / 2]);
         if (ti == 0 && label.empty()) first_threads_wall_s = wall_s;
-        const agents::RunResult& r = t.r;
+        const run::RunResult& r = t.r;
         const double steps = n * r.simulated_s / 0.1;
         std::printf(
             "| %d%s | %d | %.1f x %.1f | %.1f | %.3f | %.3f | %.3f | %.1f | %.1f | %.1f | %.2f | %.2f | %.0f | %d | "

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "app/commands.hpp"
-#include "links/lcm_bus.hpp"
+#include "bus/lcm_bus.hpp"
 
 namespace rilbed::app {
 
@@ -36,11 +36,11 @@ struct WatchArgs {
 
 // What the watcher knows of the run, kept from the messages (decoded, and checked, by
 // links::RunReportDecoder: a corrupt or hostile message is refused, never decoded blindly).
-class Watcher final : public agents::RunObserver {
+class Watcher final : public run::RunObserver {
  public:
   explicit Watcher(const WatchArgs& args) : args_(args) {}
 
-  void on_world(TimeUs, const agents::WorldReport& w) override {
+  void on_world(TimeUs, const run::WorldReport& w) override {
     heard();
     if (world_scenario_ != w.scenario) {
       world_scenario_ = w.scenario;
@@ -50,16 +50,16 @@ class Watcher final : public agents::RunObserver {
       std::fflush(stdout);
     }
   }
-  void on_poses(TimeUs, std::span<const agents::PoseReport> poses) override {
+  void on_poses(TimeUs, std::span<const run::PoseReport> poses) override {
     heard();
     robots_.clear();
-    for (const agents::PoseReport& p : poses) {
+    for (const run::PoseReport& p : poses) {
       std::string text = std::to_string(p.id) + ":" + std::string(p.behaviour);
       if (p.health != "ok") text += "(" + std::string(p.health) + ")";
       robots_.push_back(std::move(text));
     }
   }
-  void on_event(const agents::RunEvent& e) override {
+  void on_event(const run::RunEvent& e) override {
     heard();
     if (e.kind == "behaviour" || e.kind == "collision") return;  // too many to read; the status line shows them
     std::printf("  %7.1fs  %s", us_to_seconds(e.t_us), e.kind.c_str());
@@ -67,7 +67,7 @@ class Watcher final : public agents::RunObserver {
     std::printf(": %s\n", e.detail.c_str());
     std::fflush(stdout);
   }
-  void on_status(const agents::StatusReport& s) override {
+  void on_status(const run::StatusReport& s) override {
     heard();
     // The same status again (a paused run, or the end, is published more than once).
     if (last_status_ && last_status_->first == s.t_us && last_status_->second == s.state) return;
@@ -113,7 +113,7 @@ class Watcher final : public agents::RunObserver {
       if (++bad_messages_ <= 5) spdlog::warn("watch: {} (skipped)", *problem);
     }
   }
-  void set_decoder(links::RunReportDecoder* decoder) { decoder_ = decoder; }
+  void set_decoder(bus::RunReportDecoder* decoder) { decoder_ = decoder; }
 
   bool ended() const { return ended_; }
   bool heard_anything() const { return heard_anything_; }
@@ -140,7 +140,7 @@ class Watcher final : public agents::RunObserver {
   }
 
   const WatchArgs& args_;
-  links::RunReportDecoder* decoder_ = nullptr;
+  bus::RunReportDecoder* decoder_ = nullptr;
   std::string world_scenario_;
   std::vector<std::string> robots_;
   std::optional<std::pair<TimeUs, std::string>> last_status_;  // time and state of the last shown
@@ -160,25 +160,25 @@ class Watcher final : public agents::RunObserver {
 };
 
 int watch_command(const WatchArgs& args) {
-  if (const auto problem = links::check_channel_prefix(args.prefix)) {
+  if (const auto problem = bus::check_channel_prefix(args.prefix)) {
     spdlog::error("watch: {}", *problem);
     return kExitUsage;
   }
   std::string error;
-  std::unique_ptr<lcm::LCM> lcm = links::open_lcm(args.url, error);
+  std::unique_ptr<lcm::LCM> lcm = bus::open_lcm(args.url, error);
   if (!lcm) {
     spdlog::error("watch: {}", error);
     return kExitFailure;
   }
-  const links::Channels channels = links::Channels::with_prefix(args.prefix);
+  const bus::Channels channels = bus::Channels::with_prefix(args.prefix);
   Watcher watcher(args);
-  links::RunReportDecoder decoder(channels, watcher);
+  bus::RunReportDecoder decoder(channels, watcher);
   watcher.set_decoder(&decoder);
   // Raw bytes, decoded by the checked decoder.
-  std::vector<std::unique_ptr<links::LcmSubscription>> subscriptions;
+  std::vector<std::unique_ptr<bus::LcmSubscription>> subscriptions;
   for (const std::string* channel :
        {&channels.world, &channels.poses, &channels.events, &channels.status, &channels.summary}) {
-    subscriptions.push_back(std::make_unique<links::LcmSubscription>(
+    subscriptions.push_back(std::make_unique<bus::LcmSubscription>(
         *lcm, *channel,
         [&watcher](const std::string& c, const void* data, std::size_t size) { watcher.on_message(c, data, size); }));
   }

@@ -6,7 +6,7 @@
 #include <filesystem>
 
 #include "agents/builtin_controllers.hpp"
-#include "links/lcm_console.hpp"
+#include "bus/lcm_console.hpp"
 
 namespace rilbed::app {
 
@@ -34,7 +34,7 @@ std::unique_ptr<gui_web::GuiService> start_panel(const PanelOptions& o, std::str
   gui_web::WebServerConfig config;
   config.bind_address = o.bind;
   config.port = static_cast<std::uint16_t>(o.port);
-  config.token = token.empty() ? links::make_run_token() : std::move(token);
+  config.token = token.empty() ? bus::make_run_token() : std::move(token);
   config.session_id = config.token.substr(0, 8);
   if (std::filesystem::is_directory(o.web_root)) config.web_root = o.web_root;
   config.allowed_origins = o.allowed_origins;

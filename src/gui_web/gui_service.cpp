@@ -289,15 +289,15 @@ void GuiService::drive_tick(std::unique_lock<std::mutex>& lock) {
 
 bool GuiService::wants_steps() const { return server_->clients() > 0; }
 
-void GuiService::on_world(TimeUs t_us, const agents::WorldReport& world) { channels_->on_world(t_us, world); }
-void GuiService::on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) { channels_->on_poses(t_us, poses); }
-void GuiService::on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wheels) {
+void GuiService::on_world(TimeUs t_us, const run::WorldReport& world) { channels_->on_world(t_us, world); }
+void GuiService::on_poses(TimeUs t_us, std::span<const run::PoseReport> poses) { channels_->on_poses(t_us, poses); }
+void GuiService::on_wheels(TimeUs t_us, std::span<const run::WheelReport> wheels) {
   channels_->on_wheels(t_us, wheels);
 }
-void GuiService::on_sensors(TimeUs t_us, std::span<const agents::SensorReport> sensors) {
+void GuiService::on_sensors(TimeUs t_us, std::span<const run::SensorReport> sensors) {
   channels_->on_sensors(t_us, sensors);
 }
-void GuiService::on_detections(const agents::FrameReport& frame) { channels_->on_detections(frame); }
+void GuiService::on_detections(const run::FrameReport& frame) { channels_->on_detections(frame); }
 void GuiService::on_frame_jpeg(TimeUs t_us, std::int64_t, int, int, std::span<const std::uint8_t> jpeg) {
   if (server_->clients() == 0) return;
   const auto now = Clock::now();
@@ -305,8 +305,8 @@ void GuiService::on_frame_jpeg(TimeUs t_us, std::int64_t, int, int, std::span<co
   next_camera_frame_ = now + std::chrono::microseconds(static_cast<long>(1e6 / kMaxCameraFps));
   channels_->camera_frame(t_us, jpeg);
 }
-void GuiService::on_event(const agents::RunEvent& event) { channels_->on_event(event); }
-void GuiService::on_status(const agents::StatusReport& status) {
+void GuiService::on_event(const run::RunEvent& event) { channels_->on_event(event); }
+void GuiService::on_status(const run::StatusReport& status) {
   {
     std::lock_guard lock(mutex_);
     if (status.rt_factor > 0.0 && std::isfinite(status.rt_factor)) rt_factor_ = status.rt_factor;

@@ -37,9 +37,9 @@
 #include <thread>
 #include <vector>
 
-#include "agents/run_observer.hpp"
 #include "gui_web/run_channels.hpp"
 #include "gui_web/web_server.hpp"
+#include "run/run_observer.hpp"
 
 namespace rilbed::gui_web {
 
@@ -88,7 +88,7 @@ struct GuiCounters {
 };
 
 /// The panel's service. Its RunObserver side must be called from one thread.
-class GuiService final : public agents::RunObserver {
+class GuiService final : public run::RunObserver {
  public:
   /// Starts the web server (throws as WebServer does) and the service's thread.
   GuiService(WebServerConfig config, ConsoleSink sink, ManualDriveConfig drive = {});
@@ -107,17 +107,17 @@ class GuiService final : public agents::RunObserver {
 
   // agents::RunObserver: the run's reports, to the channels.
   bool wants_steps() const override;
-  void on_world(TimeUs t_us, const agents::WorldReport& world) override;
-  void on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) override;
-  void on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wheels) override;
-  void on_sensors(TimeUs t_us, std::span<const agents::SensorReport> sensors) override;
-  void on_detections(const agents::FrameReport& frame) override;
+  void on_world(TimeUs t_us, const run::WorldReport& world) override;
+  void on_poses(TimeUs t_us, std::span<const run::PoseReport> poses) override;
+  void on_wheels(TimeUs t_us, std::span<const run::WheelReport> wheels) override;
+  void on_sensors(TimeUs t_us, std::span<const run::SensorReport> sensors) override;
+  void on_detections(const run::FrameReport& frame) override;
   bool wants_frame_jpegs() const override { return true; }
   /// Passes at most max_camera_fps frames a second on, and only while someone watches.
   void on_frame_jpeg(TimeUs t_us, std::int64_t frame, int width_px, int height_px,
                      std::span<const std::uint8_t> jpeg) override;
-  void on_event(const agents::RunEvent& event) override;
-  void on_status(const agents::StatusReport& status) override;
+  void on_event(const run::RunEvent& event) override;
+  void on_status(const run::StatusReport& status) override;
   void on_summary(TimeUs t_us, const nlohmann::json& summary) override;
 
  private:

@@ -276,7 +276,7 @@ void RunChannels::send(std::uint32_t channel, TimeUs t_us, const json& message) 
                   std::make_shared<const std::string>(message.dump(-1, ' ', false, json::error_handler_t::replace)));
 }
 
-json RunChannels::world_json(TimeUs t_us, const agents::WorldReport& w) {
+json RunChannels::world_json(TimeUs t_us, const run::WorldReport& w) {
   auto points = [](const std::vector<Vec2>& ps) {
     json a = json::array();
     for (const Vec2& p : ps) a.push_back({{"x_m", p.x}, {"y_m", p.y}});
@@ -288,7 +288,7 @@ json RunChannels::world_json(TimeUs t_us, const agents::WorldReport& w) {
   for (const auto& [ps, width_m] : w.field.tracks) tracks.push_back({{"points", points(ps)}, {"width_m", width_m}});
   // Each distinct sensor geometry once, as JSON; each robot refers to its own.
   std::vector<json> geometries;
-  for (const agents::SensorGeometry& g : w.sensor_geometries) {
+  for (const run::SensorGeometry& g : w.sensor_geometries) {
     json ranges = json::array();
     for (const auto& r : g.ranges)
       ranges.push_back({{"mount_rad", r.mount_rad}, {"opening_rad", r.opening_rad}, {"max_m", r.max_m}});
@@ -321,7 +321,7 @@ json RunChannels::world_json(TimeUs t_us, const agents::WorldReport& w) {
           {"robots", robots}};
 }
 
-json RunChannels::poses_json(TimeUs t_us, std::span<const agents::PoseReport> poses) {
+json RunChannels::poses_json(TimeUs t_us, std::span<const run::PoseReport> poses) {
   json robots = json::array();
   for (const auto& p : poses) {
     robots.push_back({{"id", p.id},
@@ -336,7 +336,7 @@ json RunChannels::poses_json(TimeUs t_us, std::span<const agents::PoseReport> po
   return {{"t_s", seconds(t_us)}, {"robots", robots}};
 }
 
-json RunChannels::status_json(const agents::StatusReport& s) {
+json RunChannels::status_json(const run::StatusReport& s) {
   return {{"t_s", seconds(s.t_us)},
           {"wall_s", s.wall_s},
           {"scenario", s.scenario},
@@ -356,8 +356,8 @@ json RunChannels::status_json(const agents::StatusReport& s) {
           {"frames", s.frames}};
 }
 
-json RunChannels::scene_json(TimeUs t_us, std::span<const agents::PoseReport> poses,
-                             const std::optional<agents::WorldReport>& world) {
+json RunChannels::scene_json(TimeUs t_us, std::span<const run::PoseReport> poses,
+                             const std::optional<run::WorldReport>& world) {
   json entities = json::array();
   if (world) {
     json field = entity(t_us, "field");
@@ -437,14 +437,14 @@ bool RunChannels::flush(std::chrono::milliseconds timeout) {
   return jobs_changed_.wait_for(lock, timeout, [this] { return jobs_.empty() && !building_; });
 }
 
-void RunChannels::on_world(TimeUs t_us, const agents::WorldReport& world) {
+void RunChannels::on_world(TimeUs t_us, const run::WorldReport& world) {
   {
     std::lock_guard lock(latest_->mutex);
     latest_->world = world;
   }
   post(world_, false, [this, t_us, world] {
     if (world.camera) {
-      const agents::CameraReport& c = *world.camera;
+      const run::CameraReport& c = *world.camera;
       const auto to_image = inverse(c.image_to_field);
       send(camera_calibration_, t_us,
            {{"t_s", seconds(t_us)},
@@ -459,17 +459,17 @@ void RunChannels::on_world(TimeUs t_us, const agents::WorldReport& world) {
   });
 }
 
-void RunChannels::OwnedPoses::assign(std::span<const agents::PoseReport> from) {
+void RunChannels::OwnedPoses::assign(std::span<const run::PoseReport> from) {
   poses.assign(from.begin(), from.end());
   strings.clear();
   strings.reserve(2 * poses.size());
-  for (agents::PoseReport& p : poses) {
+  for (run::PoseReport& p : poses) {
     p.behaviour = strings.emplace_back(p.behaviour);
     p.health = strings.emplace_back(p.health);
   }
 }
 
-void RunChannels::on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) {
+void RunChannels::on_poses(TimeUs t_us, std::span<const run::PoseReport> poses) {
   // Kept (and marked unsent) before anything else: a client subscribing meanwhile gets them
   // from the latch source, at worst twice.
   Latest& l = *latest_;
@@ -483,7 +483,7 @@ void RunChannels::on_poses(TimeUs t_us, std::span<const agents::PoseReport> pose
   auto owned = std::make_shared<OwnedPoses>();
   owned->assign(poses);
   post(poses_, true, [this, t_us, owned] {
-    const std::vector<agents::PoseReport>& copy = owned->poses;
+    const std::vector<run::PoseReport>& copy = owned->poses;
     Latest& l = *latest_;
     if (server_.subscribed(poses_)) {
       send(poses_, t_us, poses_json(t_us, copy));
@@ -491,7 +491,7 @@ void RunChannels::on_poses(TimeUs t_us, std::span<const agents::PoseReport> pose
       if (l.poses_t_us == t_us) l.poses_unsent = false;
     }
     if (server_.subscribed(scene_)) {
-      std::optional<agents::WorldReport> world;
+      std::optional<run::WorldReport> world;
       {
         std::lock_guard lock(l.mutex);
         world = l.world;  // 1 Hz's copy, only while someone watches the scene
@@ -513,9 +513,9 @@ std::shared_ptr<const std::string> RunChannels::Latest::build(bool scene, std::u
   return std::make_shared<const std::string>(message.dump(-1, ' ', false, json::error_handler_t::replace));
 }
 
-void RunChannels::on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wheels) {
+void RunChannels::on_wheels(TimeUs t_us, std::span<const run::WheelReport> wheels) {
   if (!server_.subscribed(wheels_)) return;  // nobody would get it
-  post(wheels_, true, [this, t_us, copy = std::vector<agents::WheelReport>(wheels.begin(), wheels.end())] {
+  post(wheels_, true, [this, t_us, copy = std::vector<run::WheelReport>(wheels.begin(), wheels.end())] {
     json robots = json::array();
     for (const auto& w : copy)
       robots.push_back({{"id", w.id}, {"left_units", w.wheels.left}, {"right_units", w.wheels.right}});
@@ -523,7 +523,7 @@ void RunChannels::on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wh
   });
 }
 
-void RunChannels::on_sensors(TimeUs t_us, std::span<const agents::SensorReport> sensors) {
+void RunChannels::on_sensors(TimeUs t_us, std::span<const run::SensorReport> sensors) {
   if (!server_.subscribed(sensors_)) return;  // nobody would get it
   std::vector<std::pair<int, environment::SensorReadings>> copy;
   copy.reserve(sensors.size());
@@ -552,11 +552,11 @@ void RunChannels::on_sensors(TimeUs t_us, std::span<const agents::SensorReport> 
   });
 }
 
-void RunChannels::on_detections(const agents::FrameReport& f) {
+void RunChannels::on_detections(const run::FrameReport& f) {
   if (!server_.subscribed(detections_)) return;  // nobody would get it
   post(detections_, true,
        [this, t_us = f.t_us, frame = f.frame, process_ms = f.process_ms,
-        copy = std::vector<agents::DetectionReport>(f.detections.begin(), f.detections.end())] {
+        copy = std::vector<run::DetectionReport>(f.detections.begin(), f.detections.end())] {
          json list = json::array();
          for (const auto& d : copy) {
            list.push_back({{"id", d.id},
@@ -574,14 +574,14 @@ void RunChannels::on_detections(const agents::FrameReport& f) {
        });
 }
 
-void RunChannels::on_event(const agents::RunEvent& e) {
+void RunChannels::on_event(const run::RunEvent& e) {
   post(events_, false, [this, e] {
     send(events_, e.t_us,
          {{"t_s", seconds(e.t_us)}, {"kind", e.kind}, {"id", e.id}, {"other", e.other}, {"detail", e.detail}});
   });
 }
 
-void RunChannels::on_status(const agents::StatusReport& status) {
+void RunChannels::on_status(const run::StatusReport& status) {
   post(status_, false, [this, status] { send(status_, status.t_us, status_json(status)); });
 }
 

@@ -32,15 +32,15 @@
 #include <thread>
 #include <vector>
 
-#include "agents/run_observer.hpp"
 #include "gui_web/web_server.hpp"
+#include "run/run_observer.hpp"
 
 namespace rilbed::gui_web {
 
 /// Publishes a run's reports on `server` (which must outlive it). Each on_ call converts
 /// and queues (WebServer::publish never blocks); call from one thread (the server's thread
 /// builds the latest poses and scene for a new subscriber, under a mutex).
-class RunChannels final : public agents::RunObserver {
+class RunChannels final : public run::RunObserver {
  public:
   explicit RunChannels(WebServer& server);
   /// Builds and publishes what was handed over, then stops its thread.
@@ -50,13 +50,13 @@ class RunChannels final : public agents::RunObserver {
   /// Waits until everything reported so far has been published on the server (not yet
   /// written to the clients: see WebServer::flush), at most `timeout`; returns whether it was.
   bool flush(std::chrono::milliseconds timeout);
-  void on_world(TimeUs t_us, const agents::WorldReport& world) override;
-  void on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) override;
-  void on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wheels) override;
-  void on_sensors(TimeUs t_us, std::span<const agents::SensorReport> sensors) override;
-  void on_detections(const agents::FrameReport& frame) override;
-  void on_event(const agents::RunEvent& event) override;
-  void on_status(const agents::StatusReport& status) override;
+  void on_world(TimeUs t_us, const run::WorldReport& world) override;
+  void on_poses(TimeUs t_us, std::span<const run::PoseReport> poses) override;
+  void on_wheels(TimeUs t_us, std::span<const run::WheelReport> wheels) override;
+  void on_sensors(TimeUs t_us, std::span<const run::SensorReport> sensors) override;
+  void on_detections(const run::FrameReport& frame) override;
+  void on_event(const run::RunEvent& event) override;
+  void on_status(const run::StatusReport& status) override;
   void on_summary(TimeUs t_us, const nlohmann::json& summary) override;
   /// A camera frame (JPEG) as foxglove.CompressedImage on /rilbed/camera. Call at the rate
   /// viewers should get them: each is base64 text of about 4/3 of the JPEG's size.
@@ -65,13 +65,13 @@ class RunChannels final : public agents::RunObserver {
   void console_reply(TimeUs t_us, bool accepted, const std::string& reason, const std::string& client);
 
   /// The JSON messages, for tests and other servers.
-  static nlohmann::json world_json(TimeUs t_us, const agents::WorldReport& world);
-  static nlohmann::json poses_json(TimeUs t_us, std::span<const agents::PoseReport> poses);
-  static nlohmann::json status_json(const agents::StatusReport& status);
+  static nlohmann::json world_json(TimeUs t_us, const run::WorldReport& world);
+  static nlohmann::json poses_json(TimeUs t_us, std::span<const run::PoseReport> poses);
+  static nlohmann::json status_json(const run::StatusReport& status);
   /// foxglove.SceneUpdate: every robot as a disc (virtual red, real blue) with its ID and
   /// behaviour, and the field's boundary, obstacles and tracks as lines.
-  static nlohmann::json scene_json(TimeUs t_us, std::span<const agents::PoseReport> poses,
-                                   const std::optional<agents::WorldReport>& world);
+  static nlohmann::json scene_json(TimeUs t_us, std::span<const run::PoseReport> poses,
+                                   const std::optional<run::WorldReport>& world);
 
  private:
   // Something to build and publish on the channels' thread.
@@ -88,19 +88,19 @@ class RunChannels final : public agents::RunObserver {
   // those a bus decoder hands over live only during the call (`rilbed gui --lcm`), and
   // these are kept for later. Not copyable: the reports view its own strings.
   struct OwnedPoses {
-    std::vector<agents::PoseReport> poses;
+    std::vector<run::PoseReport> poses;
     std::vector<std::string> strings;  // reserved up front, so that the views stay put
     OwnedPoses() = default;
     OwnedPoses(const OwnedPoses&) = delete;
     OwnedPoses& operator=(const OwnedPoses&) = delete;
-    void assign(std::span<const agents::PoseReport> from);
+    void assign(std::span<const run::PoseReport> from);
   };
 
   // What the poses and scene channels' latch sources build from; shared with them (they
   // run on the server's thread, which may outlive this object).
   struct Latest {
     std::mutex mutex;  // guards all of it
-    std::optional<agents::WorldReport> world;
+    std::optional<run::WorldReport> world;
     TimeUs poses_t_us = 0;
     OwnedPoses poses;
     bool poses_unsent = false, scene_unsent = false;  // the last poses were not published on the channel

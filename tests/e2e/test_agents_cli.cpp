@@ -16,9 +16,9 @@
 #include <sstream>
 #include <string>
 
-#include "app/agent_processes.hpp"
 #include "lcm_namespace.hpp"
 #include "run_command.hpp"
+#include "session/agent_processes.hpp"
 
 namespace rilbed::e2e {
 namespace {
@@ -390,9 +390,9 @@ TEST(AgentLaunch, TheCommandReachesTheRemoteShellWordForWord) {
   const std::vector<std::string> words = {"/opt/lab's rilbed/rilbed", "--lcm", "udpm://239.255.76.67:7667?ttl=1",
                                           "$HOME `id` \"x\" \\ ;|&*", "",      "a\nb"};
   std::string command = "printf '<%s>'";
-  for (const std::string& w : words) command.append(" ").append(app::shell_quote(w));
+  for (const std::string& w : words) command.append(" ").append(session::shell_quote(w));
   const std::vector<std::string> argv =
-      app::launch_arguments({"ssh", "-p", "22", "{host}", "{command}"}, "pi@h{command}", command);
+      session::launch_arguments({"ssh", "-p", "22", "{host}", "{command}"}, "pi@h{command}", command);
   ASSERT_EQ(argv.size(), 5u);
   EXPECT_EQ(argv[3], "pi@h{command}");  // a host's text is put in, never searched again
   EXPECT_EQ(argv[4], command);
@@ -427,7 +427,7 @@ TEST(AgentLaunch, AScenarioOnStandardInputEndsAtItsDocumentEndAndTheAgentWithIts
 }
 
 TEST(AgentLaunch, ProcessesTakeTheHostsInTurn) {
-  const std::vector<app::AgentPlacement> p = app::place_agents({1, 2, 3, 4, 5, 6, 7, 8}, 3, {"a", "b"});
+  const std::vector<session::AgentPlacement> p = session::place_agents({1, 2, 3, 4, 5, 6, 7, 8}, 3, {"a", "b"});
   ASSERT_EQ(p.size(), 3u);
   EXPECT_EQ(p[0].ids, (std::vector<int>{1, 2, 3}));
   EXPECT_EQ(p[0].host, "a");
@@ -435,7 +435,7 @@ TEST(AgentLaunch, ProcessesTakeTheHostsInTurn) {
   EXPECT_EQ(p[1].host, "b");
   EXPECT_EQ(p[2].ids, (std::vector<int>{7, 8}));
   EXPECT_EQ(p[2].host, "a");
-  EXPECT_TRUE(app::place_agents({1, 2}, 2, {})[1].host.empty());
+  EXPECT_TRUE(session::place_agents({1, 2}, 2, {})[1].host.empty());
 }
 
 TEST(AgentsCli, AgentsInOtherProcessesNeedABusTheyReach) {

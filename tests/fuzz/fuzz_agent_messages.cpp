@@ -1,5 +1,5 @@
-// Fuzz target for the agent exchange's messages (issue 18; src/links/remote_agents.hpp,
-// src/links/agent_server.hpp): the first input byte picks who hears the rest, as it would
+// Fuzz target for the agent exchange's messages (issue 18; src/bus/remote_agents.hpp,
+// src/bus/agent_server.hpp): the first input byte picks who hears the rest, as it would
 // come off the bus from anyone on the multicast group:
 //   0: an agent process (a real AgentServer) on RILBED_QUANTUM, its controllers stand-ins
 //      that read every field they are handed (a mock is fine in a test);
@@ -21,11 +21,11 @@
 #include <vector>
 
 #include "agents/controller.hpp"
-#include "links/agent_messages.hpp"
-#include "links/agent_server.hpp"
-#include "links/lcm_bus.hpp"
-#include "links/lcm_checked.hpp"
-#include "links/remote_agents.hpp"
+#include "bus/agent_messages.hpp"
+#include "bus/agent_server.hpp"
+#include "bus/lcm_bus.hpp"
+#include "bus/lcm_checked.hpp"
+#include "bus/remote_agents.hpp"
 
 namespace {
 
@@ -78,7 +78,7 @@ class TouchingController final : public agents::Controller {
 lcm::LCM& memq() {
   static std::unique_ptr<lcm::LCM> lcm = [] {
     std::string error;
-    auto made = links::open_lcm("memq://", error);
+    auto made = bus::open_lcm("memq://", error);
     if (!made) broken("memq:// did not open");
     return made;
   }();
@@ -88,17 +88,17 @@ lcm::LCM& memq() {
 
 void fuzz_server(const std::uint8_t* data, std::size_t size) {
   lcm::LCM* lcm = &memq();
-  links::AgentServerConfig config;
+  bus::AgentServerConfig config;
   config.scenario_name = "fuzz";
   config.robot_ids = {1, 2, 3};
-  links::AgentServer server(*lcm, *lcm, config, [](int) { return std::make_unique<TouchingController>(); });
+  bus::AgentServer server(*lcm, *lcm, config, [](int) { return std::make_unique<TouchingController>(); });
   // The bytes as they are, and again with the session set to this server's (else nearly
   // every message would be for someone else).
   g_steps = 0;
   server.handle_quantum(data, size);
   FUZZ_CHECK(server.counters().steps == 0 || g_steps > 0);
   rilbed::quantum_t q{};
-  if (!links::decode_checked(data, size, q)) {
+  if (!bus::decode_checked(data, size, q)) {
     FUZZ_CHECK(server.counters().refused == 1 && g_steps == 0);
     return;
   }
@@ -112,7 +112,7 @@ void fuzz_server(const std::uint8_t* data, std::size_t size) {
   const auto steps_before = server.counters().steps;
   g_steps = 0;
   server.handle_quantum(bytes.data(), bytes.size());
-  if (!links::plausible(q) || q.run.empty()) {
+  if (!bus::plausible(q) || q.run.empty()) {
     FUZZ_CHECK(server.counters().refused == refused_before + 1 && g_steps == 0);
     return;
   }
@@ -132,10 +132,10 @@ void fuzz_server(const std::uint8_t* data, std::size_t size) {
 
 void fuzz_run(const std::uint8_t* data, std::size_t size, bool hello) {
   lcm::LCM* lcm = &memq();
-  links::RemoteAgentsConfig config;
+  bus::RemoteAgentsConfig config;
   config.scenario_name = "fuzz";
   config.robot_ids = {1, 2};
-  links::RemoteAgents run(*lcm, *lcm, config);
+  bus::RemoteAgents run(*lcm, *lcm, config);
   rilbed::agent_hello_t h{};
   h.session = "known";
   h.scenario = "fuzz";
@@ -143,17 +143,17 @@ void fuzz_run(const std::uint8_t* data, std::size_t size, bool hello) {
   h.num_ids = 2;
   h.host = "here";
   h.pid = 1;
-  links::publish_encoded(*lcm, config.channels.agent_hello, h);
+  bus::publish_encoded(*lcm, config.channels.agent_hello, h);
   if (run.wait_for_agents(std::chrono::milliseconds(50))) broken("the known process was not taken");
   lcm->publish(hello ? config.channels.agent_hello : config.channels.quantum_reply, data, static_cast<unsigned>(size));
   while (lcm->handleTimeout(0) > 0) {}
   if (hello) {
     rilbed::agent_hello_t m{};
-    const bool refused = !links::decode_checked(data, size, m) || m.session.empty() || m.scenario != "fuzz";
+    const bool refused = !bus::decode_checked(data, size, m) || m.session.empty() || m.scenario != "fuzz";
     FUZZ_CHECK(run.counters().refused == (refused ? 1 : 0));
   } else {
     rilbed::quantum_reply_t m{};
-    if (!links::decode_checked(data, size, m)) FUZZ_CHECK(run.counters().refused == 1);
+    if (!bus::decode_checked(data, size, m)) FUZZ_CHECK(run.counters().refused == 1);
   }
   // Whatever came, an exchange with the process still works (it has nothing to answer:
   // no input was submitted).

@@ -1,4 +1,4 @@
-// Fuzz target for the console's commands (src/links/lcm_console.hpp): the input is one
+// Fuzz target for the console's commands (src/bus/lcm_console.hpp): the input is one
 // message as it would come off the bus on RILBED_CONSOLE, from anyone on the multicast
 // group. It goes to a real LcmConsoleServer on the in-process bus (handled on this thread),
 // whose run is a stand-in that takes every action it is handed (a mock is fine in a test).
@@ -21,10 +21,10 @@
 #include <variant>
 #include <vector>
 
-#include "agents/run_control.hpp"
-#include "links/lcm_bus.hpp"
-#include "links/lcm_checked.hpp"
-#include "links/lcm_console.hpp"
+#include "bus/lcm_bus.hpp"
+#include "bus/lcm_checked.hpp"
+#include "bus/lcm_console.hpp"
+#include "run/run_control.hpp"
 
 namespace {
 
@@ -50,18 +50,18 @@ struct Replies {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static lcm::LCM bus("memq://");
   if (!bus.good()) broken("memq:// did not open");
-  const links::Channels channels = links::Channels::with_prefix("");
-  agents::RunControl control;
-  std::vector<agents::ControlAction> taken;
-  control.attach([](const agents::ControlAction&) -> std::optional<std::string> { return std::nullopt; },
-                 [&taken](const agents::ControlAction& a) { taken.push_back(a); });
-  links::LcmConsoleServer server(bus, channels, kToken, control, {}, false);
+  const bus::Channels channels = bus::Channels::with_prefix("");
+  run::RunControl control;
+  std::vector<run::ControlAction> taken;
+  control.attach([](const run::ControlAction&) -> std::optional<std::string> { return std::nullopt; },
+                 [&taken](const run::ControlAction& a) { taken.push_back(a); });
+  bus::LcmConsoleServer server(bus, channels, kToken, control, {}, false);
   Replies replies;
-  links::LcmSubscription subscription(bus, channels.console_reply,
-                                      [&replies](const std::string&, const void* d, std::size_t n) {
-                                        rilbed::console_reply_t r;
-                                        if (links::decode_checked(d, n, r)) replies.got.push_back(r);
-                                      });
+  bus::LcmSubscription subscription(bus, channels.console_reply,
+                                    [&replies](const std::string&, const void* d, std::size_t n) {
+                                      rilbed::console_reply_t r;
+                                      if (bus::decode_checked(d, n, r)) replies.got.push_back(r);
+                                    });
 
   for (int send = 0; send < 2; ++send) {
     bus.publish(channels.console, data, static_cast<unsigned>(size));
@@ -69,7 +69,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
 
   rilbed::console_command_t c;
-  if (!links::decode_checked(data, size, c)) {
+  if (!bus::decode_checked(data, size, c)) {
     FUZZ_CHECK(replies.got.empty() && taken.empty());
     return 0;
   }
@@ -81,18 +81,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   FUZZ_CHECK(taken.size() <= 1);  // the retry did nothing
   if (c.token != kToken) {
     FUZZ_CHECK(!r.accepted);
-    FUZZ_CHECK(taken.size() == 1 && taken[0].kind == agents::ControlAction::Kind::kRefused);
+    FUZZ_CHECK(taken.size() == 1 && taken[0].kind == run::ControlAction::Kind::kRefused);
     return 0;
   }
-  const auto parsed = links::parse_console_command(c);
-  FUZZ_CHECK(r.accepted == std::holds_alternative<agents::ControlAction>(parsed));
+  const auto parsed = bus::parse_console_command(c);
+  FUZZ_CHECK(r.accepted == std::holds_alternative<run::ControlAction>(parsed));
   if (!r.accepted) {
     FUZZ_CHECK(taken.empty() && !r.reason.empty());
     return 0;
   }
   FUZZ_CHECK(taken.size() == 1);
-  const agents::ControlAction& a = taken[0];
-  using Kind = agents::ControlAction::Kind;
+  const run::ControlAction& a = taken[0];
+  using Kind = run::ControlAction::Kind;
   switch (a.kind) {
     case Kind::kPause: FUZZ_CHECK(c.command == "pause" && c.args.empty()); break;
     case Kind::kResume: FUZZ_CHECK(c.command == "resume" && c.args.empty()); break;

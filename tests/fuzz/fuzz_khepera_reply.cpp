@@ -1,4 +1,4 @@
-// Fuzz target for the Khepera serial protocol (src/links/khepera_protocol.hpp): arbitrary
+// Fuzz target for the Khepera serial protocol (src/serial/khepera_protocol.hpp): arbitrary
 // bytes from a "serial port" go through the line assembler, and every line (and the raw
 // input as one line) through decode_reply for every command kind of both robot models,
 // looks_like_reply_to, decode_command and printable.
@@ -24,11 +24,11 @@
 
 #include <fuzzer/FuzzedDataProvider.h>
 
-#include "links/khepera_protocol.hpp"
+#include "serial/khepera_protocol.hpp"
 
 namespace {
 
-using namespace rilbed::links;
+using namespace rilbed::serial;
 
 constexpr CommandKind kKinds[] = {CommandKind::kReadVersions, CommandKind::kSetSpeeds,    CommandKind::kReadSpeeds,
                                   CommandKind::kSetCounters,  CommandKind::kReadCounters, CommandKind::kReadProximity,

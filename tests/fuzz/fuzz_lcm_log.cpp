@@ -1,7 +1,7 @@
 // Fuzz target for reading a recording (`rilbed replay FILE --out DIR`, src/app/cmd_replay.cpp):
 // the input is an LCM log file's bytes. They are written to a temporary file, which
 // links::LcmLogReader reads event by event (as replay does: liblcm's own reader trusts the
-// lengths in the file); RunReportDecoder (src/links/lcm_bus.hpp) decodes each
+// lengths in the file); RunReportDecoder (src/bus/lcm_bus.hpp) decodes each
 // event of the run's channels into a run folder (agents::RunFolderWriter, the real one,
 // writing into a temporary folder), and a recording without its summary is finished as
 // cmd_replay finishes it. Both temporaries (in TMPDIR, else /dev/shm, else /tmp; named
@@ -31,8 +31,8 @@
 #include <lcm/lcm-cpp.hpp>
 #include <nlohmann/json.hpp>
 
-#include "agents/run_folder_writer.hpp"
-#include "links/lcm_bus.hpp"
+#include "bus/lcm_bus.hpp"
+#include "run/run_folder_writer.hpp"
 #include "touching_observer.hpp"
 
 namespace {
@@ -50,22 +50,22 @@ using namespace rilbed;
   } while (false)
 
 // Hands every report to the touching observer, then to the folder writer.
-class Tee final : public agents::RunObserver {
+class Tee final : public run::RunObserver {
  public:
-  Tee(agents::RunObserver& a, agents::RunObserver& b) : a_(a), b_(b) {}
-  void on_world(TimeUs t_us, const agents::WorldReport& world) override {
+  Tee(run::RunObserver& a, run::RunObserver& b) : a_(a), b_(b) {}
+  void on_world(TimeUs t_us, const run::WorldReport& world) override {
     a_.on_world(t_us, world);
     b_.on_world(t_us, world);
   }
-  void on_poses(TimeUs t_us, std::span<const agents::PoseReport> poses) override {
+  void on_poses(TimeUs t_us, std::span<const run::PoseReport> poses) override {
     a_.on_poses(t_us, poses);
     b_.on_poses(t_us, poses);
   }
-  void on_event(const agents::RunEvent& event) override {
+  void on_event(const run::RunEvent& event) override {
     a_.on_event(event);
     b_.on_event(event);
   }
-  void on_status(const agents::StatusReport& status) override {
+  void on_status(const run::StatusReport& status) override {
     a_.on_status(status);
     b_.on_status(status);
   }
@@ -73,22 +73,22 @@ class Tee final : public agents::RunObserver {
     a_.on_summary(t_us, summary);
     b_.on_summary(t_us, summary);
   }
-  void on_wheels(TimeUs t_us, std::span<const agents::WheelReport> wheels) override {
+  void on_wheels(TimeUs t_us, std::span<const run::WheelReport> wheels) override {
     a_.on_wheels(t_us, wheels);
     b_.on_wheels(t_us, wheels);
   }
-  void on_sensors(TimeUs t_us, std::span<const agents::SensorReport> sensors) override {
+  void on_sensors(TimeUs t_us, std::span<const run::SensorReport> sensors) override {
     a_.on_sensors(t_us, sensors);
     b_.on_sensors(t_us, sensors);
   }
-  void on_detections(const agents::FrameReport& frame) override {
+  void on_detections(const run::FrameReport& frame) override {
     a_.on_detections(frame);
     b_.on_detections(frame);
   }
 
  private:
-  agents::RunObserver& a_;
-  agents::RunObserver& b_;
+  run::RunObserver& a_;
+  run::RunObserver& b_;
 };
 
 struct TempPaths {
@@ -133,12 +133,12 @@ std::string read_all(const fs::path& path) {
 
 // What `rilbed replay --out` does with the recording (cmd_replay.cpp, write_folder).
 void replay(const TempPaths& paths) {
-  links::LcmLogReader log(paths.log.string());
+  bus::LcmLogReader log(paths.log.string());
   FUZZ_CHECK(log.good());
   rilbed_fuzz::TouchingObserver seen;
-  agents::RunFolderWriter writer(paths.folder);
+  run::RunFolderWriter writer(paths.folder);
   Tee tee(seen, writer);
-  links::RunReportDecoder decoder(links::Channels::with_prefix(""), tee);
+  bus::RunReportDecoder decoder(bus::Channels::with_prefix(""), tee);
   bool truncated = false;
   try {
     while (const auto e = log.next()) {

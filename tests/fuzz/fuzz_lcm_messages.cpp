@@ -1,4 +1,4 @@
-// Fuzz target for the LCM messages of a run (src/links/lcm_bus.hpp): the first input byte
+// Fuzz target for the LCM messages of a run (src/bus/lcm_bus.hpp): the first input byte
 // picks one of the run's channels (Channels::with_prefix(""): poses, events, status, world,
 // summary, or a channel that is none of them), the rest are the message's bytes, as they
 // would come off the bus, for RunReportDecoder::decode. The observer reads every field it
@@ -33,8 +33,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "links/lcm_bus.hpp"
-#include "links/lcm_checked.hpp"
+#include "bus/lcm_bus.hpp"
+#include "bus/lcm_checked.hpp"
 #include "touching_observer.hpp"
 
 namespace {
@@ -55,7 +55,7 @@ std::string g_channel;  // the channel of the input being checked, for the repor
 // The channels the first byte picks from: the run's five and one it does not use.
 const std::vector<std::string>& channel_names() {
   static const std::vector<std::string> names = [] {
-    const links::Channels c = links::Channels::with_prefix("");
+    const bus::Channels c = bus::Channels::with_prefix("");
     return std::vector<std::string>{c.poses,         c.events,  c.status,        c.world,  c.summary,
                                     c.wheels,        c.sensors, c.detections,    c.frames, c.camera,
                                     c.sensor_layout, c.vision,  "RILBED_UNKNOWN"};
@@ -155,14 +155,14 @@ void check_poses(const rilbed_fuzz::TouchingObserver& seen, const rilbed::poses_
 
 void check_event(const rilbed_fuzz::TouchingObserver& seen, const rilbed::event_t& m) {
   FUZZ_CHECK(seen.calls.event == 1);
-  const agents::RunEvent& e = seen.last_event;
+  const run::RunEvent& e = seen.last_event;
   FUZZ_CHECK(e.t_us == m.utime && e.kind == m.kind && e.id == m.id && e.other == m.other && e.detail == m.detail);
 }
 
-void check_status(const rilbed_fuzz::TouchingObserver& seen, const links::RunReportDecoder& decoder,
+void check_status(const rilbed_fuzz::TouchingObserver& seen, const bus::RunReportDecoder& decoder,
                   const rilbed::status_t& m) {
   FUZZ_CHECK(seen.calls.status == 1);
-  const agents::StatusReport& s = seen.last_status;
+  const run::StatusReport& s = seen.last_status;
   FUZZ_CHECK(s.t_us == m.utime && same_bits(s.wall_s, static_cast<double>(m.wall_utime) * 1e-6));
   FUZZ_CHECK(s.scenario == m.scenario && s.seed == static_cast<std::uint64_t>(m.seed) && s.mode == m.mode);
   FUZZ_CHECK(s.realtime == (m.realtime != 0) && same_bits(s.rt_factor, m.rt_factor));
@@ -189,7 +189,7 @@ void check_status(const rilbed_fuzz::TouchingObserver& seen, const links::RunRep
 void check_world(const rilbed_fuzz::TouchingObserver& seen, const rilbed::world_t& m) {
   FUZZ_CHECK(seen.calls.world == 1);
   FUZZ_CHECK(seen.last_world_t_us == m.utime);
-  const agents::WorldReport& w = seen.last_world;
+  const run::WorldReport& w = seen.last_world;
   FUZZ_CHECK(w.scenario == m.scenario && w.walls == (m.walls != 0));
   FUZZ_CHECK(same_bits(w.field.width_m, m.width_m) && same_bits(w.field.height_m, m.height_m));
   auto same_points = [](const std::vector<Vec2>& points, const rilbed::polyline_t& p) {
@@ -265,7 +265,7 @@ void check_detections(const rilbed_fuzz::TouchingObserver& seen, const rilbed::d
   }
 }
 
-void check_summary(const rilbed_fuzz::TouchingObserver& seen, const links::RunReportDecoder& decoder,
+void check_summary(const rilbed_fuzz::TouchingObserver& seen, const bus::RunReportDecoder& decoder,
                    const rilbed::summary_t& m) {
   FUZZ_CHECK(seen.calls.summary == 1 && decoder.summary_seen());
   FUZZ_CHECK(seen.last_summary_t_us == m.utime);
@@ -278,7 +278,7 @@ void check_summary(const rilbed_fuzz::TouchingObserver& seen, const links::RunRe
 // a read far past the buffer) in asking lcm-gen's decoder about those.
 template <typename Message>
 bool refused_before_decoding(const std::uint8_t* data, std::size_t size) {
-  return !links::well_formed<Message>(data, size);
+  return !bus::well_formed<Message>(data, size);
 }
 
 // What the decoder should have made of `data`, with lcm-gen's decoder of the channel's type.
@@ -308,7 +308,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::size_t length = size - 1;
 
   rilbed_fuzz::TouchingObserver seen;
-  links::RunReportDecoder decoder(links::Channels::with_prefix(""), seen);
+  bus::RunReportDecoder decoder(bus::Channels::with_prefix(""), seen);
   std::optional<std::string> problem;
   try {
     problem = decoder.decode(g_channel, message, length);
@@ -403,9 +403,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       rilbed::world_t world;
       std::vector<std::uint8_t> bytes(static_cast<std::size_t>(world.getEncodedSize()));
       FUZZ_CHECK(world.encode(bytes.data(), 0, static_cast<int>(bytes.size())) > 0);
-      FUZZ_CHECK(!decoder.decode(links::Channels::with_prefix("").world, bytes.data(), bytes.size()));
+      FUZZ_CHECK(!decoder.decode(bus::Channels::with_prefix("").world, bytes.data(), bytes.size()));
       FUZZ_CHECK(seen.calls.world == 1 && seen.last_world.camera.has_value());
-      const agents::CameraReport& c = *seen.last_world.camera;
+      const run::CameraReport& c = *seen.last_world.camera;
       FUZZ_CHECK(c.width_px == m.width_px && c.height_px == m.height_px &&
                  c.lens_distortion == (m.lens_distortion != 0));
       for (int i = 0; i < 9; ++i)
@@ -419,7 +419,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       rilbed::vision_settings_t m;
       if (problem && refused_before_decoding<rilbed::vision_settings_t>(message, length)) break;
       const bool readable = generated_decode(message, length, m);
-      const vision::VisionSettings s = links::from_lcm(m);
+      const vision::VisionSettings s = bus::from_lcm(m);
       const bool usable = readable && !vision::check_vision_settings(s);
       FUZZ_CHECK(usable == !problem);
       if (problem) break;
@@ -427,7 +427,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       rilbed::status_t status;
       std::vector<std::uint8_t> bytes(static_cast<std::size_t>(status.getEncodedSize()));
       FUZZ_CHECK(status.encode(bytes.data(), 0, static_cast<int>(bytes.size())) > 0);
-      const std::string channel = links::Channels::with_prefix("").status;
+      const std::string channel = bus::Channels::with_prefix("").status;
       FUZZ_CHECK(!decoder.decode(channel, bytes.data(), bytes.size()));
       FUZZ_CHECK(seen.calls.status == 1 && seen.last_status.vision == s);
       FUZZ_CHECK(!decoder.decode(channel, bytes.data(), bytes.size()));
@@ -462,9 +462,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       rilbed::world_t world;
       std::vector<std::uint8_t> bytes(static_cast<std::size_t>(world.getEncodedSize()));
       FUZZ_CHECK(world.encode(bytes.data(), 0, static_cast<int>(bytes.size())) > 0);
-      FUZZ_CHECK(!decoder.decode(links::Channels::with_prefix("").world, bytes.data(), bytes.size()));
+      FUZZ_CHECK(!decoder.decode(bus::Channels::with_prefix("").world, bytes.data(), bytes.size()));
       FUZZ_CHECK(seen.calls.world == 1);
-      const agents::WorldReport& w = seen.last_world;
+      const run::WorldReport& w = seen.last_world;
       FUZZ_CHECK(w.sensor_geometries.size() == m.geometries.size());
       std::set<std::int32_t> ids(m.robot_ids.begin(), m.robot_ids.end());
       FUZZ_CHECK(w.sensor_geometry_of.size() == ids.size());

@@ -1,4 +1,4 @@
-// Fuzz target for scenario files (src/agents/scenario.hpp): arbitrary text goes to
+// Fuzz target for scenario files (src/run/scenario.hpp): arbitrary text goes to
 // parse_scenario. A ScenarioError is the expected answer to bad input; any other exception
 // escaping, a crash, a leak or undefined behaviour is a bug. A scenario that parses must
 // hold what the parser promises to have checked, and an error must name the file first.
@@ -14,12 +14,12 @@
 #include <string>
 #include <typeinfo>
 
-#include "agents/scenario.hpp"
+#include "run/scenario.hpp"
 
 namespace {
 
-using rilbed::agents::Scenario;
-using rilbed::agents::ScenarioError;
+using rilbed::run::Scenario;
+using rilbed::run::ScenarioError;
 
 constexpr const char* kSource = "fuzz.yaml";
 
@@ -59,7 +59,7 @@ void check(const Scenario& s) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   try {
-    check(rilbed::agents::parse_scenario(text, kSource));
+    check(rilbed::run::parse_scenario(text, kSource));
   } catch (const ScenarioError& e) {
     // "FILE:LINE: KEY: problem" (or "FILE: problem").
     const std::string message = e.what();

@@ -14,7 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "agents/run_observer.hpp"
+#include "run/run_observer.hpp"
 
 namespace rilbed_fuzz {
 
@@ -28,14 +28,14 @@ struct OwnedPose {
   std::string health;
 };
 
-class TouchingObserver : public rilbed::agents::RunObserver {
+class TouchingObserver : public rilbed::run::RunObserver {
  public:
   struct Calls {
     int world = 0, poses = 0, event = 0, status = 0, summary = 0, wheels = 0, sensors = 0, detections = 0, frames = 0;
     int total() const { return world + poses + event + status + summary + wheels + sensors + detections + frames; }
   };
 
-  void on_world(rilbed::TimeUs t_us, const rilbed::agents::WorldReport& w) override {
+  void on_world(rilbed::TimeUs t_us, const rilbed::run::WorldReport& w) override {
     ++calls.world;
     touch(t_us);
     touch(w.scenario);
@@ -54,12 +54,12 @@ class TouchingObserver : public rilbed::agents::RunObserver {
     last_world = w;
   }
 
-  void on_poses(rilbed::TimeUs t_us, std::span<const rilbed::agents::PoseReport> poses) override {
+  void on_poses(rilbed::TimeUs t_us, std::span<const rilbed::run::PoseReport> poses) override {
     ++calls.poses;
     touch(t_us);
     last_poses_t_us = t_us;
     last_poses.clear();
-    for (const rilbed::agents::PoseReport& p : poses) {
+    for (const rilbed::run::PoseReport& p : poses) {
       touch(p.id);
       touch(p.real);
       touch(p.seen);
@@ -70,7 +70,7 @@ class TouchingObserver : public rilbed::agents::RunObserver {
     }
   }
 
-  void on_event(const rilbed::agents::RunEvent& e) override {
+  void on_event(const rilbed::run::RunEvent& e) override {
     ++calls.event;
     touch(e.t_us);
     touch(e.kind);
@@ -80,7 +80,7 @@ class TouchingObserver : public rilbed::agents::RunObserver {
     last_event = e;
   }
 
-  void on_status(const rilbed::agents::StatusReport& s) override {
+  void on_status(const rilbed::run::StatusReport& s) override {
     ++calls.status;
     touch(s.t_us);
     touch(s.wall_s);
@@ -102,7 +102,7 @@ class TouchingObserver : public rilbed::agents::RunObserver {
     last_status = s;
   }
 
-  void on_wheels(rilbed::TimeUs t_us, std::span<const rilbed::agents::WheelReport> wheels) override {
+  void on_wheels(rilbed::TimeUs t_us, std::span<const rilbed::run::WheelReport> wheels) override {
     ++calls.wheels;
     touch(t_us);
     last_wheels.assign(wheels.begin(), wheels.end());
@@ -113,7 +113,7 @@ class TouchingObserver : public rilbed::agents::RunObserver {
     }
   }
 
-  void on_sensors(rilbed::TimeUs t_us, std::span<const rilbed::agents::SensorReport> sensors) override {
+  void on_sensors(rilbed::TimeUs t_us, std::span<const rilbed::run::SensorReport> sensors) override {
     ++calls.sensors;
     touch(t_us);
     last_sensors.clear();
@@ -141,7 +141,7 @@ class TouchingObserver : public rilbed::agents::RunObserver {
     }
   }
 
-  void on_detections(const rilbed::agents::FrameReport& f) override {
+  void on_detections(const rilbed::run::FrameReport& f) override {
     ++calls.detections;
     touch(f.t_us);
     touch(f.frame);
@@ -183,14 +183,14 @@ class TouchingObserver : public rilbed::agents::RunObserver {
 
   Calls calls;
   rilbed::TimeUs last_world_t_us = 0, last_poses_t_us = 0, last_summary_t_us = 0;
-  rilbed::agents::WorldReport last_world;
+  rilbed::run::WorldReport last_world;
   std::vector<OwnedPose> last_poses;
-  rilbed::agents::RunEvent last_event;
-  rilbed::agents::StatusReport last_status;
+  rilbed::run::RunEvent last_event;
+  rilbed::run::StatusReport last_status;
   nlohmann::json last_summary;
-  std::vector<rilbed::agents::WheelReport> last_wheels;
+  std::vector<rilbed::run::WheelReport> last_wheels;
   std::vector<std::pair<int, rilbed::environment::SensorReadings>> last_sensors;
-  std::vector<rilbed::agents::DetectionReport> last_detections;
+  std::vector<rilbed::run::DetectionReport> last_detections;
   std::int64_t last_frame_number = 0;
   cv::Size last_image_size;
   /// What was read, summed, so that no read can be optimised away.

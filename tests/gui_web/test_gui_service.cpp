@@ -15,10 +15,13 @@
 #include <nlohmann/json.hpp>
 
 #include "gui_web/gui_service.hpp"
+#include "support/eventually.hpp"
 #include "ws_test_client.hpp"
 
 namespace rilbed::gui_web {
 namespace {
+
+using rilbed::testing::eventually;
 
 using namespace rilbed::gui_web::testing;
 using nlohmann::json;
@@ -60,16 +63,6 @@ struct RecordingSink {
     return out;
   }
 };
-
-template <typename Predicate>
-bool eventually(Predicate done, std::chrono::milliseconds limit = std::chrono::seconds(10)) {
-  const auto deadline = Clock::now() + limit;
-  while (!done()) {
-    if (Clock::now() > deadline) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  return true;
-}
 
 // A client that has read the greeting and advertised its two topics (1: console, 2: drive).
 struct PanelClient : Client {
@@ -298,8 +291,8 @@ std::map<std::string, json> values_of(const json& parameter_values) {
   return out;
 }
 
-agents::StatusReport status_with(std::optional<vision::VisionSettings> settings) {
-  agents::StatusReport s;
+run::StatusReport status_with(std::optional<vision::VisionSettings> settings) {
+  run::StatusReport s;
   s.state = "running";
   s.vision = settings;
   return s;
@@ -390,7 +383,7 @@ TEST(GuiService, AViewerJoiningLaterGetsTheLatestPosesAndSceneThoughNobodyWatche
   RecordingSink run;
   GuiService gui(config(), run.sink());
   // Reported while nobody watches: nothing is built, but the latest is kept.
-  std::vector<agents::PoseReport> poses{{3, false, true, Pose2{{0.5, 0.25}, 1.0}, "wander", "ok"}};
+  std::vector<run::PoseReport> poses{{3, false, true, Pose2{{0.5, 0.25}, 1.0}, "wander", "ok"}};
   gui.on_poses(1'000'000, poses);
   poses[0].pose.position_m = {0.75, 0.5};
   gui.on_poses(1'100'000, poses);

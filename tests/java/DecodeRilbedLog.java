@@ -1,4 +1,4 @@
-// Reads a rilbed LCM log with the Java classes that lcm-gen made from src/links/msgs/*.lcm
+// Reads a rilbed LCM log with the Java classes that lcm-gen made from src/bus/msgs/*.lcm
 // (build/rilbed_lcmtypes.jar) the way lcm-spy does: each message's class is found by the
 // fingerprint in its first 8 bytes. Every message must decode, and encode again to the same
 // bytes; the poses, events and summary must be the run folder's (trajectories.csv,

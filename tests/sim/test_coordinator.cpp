@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "sim/coordinator.hpp"
+#include "support/eventually.hpp"
 #include "test_models.hpp"
 
 using namespace rilbed::sim;
@@ -14,6 +15,8 @@ using namespace rilbed::sim::testing;
 using rilbed::TimeUs;
 
 namespace {
+
+using rilbed::testing::eventually;
 
 constexpr TimeUs kMs = 1000;
 using Received = std::vector<std::pair<TimeUs, int>>;
@@ -38,17 +41,6 @@ struct Chain {
     coordinator.on_step([log = log](const StepReport& report) { log->push_back("@" + std::to_string(report.t_us)); });
   }
 };
-
-/// Waits (polling) until `condition` holds or 5 s pass; returns whether it held.
-template <class Condition>
-bool eventually(Condition condition) {
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-  while (!condition()) {
-    if (std::chrono::steady_clock::now() > give_up) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-  return true;
-}
 
 }  // namespace
 

@@ -1,0 +1,708 @@
+#include "run/scenario.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "agents/builtin_controllers.hpp"
+#include "core/id_list.hpp"
+#include "environment/shapes.hpp"
+
+namespace rilbed::run {
+
+namespace {
+
+// (Vec2 is rilbed::Vec2)
+
+// Reads one YAML mapping with strict checks; every error names file, line and key.
+class Reader {
+ public:
+  Reader(const YAML::Node& node, std::string source, std::string path)
+      : node_(node), source_(std::move(source)), path_(std::move(path)) {
+    if (!node_.IsMap()) fail(node_, "expected a mapping of keys");
+  }
+  [[noreturn]] void fail(const YAML::Node& at, const std::string& what) const {
+    const int line = at.Mark().line >= 0 ? at.Mark().line + 1 : 0;
+    throw ScenarioError(source_ + ":" + std::to_string(line) + ": " + (path_.empty() ? "(top level)" : path_) + ": " +
+                        what);
+  }
+  [[noreturn]] void fail_key(const std::string& key, const std::string& what) const {
+    throw ScenarioError(source_ + ":" + std::to_string(line_of(key)) + ": " + join(key) + ": " + what);
+  }
+
+  // Every key must be one of `allowed`.
+  void allow(std::initializer_list<const char*> allowed) const {
+    for (const auto& kv : node_) {
+      const std::string key = kv.first.as<std::string>();
+      if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
+        std::string list;
+        for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
+        throw ScenarioError(source_ + ":" + std::to_string(kv.first.Mark().line + 1) + ": " + join(key) +
+                            ": unknown key (allowed here: " + list + ")");
+      }
+    }
+  }
+  bool has(const std::string& key) const { return static_cast<bool>(node_[key]); }
+  YAML::Node get(const std::string& key) const { return node_[key]; }
+  std::string join(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  int line_of(const std::string& key) const {
+    for (const auto& kv : node_) {
+      if (kv.first.as<std::string>() == key) return kv.first.Mark().line + 1;
+    }
+    return node_.Mark().line + 1;
+  }
+  Reader child(const std::string& key) const { return Reader(node_[key], source_, join(key)); }
+  const std::string& source() const { return source_; }
+
+  double number(const std::string& key, double fallback) const {
+    if (!has(key)) return fallback;
+    return as_number(node_[key], key);
+  }
+  double positive(const std::string& key, double fallback) const {
+    const double v = number(key, fallback);
+    if (!(v > 0.0)) fail_key(key, "must be greater than 0");
+    return v;
+  }
+  double non_negative(const std::string& key, double fallback) const {
+    const double v = number(key, fallback);
+    if (!(v >= 0.0)) fail_key(key, "must not be negative");
+    return v;
+  }
+  int integer(const std::string& key, int fallback) const {
+    if (!has(key)) return fallback;
+    const double v = as_number(node_[key], key);
+    if (v != std::floor(v) || std::abs(v) > 1e9) fail_key(key, "must be a whole number");
+    return static_cast<int>(v);
+  }
+  bool boolean(const std::string& key, bool fallback) const {
+    if (!has(key)) return fallback;
+    try {
+      return node_[key].as<bool>();
+    } catch (const YAML::Exception&) {
+      fail_key(key, "must be true or false");
+    }
+  }
+  std::string text(const std::string& key, const std::string& fallback) const {
+    if (!has(key)) return fallback;
+    if (!node_[key].IsScalar()) fail_key(key, "must be a text value");
+    return node_[key].as<std::string>();
+  }
+  Vec2 point(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsSequence() || n.size() != 2) fail_key(key, "must be a point [x_m, y_m]");
+    return {as_number(n[0], key), as_number(n[1], key)};
+  }
+  /// A list of text values (a single one counts as a list of one).
+  std::vector<std::string> words(const std::string& key) const {
+    const YAML::Node n = node_[key];
+    std::vector<std::string> out;
+    if (n.IsScalar()) return {n.as<std::string>()};
+    if (!n.IsSequence()) fail_key(key, "must be a list of text values");
+    for (const auto& w : n) {
+      if (!w.IsScalar()) fail_key(key, "must be a list of text values");
+      out.push_back(w.as<std::string>());
+    }
+    return out;
+  }
+  std::vector<Vec2> points(const std::string& key) const {
+    const YAML::Node n = node_[key];
+    if (!n || !n.IsSequence()) fail_key(key, "must be a list of points [[x_m, y_m], ...]");
+    std::vector<Vec2> out;
+    for (const auto& p : n) out.push_back(point(p, key));
+    return out;
+  }
+
+ private:
+  double as_number(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsScalar()) fail_key(key, "must be a number");
+    double v = 0.0;
+    try {
+      v = n.as<double>();
+    } catch (const YAML::Exception&) {
+      fail_key(key, "must be a number, not '" + n.as<std::string>() + "'");
+    }
+    if (!std::isfinite(v)) fail_key(key, "must be a finite number");
+    return v;
+  }
+
+  YAML::Node node_;
+  std::string source_;
+  std::string path_;
+};
+
+TimeUs milliseconds(const Reader& r, const std::string& key, TimeUs fallback_us) {
+  const double ms = r.positive(key, static_cast<double>(fallback_us) / 1000.0);
+  const TimeUs us = static_cast<TimeUs>(std::llround(ms * 1000.0));
+  if (us <= 0) r.fail_key(key, "must be at least 0.001 ms");
+  return us;
+}
+
+environment::SensorSuiteConfig read_sensors(const Reader& r) {
+  environment::SensorSuiteConfig s;
+  r.allow({"proximity", "range_finders", "beacon_finder", "track", "odometer"});
+  if (r.has("proximity")) {
+    const YAML::Node n = r.get("proximity");
+    if (n.IsScalar()) {
+      if (r.boolean("proximity", true)) {
+        s.proximity = environment::ProximityConfig{};
+      } else {
+        s.proximity.reset();
+      }
+    } else {
+      const Reader p = r.child("proximity");
+      p.allow({"range_m", "falloff_m", "half_angle_deg", "noise_sd"});
+      environment::ProximityConfig c;
+      c.range_m = p.positive("range_m", c.range_m);
+      c.falloff_m = p.positive("falloff_m", c.falloff_m);
+      c.half_angle_rad = deg_to_rad(p.positive("half_angle_deg", rad_to_deg(c.half_angle_rad)));
+      c.noise_sd = p.non_negative("noise_sd", c.noise_sd);
+      s.proximity = c;
+    }
+  }
+  if (r.has("range_finders")) {
+    const YAML::Node list = r.get("range_finders");
+    if (!list.IsSequence()) r.fail_key("range_finders", "must be a list");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const Reader f(list[i], r.source(), r.join("range_finders") + "[" + std::to_string(i) + "]");
+      f.allow({"mount_deg", "opening_deg", "max_range_m", "noise_sd_m"});
+      environment::RangeFinderConfig c;
+      c.mount_angle_rad = deg_to_rad(f.number("mount_deg", 0.0));
+      c.opening_angle_rad = deg_to_rad(f.positive("opening_deg", rad_to_deg(c.opening_angle_rad)));
+      c.max_range_m = f.positive("max_range_m", c.max_range_m);
+      c.noise_sd_m = f.non_negative("noise_sd_m", c.noise_sd_m);
+      s.range_finders.push_back(c);
+    }
+  }
+  if (r.has("beacon_finder")) {
+    const Reader b = r.child("beacon_finder");
+    b.allow({"field_of_view_deg", "bearing_noise_deg"});
+    environment::BeaconFinderConfig c;
+    c.field_of_view_rad = deg_to_rad(b.positive("field_of_view_deg", 360.0));
+    c.bearing_noise_sd_rad = deg_to_rad(b.non_negative("bearing_noise_deg", 0.0));
+    s.beacon_finder = c;
+  }
+  if (r.has("track")) {
+    const YAML::Node list = r.get("track");
+    if (!list.IsSequence()) r.fail_key("track", "must be a list of track sensor elements");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const Reader t(list[i], r.source(), r.join("track") + "[" + std::to_string(i) + "]");
+      // One key per parameter of paper 000 §8.2's configuration block, plus the mount.
+      t.allow({"mount_x_m", "mount_y_m", "mount_yaw_deg", "height_mm", "inclination_deg", "cone_angle_deg", "precision",
+               "coverage_percent", "max_value", "error_level_percent", "graded"});
+      environment::TrackSensorConfig c;
+      c.mount_x_m = t.number("mount_x_m", c.mount_x_m);
+      c.mount_y_m = t.number("mount_y_m", c.mount_y_m);
+      c.mount_yaw_deg = t.number("mount_yaw_deg", c.mount_yaw_deg);
+      c.height_mm = t.positive("height_mm", c.height_mm);
+      c.inclination_deg = t.number("inclination_deg", c.inclination_deg);
+      c.cone_angle_deg = t.positive("cone_angle_deg", c.cone_angle_deg);
+      c.precision = t.integer("precision", c.precision);
+      c.coverage_percent = t.non_negative("coverage_percent", c.coverage_percent);
+      c.max_value = t.integer("max_value", c.max_value);
+      c.error_level_percent = t.non_negative("error_level_percent", c.error_level_percent);
+      c.graded = t.boolean("graded", c.graded);
+      s.track_sensors.push_back(c);
+    }
+  }
+  s.odometer = r.boolean("odometer", s.odometer);
+  return s;
+}
+
+std::vector<RobotSpec> read_robots(const Reader& top, const agents::ControllerRegistry& controllers) {
+  const YAML::Node list = top.get("robots");
+  if (!list || !list.IsSequence() || list.size() == 0) top.fail_key("robots", "must be a non-empty list of robots");
+  std::vector<RobotSpec> robots;
+  std::set<int> seen;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const Reader r(list[i], top.source(), "robots[" + std::to_string(i) + "]");
+    r.allow({"id", "ids", "kind", "pose", "controller", "params", "noise", "sensors", "link"});
+    RobotSpec base;
+    base.line = list[i].Mark().line + 1;
+    std::vector<int> ids;
+    if (r.has("id") == r.has("ids")) r.fail(list[i], "give exactly one of `id` (one robot) or `ids` (e.g. 1-8)");
+    if (r.has("id")) {
+      ids.push_back(r.integer("id", 0));
+    } else {
+      const auto parsed = parse_id_list(r.text("ids", ""), 1, 100000);
+      if (!parsed.ok()) r.fail_key("ids", parsed.error);
+      ids = parsed.ids;
+    }
+    const std::string kind = r.text("kind", "virtual");
+    if (kind == "virtual") {
+      base.kind = environment::RobotKind::kVirtual;
+    } else if (kind == "real") {
+      base.kind = environment::RobotKind::kReal;
+    } else {
+      r.fail_key("kind", "must be virtual or real, not '" + kind + "'");
+    }
+    if (r.has("pose")) {
+      const YAML::Node p = r.get("pose");
+      if (p.IsScalar() && p.as<std::string>() == "random") {
+        base.pose.reset();
+      } else {
+        if (!p.IsSequence() || p.size() != 3) r.fail_key("pose", "must be `random` or [x_m, y_m, theta_deg]");
+        double v[3];
+        for (int k = 0; k < 3; ++k) {
+          try {
+            v[k] = p[k].as<double>();
+          } catch (const YAML::Exception&) {
+            r.fail_key("pose", "must be `random` or [x_m, y_m, theta_deg]");
+          }
+          if (!std::isfinite(v[k])) r.fail_key("pose", "must hold finite numbers");
+        }
+        if (ids.size() > 1)
+          r.fail_key("pose", "one pose cannot place several robots; use `random` or one entry per robot");
+        base.pose = Pose2{{v[0], v[1]}, deg_to_rad(v[2])};
+      }
+    }
+    base.controller.name = r.text("controller", "convoy");
+    const agents::ControllerEntry* controller = controllers.find(base.controller.name);
+    if (!controller) {
+      r.fail_key("controller", "unknown controller '" + base.controller.name + "' (known: " + controllers.names_text() +
+                                   "; `rilbed controllers` lists them)");
+    }
+    if (r.has("params")) {
+      const Reader p = r.child("params");
+      for (const auto& kv : r.get("params")) {
+        const std::string key = kv.first.as<std::string>();
+        base.controller.params[key] = p.number(key, 0.0);
+      }
+      if (const auto problem = agents::check_params(*controller, base.controller.params)) {
+        if (problem->key.empty()) r.fail_key("params", problem->problem);
+        p.fail_key(problem->key, problem->problem);
+      }
+    } else if (const auto problem = agents::check_params(*controller, {})) {
+      r.fail_key("controller", problem->problem);
+    }
+    if (r.has("noise")) {
+      const Reader n = r.child("noise");
+      n.allow({"slip_sd", "left_bias", "right_bias", "odometer_counts_slip"});
+      base.noise.slip_sd = n.non_negative("slip_sd", 0.0);
+      base.noise.left_bias = n.number("left_bias", 0.0);
+      base.noise.right_bias = n.number("right_bias", 0.0);
+      base.noise.odometer_counts_slip = n.boolean("odometer_counts_slip", true);
+    }
+    if (r.has("sensors")) base.sensors = read_sensors(r.child("sensors"));
+    if (const auto sensor = agents::missing_sensor(*controller, base.sensors)) {
+      r.fail_key(r.has("sensors") ? "sensors" : "controller",
+                 base.controller.name + " needs `sensors: " + *sensor + ":` (see scenarios/README.md)");
+    }
+    if (r.has("link")) {
+      if (base.kind != environment::RobotKind::kReal) r.fail_key("link", "only a robot of kind real has a link");
+      const Reader l = r.child("link");
+      l.allow({"port", "baud", "model", "emulate", "placement", "faults", "reply_timeout_ms", "retries",
+               "counters_period_ms"});
+      LinkSpec link;
+      link.port = l.text("port", "");
+      link.baud = l.integer("baud", link.baud);
+      link.model = l.text("model", link.model);
+      link.emulate = l.boolean("emulate", false);
+      link.reply_timeout_ms = l.integer("reply_timeout_ms", link.reply_timeout_ms);
+      if (link.reply_timeout_ms <= 0) l.fail_key("reply_timeout_ms", "must be greater than 0");
+      link.retries = l.integer("retries", link.retries);
+      if (link.retries < 0) l.fail_key("retries", "must not be negative");
+      link.counters_period_ms = l.integer("counters_period_ms", link.counters_period_ms);
+      if (link.counters_period_ms < 0) l.fail_key("counters_period_ms", "must not be negative");
+      if (link.port.empty() == !link.emulate) l.fail(r.get("link"), "give either `port` or `emulate: true`");
+      const std::string placement = l.text("placement", link.emulate ? "teleport" : "drive");
+      if (placement == "drive") {
+        link.placement = Placement::kDrive;
+      } else if (placement == "teleport") {
+        if (!link.emulate)
+          l.fail_key("placement", "only an emulated robot can be put in place by rilbed (a real one is driven there)");
+        link.placement = Placement::kTeleport;
+      } else {
+        l.fail_key("placement", "is drive or teleport, not '" + placement + "'");
+      }
+      if (l.has("faults")) {
+        if (!link.emulate) l.fail_key("faults", "only an emulated robot injects faults");
+        const Reader f = l.child("faults");
+        f.allow({"reply_delay_ms", "drop", "garbage", "corrupt", "disconnect_after_s", "replug_after_s"});
+        link.faults.reply_delay_ms = f.integer("reply_delay_ms", 0);
+        if (link.faults.reply_delay_ms < 0) f.fail_key("reply_delay_ms", "must not be negative");
+        for (auto [key, value] : {std::pair{"drop", &link.faults.drop},
+                                  {"garbage", &link.faults.garbage},
+                                  {"corrupt", &link.faults.corrupt}}) {
+          *value = f.non_negative(key, 0.0);
+          if (*value > 1.0) f.fail_key(key, "is a probability, at most 1");
+        }
+        link.faults.disconnect_after_s = f.non_negative("disconnect_after_s", 0.0);
+        link.faults.replug_after_s = f.non_negative("replug_after_s", 0.0);
+      }
+      base.link = link;
+    } else if (base.kind == environment::RobotKind::kReal) {
+      r.fail(list[i], "a robot of kind real needs a `link` ({port: /dev/ttyUSB0, baud: 38400} or {emulate: true})");
+    }
+    for (int id : ids) {
+      if (id < 1) r.fail(list[i], "robot IDs start at 1");
+      if (!seen.insert(id).second) r.fail(list[i], "robot " + std::to_string(id) + " is defined twice");
+      RobotSpec spec = base;
+      spec.id = id;
+      robots.push_back(spec);
+    }
+  }
+  std::sort(robots.begin(), robots.end(), [](const RobotSpec& a, const RobotSpec& b) { return a.id < b.id; });
+  return robots;
+}
+
+Scenario read_scenario(const YAML::Node& root, const std::string& source,
+                       const agents::ControllerRegistry& controllers) {
+  Scenario s;
+  const Reader top(root, source, "");
+  top.allow({"name", "description", "mode", "field", "timing", "duration_s", "convoy", "obstacles", "tracks", "beacons",
+             "moving_obstacles", "robots", "camera", "safety", "agents"});
+  s.name = top.text("name", std::filesystem::path(source).stem().string());
+  const std::string mode = top.text("mode", "distributed");
+  if (mode == "distributed") {
+    s.mode = ConvoyMode::kDistributed;
+  } else if (mode == "central") {
+    s.mode = ConvoyMode::kCentral;
+  } else {
+    top.fail_key("mode", "must be central or distributed, not '" + mode + "'");
+  }
+  if (top.has("field")) {
+    const Reader f = top.child("field");
+    f.allow({"width_m", "height_m", "walls"});
+    s.map.field.width_m = f.positive("width_m", s.map.field.width_m);
+    s.map.field.height_m = f.positive("height_m", s.map.field.height_m);
+    s.map.field.boundary_walls = f.boolean("walls", true);
+  }
+  if (top.has("timing")) {
+    const Reader t = top.child("timing");
+    t.allow({"physics_step_ms", "control_period_ms", "broadcast_period_ms"});
+    s.physics_step_us = milliseconds(t, "physics_step_ms", s.physics_step_us);
+    s.control_period_us = milliseconds(t, "control_period_ms", s.control_period_us);
+    s.broadcast_period_us = milliseconds(t, "broadcast_period_ms", s.broadcast_period_us);
+  }
+  s.duration_s = top.positive("duration_s", s.duration_s);
+  if (top.has("convoy")) {
+    const Reader c = top.child("convoy");
+    c.allow({"standoff_m", "engage_m", "max_speed_mps", "avoid_low", "avoid_high"});
+    s.convoy.standoff_m = c.positive("standoff_m", s.convoy.standoff_m);
+    s.convoy.engage_m = c.positive("engage_m", s.convoy.engage_m);
+    s.convoy.steering.max_speed_mps = c.positive("max_speed_mps", s.convoy.steering.max_speed_mps);
+    s.convoy.avoid_low = c.non_negative("avoid_low", s.convoy.avoid_low);
+    s.convoy.avoid_high = c.positive("avoid_high", s.convoy.avoid_high);
+    if (s.convoy.avoid_high <= s.convoy.avoid_low) c.fail_key("avoid_high", "must be above avoid_low");
+  }
+  auto each = [&](const char* key, auto&& read) {
+    if (!top.has(key)) return;
+    const YAML::Node list = top.get(key);
+    if (!list.IsSequence()) top.fail_key(key, "must be a list");
+    for (std::size_t i = 0; i < list.size(); ++i)
+      read(Reader(list[i], source, std::string(key) + "[" + std::to_string(i) + "]"));
+  };
+  each("obstacles", [&](const Reader& o) {
+    o.allow({"name", "polygon"});
+    s.map.obstacles.push_back({o.points("polygon"), o.text("name", "")});
+  });
+  each("tracks", [&](const Reader& t) {
+    t.allow({"name", "points", "width_m", "closed"});
+    environment::TrackConfig c;
+    c.points_m = t.points("points");
+    c.width_m = t.positive("width_m", c.width_m);
+    c.closed = t.boolean("closed", false);
+    c.name = t.text("name", "");
+    s.map.tracks.push_back(c);
+  });
+  each("beacons", [&](const Reader& b) {
+    b.allow({"id", "position", "facing_deg", "aperture_deg", "range_m"});
+    environment::BeaconConfig c;
+    c.id = b.integer("id", 0);
+    if (!b.has("position")) b.fail_key("position", "is required");
+    c.position_m = b.point(b.get("position"), "position");
+    c.facing_rad = deg_to_rad(b.number("facing_deg", 0.0));
+    c.aperture_rad = deg_to_rad(b.positive("aperture_deg", 360.0));
+    c.range_m = b.positive("range_m", c.range_m);
+    s.map.beacons.push_back(c);
+  });
+  each("moving_obstacles", [&](const Reader& m) {
+    m.allow({"name", "shape", "radius_m", "vertices", "position", "velocity_mps"});
+    environment::MovingObstacleConfig c;
+    const std::string shape = m.text("shape", "disc");
+    if (shape == "disc") {
+      c.shape = environment::MovingShape::kDisc;
+      c.radius_m = m.positive("radius_m", c.radius_m);
+    } else if (shape == "polygon") {
+      c.shape = environment::MovingShape::kPolygon;
+      c.vertices_m = m.points("vertices");
+    } else {
+      m.fail_key("shape", "must be disc or polygon");
+    }
+    if (!m.has("position")) m.fail_key("position", "is required");
+    c.position_m = m.point(m.get("position"), "position");
+    c.velocity_mps = m.has("velocity_mps") ? m.point(m.get("velocity_mps"), "velocity_mps") : Vec2{};
+    c.name = m.text("name", "");
+    s.moving_obstacles.push_back(c);
+  });
+  s.robots = read_robots(top, controllers);
+  if (top.has("camera")) {
+    const Reader c = top.child("camera");
+    c.allow({"emulate", "device", "file", "calibration", "fps", "marker_diameter_m", "family", "vision"});
+    CameraSpec cam;
+    cam.line = top.line_of("camera");
+    cam.emulate = c.boolean("emulate", false);
+    if (c.has("device")) cam.device = c.integer("device", 0);
+    cam.file = c.text("file", "");
+    cam.calibration = c.text("calibration", "");
+    cam.fps = c.positive("fps", cam.fps);
+    cam.marker_diameter_m = c.positive("marker_diameter_m", cam.marker_diameter_m);
+    cam.family = c.text("family", cam.family);
+    if (c.has("vision")) {
+      const Reader v = c.child("vision");
+      v.allow({"brightness", "contrast", "threshold", "min_diameter_px", "max_diameter_px", "min_score"});
+      for (const std::string_view setting : vision::kVisionSettingNames) {
+        const std::string name(setting);
+        if (!v.has(name)) continue;
+        if (auto why = vision::set_vision_setting(cam.vision, name, v.number(name, 0.0))) v.fail_key(name, *why);
+      }
+      if (auto why = vision::check_vision_settings(cam.vision)) c.fail_key("vision", *why);
+    }
+    const int sources = (cam.emulate ? 1 : 0) + (cam.device ? 1 : 0) + (cam.file.empty() ? 0 : 1);
+    if (sources != 1) top.fail_key("camera", "give exactly one of `emulate: true`, `device: N` or `file: PATH`");
+    if (!cam.emulate && cam.calibration.empty())
+      c.fail_key("calibration", "a real camera needs its field calibration file");
+    s.camera = cam;
+  }
+  if (top.has("safety")) {
+    const Reader f = top.child("safety");
+    f.allow({"lost_timeout_ms", "geofence_margin_m"});
+    s.lost_timeout_ms = f.integer("lost_timeout_ms", s.lost_timeout_ms);
+    if (s.lost_timeout_ms <= 0) f.fail_key("lost_timeout_ms", "must be greater than 0");
+    s.geofence_margin_m = f.non_negative("geofence_margin_m", s.geofence_margin_m);
+  }
+  if (top.has("agents")) {
+    const Reader a = top.child("agents");
+    a.allow({"processes", "ids", "announce_timeout_s", "resend_ms", "dead_after_ms", "deadline_ms", "hosts", "launch",
+             "remote_rilbed"});
+    AgentsSpec spec;
+    if (a.has("hosts")) spec.hosts = a.words("hosts");
+    for (const std::string& host : spec.hosts) {
+      // A host is one argument of the launch command: one starting with '-' would be taken
+      // for an option of ssh (e.g. -oProxyCommand=...), not a machine.
+      if (host.empty() || host.front() == '-' || host.find_first_of(" \t\r\n") != std::string::npos) {
+        a.fail_key("hosts", "'" + host + "' is not a host name (no spaces, not starting with '-')");
+      }
+    }
+    spec.processes = a.integer("processes", static_cast<int>(spec.hosts.size()));
+    if (spec.processes < 0 || spec.processes > 64) a.fail_key("processes", "must be 0 to 64");
+    if (!spec.hosts.empty() && spec.processes < 1) a.fail_key("processes", "the hosts need at least one process");
+    if (a.has("launch")) {
+      spec.launch = a.words("launch");
+      if (spec.launch.empty() || spec.launch.front().empty()) a.fail_key("launch", "must name a program to start");
+      if (std::none_of(spec.launch.begin(), spec.launch.end(),
+                       [](const std::string& w) { return w.find("{command}") != std::string::npos; })) {
+        a.fail_key("launch", "must have a {command} item (the agent's command line)");
+      }
+    }
+    spec.remote_rilbed = a.text("remote_rilbed", "");
+    if (a.has("ids")) {
+      const auto parsed = parse_id_list(a.text("ids", ""), 1, 100000);
+      if (!parsed.ok()) a.fail_key("ids", parsed.error);
+      for (const int id : parsed.ids) {
+        const auto robot =
+            std::find_if(s.robots.begin(), s.robots.end(), [&](const RobotSpec& r) { return r.id == id; });
+        if (robot == s.robots.end()) a.fail_key("ids", "there is no robot " + std::to_string(id));
+        if (robot->controller.name == "none") a.fail_key("ids", "robot " + std::to_string(id) + " has no controller");
+      }
+      spec.ids = parsed.ids;
+    } else {
+      for (const RobotSpec& r : s.robots) {
+        if (r.controller.name != "none") spec.ids.push_back(r.id);
+      }
+    }
+    if (spec.ids.empty()) a.fail_key("ids", "no robot has a controller to run elsewhere");
+    if (spec.processes > static_cast<int>(spec.ids.size())) {
+      a.fail_key("processes", "more processes than robots to run (" + std::to_string(spec.ids.size()) + ")");
+    }
+    spec.announce_timeout_s = a.positive("announce_timeout_s", spec.announce_timeout_s);
+    spec.resend_ms = a.integer("resend_ms", spec.resend_ms);
+    if (spec.resend_ms < 1) a.fail_key("resend_ms", "must be at least 1");
+    spec.dead_after_ms = a.integer("dead_after_ms", spec.dead_after_ms);
+    if (spec.dead_after_ms <= spec.resend_ms) a.fail_key("dead_after_ms", "must be longer than resend_ms");
+    spec.deadline_ms = a.integer("deadline_ms", spec.deadline_ms);
+    if (spec.deadline_ms < 1) a.fail_key("deadline_ms", "must be at least 1");
+    s.agents = spec;
+  }
+  const bool any_real = std::any_of(s.robots.begin(), s.robots.end(),
+                                    [](const RobotSpec& r) { return r.kind == environment::RobotKind::kReal; });
+  if (any_real && !s.camera) top.fail_key("camera", "a scenario with real robots needs a `camera` to see them");
+  // The static map validates its own geometry; report its complaint against the file.
+  try {
+    environment::StaticMap check(s.map);
+  } catch (const std::invalid_argument& e) {
+    throw ScenarioError(source + ": " + e.what());
+  }
+  return s;
+}
+
+}  // namespace
+
+Scenario parse_scenario(const std::string& yaml_text, const std::string& source_name,
+                        std::shared_ptr<const agents::ControllerRegistry> controllers) {
+  if (!controllers) controllers = agents::default_controllers();
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::ParserException& e) {
+    throw ScenarioError(source_name + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
+  }
+  if (!root || root.IsNull()) throw ScenarioError(source_name + ": the scenario is empty");
+  try {
+    Scenario scenario = read_scenario(root, source_name, *controllers);
+    scenario.controllers = std::move(controllers);
+    return scenario;
+  } catch (const YAML::Exception& e) {
+    throw ScenarioError(source_name + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+}
+
+Scenario load_scenario(const std::filesystem::path& path,
+                       std::shared_ptr<const agents::ControllerRegistry> controllers) {
+  std::ifstream in(path);
+  if (!in) throw ScenarioError(path.string() + ": cannot open the scenario file");
+  std::stringstream text;
+  text << in.rdbuf();
+  Scenario s = parse_scenario(text.str(), path.string(), std::move(controllers));
+  s.source = path;
+  return s;
+}
+
+namespace {
+
+// Points hashed in a uniform grid of cells at least `spacing_m` wide, so that whether a new
+// point comes nearer than that to one of them looks at 3 x 3 cells, not at every point:
+// placing 100,000 robots took 14 s with a list. At most about 2^20 cells (wider ones on a
+// huge field); points off the field go to its edge cells.
+class PlacedPoints {
+ public:
+  PlacedPoints(double width_m, double height_m, double spacing_m)
+      // A hair wider than the spacing: two points nearer than it never round two cells apart.
+      : cell_m_(std::max(spacing_m, std::sqrt(std::max(width_m * height_m, 1e-12) / double(1 << 20))) * (1.0 + 1e-9)),
+        nx_(cells_along(width_m)),
+        ny_(cells_along(height_m)),
+        head_(static_cast<std::size_t>(nx_) * ny_, -1) {}
+  void add(Vec2 p) {
+    const std::size_t c = cell(index_x(p.x), index_y(p.y));
+    next_.push_back(head_[c]);
+    head_[c] = static_cast<int>(points_.size());
+    points_.push_back(p);
+  }
+  // Whether a point lies strictly nearer than `distance_m` (at most the spacing) to p.
+  bool any_nearer(Vec2 p, double distance_m) const {
+    const int cx = index_x(p.x), cy = index_y(p.y);
+    for (int y = std::max(0, cy - 1); y <= std::min(ny_ - 1, cy + 1); ++y) {
+      for (int x = std::max(0, cx - 1); x <= std::min(nx_ - 1, cx + 1); ++x) {
+        for (int k = head_[cell(x, y)]; k >= 0; k = next_[static_cast<std::size_t>(k)]) {
+          if (environment::distance_sq(p, points_[static_cast<std::size_t>(k)]) < distance_m * distance_m) return true;
+        }
+      }
+    }
+    return false;
+  }
+
+ private:
+  int cells_along(double length_m) const {
+    return static_cast<int>(std::clamp(std::ceil(length_m / cell_m_), 1.0, double(1 << 20)));
+  }
+  // Clamped before the cast: a fixed pose far off the field must not overflow an int.
+  int index_x(double x) const { return static_cast<int>(std::clamp(std::floor(x / cell_m_), 0.0, double(nx_ - 1))); }
+  int index_y(double y) const { return static_cast<int>(std::clamp(std::floor(y / cell_m_), 0.0, double(ny_ - 1))); }
+  std::size_t cell(int x, int y) const { return static_cast<std::size_t>(y) * nx_ + x; }
+  double cell_m_;
+  int nx_, ny_;
+  std::vector<int> head_, next_;
+  std::vector<Vec2> points_;
+};
+
+}  // namespace
+
+std::vector<Pose2> draw_initial_poses(const Scenario& scenario, std::mt19937_64& rng, double clearance_m) {
+  const environment::FieldConfig& field = scenario.map.field;
+  const double radius = environment::kKheperaRadius_m;
+  const double margin = radius + clearance_m;
+  std::vector<Pose2> poses(scenario.robots.size());
+  const double spacing_m = 2 * radius + clearance_m;
+  PlacedPoints placed(field.width_m, field.height_m, spacing_m);
+  for (std::size_t i = 0; i < scenario.robots.size(); ++i) {
+    if (scenario.robots[i].pose) {
+      poses[i] = *scenario.robots[i].pose;
+      placed.add(poses[i].position_m);
+    }
+  }
+  auto free = [&](Vec2 p) {
+    if (placed.any_nearer(p, spacing_m)) return false;
+    for (const auto& o : scenario.map.obstacles) {
+      if (environment::point_in_polygon(p, o.vertices_m)) return false;
+      for (std::size_t k = 0; k < o.vertices_m.size(); ++k) {
+        const Vec2 a = o.vertices_m[k], b = o.vertices_m[(k + 1) % o.vertices_m.size()];
+        if (environment::distance_sq_to_segment(p, a, b) < margin * margin) return false;
+      }
+    }
+    // A moving obstacle where it starts, by its bounding circle (a polygon's vertices are
+    // relative to its position).
+    for (const auto& m : scenario.moving_obstacles) {
+      double reach_m = m.shape == environment::MovingShape::kDisc ? m.radius_m : 0.0;
+      for (const Vec2& v : m.vertices_m) reach_m = std::max(reach_m, std::hypot(v.x, v.y));
+      if (environment::distance_sq(p, m.position_m) < (reach_m + margin) * (reach_m + margin)) return false;
+    }
+    return true;
+  };
+  std::uniform_real_distribution<double> ux(margin, field.width_m - margin), uy(margin, field.height_m - margin);
+  std::uniform_real_distribution<double> heading(-kPi, kPi);
+  if (field.width_m <= 2 * margin || field.height_m <= 2 * margin) {
+    throw ScenarioError(scenario.source.string() + ": the field is too small for a robot");
+  }
+  for (std::size_t i = 0; i < scenario.robots.size(); ++i) {
+    if (scenario.robots[i].pose) continue;
+    bool done = false;
+    for (int attempt = 0; attempt < 10000 && !done; ++attempt) {
+      const Vec2 p{ux(rng), uy(rng)};
+      if (!free(p)) continue;
+      poses[i] = {p, heading(rng)};
+      placed.add(p);
+      done = true;
+    }
+    if (!done) {
+      throw ScenarioError(scenario.source.string() + ":" + std::to_string(scenario.robots[i].line) +
+                          ": no free place for robot " + std::to_string(scenario.robots[i].id) +
+                          " after 10000 tries: the field is too crowded");
+    }
+  }
+  return poses;
+}
+
+std::vector<int> real_robot_ids(const Scenario& scenario) {
+  std::vector<int> ids;
+  for (const RobotSpec& r : scenario.robots) {
+    if (r.kind == environment::RobotKind::kReal) ids.push_back(r.id);
+  }
+  return ids;
+}
+
+Scenario wandering_scenario(int robots, double seconds, double physics_step_ms, double density_per_m2) {
+  Scenario s;
+  s.name = "wander-" + std::to_string(robots);
+  s.source = "(benchmark)";
+  s.controllers = agents::default_controllers();
+  const double area_m2 = robots / density_per_m2;
+  s.map.field.width_m = std::sqrt(area_m2 * 1.25);
+  s.map.field.height_m = area_m2 / s.map.field.width_m;
+  s.physics_step_us = static_cast<TimeUs>(std::llround(physics_step_ms * 1000));
+  s.control_period_us = 100'000;
+  s.duration_s = seconds;
+  for (int id = 1; id <= robots; ++id) {
+    RobotSpec r;
+    r.id = id;
+    r.controller.name = "wander";
+    r.noise.slip_sd = 0.02;
+    r.sensors.proximity = environment::ProximityConfig{};
+    s.robots.push_back(r);
+  }
+  return s;
+}
+
+}  // namespace rilbed::run
