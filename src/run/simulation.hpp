@@ -1,127 +1,114 @@
 // One run of a scenario: builds the world and the robots' bodies, couples the DEVS
-// models (world, agents, team broadcast or central coordinator, monitor), and runs them
-// as fast as possible or paced to the wall clock, recording the run's folder.
+// models (world, sensing, agents, team broadcast or central coordinator, monitor, camera,
+// control), runs them as fast as possible or paced to the wall clock, and ends it:
+// every body stopped, the summary written and reported.
 //
 // Model order (the coordinator's tie-break at equal times): the world first, so it has
-// moved to time t before any agent senses at t; then the agents; then the team
-// broadcaster or the central coordinator; the monitor samples 1 µs after each control
-// step, when every decision of that step has been applied.
+// moved to time t before any agent senses at t; then the sensing sweep and the agents;
+// then the remote agents' quantum; then the team broadcaster or the central coordinator;
+// the monitor samples 1 µs after each control step, when every decision of that step has
+// been applied; the camera comes last.
 #pragma once
 
 #include <atomic>
-#include <cstdint>
-#include <filesystem>
-#include <functional>
+#include <chrono>
+#include <exception>
 #include <memory>
 #include <optional>
-#include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "agents/body.hpp"
-#include "agents/controller.hpp"
+#include "core/worker_pool.hpp"
 #include "environment/world.hpp"
-#include "run/agent_exchange.hpp"
-#include "run/run_control.hpp"
-#include "run/run_observer.hpp"
-#include "run/run_profile.hpp"
-#include "run/run_recorder.hpp"
+#include "run/run_options.hpp"
+#include "run/run_setup.hpp"
 #include "run/scenario.hpp"
-#include "vision/synthetic_camera.hpp"
+#include "sim/clock.hpp"
+#include "sim/coordinator.hpp"
+#include "sim/coupled.hpp"
 
 namespace rilbed::run {
 
-/// How to run.
-struct RunOptions {
-  std::uint64_t seed = 1;            ///< initial poses, wheel slip and sensor noise derive from it
-  std::optional<double> duration_s;  ///< simulated seconds; default: the scenario's duration_s
-  bool realtime = false;             ///< pace to the wall clock (else as fast as possible)
-  double rt_factor = 1.0;            ///< simulated seconds per wall second when realtime
-  bool stop_when_formed = false;     ///< end after_formed_s after the convoy formed
-  bool stop_when_done = false;       ///< end once every agent is done (Controller::done)
-  double after_formed_s = 5.0;
-  std::optional<std::filesystem::path> out_dir;  ///< write the run folder here
-  /// Set from another thread or a signal handler (it is only read) to end the run early.
-  const std::atomic<bool>* interrupt = nullptr;
-  /// Record trajectories and events even without an out_dir (kept in memory, for tests).
-  bool keep_in_memory = false;
-  /// With `camera: {emulate: true}`: the markers of the emulated real robots at their true
-  /// poses now (the links layer reads them from its emulators). Called on the run's thread.
-  std::function<std::vector<vision::SceneMarker>()> emulated_markers;
-  /// The scenario's real robots that this run simulates instead (`--all-virtual`): written
-  /// to summary.json, so that `rilbed compare` knows which robots the comparison is about.
-  std::vector<int> virtual_stand_ins;
-  /// Told the world, every robot's pose at every control step, every event and the
-  /// status as the run goes (the LCM bus, tests); may be null. Must outlive the call.
-  RunObserver* observer = nullptr;
-  /// Attached while the run runs, so that another thread (a console) can pause, resume,
-  /// change the real-time factor or end it; may be null. Must outlive the call.
-  RunControl* control = nullptr;
-  /// The controllers that run in other processes or on other machines (issue 18): each
-  /// robot it serves is stepped through it, one quantum per control instant. May be null
-  /// (every controller in this process). Must outlive the call.
-  AgentExchange* remote_agents = nullptr;
-  /// Time the run's parts (RunResult::profile): a few clock reads per robot and step.
-  bool profile = false;
-  /// Threads that step the world and the agents (>= 1). The run folder and every result
-  /// are the same for any count (each robot's noise has its own stream, and what runs at
-  /// once depends on nothing that runs beside it); only the speed differs. Agents whose
-  /// controllers run in another process, and real robots, stay on the run's thread.
-  int threads = 1;
-  /// How often the monitor checks every robot for overlaps (RunResult::max_overlap_m):
-  /// 0 at every control step; otherwise at the first control step of each such period.
-  /// The check visits every robot's neighbours: at every step it costs about 5 % of a
-  /// swarm's run (sim-bench checks once per simulated second).
-  TimeUs overlap_check_us = 0;
-};
+class VisionModel;
+class WorldModel;
+class SensingModel;
+class AgentModel;
+class QuantumModel;
+class CentralConvoyModel;
+class MonitorModel;
 
-/// What a run came to.
-struct RunResult {
-  std::uint64_t seed = 0;
-  int convoy_size = 0;                     ///< robots with the convoy controller (0: no convoy)
-  bool formed = false;                     ///< the convoy formed (see FormationMonitor)
-  std::optional<double> formation_time_s;  ///< when the hold that formed it began
-  int collisions = 0;                      ///< contact episodes (robot–anything)
-  int robot_collisions = 0;                ///< of those, robot–robot
-  double max_overlap_m = 0.0;  ///< largest overlap seen at the control steps checked (RunOptions::overlap_check_us)
-  double simulated_s = 0.0;
-  double wall_s = 0.0;      ///< the whole call, building the world included
-  double run_wall_s = 0.0;  ///< the DEVS run alone (what sim-bench reports)
-  double run_cpu_s =
-      0.0;  ///< CPU time of the run's threads (the caller's and RunOptions::threads' workers) in the DEVS run
-  /// A 64-bit digest of every trajectory sample (the sum of a hash of each sample's time,
-  /// id, position and heading, bit for bit): equal digests mean, but for a tiny chance,
-  /// the same trajectories (runs on different thread counts are compared by it).
-  std::uint64_t trajectory_digest = 0;
-  /// With RunOptions::profile: where run_wall_s went (the rest is the DEVS kernel's).
-  std::optional<RunProfile> profile;
-  std::string ended_by;                      ///< "duration", "formed", "done" or "interrupt"
-  std::vector<int> not_done;                 ///< with stop_when_done: the robots whose agent was not done at the end
-  std::vector<TrajectorySample> trajectory;  ///< with keep_in_memory only
-  /// A real-time run with an observer: how far behind the wall clock each control step
-  /// finished, its reports handed to the observer, ms (what a viewer's cost adds to).
-  std::vector<float> loop_latency_ms;
-  /// summary.json's content.
+/// A run, in three steps: the constructor builds it, loop() runs it, end() stops every body
+/// and reports what it came to. Borrows the scenario, the options and what they point to
+/// (observer, control, remote agents), which must outlive it. Not copyable or movable:
+/// its models hold references to its world and bodies. Every body is stopped by end(), or
+/// by the destructor if end() was never called.
+class Run {
+ public:
+  /// Builds the world, the bodies (real ones from `real_bodies`; the camera is checked
+  /// before any real body is made) and the models. Throws ScenarioError for a scenario the
+  /// run cannot use (convoy IDs not 1..N, real robots without a factory or not in real time
+  /// at factor 1, a bad camera) and std::runtime_error for a run folder it cannot write.
+  Run(const Scenario& scenario, const RunOptions& options, const RealBodyFactory& real_bodies = {});
+  ~Run();
+  Run(const Run&) = delete;
+  Run& operator=(const Run&) = delete;
+
+  /// Runs the DEVS models to the run's end time, or until the monitor, the console or an
+  /// interrupt stops them. An exception from a model ends the loop; end() rethrows it.
+  void loop();
+
+  /// Stops every body (a real robot must not drive on), fills the result, writes the
+  /// summary and reports the end to the observer. Rethrows an exception loop() caught,
+  /// after all that. Call once.
+  RunResult end();
+
+ private:
+  void check_convoy();
+  void make_bodies(const RealBodyFactory& real_bodies);
+  void add_agents();
+  void add_team_models();
+  void add_monitor();
+  void add_control();
+  void attach_control();
+  void finish_profile();
   nlohmann::json summary() const;
+  void report_end(const nlohmann::json& summary);
+
+  const Scenario& scenario_;
+  const RunOptions& options_;
+  std::chrono::steady_clock::time_point wall_start_;
+  RunResult result_;
+  std::vector<int> convoy_ids_;  // the convoy's robots, 1..N (empty: no convoy)
+  std::vector<int> real_ids_;
+  environment::World world_;
+  std::optional<core::WorkerPool> workers_;
+  std::shared_ptr<VisionModel> camera_;
+  std::vector<std::unique_ptr<agents::Body>> bodies_;  // in scenario.robots' order
+  std::shared_ptr<sim::Coupled> root_;
+  WorldModel* world_model_ = nullptr;
+  SensingModel* sensing_ = nullptr;
+  std::vector<AgentModel*> agents_;  // in scenario.robots' (ID) order
+  QuantumModel* quantum_ = nullptr;
+  CentralConvoyModel* central_model_ = nullptr;
+  MonitorModel* monitor_ = nullptr;
+  RunProfile profile_;
+  std::unique_ptr<RunRecorder> recorder_;
+  TimeUs end_us_ = 0;
+  sim::Coordinator* coordinator_ptr_ = nullptr;  // the monitor's way to stop the run
+  sim::FastClock fast_clock_;
+  std::optional<sim::RealTimeClock> real_clock_;
+  sim::Port<ControlAction>* control_in_ = nullptr;
+  std::optional<sim::Coordinator> coordinator_;
+  // The run as the console's accepted actions leave it, for checking the next one at once.
+  std::atomic<bool> paused_{false};
+  std::atomic<bool> central_now_{false};
+  bool control_attached_ = false;
+  bool ended_ = false;
+  std::exception_ptr failure_;
 };
 
-/// Makes the body of a real robot (the links module supplies it); nullptr if it cannot.
-/// Its virtual sensors read the world (World::sense), with the world's noise streams.
-using RealBodyFactory = std::function<std::unique_ptr<agents::Body>(const RobotSpec&, environment::World&)>;
-
-/// Makes the controller named in `spec` (nullptr for a commanded convoy agent in central
-/// mode, or "none"). Throws ScenarioError for an unknown name or parameter.
-std::unique_ptr<agents::Controller> make_controller(const Scenario& scenario, const RobotSpec& spec);
-
-/// The robots' start poses of a run with `seed` (in scenario.robots' order): fixed poses
-/// as given, the others drawn from the seed (draw_initial_poses), exactly as
-/// run_scenario() places them. Real robots are placed there before a run (RealRobots).
-std::vector<Pose2> start_poses(const Scenario& scenario, std::uint64_t seed);
-
-/// Runs `scenario` once with `options`. Throws ScenarioError for a scenario the run cannot
-/// use (e.g. convoy IDs not 1..N, real robots without a factory) and std::runtime_error
-/// for an output folder it cannot write.
+/// Runs `scenario` once with `options`: Run's three steps. Throws as Run's constructor
+/// does, and rethrows what a model threw once every body is stopped.
 RunResult run_scenario(const Scenario& scenario, const RunOptions& options, const RealBodyFactory& real_bodies = {});
 
 }  // namespace rilbed::run
