@@ -43,6 +43,7 @@
 #include <vector>
 
 #include "bus/lcm_bus.hpp"
+#include "bus/run_publisher.hpp"
 #include "core/id_list.hpp"
 #include "core/statistics.hpp"
 #include "gui_web/gui_service.hpp"

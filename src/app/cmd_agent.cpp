@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "app/commands.hpp"
+#include "app/interrupt.hpp"
 #include "bus/agent_server.hpp"
 #include "bus/lcm_bus.hpp"
 #include "core/id_list.hpp"
@@ -29,9 +30,6 @@
 namespace rilbed::app {
 
 namespace {
-
-std::atomic<bool> agent_interrupted{false};
-extern "C" void on_agent_signal(int) { agent_interrupted.store(true); }
 
 struct AgentArgs {
   std::string scenario;
@@ -81,7 +79,7 @@ void watch_lifeline() {
       const ssize_t n = read(STDIN_FILENO, byte, sizeof byte);
       if (n == 0 || (n < 0 && errno != EINTR)) break;
     }
-    agent_interrupted.store(true);
+    InterruptFlag::raise();
   }).detach();
 }
 
@@ -155,15 +153,14 @@ int agent_command(const AgentArgs& args) {
         std::find_if(scenario.robots.begin(), scenario.robots.end(), [&](const auto& r) { return r.id == id; });
     return run::make_controller(scenario, *spec);
   });
-  std::signal(SIGINT, on_agent_signal);
-  std::signal(SIGTERM, on_agent_signal);
+  const InterruptFlag interrupt;
   if (lifeline) watch_lifeline();
   if (!args.quiet) {
     std::printf("agent %s: robots %s of %s, on %s\n", server.session().c_str(), args.ids.c_str(), scenario.name.c_str(),
                 args.url.empty() ? "LCM's default bus" : args.url.c_str());
     std::fflush(stdout);
   }
-  server.serve(agent_interrupted);
+  server.serve(interrupt.flag());
   if (!args.quiet) {
     const auto& c = server.counters();
     std::printf("agent %s: %lld run(s), %lld steps, %lld repeated answers, %lld quanta skipped\n",

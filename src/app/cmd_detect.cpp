@@ -14,6 +14,7 @@
 #include <optional>
 
 #include "app/commands.hpp"
+#include "app/interrupt.hpp"
 #include "bus/lcm_frame_source.hpp"
 #include "core/geometry.hpp"
 #include "core/id_list.hpp"
@@ -23,9 +24,6 @@
 
 namespace rilbed::app {
 namespace {
-
-std::atomic<bool> g_interrupted{false};
-extern "C" void on_interrupt(int) { g_interrupted = true; }
 
 struct DetectOptions {
   std::string input;
@@ -70,26 +68,92 @@ void print_progress(int done, std::optional<int> total, double fps) {
                std::string(width - filled, '.').c_str(), done, *total, fps);
 }
 
-int run_detect(const DetectOptions& opt) {
-  // The family and IDs first: a typo there is a usage error before any file is opened.
-  std::optional<vision::MarkerFamily> family;
+// The marker family and the IDs to look for (every ID of the family when none are given);
+// false (logged) for a name or list that cannot be used.
+bool family_and_ids(const DetectOptions& opt, std::optional<vision::MarkerFamily>& family, std::vector<int>& ids) {
   try {
     family = vision::MarkerFamily::by_name(opt.family);
   } catch (const std::invalid_argument& e) {
     spdlog::error("--family: {}", e.what());
-    return kExitUsage;
+    return false;
   }
-  std::vector<int> ids;
   if (opt.ids.empty()) {
     for (int id = family->min_id(); id <= family->max_id(); ++id) ids.push_back(id);
-  } else {
-    const auto parsed = parse_id_list(opt.ids, family->min_id(), family->max_id());
-    if (!parsed.ok()) {
-      spdlog::error("--ids: {}", parsed.error);
-      return kExitUsage;
-    }
-    ids = parsed.ids;
+    return true;
   }
+  const auto parsed = parse_id_list(opt.ids, family->min_id(), family->max_id());
+  if (!parsed.ok()) {
+    spdlog::error("--ids: {}", parsed.error);
+    return false;
+  }
+  ids = parsed.ids;
+  return true;
+}
+
+// One frame's detections as CSV rows (`frame,id,u,v,heading_deg,score`, with the field
+// pose when calibrated).
+void write_rows(std::ostream& csv, int frame, const std::vector<vision::MarkerDetection>& found,
+                const std::optional<vision::FieldCalibration>& calib) {
+  char line[256];
+  for (const auto& d : found) {
+    std::snprintf(line, sizeof line, "%d,%d,%.3f,%.3f,%.2f,%.4f", frame, d.id, d.u, d.v, d.heading_deg, d.score);
+    csv << line;
+    if (calib) {
+      const Vec2 f = vision::pixel_to_field(*calib, d.u, d.v);
+      const double theta = vision::image_heading_to_field_deg(*calib, d.u, d.v, d.heading_deg);
+      std::snprintf(line, sizeof line, ",%.5f,%.5f,%.2f", f.x, f.y, theta);
+      csv << line;
+    }
+    csv << '\n';
+  }
+}
+
+// The frame with what was found drawn over it, into the annotated video (opened at the
+// first frame, at the source's rate).
+void write_annotated(cv::VideoWriter& video, const DetectOptions& opt, const vision::FrameSource& source,
+                     const vision::FrameResult& r, const std::vector<vision::MarkerDetection>& found) {
+  cv::Mat bgr;
+  if (r.image.channels() == 1) {
+    cv::cvtColor(r.image, bgr, cv::COLOR_GRAY2BGR);
+  } else {
+    bgr = r.image.clone();
+  }
+  annotate_frame(bgr, found, r.index);
+  if (!video.isOpened()) {
+    const double fps = source.fps() > 0 ? source.fps() : 30.0;
+    video.open(opt.annotate, cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps, bgr.size());
+    if (!video.isOpened()) spdlog::error("--annotate: cannot write '{}'", opt.annotate);
+  }
+  if (video.isOpened()) video.write(bgr);
+}
+
+// What a detect run counted, for its summary.
+struct DetectCounts {
+  std::map<int, long> per_id;
+  long frames = 0, bad_frames = 0, rows = 0, declined = 0;
+  double pipeline_s = 0.0;
+};
+
+void print_summary(const DetectCounts& c, const std::vector<int>& ids, double wall, bool interrupted) {
+  std::fprintf(stderr, "summary: %ld frames read, %ld bad frames skipped, %ld detections%s\n", c.frames, c.bad_frames,
+               c.rows, interrupted ? " (interrupted)" : "");
+  for (int id : ids) {
+    const auto it = c.per_id.find(id);
+    const long n = it == c.per_id.end() ? 0 : it->second;
+    std::fprintf(stderr, "  id %3d: %6ld frames (%5.1f%%)\n", id, n, c.frames ? 100.0 * n / c.frames : 0.0);
+  }
+  // A marker two readings explain almost equally well is reported as nothing: counted here.
+  std::fprintf(stderr, "  declined: %ld markers left unnamed (two IDs or headings read almost alike)\n", c.declined);
+  std::fprintf(stderr, "  speed: %.1f frames/s overall, %.1f frames/s in the pipeline (%.3f ms/frame)\n",
+               c.frames / std::max(wall, 1e-9), c.frames / std::max(c.pipeline_s, 1e-9),
+               c.frames ? 1000.0 * c.pipeline_s / c.frames : 0.0);
+}
+
+int run_detect(const DetectOptions& opt) {
+  // The family and IDs first: a typo there is a usage error before any file is opened.
+  std::optional<vision::MarkerFamily> family;
+  std::vector<int> ids;
+  if (!family_and_ids(opt, family, ids)) return kExitUsage;
 
   std::optional<vision::FieldCalibration> calib;
   if (!opt.calib.empty()) {
@@ -132,81 +196,37 @@ int run_detect(const DetectOptions& opt) {
 
   cv::VideoWriter annotated;
   const bool show_progress = !opt.quiet && ::isatty(STDERR_FILENO);
-  std::map<int, long> per_id;
-  long frames = 0, bad_frames = 0, rows = 0, declined = 0;
-  double pipeline_s = 0.0;
+  DetectCounts counts;
   const auto start = std::chrono::steady_clock::now();
-  g_interrupted = false;
-  auto previous_int = std::signal(SIGINT, on_interrupt);
-  auto previous_term = std::signal(SIGTERM, on_interrupt);
-
-  while (!g_interrupted && (opt.max_frames < 0 || frames < opt.max_frames)) {
+  const InterruptFlag interrupt;
+  while (!interrupt.raised() && (opt.max_frames < 0 || counts.frames < opt.max_frames)) {
     vision::FrameResult r = source.next();
     if (r.is_end()) break;
     if (r.is_error()) {
-      ++bad_frames;
+      ++counts.bad_frames;
       if (show_progress) std::fputc('\n', stderr);
       spdlog::warn("{}", r.error);
       continue;
     }
-    ++frames;
+    ++counts.frames;
     const auto t0 = std::chrono::steady_clock::now();
     const auto found = opt.no_track ? tracker.detect_full_frame(r.image) : tracker.process(r.image);
-    pipeline_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    declined += tracker.last_stats().declined;
-
-    char line[256];
-    for (const auto& d : found) {
-      ++per_id[d.id];
-      ++rows;
-      std::snprintf(line, sizeof line, "%d,%d,%.3f,%.3f,%.2f,%.4f", r.index, d.id, d.u, d.v, d.heading_deg, d.score);
-      *csv << line;
-      if (calib) {
-        const Vec2 f = vision::pixel_to_field(*calib, d.u, d.v);
-        const double theta = vision::image_heading_to_field_deg(*calib, d.u, d.v, d.heading_deg);
-        std::snprintf(line, sizeof line, ",%.5f,%.5f,%.2f", f.x, f.y, theta);
-        *csv << line;
-      }
-      *csv << '\n';
-    }
-    if (!opt.annotate.empty()) {
-      cv::Mat bgr;
-      if (r.image.channels() == 1)
-        cv::cvtColor(r.image, bgr, cv::COLOR_GRAY2BGR);
-      else
-        bgr = r.image.clone();
-      annotate_frame(bgr, found, r.index);
-      if (!annotated.isOpened()) {
-        const double fps = source.fps() > 0 ? source.fps() : 30.0;
-        annotated.open(opt.annotate, cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps,
-                       bgr.size());
-        if (!annotated.isOpened()) spdlog::error("--annotate: cannot write '{}'", opt.annotate);
-      }
-      if (annotated.isOpened()) annotated.write(bgr);
-    }
-    if (show_progress && frames % 5 == 0) {
+    counts.pipeline_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    counts.declined += tracker.last_stats().declined;
+    for (const auto& d : found) ++counts.per_id[d.id];
+    counts.rows += static_cast<long>(found.size());
+    write_rows(*csv, r.index, found, calib);
+    if (!opt.annotate.empty()) write_annotated(annotated, opt, source, r, found);
+    if (show_progress && counts.frames % 5 == 0) {
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      print_progress(r.index + 1, source.frame_count(), frames / std::max(wall, 1e-9));
+      print_progress(r.index + 1, source.frame_count(), counts.frames / std::max(wall, 1e-9));
     }
   }
-  std::signal(SIGINT, previous_int);
-  std::signal(SIGTERM, previous_term);
   if (show_progress) std::fputc('\n', stderr);
   csv->flush();
-
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::fprintf(stderr, "summary: %ld frames read, %ld bad frames skipped, %ld detections%s\n", frames, bad_frames, rows,
-               g_interrupted ? " (interrupted)" : "");
-  for (int id : ids) {
-    const long n = per_id.count(id) ? per_id[id] : 0;
-    std::fprintf(stderr, "  id %3d: %6ld frames (%5.1f%%)\n", id, n, frames ? 100.0 * n / frames : 0.0);
-  }
-  // A marker two readings explain almost equally well is reported as nothing: counted here.
-  std::fprintf(stderr, "  declined: %ld markers left unnamed (two IDs or headings read almost alike)\n", declined);
-  std::fprintf(stderr, "  speed: %.1f frames/s overall, %.1f frames/s in the pipeline (%.3f ms/frame)\n",
-               frames / std::max(wall, 1e-9), frames / std::max(pipeline_s, 1e-9),
-               frames ? 1000.0 * pipeline_s / frames : 0.0);
-  if (frames == 0) {
+  print_summary(counts, ids, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+                interrupt.raised());
+  if (counts.frames == 0) {
     spdlog::error("no frame could be read from {}",
                   opt.camera >= 0 ? "camera " + std::to_string(opt.camera) : opt.input);
     return kExitFailure;

@@ -18,24 +18,24 @@
 
 #include <nlohmann/json.hpp>
 
+#include "agents/builtin_controllers.hpp"
 #include "app/commands.hpp"
+#include "app/interrupt.hpp"
 #include "app/panel_options.hpp"
 #include "bus/lcm_bus.hpp"
 #include "bus/lcm_console.hpp"
+#include "bus/report_decoder.hpp"
 #include "gui_web/gui_service.hpp"
 
 namespace rilbed::app {
 
 namespace {
 
-std::atomic<bool> gui_interrupted{false};
-extern "C" void on_gui_signal(int) { gui_interrupted.store(true); }
-
 struct GuiArgs {
   std::string url;
   std::string prefix;
   std::string run_token;  // the run's console token (default: its token file)
-  PanelOptions panel;
+  session::PanelOptions panel;
 };
 
 // The console sink of `rilbed gui`: each command goes to the run over LCM with the run's
@@ -61,7 +61,7 @@ int gui_command(const GuiArgs& args) {
     spdlog::error("gui: {}", *problem);
     return kExitUsage;
   }
-  if (const auto problem = check_panel_options(args.panel)) {
+  if (const auto problem = session::check_panel_options(args.panel)) {
     spdlog::error("gui: {}", *problem);
     return kExitUsage;
   }
@@ -78,7 +78,8 @@ int gui_command(const GuiArgs& args) {
     return kExitFailure;
   }
   // The panel's own token: the run's stays with the run (it goes only into console commands).
-  std::unique_ptr<gui_web::GuiService> gui = start_panel(args.panel, "", lcm_console_sink(args));
+  std::unique_ptr<gui_web::GuiService> gui =
+      session::start_panel(args.panel, "", lcm_console_sink(args), *agents::default_controllers());
   if (!gui) return kExitFailure;
   const bus::Channels run_channels = bus::Channels::with_prefix(args.prefix);
   bus::RunReportDecoder decoder(run_channels, *gui);
@@ -97,10 +98,9 @@ int gui_command(const GuiArgs& args) {
   }
   std::printf("rilbed gui: %s (the run on %s)\n", gui->url().c_str(), args.url.c_str());
   std::fflush(stdout);
-  std::signal(SIGINT, on_gui_signal);
-  std::signal(SIGTERM, on_gui_signal);
-  while (!gui_interrupted.load()) {
-    if (lcm->handleTimeout(100) < 0 && !gui_interrupted.load()) {
+  const InterruptFlag interrupt;
+  while (!interrupt.raised()) {
+    if (lcm->handleTimeout(100) < 0 && !interrupt.raised()) {
       spdlog::error("gui: reading the LCM bus {} failed", args.url);
       return kExitFailure;
     }

@@ -13,15 +13,15 @@
 #include <thread>
 
 #include "app/commands.hpp"
+#include "app/interrupt.hpp"
 #include "bus/lcm_bus.hpp"
+#include "bus/lcm_log_reader.hpp"
+#include "bus/report_decoder.hpp"
 #include "run/run_folder_writer.hpp"
 
 namespace rilbed::app {
 
 namespace {
-
-std::atomic<bool> replay_interrupted{false};
-extern "C" void on_replay_signal(int) { replay_interrupted.store(true); }
 
 struct ReplayArgs {
   std::string log;
@@ -87,13 +87,12 @@ int publish(const ReplayArgs& args) {
     spdlog::error("replay: {}", error);
     return kExitFailure;
   }
-  std::signal(SIGINT, on_replay_signal);
-  std::signal(SIGTERM, on_replay_signal);
+  const InterruptFlag interrupt;
   std::int64_t first_us = -1;
   const auto start = std::chrono::steady_clock::now();
   long published = 0;
   while (const auto e = log.next()) {
-    if (replay_interrupted.load()) break;
+    if (interrupt.raised()) break;
     if (first_us < 0) first_us = e->timestamp_us;
     const double at_s = static_cast<double>(e->timestamp_us - first_us) * 1e-6;
     if (at_s < args.from_s) continue;

@@ -14,6 +14,7 @@
 
 #include "app/commands.hpp"
 #include "bus/lcm_bus.hpp"
+#include "bus/run_publisher.hpp"
 #include "core/id_list.hpp"
 #include "run/scenario.hpp"
 #include "run/simulation.hpp"
@@ -84,42 +85,25 @@ void print_splits(const std::vector<Split>& splits) {
   }
 }
 
-int bench_command(const BenchArgs& args) {
-  const auto counts = parse_id_list(args.robots, 1, 1'000'000, "list");
-  if (!counts.ok()) {
-    spdlog::error("--robots: {}", counts.error);
-    return kExitUsage;
+// One run of sim-bench: its options, the buses it also publishes on, and what it measured.
+class SimBench {
+ public:
+  SimBench(const BenchArgs& args, std::vector<int> counts, std::vector<int> threads)
+      : args_(args), counts_(std::move(counts)), thread_counts_(std::move(threads)) {}
+
+  int run() {
+    print_intro();
+    if (!open_buses()) return kExitFailure;
+    for (const int n : counts_) {
+      if (!time_count(n)) return kExitFailure;
+    }
+    if (!splits_.empty()) print_splits(splits_);
+    if (any_differs_) spdlog::error("runs of the same robot count gave different trajectories (the \"same\" column)");
+    if (!buses_.empty()) print_bus_tables();
+    return any_differs_ ? kExitFailure : 0;
   }
-  const auto thread_counts = parse_id_list(args.threads, 1, 256, "list");
-  if (!thread_counts.ok()) {
-    spdlog::error("--threads: {}", thread_counts.error);
-    return kExitUsage;
-  }
-  if (!args.lcm_urls.empty() && thread_counts.ids != std::vector<int>{1}) {
-    spdlog::error("--lcm times the bus on one thread: give it without --threads");
-    return kExitUsage;
-  }
-  std::printf("## Simulation speed (rilbed sim-bench)\n\n");
-  std::printf(
-      "Virtual Kheperas (55 mm discs) with all 8 IR proximity sensors (cones of +-30 deg, 50 mm range, noise), "
-      "the wander controller (Braitenberg avoidance), wheel slip 2 %%, collisions on (robot-robot, robot-wall), "
-      "control period 100 ms, physics step %.0f ms (exact arcs, collision substeps as needed), a field of %.2f "
-      "robots per m^2 (the lab's 8 robots on 1.5 x 1.2 m), random starts (seed %llu). The whole DEVS "
-      "run (world model, one atomic model per agent, monitor; no files written) on the given threads (`--threads`: "
-      "agents and robot motion spread over them, collisions and recording on the run's thread), timed from the "
-      "first event to the last (building the world, the start-up column, excluded); wall and the CPU time of the "
-      "run's threads, medians of --repeat runs; speed-up is against the same count on the fewest threads; peak "
-      "memory is the process's resident peak so far (getrusage). Every run of a count, on any threads, must give the "
-      "same trajectories (the \"same\" column).\n\n",
-      args.physics_step_ms, args.density_per_m2, static_cast<unsigned long long>(args.seed));
-  std::printf(
-      "| robots | threads | field m | simulated s | start-up s | wall s (median of %d) | CPU s (median) | wall ms per "
-      "simulated s | real-time factor (wall) | real-time factor (CPU) | us per robot-step (CPU) | speed-up | peak "
-      "memory MB | collisions | max overlap m (each simulated s) | same |\n",
-      args.repeat);
-  std::printf(
-      "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- "
-      "|\n");
+
+ private:
   struct Split {
     int robots = 0;
     int threads = 1;
@@ -127,8 +111,6 @@ int bench_command(const BenchArgs& args) {
     double plain_wall_per_simulated_s = 0.0;  // the untimed runs' median
     run::RunProfile profile;
   };
-  std::vector<Split> splits;
-  bool any_differs = false;
   // With --lcm: each count also with every message of the run published on each bus
   // (nobody need listen), runs with and without it taking turns so that other load on
   // the machine falls on all alike.
@@ -139,80 +121,136 @@ int bench_command(const BenchArgs& args) {
     std::vector<std::pair<int, double>> costs;  // robots, CPU cost in per cent
     std::vector<double> core_shares;            // extra CPU per simulated second: the share of a core at real time
   };
-  std::vector<Bus> buses;
-  for (const std::string& url : args.lcm_urls) {
-    Bus bus;
-    bus.url = url;
-    std::string error;
-    bus.lcm = bus::open_lcm(url, error);
-    if (!bus.lcm) {
-      spdlog::error("sim-bench: {}", error);
-      return kExitFailure;
-    }
-    bus.publisher = std::make_unique<bus::LcmRunPublisher>(*bus.lcm, bus::Channels{}, url.rfind("memq://", 0) == 0);
-    buses.push_back(std::move(bus));
-  }
   struct Timing {
     std::vector<double> walls, cpus, startups;
     run::RunResult r;
   };
-  for (int n : counts.ids) {
-    const run::Scenario s = bench_scenario(n, args);
+  // One robot count's runs: per thread count, the plain runs and each bus's.
+  struct CountRuns {
+    explicit CountRuns(std::size_t thread_rows, std::size_t buses)
+        : plain(thread_rows),
+          bused(thread_rows, std::vector<Timing>(buses)),
+          splits(thread_rows),
+          same(thread_rows, 1) {}
+    std::vector<Timing> plain;
+    std::vector<std::vector<Timing>> bused;
+    std::vector<Split> splits;
+    std::vector<char> same;
     std::optional<std::uint64_t> first_digest;
-    const std::size_t thread_rows = thread_counts.ids.size();
-    // Per thread count: the plain runs and each bus's.
-    std::vector<Timing> plain(thread_rows);
-    std::vector<std::vector<Timing>> bused(thread_rows, std::vector<Timing>(buses.size()));
-    std::vector<Split> row_splits(thread_rows);
-    std::vector<char> same(thread_rows, 1);
+  };
+
+  void print_intro() const {
+    const BenchArgs& args = args_;
+    std::printf("## Simulation speed (rilbed sim-bench)\n\n");
+    std::printf(
+        "Virtual Kheperas (55 mm discs) with all 8 IR proximity sensors (cones of +-30 deg, 50 mm range, noise), "
+        "the wander controller (Braitenberg avoidance), wheel slip 2 %%, collisions on (robot-robot, robot-wall), "
+        "control period 100 ms, physics step %.0f ms (exact arcs, collision substeps as needed), a field of %.2f "
+        "robots per m^2 (the lab's 8 robots on 1.5 x 1.2 m), random starts (seed %llu). The whole DEVS "
+        "run (world model, one atomic model per agent, monitor; no files written) on the given threads (`--threads`: "
+        "agents and robot motion spread over them, collisions and recording on the run's thread), timed from the "
+        "first event to the last (building the world, the start-up column, excluded); wall and the CPU time of the "
+        "run's threads, medians of --repeat runs; speed-up is against the same count on the fewest threads; peak "
+        "memory is the process's resident peak so far (getrusage). Every run of a count, on any threads, must give the "
+        "same trajectories (the \"same\" column).\n\n",
+        args.physics_step_ms, args.density_per_m2, static_cast<unsigned long long>(args.seed));
+    std::printf(
+        "| robots | threads | field m | simulated s | start-up s | wall s (median of %d) | CPU s (median) | wall ms "
+        "per "
+        "simulated s | real-time factor (wall) | real-time factor (CPU) | us per robot-step (CPU) | speed-up | peak "
+        "memory MB | collisions | max overlap m (each simulated s) | same |\n",
+        args.repeat);
+    std::printf(
+        "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | "
+        "--- "
+        "|\n");
+  }
+
+  bool open_buses() {
+    for (const std::string& url : args_.lcm_urls) {
+      Bus b;
+      b.url = url;
+      std::string error;
+      b.lcm = bus::open_lcm(url, error);
+      if (!b.lcm) {
+        spdlog::error("sim-bench: {}", error);
+        return false;
+      }
+      b.publisher = std::make_unique<bus::LcmRunPublisher>(*b.lcm, bus::Channels{}, url.rfind("memq://", 0) == 0);
+      buses_.push_back(std::move(b));
+    }
+    return true;
+  }
+
+  // Every round of one robot count, then its rows.
+  bool time_count(int n) {
+    const run::Scenario s = bench_scenario(n, args_);
+    CountRuns runs(thread_counts_.size(), buses_.size());
     // The timed runs carry no timers (they cost 3-8 %); one more round, after them, is
     // timed in parts for the split table. Each round runs every thread count (and bus) in
     // turn, so that other load on the machine falls on all of them alike.
-    const int rounds = args.repeat + (args.no_split ? 0 : 1);
+    const int rounds = args_.repeat + (args_.no_split ? 0 : 1);
     for (int rep = 0; rep < rounds; ++rep) {
-      const bool split_run = rep == args.repeat;
-      for (std::size_t ti = 0; ti < thread_rows; ++ti) {
-        for (std::size_t k = 0; k <= buses.size(); ++k) {
-          if (split_run && k > 0) break;
-          Timing scratch;
-          Timing& t = split_run ? scratch : k == 0 ? plain[ti] : bused[ti][k - 1];
-          run::RunOptions o;
-          o.seed = args.seed;
-          o.duration_s = args.seconds;
-          o.threads = thread_counts.ids[ti];
-          o.overlap_check_us = 1'000'000;
-          if (k > 0) o.observer = buses[k - 1].publisher.get();
-          o.profile = split_run;
-          try {
-            t.r = run::run_scenario(s, o);
-          } catch (const std::exception& e) {
-            spdlog::error("{} robots: {}", n, e.what());
-            return kExitFailure;
-          }
-          if (!first_digest) first_digest = t.r.trajectory_digest;
-          if (t.r.trajectory_digest != *first_digest) same[ti] = 0;
-          t.walls.push_back(t.r.run_wall_s);
-          t.cpus.push_back(t.r.run_cpu_s);
-          t.startups.push_back(t.r.wall_s - t.r.run_wall_s);
-          if (t.r.profile) {
-            Split& split = row_splits[ti];
-            split.robots = n;
-            split.threads = thread_counts.ids[ti];
-            split.run_s += t.r.run_wall_s;
-            split.simulated_s += t.r.simulated_s;
-            const run::RunProfile& p = *t.r.profile;
-            split.profile.sensing_s += p.sensing_s;
-            split.profile.behaviours_s += p.behaviours_s;
-            split.profile.integration_s += p.integration_s;
-            split.profile.collisions_s += p.collisions_s;
-            split.profile.monitor_s += p.monitor_s;
-          }
-        }
+      for (std::size_t ti = 0; ti < thread_counts_.size(); ++ti) {
+        if (!time_round(s, n, ti, rep == args_.repeat, runs)) return false;
       }
     }
+    print_rows(s, n, runs);
+    std::fflush(stdout);
+    return true;
+  }
+
+  // One round of one thread count: plain, then on each bus (the split round: plain only).
+  bool time_round(const run::Scenario& s, int n, std::size_t ti, bool split_run, CountRuns& runs) {
+    for (std::size_t k = 0; k <= buses_.size(); ++k) {
+      if (split_run && k > 0) break;
+      Timing scratch;
+      Timing& t = split_run ? scratch : k == 0 ? runs.plain[ti] : runs.bused[ti][k - 1];
+      run::RunOptions o;
+      o.seed = args_.seed;
+      o.duration_s = args_.seconds;
+      o.threads = thread_counts_[ti];
+      o.overlap_check_us = 1'000'000;
+      if (k > 0) o.observer = buses_[k - 1].publisher.get();
+      o.profile = split_run;
+      try {
+        t.r = run::run_scenario(s, o);
+      } catch (const std::exception& e) {
+        spdlog::error("{} robots: {}", n, e.what());
+        return false;
+      }
+      if (!runs.first_digest) runs.first_digest = t.r.trajectory_digest;
+      if (t.r.trajectory_digest != *runs.first_digest) runs.same[ti] = 0;
+      t.walls.push_back(t.r.run_wall_s);
+      t.cpus.push_back(t.r.run_cpu_s);
+      t.startups.push_back(t.r.wall_s - t.r.run_wall_s);
+      if (t.r.profile) add_split(runs.splits[ti], n, thread_counts_[ti], t.r);
+    }
+    return true;
+  }
+
+  static void add_split(Split& split, int robots, int threads, const run::RunResult& r) {
+    split.robots = robots;
+    split.threads = threads;
+    split.run_s += r.run_wall_s;
+    split.simulated_s += r.simulated_s;
+    const run::RunProfile& p = *r.profile;
+    split.profile.sensing_s += p.sensing_s;
+    split.profile.behaviours_s += p.behaviours_s;
+    split.profile.integration_s += p.integration_s;
+    split.profile.collisions_s += p.collisions_s;
+    split.profile.monitor_s += p.monitor_s;
+  }
+
+  void print_rows(const run::Scenario& s, int n, CountRuns& runs) {
+    auto& plain = runs.plain;
+    auto& bused = runs.bused;
+    auto& row_splits = runs.splits;
+    auto& same = runs.same;
+    const std::vector<int>& thread_counts_ids = thread_counts_;
     double first_threads_wall_s = 0.0;
-    for (std::size_t ti = 0; ti < thread_rows; ++ti) {
-      const int threads = thread_counts.ids[ti];
+    for (std::size_t ti = 0; ti < thread_counts_.size(); ++ti) {
+      const int threads = thread_counts_ids[ti];
       auto row = [&](Timing& t, const std::string& label) {
         std::sort(t.walls.begin(), t.walls.end());
         std::sort(t.cpus.begin(), t.cpus.end());
@@ -233,19 +271,19 @@ int bench_command(const BenchArgs& args) {
       };
       const double plain_cpu = row(plain[ti], "");
       row_splits[ti].plain_wall_per_simulated_s = plain[ti].walls[plain[ti].walls.size() / 2] / plain[ti].r.simulated_s;
-      for (std::size_t k = 0; k < buses.size(); ++k) {
-        const double bused_cpu = row(bused[ti][k], " (bus " + buses[k].url + ")");
-        buses[k].costs.push_back({n, 100.0 * (bused_cpu / plain_cpu - 1.0)});
-        buses[k].core_shares.push_back(100.0 * (bused_cpu - plain_cpu) / std::max(1e-9, bused[ti][k].r.simulated_s));
+      for (std::size_t k = 0; k < buses_.size(); ++k) {
+        const double bused_cpu = row(bused[ti][k], " (bus " + buses_[k].url + ")");
+        buses_[k].costs.push_back({n, 100.0 * (bused_cpu / plain_cpu - 1.0)});
+        buses_[k].core_shares.push_back(100.0 * (bused_cpu - plain_cpu) / std::max(1e-9, bused[ti][k].r.simulated_s));
       }
-      if (!same[ti]) any_differs = true;
-      if (row_splits[ti].robots > 0) splits.push_back(row_splits[ti]);
+      if (!same[ti]) any_differs_ = true;
+      if (row_splits[ti].robots > 0) splits_.push_back(row_splits[ti]);
     }
-    std::fflush(stdout);
   }
-  if (!splits.empty()) print_splits(splits);
-  if (any_differs) spdlog::error("runs of the same robot count gave different trajectories (the \"same\" column)");
-  if (!buses.empty()) {
+
+  void print_bus_tables() const {
+    const auto& buses = buses_;
+    const auto& counts_ids = counts_;
     std::printf(
         "\nThe bus: every message of the run published on it (rows \"(bus ...)\"): the world and status every "
         "simulated second; every robot's pose, wheel command and sensor readings every control step; each event. "
@@ -258,8 +296,8 @@ int bench_command(const BenchArgs& args) {
     std::printf("\n| ---: |");
     for (std::size_t k = 0; k < buses.size(); ++k) std::printf(" ---: | ---: |");
     std::printf("\n");
-    for (std::size_t i = 0; i < counts.ids.size(); ++i) {
-      std::printf("| %d |", counts.ids[i]);
+    for (std::size_t i = 0; i < counts_ids.size(); ++i) {
+      std::printf("| %d |", counts_ids[i]);
       for (const Bus& b : buses) std::printf(" %+.1f %% | %.2f %% |", b.costs[i].second, b.core_shares[i]);
       std::printf("\n");
     }
@@ -276,7 +314,31 @@ int bench_command(const BenchArgs& args) {
       }
     }
   }
-  return any_differs ? kExitFailure : 0;
+
+  const BenchArgs& args_;
+  std::vector<int> counts_;
+  std::vector<int> thread_counts_;
+  std::vector<Bus> buses_;
+  std::vector<Split> splits_;
+  bool any_differs_ = false;
+};
+
+int bench_command(const BenchArgs& args) {
+  const auto counts = parse_id_list(args.robots, 1, 1'000'000, "list");
+  if (!counts.ok()) {
+    spdlog::error("--robots: {}", counts.error);
+    return kExitUsage;
+  }
+  const auto thread_counts = parse_id_list(args.threads, 1, 256, "list");
+  if (!thread_counts.ok()) {
+    spdlog::error("--threads: {}", thread_counts.error);
+    return kExitUsage;
+  }
+  if (!args.lcm_urls.empty() && thread_counts.ids != std::vector<int>{1}) {
+    spdlog::error("--lcm times the bus on one thread: give it without --threads");
+    return kExitUsage;
+  }
+  return SimBench(args, counts.ids, thread_counts.ids).run();
 }
 
 }  // namespace

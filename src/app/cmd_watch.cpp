@@ -17,14 +17,13 @@
 #include <vector>
 
 #include "app/commands.hpp"
+#include "app/interrupt.hpp"
 #include "bus/lcm_bus.hpp"
+#include "bus/report_decoder.hpp"
 
 namespace rilbed::app {
 
 namespace {
-
-std::atomic<bool> watch_interrupted{false};
-extern "C" void on_watch_signal(int) { watch_interrupted.store(true); }
 
 struct WatchArgs {
   std::string url;
@@ -182,12 +181,11 @@ int watch_command(const WatchArgs& args) {
         *lcm, *channel,
         [&watcher](const std::string& c, const void* data, std::size_t size) { watcher.on_message(c, data, size); }));
   }
-  std::signal(SIGINT, on_watch_signal);
-  std::signal(SIGTERM, on_watch_signal);
+  const InterruptFlag interrupt;
   const auto start = std::chrono::steady_clock::now();
-  while (!watch_interrupted.load()) {
+  while (!interrupt.raised()) {
     const int handled = lcm->handleTimeout(100);
-    if (handled < 0 && watch_interrupted.load()) break;  // Ctrl-C while waiting: not a failure
+    if (handled < 0 && interrupt.raised()) break;  // Ctrl-C while waiting: not a failure
     if (handled < 0) {
       spdlog::error("watch: reading the LCM bus {} failed", args.url);
       return kExitFailure;

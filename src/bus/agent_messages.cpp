@@ -7,6 +7,7 @@
 #include <string>
 
 #include "bus/lcm_bus.hpp"
+#include "bus/lcm_conversion.hpp"
 
 namespace rilbed::bus {
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "agents/controller.hpp"
+#include "bus/lcm_conversion.hpp"
 #include "rilbed/agent_input_t.hpp"
 #include "rilbed/agent_output_t.hpp"
 #include "rilbed/quantum_t.hpp"

@@ -8,6 +8,7 @@
 
 #include "bus/agent_messages.hpp"
 #include "bus/lcm_checked.hpp"
+#include "bus/lcm_conversion.hpp"
 #include "rilbed/agent_hello_t.hpp"
 #include "rilbed/quantum_t.hpp"
 

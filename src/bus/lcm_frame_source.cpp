@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bus/lcm_checked.hpp"
+#include "bus/lcm_log_reader.hpp"
 
 namespace rilbed::bus {
 

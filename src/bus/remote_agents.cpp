@@ -9,6 +9,7 @@
 
 #include "bus/agent_messages.hpp"
 #include "bus/lcm_checked.hpp"
+#include "bus/lcm_conversion.hpp"
 
 namespace rilbed::bus {
 

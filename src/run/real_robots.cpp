@@ -22,13 +22,7 @@ serial::EmulatorConfig emulator_config(const run::RobotSpec& spec, const serial:
   emu.model = model;
   emu.initial_pose = pose;
   emu.seed = static_cast<std::uint64_t>(spec.id);
-  const auto& f = spec.link->faults;
-  emu.faults.reply_delay_ms = f.reply_delay_ms;
-  emu.faults.drop_probability = f.drop;
-  emu.faults.garbage_probability = f.garbage;
-  emu.faults.corrupt_probability = f.corrupt;
-  emu.faults.disconnect_after_s = f.disconnect_after_s;
-  emu.faults.replug_after_s = f.replug_after_s;
+  emu.faults = spec.link->faults;
   return emu;
 }
 

@@ -1,5 +1,7 @@
 #include "run/run_comparison.hpp"
 
+#include "run/batch_summary.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -132,6 +134,15 @@ bool is_batch_folder(const std::filesystem::path& dir) {
 
 BatchComparison compare_batches(const std::filesystem::path& a, const std::filesystem::path& b) {
   BatchComparison c;
+  // A batch's own summary, where it wrote one, must be readable: a damaged batch.json
+  // means the folder is not what it says.
+  for (const std::filesystem::path& dir : {a, b}) {
+    std::string error;
+    if (std::filesystem::exists(dir / "batch.json") && !read_batch_summary(dir / "batch.json", error)) {
+      c.error = error;
+      return c;
+    }
+  }
   const std::vector<std::uint64_t> sa = seeds_in(a), sb = seeds_in(b);
   if (sa.empty()) c.error = a.string() + ": no seed_<N> run folders (not a batch folder of rilbed run --seeds)";
   if (c.error.empty() && sb.empty())

@@ -211,6 +211,132 @@ environment::SensorSuiteConfig read_sensors(const Reader& r) {
   return s;
 }
 
+// The robot IDs of one entry: `id: 3` or `ids: 1-8`.
+std::vector<int> read_robot_ids(const Reader& r, const YAML::Node& entry) {
+  std::vector<int> ids;
+  if (r.has("id") == r.has("ids")) r.fail(entry, "give exactly one of `id` (one robot) or `ids` (e.g. 1-8)");
+  if (r.has("id")) {
+    ids.push_back(r.integer("id", 0));
+  } else {
+    const auto parsed = parse_id_list(r.text("ids", ""), 1, 100000);
+    if (!parsed.ok()) r.fail_key("ids", parsed.error);
+    ids = parsed.ids;
+  }
+  return ids;
+}
+
+environment::RobotKind read_kind(const Reader& r) {
+  const std::string kind = r.text("kind", "virtual");
+  if (kind == "real") return environment::RobotKind::kReal;
+  if (kind != "virtual") r.fail_key("kind", "must be virtual or real, not '" + kind + "'");
+  return environment::RobotKind::kVirtual;
+}
+
+// `pose: random` (nullopt) or [x_m, y_m, theta_deg]; one pose places one robot only.
+std::optional<Pose2> read_pose(const Reader& r, std::size_t robots) {
+  if (!r.has("pose")) return std::nullopt;
+  const YAML::Node p = r.get("pose");
+  if (p.IsScalar() && p.as<std::string>() == "random") return std::nullopt;
+  if (!p.IsSequence() || p.size() != 3) r.fail_key("pose", "must be `random` or [x_m, y_m, theta_deg]");
+  double v[3];
+  for (int k = 0; k < 3; ++k) {
+    try {
+      v[k] = p[k].as<double>();
+    } catch (const YAML::Exception&) {
+      r.fail_key("pose", "must be `random` or [x_m, y_m, theta_deg]");
+    }
+    if (!std::isfinite(v[k])) r.fail_key("pose", "must hold finite numbers");
+  }
+  if (robots > 1) r.fail_key("pose", "one pose cannot place several robots; use `random` or one entry per robot");
+  return Pose2{{v[0], v[1]}, deg_to_rad(v[2])};
+}
+
+// `controller` and `params`, checked against the controller's registry entry; the entry,
+// for the robot's sensors to be checked against.
+const agents::ControllerEntry& read_controller(const Reader& r, const agents::ControllerRegistry& controllers,
+                                               ControllerSpec& spec) {
+  spec.name = r.text("controller", "convoy");
+  const agents::ControllerEntry* controller = controllers.find(spec.name);
+  if (!controller) {
+    r.fail_key("controller", "unknown controller '" + spec.name + "' (known: " + controllers.names_text() +
+                                 "; `rilbed controllers` lists them)");
+  }
+  if (!r.has("params")) {
+    if (const auto problem = agents::check_params(*controller, {})) r.fail_key("controller", problem->problem);
+    return *controller;
+  }
+  const Reader p = r.child("params");
+  for (const auto& kv : r.get("params")) {
+    const std::string key = kv.first.as<std::string>();
+    spec.params[key] = p.number(key, 0.0);
+  }
+  if (const auto problem = agents::check_params(*controller, spec.params)) {
+    if (problem->key.empty()) r.fail_key("params", problem->problem);
+    p.fail_key(problem->key, problem->problem);
+  }
+  return *controller;
+}
+
+environment::WheelNoiseConfig read_noise(const Reader& n) {
+  n.allow({"slip_sd", "left_bias", "right_bias", "odometer_counts_slip"});
+  environment::WheelNoiseConfig noise;
+  noise.slip_sd = n.non_negative("slip_sd", 0.0);
+  noise.left_bias = n.number("left_bias", 0.0);
+  noise.right_bias = n.number("right_bias", 0.0);
+  noise.odometer_counts_slip = n.boolean("odometer_counts_slip", true);
+  return noise;
+}
+
+// An emulated robot's `faults:`.
+serial::EmulatorFaults read_faults(const Reader& f) {
+  f.allow({"reply_delay_ms", "drop", "garbage", "corrupt", "disconnect_after_s", "replug_after_s"});
+  serial::EmulatorFaults faults;
+  faults.reply_delay_ms = f.integer("reply_delay_ms", 0);
+  if (faults.reply_delay_ms < 0) f.fail_key("reply_delay_ms", "must not be negative");
+  for (auto [key, value] : {std::pair{"drop", &faults.drop_probability},
+                            {"garbage", &faults.garbage_probability},
+                            {"corrupt", &faults.corrupt_probability}}) {
+    *value = f.non_negative(key, 0.0);
+    if (*value > 1.0) f.fail_key(key, "is a probability, at most 1");
+  }
+  faults.disconnect_after_s = f.non_negative("disconnect_after_s", 0.0);
+  faults.replug_after_s = f.non_negative("replug_after_s", 0.0);
+  return faults;
+}
+
+LinkSpec read_link(const Reader& l, const YAML::Node& at) {
+  l.allow(
+      {"port", "baud", "model", "emulate", "placement", "faults", "reply_timeout_ms", "retries", "counters_period_ms"});
+  LinkSpec link;
+  link.port = l.text("port", "");
+  link.baud = l.integer("baud", link.baud);
+  link.model = l.text("model", link.model);
+  link.emulate = l.boolean("emulate", false);
+  link.reply_timeout_ms = l.integer("reply_timeout_ms", link.reply_timeout_ms);
+  if (link.reply_timeout_ms <= 0) l.fail_key("reply_timeout_ms", "must be greater than 0");
+  link.retries = l.integer("retries", link.retries);
+  if (link.retries < 0) l.fail_key("retries", "must not be negative");
+  link.counters_period_ms = l.integer("counters_period_ms", link.counters_period_ms);
+  if (link.counters_period_ms < 0) l.fail_key("counters_period_ms", "must not be negative");
+  if (link.port.empty() == !link.emulate) l.fail(at, "give either `port` or `emulate: true`");
+  const std::string placement = l.text("placement", link.emulate ? "teleport" : "drive");
+  if (placement == "drive") {
+    link.placement = Placement::kDrive;
+  } else if (placement == "teleport") {
+    if (!link.emulate)
+      l.fail_key("placement", "only an emulated robot can be put in place by rilbed (a real one is driven there)");
+    link.placement = Placement::kTeleport;
+  } else {
+    l.fail_key("placement", "is drive or teleport, not '" + placement + "'");
+  }
+  if (l.has("faults")) {
+    if (!link.emulate) l.fail_key("faults", "only an emulated robot injects faults");
+    link.faults = read_faults(l.child("faults"));
+  }
+  return link;
+}
+
+// Every robot entry, each of one robot (`id`) or several alike (`ids`), sorted by ID.
 std::vector<RobotSpec> read_robots(const Reader& top, const agents::ControllerRegistry& controllers) {
   const YAML::Node list = top.get("robots");
   if (!list || !list.IsSequence() || list.size() == 0) top.fail_key("robots", "must be a non-empty list of robots");
@@ -221,118 +347,19 @@ std::vector<RobotSpec> read_robots(const Reader& top, const agents::ControllerRe
     r.allow({"id", "ids", "kind", "pose", "controller", "params", "noise", "sensors", "link"});
     RobotSpec base;
     base.line = list[i].Mark().line + 1;
-    std::vector<int> ids;
-    if (r.has("id") == r.has("ids")) r.fail(list[i], "give exactly one of `id` (one robot) or `ids` (e.g. 1-8)");
-    if (r.has("id")) {
-      ids.push_back(r.integer("id", 0));
-    } else {
-      const auto parsed = parse_id_list(r.text("ids", ""), 1, 100000);
-      if (!parsed.ok()) r.fail_key("ids", parsed.error);
-      ids = parsed.ids;
-    }
-    const std::string kind = r.text("kind", "virtual");
-    if (kind == "virtual") {
-      base.kind = environment::RobotKind::kVirtual;
-    } else if (kind == "real") {
-      base.kind = environment::RobotKind::kReal;
-    } else {
-      r.fail_key("kind", "must be virtual or real, not '" + kind + "'");
-    }
-    if (r.has("pose")) {
-      const YAML::Node p = r.get("pose");
-      if (p.IsScalar() && p.as<std::string>() == "random") {
-        base.pose.reset();
-      } else {
-        if (!p.IsSequence() || p.size() != 3) r.fail_key("pose", "must be `random` or [x_m, y_m, theta_deg]");
-        double v[3];
-        for (int k = 0; k < 3; ++k) {
-          try {
-            v[k] = p[k].as<double>();
-          } catch (const YAML::Exception&) {
-            r.fail_key("pose", "must be `random` or [x_m, y_m, theta_deg]");
-          }
-          if (!std::isfinite(v[k])) r.fail_key("pose", "must hold finite numbers");
-        }
-        if (ids.size() > 1)
-          r.fail_key("pose", "one pose cannot place several robots; use `random` or one entry per robot");
-        base.pose = Pose2{{v[0], v[1]}, deg_to_rad(v[2])};
-      }
-    }
-    base.controller.name = r.text("controller", "convoy");
-    const agents::ControllerEntry* controller = controllers.find(base.controller.name);
-    if (!controller) {
-      r.fail_key("controller", "unknown controller '" + base.controller.name + "' (known: " + controllers.names_text() +
-                                   "; `rilbed controllers` lists them)");
-    }
-    if (r.has("params")) {
-      const Reader p = r.child("params");
-      for (const auto& kv : r.get("params")) {
-        const std::string key = kv.first.as<std::string>();
-        base.controller.params[key] = p.number(key, 0.0);
-      }
-      if (const auto problem = agents::check_params(*controller, base.controller.params)) {
-        if (problem->key.empty()) r.fail_key("params", problem->problem);
-        p.fail_key(problem->key, problem->problem);
-      }
-    } else if (const auto problem = agents::check_params(*controller, {})) {
-      r.fail_key("controller", problem->problem);
-    }
-    if (r.has("noise")) {
-      const Reader n = r.child("noise");
-      n.allow({"slip_sd", "left_bias", "right_bias", "odometer_counts_slip"});
-      base.noise.slip_sd = n.non_negative("slip_sd", 0.0);
-      base.noise.left_bias = n.number("left_bias", 0.0);
-      base.noise.right_bias = n.number("right_bias", 0.0);
-      base.noise.odometer_counts_slip = n.boolean("odometer_counts_slip", true);
-    }
+    const std::vector<int> ids = read_robot_ids(r, list[i]);
+    base.kind = read_kind(r);
+    base.pose = read_pose(r, ids.size());
+    const agents::ControllerEntry& controller = read_controller(r, controllers, base.controller);
+    if (r.has("noise")) base.noise = read_noise(r.child("noise"));
     if (r.has("sensors")) base.sensors = read_sensors(r.child("sensors"));
-    if (const auto sensor = agents::missing_sensor(*controller, base.sensors)) {
+    if (const auto sensor = agents::missing_sensor(controller, base.sensors)) {
       r.fail_key(r.has("sensors") ? "sensors" : "controller",
                  base.controller.name + " needs `sensors: " + *sensor + ":` (see scenarios/README.md)");
     }
     if (r.has("link")) {
       if (base.kind != environment::RobotKind::kReal) r.fail_key("link", "only a robot of kind real has a link");
-      const Reader l = r.child("link");
-      l.allow({"port", "baud", "model", "emulate", "placement", "faults", "reply_timeout_ms", "retries",
-               "counters_period_ms"});
-      LinkSpec link;
-      link.port = l.text("port", "");
-      link.baud = l.integer("baud", link.baud);
-      link.model = l.text("model", link.model);
-      link.emulate = l.boolean("emulate", false);
-      link.reply_timeout_ms = l.integer("reply_timeout_ms", link.reply_timeout_ms);
-      if (link.reply_timeout_ms <= 0) l.fail_key("reply_timeout_ms", "must be greater than 0");
-      link.retries = l.integer("retries", link.retries);
-      if (link.retries < 0) l.fail_key("retries", "must not be negative");
-      link.counters_period_ms = l.integer("counters_period_ms", link.counters_period_ms);
-      if (link.counters_period_ms < 0) l.fail_key("counters_period_ms", "must not be negative");
-      if (link.port.empty() == !link.emulate) l.fail(r.get("link"), "give either `port` or `emulate: true`");
-      const std::string placement = l.text("placement", link.emulate ? "teleport" : "drive");
-      if (placement == "drive") {
-        link.placement = Placement::kDrive;
-      } else if (placement == "teleport") {
-        if (!link.emulate)
-          l.fail_key("placement", "only an emulated robot can be put in place by rilbed (a real one is driven there)");
-        link.placement = Placement::kTeleport;
-      } else {
-        l.fail_key("placement", "is drive or teleport, not '" + placement + "'");
-      }
-      if (l.has("faults")) {
-        if (!link.emulate) l.fail_key("faults", "only an emulated robot injects faults");
-        const Reader f = l.child("faults");
-        f.allow({"reply_delay_ms", "drop", "garbage", "corrupt", "disconnect_after_s", "replug_after_s"});
-        link.faults.reply_delay_ms = f.integer("reply_delay_ms", 0);
-        if (link.faults.reply_delay_ms < 0) f.fail_key("reply_delay_ms", "must not be negative");
-        for (auto [key, value] : {std::pair{"drop", &link.faults.drop},
-                                  {"garbage", &link.faults.garbage},
-                                  {"corrupt", &link.faults.corrupt}}) {
-          *value = f.non_negative(key, 0.0);
-          if (*value > 1.0) f.fail_key(key, "is a probability, at most 1");
-        }
-        link.faults.disconnect_after_s = f.non_negative("disconnect_after_s", 0.0);
-        link.faults.replug_after_s = f.non_negative("replug_after_s", 0.0);
-      }
-      base.link = link;
+      base.link = read_link(r.child("link"), r.get("link"));
     } else if (base.kind == environment::RobotKind::kReal) {
       r.fail(list[i], "a robot of kind real needs a `link` ({port: /dev/ttyUSB0, baud: 38400} or {emulate: true})");
     }
@@ -348,13 +375,8 @@ std::vector<RobotSpec> read_robots(const Reader& top, const agents::ControllerRe
   return robots;
 }
 
-Scenario read_scenario(const YAML::Node& root, const std::string& source,
-                       const agents::ControllerRegistry& controllers) {
-  Scenario s;
-  const Reader top(root, source, "");
-  top.allow({"name", "description", "mode", "field", "timing", "duration_s", "convoy", "obstacles", "tracks", "beacons",
-             "moving_obstacles", "robots", "camera", "safety", "agents"});
-  s.name = top.text("name", std::filesystem::path(source).stem().string());
+// `mode`, `field` and `timing`.
+void read_mode_field_and_timing(const Reader& top, Scenario& s) {
   const std::string mode = top.text("mode", "distributed");
   if (mode == "distributed") {
     s.mode = ConvoyMode::kDistributed;
@@ -377,17 +399,23 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source,
     s.control_period_us = milliseconds(t, "control_period_ms", s.control_period_us);
     s.broadcast_period_us = milliseconds(t, "broadcast_period_ms", s.broadcast_period_us);
   }
-  s.duration_s = top.positive("duration_s", s.duration_s);
-  if (top.has("convoy")) {
-    const Reader c = top.child("convoy");
-    c.allow({"standoff_m", "engage_m", "max_speed_mps", "avoid_low", "avoid_high"});
-    s.convoy.standoff_m = c.positive("standoff_m", s.convoy.standoff_m);
-    s.convoy.engage_m = c.positive("engage_m", s.convoy.engage_m);
-    s.convoy.steering.max_speed_mps = c.positive("max_speed_mps", s.convoy.steering.max_speed_mps);
-    s.convoy.avoid_low = c.non_negative("avoid_low", s.convoy.avoid_low);
-    s.convoy.avoid_high = c.positive("avoid_high", s.convoy.avoid_high);
-    if (s.convoy.avoid_high <= s.convoy.avoid_low) c.fail_key("avoid_high", "must be above avoid_low");
-  }
+}
+
+// The convoy's knobs (`convoy:`).
+void read_convoy(const Reader& top, Scenario& s) {
+  if (!top.has("convoy")) return;
+  const Reader c = top.child("convoy");
+  c.allow({"standoff_m", "engage_m", "max_speed_mps", "avoid_low", "avoid_high"});
+  s.convoy.standoff_m = c.positive("standoff_m", s.convoy.standoff_m);
+  s.convoy.engage_m = c.positive("engage_m", s.convoy.engage_m);
+  s.convoy.steering.max_speed_mps = c.positive("max_speed_mps", s.convoy.steering.max_speed_mps);
+  s.convoy.avoid_low = c.non_negative("avoid_low", s.convoy.avoid_low);
+  s.convoy.avoid_high = c.positive("avoid_high", s.convoy.avoid_high);
+  if (s.convoy.avoid_high <= s.convoy.avoid_low) c.fail_key("avoid_high", "must be above avoid_low");
+}
+
+// The field's contents: `obstacles`, `tracks`, `beacons` and `moving_obstacles`.
+void read_map_lists(const Reader& top, const std::string& source, Scenario& s) {
   auto each = [&](const char* key, auto&& read) {
     if (!top.has(key)) return;
     const YAML::Node list = top.get(key);
@@ -438,35 +466,105 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source,
     c.name = m.text("name", "");
     s.moving_obstacles.push_back(c);
   });
-  s.robots = read_robots(top, controllers);
-  if (top.has("camera")) {
-    const Reader c = top.child("camera");
-    c.allow({"emulate", "device", "file", "calibration", "fps", "marker_diameter_m", "family", "vision"});
-    CameraSpec cam;
-    cam.line = top.line_of("camera");
-    cam.emulate = c.boolean("emulate", false);
-    if (c.has("device")) cam.device = c.integer("device", 0);
-    cam.file = c.text("file", "");
-    cam.calibration = c.text("calibration", "");
-    cam.fps = c.positive("fps", cam.fps);
-    cam.marker_diameter_m = c.positive("marker_diameter_m", cam.marker_diameter_m);
-    cam.family = c.text("family", cam.family);
-    if (c.has("vision")) {
-      const Reader v = c.child("vision");
-      v.allow({"brightness", "contrast", "threshold", "min_diameter_px", "max_diameter_px", "min_score"});
-      for (const std::string_view setting : vision::kVisionSettingNames) {
-        const std::string name(setting);
-        if (!v.has(name)) continue;
-        if (auto why = vision::set_vision_setting(cam.vision, name, v.number(name, 0.0))) v.fail_key(name, *why);
-      }
-      if (auto why = vision::check_vision_settings(cam.vision)) c.fail_key("vision", *why);
+}
+
+// The overhead camera of a scenario with real robots (`camera:`).
+CameraSpec read_camera(const Reader& top) {
+  const Reader c = top.child("camera");
+  c.allow({"emulate", "device", "file", "calibration", "fps", "marker_diameter_m", "family", "vision"});
+  CameraSpec cam;
+  cam.line = top.line_of("camera");
+  cam.emulate = c.boolean("emulate", false);
+  if (c.has("device")) cam.device = c.integer("device", 0);
+  cam.file = c.text("file", "");
+  cam.calibration = c.text("calibration", "");
+  cam.fps = c.positive("fps", cam.fps);
+  cam.marker_diameter_m = c.positive("marker_diameter_m", cam.marker_diameter_m);
+  cam.family = c.text("family", cam.family);
+  if (c.has("vision")) {
+    const Reader v = c.child("vision");
+    v.allow({"brightness", "contrast", "threshold", "min_diameter_px", "max_diameter_px", "min_score"});
+    for (const std::string_view setting : vision::kVisionSettingNames) {
+      const std::string name(setting);
+      if (!v.has(name)) continue;
+      if (auto why = vision::set_vision_setting(cam.vision, name, v.number(name, 0.0))) v.fail_key(name, *why);
     }
-    const int sources = (cam.emulate ? 1 : 0) + (cam.device ? 1 : 0) + (cam.file.empty() ? 0 : 1);
-    if (sources != 1) top.fail_key("camera", "give exactly one of `emulate: true`, `device: N` or `file: PATH`");
-    if (!cam.emulate && cam.calibration.empty())
-      c.fail_key("calibration", "a real camera needs its field calibration file");
-    s.camera = cam;
+    if (auto why = vision::check_vision_settings(cam.vision)) c.fail_key("vision", *why);
   }
+  const int sources = (cam.emulate ? 1 : 0) + (cam.device ? 1 : 0) + (cam.file.empty() ? 0 : 1);
+  if (sources != 1) top.fail_key("camera", "give exactly one of `emulate: true`, `device: N` or `file: PATH`");
+  if (!cam.emulate && cam.calibration.empty())
+    c.fail_key("calibration", "a real camera needs its field calibration file");
+  return cam;
+}
+
+// Where the robots' controllers run (`agents:`), checked against the robots.
+AgentsSpec read_agents(const Reader& top, const std::vector<RobotSpec>& robots) {
+  const Reader a = top.child("agents");
+  a.allow({"processes", "ids", "announce_timeout_s", "resend_ms", "dead_after_ms", "deadline_ms", "hosts", "launch",
+           "remote_rilbed"});
+  AgentsSpec spec;
+  if (a.has("hosts")) spec.hosts = a.words("hosts");
+  for (const std::string& host : spec.hosts) {
+    // A host is one argument of the launch command: one starting with '-' would be taken
+    // for an option of ssh (e.g. -oProxyCommand=...), not a machine.
+    if (host.empty() || host.front() == '-' || host.find_first_of(" \t\r\n") != std::string::npos) {
+      a.fail_key("hosts", "'" + host + "' is not a host name (no spaces, not starting with '-')");
+    }
+  }
+  spec.processes = a.integer("processes", static_cast<int>(spec.hosts.size()));
+  if (spec.processes < 0 || spec.processes > 64) a.fail_key("processes", "must be 0 to 64");
+  if (!spec.hosts.empty() && spec.processes < 1) a.fail_key("processes", "the hosts need at least one process");
+  if (a.has("launch")) {
+    spec.launch = a.words("launch");
+    if (spec.launch.empty() || spec.launch.front().empty()) a.fail_key("launch", "must name a program to start");
+    if (std::none_of(spec.launch.begin(), spec.launch.end(),
+                     [](const std::string& w) { return w.find("{command}") != std::string::npos; })) {
+      a.fail_key("launch", "must have a {command} item (the agent's command line)");
+    }
+  }
+  spec.remote_rilbed = a.text("remote_rilbed", "");
+  if (a.has("ids")) {
+    const auto parsed = parse_id_list(a.text("ids", ""), 1, 100000);
+    if (!parsed.ok()) a.fail_key("ids", parsed.error);
+    for (const int id : parsed.ids) {
+      const auto robot = std::find_if(robots.begin(), robots.end(), [&](const RobotSpec& r) { return r.id == id; });
+      if (robot == robots.end()) a.fail_key("ids", "there is no robot " + std::to_string(id));
+      if (robot->controller.name == "none") a.fail_key("ids", "robot " + std::to_string(id) + " has no controller");
+    }
+    spec.ids = parsed.ids;
+  } else {
+    for (const RobotSpec& r : robots) {
+      if (r.controller.name != "none") spec.ids.push_back(r.id);
+    }
+  }
+  if (spec.ids.empty()) a.fail_key("ids", "no robot has a controller to run elsewhere");
+  if (spec.processes > static_cast<int>(spec.ids.size())) {
+    a.fail_key("processes", "more processes than robots to run (" + std::to_string(spec.ids.size()) + ")");
+  }
+  spec.announce_timeout_s = a.positive("announce_timeout_s", spec.announce_timeout_s);
+  spec.resend_ms = a.integer("resend_ms", spec.resend_ms);
+  if (spec.resend_ms < 1) a.fail_key("resend_ms", "must be at least 1");
+  spec.dead_after_ms = a.integer("dead_after_ms", spec.dead_after_ms);
+  if (spec.dead_after_ms <= spec.resend_ms) a.fail_key("dead_after_ms", "must be longer than resend_ms");
+  spec.deadline_ms = a.integer("deadline_ms", spec.deadline_ms);
+  if (spec.deadline_ms < 1) a.fail_key("deadline_ms", "must be at least 1");
+  return spec;
+}
+
+Scenario read_scenario(const YAML::Node& root, const std::string& source,
+                       const agents::ControllerRegistry& controllers) {
+  Scenario s;
+  const Reader top(root, source, "");
+  top.allow({"name", "description", "mode", "field", "timing", "duration_s", "convoy", "obstacles", "tracks", "beacons",
+             "moving_obstacles", "robots", "camera", "safety", "agents"});
+  s.name = top.text("name", std::filesystem::path(source).stem().string());
+  read_mode_field_and_timing(top, s);
+  s.duration_s = top.positive("duration_s", s.duration_s);
+  read_convoy(top, s);
+  read_map_lists(top, source, s);
+  s.robots = read_robots(top, controllers);
+  if (top.has("camera")) s.camera = read_camera(top);
   if (top.has("safety")) {
     const Reader f = top.child("safety");
     f.allow({"lost_timeout_ms", "geofence_margin_m"});
@@ -474,59 +572,7 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source,
     if (s.lost_timeout_ms <= 0) f.fail_key("lost_timeout_ms", "must be greater than 0");
     s.geofence_margin_m = f.non_negative("geofence_margin_m", s.geofence_margin_m);
   }
-  if (top.has("agents")) {
-    const Reader a = top.child("agents");
-    a.allow({"processes", "ids", "announce_timeout_s", "resend_ms", "dead_after_ms", "deadline_ms", "hosts", "launch",
-             "remote_rilbed"});
-    AgentsSpec spec;
-    if (a.has("hosts")) spec.hosts = a.words("hosts");
-    for (const std::string& host : spec.hosts) {
-      // A host is one argument of the launch command: one starting with '-' would be taken
-      // for an option of ssh (e.g. -oProxyCommand=...), not a machine.
-      if (host.empty() || host.front() == '-' || host.find_first_of(" \t\r\n") != std::string::npos) {
-        a.fail_key("hosts", "'" + host + "' is not a host name (no spaces, not starting with '-')");
-      }
-    }
-    spec.processes = a.integer("processes", static_cast<int>(spec.hosts.size()));
-    if (spec.processes < 0 || spec.processes > 64) a.fail_key("processes", "must be 0 to 64");
-    if (!spec.hosts.empty() && spec.processes < 1) a.fail_key("processes", "the hosts need at least one process");
-    if (a.has("launch")) {
-      spec.launch = a.words("launch");
-      if (spec.launch.empty() || spec.launch.front().empty()) a.fail_key("launch", "must name a program to start");
-      if (std::none_of(spec.launch.begin(), spec.launch.end(),
-                       [](const std::string& w) { return w.find("{command}") != std::string::npos; })) {
-        a.fail_key("launch", "must have a {command} item (the agent's command line)");
-      }
-    }
-    spec.remote_rilbed = a.text("remote_rilbed", "");
-    if (a.has("ids")) {
-      const auto parsed = parse_id_list(a.text("ids", ""), 1, 100000);
-      if (!parsed.ok()) a.fail_key("ids", parsed.error);
-      for (const int id : parsed.ids) {
-        const auto robot =
-            std::find_if(s.robots.begin(), s.robots.end(), [&](const RobotSpec& r) { return r.id == id; });
-        if (robot == s.robots.end()) a.fail_key("ids", "there is no robot " + std::to_string(id));
-        if (robot->controller.name == "none") a.fail_key("ids", "robot " + std::to_string(id) + " has no controller");
-      }
-      spec.ids = parsed.ids;
-    } else {
-      for (const RobotSpec& r : s.robots) {
-        if (r.controller.name != "none") spec.ids.push_back(r.id);
-      }
-    }
-    if (spec.ids.empty()) a.fail_key("ids", "no robot has a controller to run elsewhere");
-    if (spec.processes > static_cast<int>(spec.ids.size())) {
-      a.fail_key("processes", "more processes than robots to run (" + std::to_string(spec.ids.size()) + ")");
-    }
-    spec.announce_timeout_s = a.positive("announce_timeout_s", spec.announce_timeout_s);
-    spec.resend_ms = a.integer("resend_ms", spec.resend_ms);
-    if (spec.resend_ms < 1) a.fail_key("resend_ms", "must be at least 1");
-    spec.dead_after_ms = a.integer("dead_after_ms", spec.dead_after_ms);
-    if (spec.dead_after_ms <= spec.resend_ms) a.fail_key("dead_after_ms", "must be longer than resend_ms");
-    spec.deadline_ms = a.integer("deadline_ms", spec.deadline_ms);
-    if (spec.deadline_ms < 1) a.fail_key("deadline_ms", "must be at least 1");
-    s.agents = spec;
-  }
+  if (top.has("agents")) s.agents = read_agents(top, s.robots);
   const bool any_real = std::any_of(s.robots.begin(), s.robots.end(),
                                     [](const RobotSpec& r) { return r.kind == environment::RobotKind::kReal; });
   if (any_real && !s.camera) top.fail_key("camera", "a scenario with real robots needs a `camera` to see them");

@@ -22,6 +22,7 @@
 #include "environment/robot_state.hpp"
 #include "environment/sensor_suite.hpp"
 #include "environment/static_map.hpp"
+#include "serial/khepera_emulator.hpp"
 #include "vision/vision_settings.hpp"
 
 namespace rilbed::run {
@@ -50,14 +51,9 @@ struct LinkSpec {
   int reply_timeout_ms = 250;               ///< how long one command waits for its reply
   int retries = 3;                          ///< further attempts before a command fails
   int counters_period_ms = 200;             ///< read the wheel counters (`H`) this often (0: never)
-  /// Faults the emulated robot injects (emulate only): reply delay, dropped, garbled and
-  /// corrupted replies (probabilities per reply), and an unplug after some seconds,
-  /// plugged back in after some more (0: never).
-  struct Faults {
-    int reply_delay_ms = 0;
-    double drop = 0.0, garbage = 0.0, corrupt = 0.0;
-    double disconnect_after_s = 0.0, replug_after_s = 0.0;
-  } faults;
+  /// Faults the emulated robot injects (emulate only: `faults:`): reply delay, dropped,
+  /// garbled and corrupted replies, an unplug and a replug.
+  serial::EmulatorFaults faults;
 };
 
 /// The overhead camera of a run with real robots.

@@ -13,6 +13,10 @@
 #include <vector>
 
 #include "bus/lcm_bus.hpp"
+#include "bus/lcm_conversion.hpp"
+#include "bus/lcm_log_reader.hpp"
+#include "bus/report_decoder.hpp"
+#include "bus/run_publisher.hpp"
 #include "run/simulation.hpp"
 
 namespace rilbed::bus {

@@ -32,6 +32,8 @@
 #include <nlohmann/json.hpp>
 
 #include "bus/lcm_bus.hpp"
+#include "bus/lcm_log_reader.hpp"
+#include "bus/report_decoder.hpp"
 #include "run/run_folder_writer.hpp"
 #include "touching_observer.hpp"
 

@@ -35,6 +35,8 @@
 
 #include "bus/lcm_bus.hpp"
 #include "bus/lcm_checked.hpp"
+#include "bus/lcm_conversion.hpp"
+#include "bus/report_decoder.hpp"
 #include "touching_observer.hpp"
 
 namespace {

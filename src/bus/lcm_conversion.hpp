@@ -1,0 +1,64 @@
+// What a run reports (run_observer.hpp), as the LCM messages of src/bus/msgs and back.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include "rilbed/camera_t.hpp"
+#include "rilbed/detections_t.hpp"
+#include "rilbed/event_t.hpp"
+#include "rilbed/frame_t.hpp"
+#include "rilbed/poses_t.hpp"
+#include "rilbed/sensor_layout_t.hpp"
+#include "rilbed/sensors_t.hpp"
+#include "rilbed/status_t.hpp"
+#include "rilbed/summary_t.hpp"
+#include "rilbed/vision_settings_t.hpp"
+#include "rilbed/wheels_t.hpp"
+#include "rilbed/world_t.hpp"
+#include "run/run_observer.hpp"
+#include "run/run_recorder.hpp"
+#include "vision/vision_settings.hpp"
+
+namespace rilbed::bus {
+
+/// What a run reports, as LCM messages.
+rilbed::poses_t to_lcm(TimeUs t_us, std::span<const run::PoseReport> poses);
+/// The same into `message`, reusing its storage (a publisher keeps one between steps).
+void fill(rilbed::poses_t& message, TimeUs t_us, std::span<const run::PoseReport> poses);
+rilbed::event_t to_lcm(const run::RunEvent& event);
+rilbed::status_t to_lcm(const run::StatusReport& status);
+rilbed::world_t to_lcm(TimeUs t_us, const run::WorldReport& world);
+rilbed::summary_t to_lcm(TimeUs t_us, const nlohmann::json& summary);
+void fill(rilbed::wheels_t& message, TimeUs t_us, std::span<const run::WheelReport> wheels);
+void fill(rilbed::sensors_t& message, TimeUs t_us, std::span<const run::SensorReport> sensors);
+/// One robot's readings (counts beyond the wire's int8/int16 are cut; a robot carries a
+/// handful of each sensor).
+void fill(rilbed::robot_sensors_t& message, int id, const environment::SensorReadings& readings);
+/// The readings back, taken at `t_us` (a proximity array of another length than 8 is left out).
+environment::SensorReadings from_lcm(const rilbed::robot_sensors_t& message, TimeUs t_us);
+rilbed::detections_t to_lcm(const run::FrameReport& frame);
+/// A camera frame as JPEG of `quality` (1..100); an empty image gives size 0.
+rilbed::frame_t to_lcm(TimeUs t_us, std::int64_t frame, const cv::Mat& image, int quality);
+/// The camera's mapping onto the field.
+rilbed::camera_t to_lcm(TimeUs t_us, const run::CameraReport& camera);
+/// The camera's vision settings, and back (unchecked: see vision::check_vision_settings).
+rilbed::vision_settings_t to_lcm(TimeUs t_us, const vision::VisionSettings& settings);
+vision::VisionSettings from_lcm(const rilbed::vision_settings_t& message);
+/// A world and a status message back as the run reported them.
+run::WorldReport from_lcm(const rilbed::world_t& message);
+run::StatusReport from_lcm(const rilbed::status_t& message);
+/// The robots' sensor geometry (from a world's sensor_geometries and sensor_geometry_of).
+rilbed::sensor_layout_t sensor_layout(TimeUs t_us, const run::WorldReport& world);
+
+}  // namespace rilbed::bus
