@@ -53,6 +53,7 @@ GuiService::~GuiService() {
     std::lock_guard lock(mutex_);
     for (auto& [id, hold] : holds_) hold.ending = true;
     stopping_ = true;
+    wake_pending_ = true;
   }
   wake_.notify_all();
   thread_.join();  // sends the last stops
@@ -99,7 +100,7 @@ std::optional<std::string> GuiService::on_client_message(const std::string& clie
   std::lock_guard lock(mutex_);
   if (requests_.size() >= kMaxQueuedCommands) return std::string("too many console commands waiting");
   requests_.push_back(std::move(request));
-  wake_.notify_all();
+  wake_locked();
   return std::nullopt;
 }
 
@@ -112,12 +113,13 @@ std::optional<std::string> GuiService::on_drive_message(const std::string& clien
   if (id < 0 || id > 1'000'000) return "'" + j["id"].dump() + "' is not a robot ID";
   const int robot = static_cast<int>(id);
   std::lock_guard lock(mutex_);
+  ++counts_.drive_messages;
   if (j.value("release", false)) {
     const auto it = holds_.find(robot);
     if (it == holds_.end() || it->second.client != client || it->second.ending)
       return "robot " + std::to_string(robot) + " is not yours to release";
     it->second.ending = true;
-    wake_.notify_all();
+    wake_locked();
     return std::nullopt;
   }
   if (!j.contains("left") || !j.contains("right") || !j["left"].is_number_integer() ||
@@ -146,8 +148,8 @@ std::optional<std::string> GuiService::on_drive_message(const std::string& clien
   const bool changed = hold.left != left || hold.right != right;
   hold.left = static_cast<int>(left);
   hold.right = static_cast<int>(right);
-  hold.last_key = Clock::now();
-  if (changed || !hold.sent) wake_.notify_all();
+  hold.last_key = now();
+  if (changed || !hold.sent) wake_locked();
   return std::nullopt;
 }
 
@@ -176,7 +178,7 @@ void GuiService::on_set_parameters(const std::string& client, const std::vector<
     return;
   }
   requests_.push_back(std::move(request));
-  wake_.notify_all();
+  wake_locked();
 }
 
 void GuiService::answer(const ConsoleRequest& request, const ConsoleAnswer& answer) {
@@ -203,7 +205,7 @@ void GuiService::on_client_gone(const std::string& client) {
   for (auto& [id, hold] : holds_) {
     if (hold.client == client) any = hold.ending = true;
   }
-  if (any) wake_.notify_all();
+  if (any) wake_locked();
 }
 
 // ------------------------------------------------------------------ to the run
@@ -211,9 +213,18 @@ void GuiService::on_client_gone(const std::string& client) {
 void GuiService::loop() {
   std::unique_lock lock(mutex_);
   for (;;) {
-    wake_.wait_for(lock, std::chrono::milliseconds(drive_.tick_ms));
+    const auto woken = [this] { return wake_pending_; };
+    if (drive_.clock) {
+      wake_.wait(lock, woken);  // a clock of its own: no tick by the wall's
+    } else {
+      wake_.wait_for(lock, std::chrono::milliseconds(drive_.tick_ms), woken);
+    }
+    wake_pending_ = false;
     // Driving first: a stop must not wait behind console commands.
+    const std::uint64_t asked = ticks_asked_;
     drive_tick(lock);
+    ticks_done_ = std::max(ticks_done_, asked);
+    ticked_.notify_all();
     if (stopping_ && holds_.empty()) return;
     while (!requests_.empty() && !stopping_) {
       ConsoleRequest request = std::move(requests_.front());
@@ -227,8 +238,15 @@ void GuiService::loop() {
   }
 }
 
+void GuiService::tick() {
+  std::unique_lock lock(mutex_);
+  const std::uint64_t wanted = ++ticks_asked_;
+  wake_locked();
+  ticked_.wait(lock, [&] { return ticks_done_ >= wanted || stopping_; });
+}
+
 void GuiService::drive_tick(std::unique_lock<std::mutex>& lock) {
-  const auto now = Clock::now();
+  const auto now = this->now();
   const double hold_s = drive_.hold_wall_s * std::max(1.0, rt_factor_);
   // A third: a renewal may come a whole third late (a busy machine) before the hold lapses.
   const auto renew_after = std::chrono::duration<double>(drive_.hold_wall_s / 3);

@@ -75,6 +75,10 @@ struct ManualDriveConfig {
   /// service itself dies. Shorter costs more commands (and a robot that stutters on a
   /// late renewal).
   double hold_wall_s = 0.6;
+  /// The switch's time: steady_clock's when empty. With a clock of its own (a test's) the
+  /// service does not tick by itself: it looks at the drivers when a key message changes
+  /// the speeds, a driver lets go or goes, and when tick() asks. Must be thread-safe.
+  std::function<std::chrono::steady_clock::time_point()> clock;
 };
 
 /// Camera frames at most this often to the viewers (the limit: 10 per second).
@@ -85,6 +89,7 @@ struct GuiCounters {
   std::uint64_t console_commands = 0;  ///< console commands handed to the sink
   std::uint64_t drive_commands = 0;    ///< drive commands (holds, renewals, stops) handed to the sink
   std::uint64_t drive_stops = 0;       ///< holds ended with a stop
+  std::uint64_t drive_messages = 0;    ///< drive messages taken (keys held, releases)
 };
 
 /// The panel's service. Its RunObserver side must be called from one thread.
@@ -96,6 +101,11 @@ class GuiService final : public run::RunObserver {
   ~GuiService() override;
   GuiService(const GuiService&) = delete;
   GuiService& operator=(const GuiService&) = delete;
+
+  /// Looks at the drivers now, on the service's thread, and returns once it has: the holds
+  /// renewed, lapsed keys turned into stops, released robots given back. The service does
+  /// so every tick_ms by itself; a test with a clock of its own calls it.
+  void tick();
 
   /// The page's address with its token, for the terminal.
   std::string url() const;
@@ -142,6 +152,13 @@ class GuiService final : public run::RunObserver {
   void answer(const ConsoleRequest& request, const ConsoleAnswer& answer);
   void loop();
   void drive_tick(std::unique_lock<std::mutex>& lock);
+  Clock::time_point now() const { return drive_.clock ? drive_.clock() : Clock::now(); }
+  // Wakes the service's loop (the caller holds mutex_): a wake-up is never lost while the
+  // loop is busy, since it looks at wake_pending_ before it sleeps.
+  void wake_locked() {
+    wake_pending_ = true;
+    wake_.notify_all();
+  }
 
   WebServerConfig config_;
   ConsoleSink sink_;
@@ -151,6 +168,10 @@ class GuiService final : public run::RunObserver {
 
   mutable std::mutex mutex_;
   std::condition_variable wake_;
+  bool wake_pending_ = false;       // something for the loop since it last looked (wake_locked)
+  std::condition_variable ticked_;  // a tick() asked for has been made
+  std::uint64_t ticks_asked_ = 0;   // by tick()
+  std::uint64_t ticks_done_ = 0;
   std::deque<ConsoleRequest> requests_;
   std::map<int, Hold> holds_;  // by robot ID
   double rt_factor_ = 1.0;

@@ -132,6 +132,8 @@ struct KheperaEmulator::State {
   explicit State(EmulatorConfig c) : config(std::move(c)), faults(config.faults), rng(config.seed) {}
 
   const EmulatorConfig config;
+  // The emulated robot's time: the config's clock, or the wall's.
+  Clock::time_point now() const { return config.clock ? config.clock() : Clock::now(); }
 
   // Everything below is guarded by `mutex`. The pty is changed only by the serving thread
   // (and the constructor and destructor, while that thread does not run), always under
@@ -144,7 +146,7 @@ struct KheperaEmulator::State {
   double left_counter_pulses = 0.0;
   double right_counter_pulses = 0.0;
   WheelSpeeds speeds;
-  Clock::time_point integrated_until = Clock::now();
+  Clock::time_point integrated_until = now();
   environment::ProximityValues proximity{};
   environment::ProximityValues ambient{};
   std::array<std::uint64_t, kCommandKindCount> received{};
@@ -153,7 +155,7 @@ struct KheperaEmulator::State {
   // Faults.
   EmulatorFaults faults;
   std::mt19937_64 rng;
-  const Clock::time_point started = Clock::now();
+  const Clock::time_point started = now();
   bool timed_disconnect_done = false;
   std::optional<Clock::time_point> replug_at;
 
@@ -377,7 +379,7 @@ void KheperaEmulator::serve() {
     {
       std::unique_lock lock(s.mutex);
       if (s.quit) return;
-      const Clock::time_point now = Clock::now();
+      const Clock::time_point now = s.now();
       if (s.request != State::Request::kNone) {
         try {
           if (s.request == State::Request::kUnplug) {
@@ -438,13 +440,13 @@ void KheperaEmulator::serve() {
         lines.clear();
         std::lock_guard lock(s.mutex);
         s.assembler.feed(std::string_view(buffer.data(), static_cast<std::size_t>(n)), lines);
-        const Clock::time_point now = Clock::now();
+        const Clock::time_point now = s.now();
         for (const std::string& line : lines) s.handle_line_locked(line, now);
       } else if (n < 0 && errno != EAGAIN && errno != EINTR) {
         // We hold the slave open, so this should not happen; if it does, the pty is
         // unusable: behave as unplugged rather than spin on the error.
         std::lock_guard lock(s.mutex);
-        s.unplug_locked(Clock::now());
+        s.unplug_locked(s.now());
       } else if (n == 0) {
         std::this_thread::sleep_for(std::chrono::milliseconds(1));  // no spinning on a hang-up
       }
@@ -464,13 +466,13 @@ std::string KheperaEmulator::slave_path() const {
 
 Pose2 KheperaEmulator::true_pose() const {
   std::lock_guard lock(state_->mutex);
-  state_->integrate_locked(Clock::now());
+  state_->integrate_locked(state_->now());
   return state_->pose;
 }
 
 environment::OdometryReading KheperaEmulator::counters() const {
   std::lock_guard lock(state_->mutex);
-  state_->integrate_locked(Clock::now());
+  state_->integrate_locked(state_->now());
   return {std::llround(state_->left_counter_pulses), std::llround(state_->right_counter_pulses)};
 }
 
@@ -496,7 +498,7 @@ void KheperaEmulator::set_proximity(const environment::ProximityValues& values) 
 
 void KheperaEmulator::place(const Pose2& pose) {
   std::lock_guard lock(state_->mutex);
-  state_->integrate_locked(Clock::now());
+  state_->integrate_locked(state_->now());
   state_->pose = pose;
 }
 

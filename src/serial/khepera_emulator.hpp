@@ -15,7 +15,9 @@
 // terminal) and recreates it on replug.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <thread>
@@ -78,6 +80,11 @@ struct EmulatorConfig {
   /// If not empty: a symlink kept pointing to the current slave device (see the file
   /// comment). An existing file or symlink there is replaced.
   std::string stable_path;
+  /// The time the emulated robot lives in (its motion, reply delays, timed unplugs): the
+  /// wall's (steady_clock) when empty. A test's own clock makes the motion exact; the
+  /// serving thread sees a new time when it next wakes (a byte from the port, a request).
+  /// Called from any of the emulator's threads: it must be thread-safe.
+  std::function<std::chrono::steady_clock::time_point()> clock;
 };
 
 /// One emulated robot on a pseudo-terminal, served by its own thread from construction

@@ -208,6 +208,7 @@ struct KheperaLink::Impl {
     reopen_timer.async_wait([this](const boost::system::error_code& ec) {
       if (ec || shutting_down || port_open) return;
       if (const auto failure = try_open()) {
+        count([](LinkCounters& c) { ++c.reopen_failures; });
         log(LogLevel::kDebug, "still cannot reopen: " + *failure);
         schedule_reopen();
         return;
@@ -594,6 +595,11 @@ void KheperaLink::set_speeds(int left_units, int right_units) {
     if (!m.started) return;  // sent once the port opens
   }
   m.kick();
+}
+
+std::optional<WheelSpeeds> KheperaLink::wished_speeds() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->wished;
 }
 
 std::optional<WheelSpeeds> KheperaLink::acknowledged_speeds() const {

@@ -107,6 +107,7 @@ struct LinkCounters {
   std::uint64_t overlong_lines = 0;   ///< lines dropped for length
   std::uint64_t port_losses = 0;      ///< times the port vanished
   std::uint64_t reopens = 0;          ///< times it was opened again after a loss
+  std::uint64_t reopen_failures = 0;  ///< attempts to open it again that failed (every reopen_interval_ms while lost)
 };
 
 /// A snapshot of the link's health.
@@ -160,6 +161,8 @@ class KheperaLink {
   void set_speeds(int left_units, int right_units);
   /// The speeds the robot last acknowledged, if any.
   std::optional<WheelSpeeds> acknowledged_speeds() const;
+  /// The speeds last wished (set_speeds, stop, halt), sent or not; nullopt before the first.
+  std::optional<WheelSpeeds> wished_speeds() const;
 
   /// Asks for a proximity reading (`N`) as soon as the line is free, unless one is
   /// already queued. latest_proximity() shows it when it arrives.

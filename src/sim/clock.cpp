@@ -102,7 +102,9 @@ WaitResult RealTimeClock::wait_until(TimeUs sim_t_us) {
       return WaitResult::kWoken;
     }
     if (paused_) {
+      ++waiters_;
       changed_.wait(lock);
+      --waiters_;
       continue;
     }
     const auto wall_now = WallClock::now();
@@ -117,8 +119,15 @@ WaitResult RealTimeClock::wait_until(TimeUs sim_t_us) {
         deadline = due;
       }
     }
+    ++waiters_;
     changed_.wait_until(lock, deadline);
+    --waiters_;
   }
+}
+
+int RealTimeClock::waiters() const {
+  std::lock_guard lock(mutex_);
+  return waiters_;
 }
 
 void RealTimeClock::notify() {

@@ -79,6 +79,9 @@ class RealTimeClock final : public Clock {
   void resume();
   /// True between pause() and resume().
   bool paused() const;
+  /// How many wait_until() calls are asleep in it now (a test, or a watchdog, knows so that
+  /// a wait has begun and not yet been woken).
+  int waiters() const;
 
   void start(TimeUs sim_t_us) override;
   WaitResult wait_until(TimeUs sim_t_us) override;
@@ -98,6 +101,7 @@ class RealTimeClock final : public Clock {
   WallClock::time_point anchor_wall_;  // wall time at which simulated time was anchor_sim_us_
   TimeUs anchor_sim_us_ = 0;
   bool paused_ = false;
+  int waiters_ = 0;  // wait_until() calls asleep now
   bool stopped_ = false;
   bool notified_ = false;
 };

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -16,29 +17,36 @@
 
 #include "gui_web/gui_service.hpp"
 #include "support/eventually.hpp"
+#include "support/manual_clock.hpp"
 #include "ws_test_client.hpp"
 
 namespace rilbed::gui_web {
 namespace {
 
 using rilbed::testing::eventually;
+using rilbed::testing::ManualClock;
+using namespace std::chrono_literals;
 
 using namespace rilbed::gui_web::testing;
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
-// Records what reaches the run, and answers as the run would.
+// Records what reaches the run, and when (by `clock`: the wall's, or a test's own), and
+// answers as the run would.
 struct RecordingSink {
   struct Call {
     ConsoleRequest request;
     Clock::time_point at;
   };
+  explicit RecordingSink(std::function<Clock::time_point()> clock = [] { return Clock::now(); })
+      : clock(std::move(clock)) {}
+  std::function<Clock::time_point()> clock;
   std::mutex mutex;
   std::vector<Call> calls;
   ConsoleSink sink() {
     return [this](const ConsoleRequest& r) {
       std::lock_guard lock(mutex);
-      calls.push_back({r, Clock::now()});
+      calls.push_back({r, clock()});
       if (r.command == "pause") return ConsoleAnswer{true, "pause"};
       if (r.command == "drive" && r.args.at(0) == "99") return ConsoleAnswer{false, "this run has no robot 99"};
       if (r.command == "drive") return ConsoleAnswer{true, "drive"};
@@ -119,8 +127,7 @@ TEST(GuiService, ConsoleCommandsReachTheRunAndTheirAnswersComeBack) {
   const std::uint32_t replies = channel_id(watcher.next_json(), "/rilbed/console_reply");
   ASSERT_NE(replies, 0u);
   watcher.send_text({{"op", "subscribe"}, {"subscriptions", {{{"id", 3}, {"channelId", replies}}}}});
-  ASSERT_TRUE(gui.flush(std::chrono::seconds(5)));
-  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the subscription is read after the flush's question
+  ASSERT_TRUE(eventually([&] { return gui.server().subscribed(replies); }));
 
   PanelClient panel(gui.server().port());
   panel.publish(1, {{"command", "pause"}, {"args", json::array()}});
@@ -143,47 +150,52 @@ TEST(GuiService, ConsoleCommandsReachTheRunAndTheirAnswersComeBack) {
 }
 
 TEST(GuiService, ARobotDrivenByHandStopsWhenTheKeysStopComing) {
-  RecordingSink run;
-  ManualDriveConfig timing;  // the defaults: 300 ms
+  // On a clock of the test's own: the switch's timing is exact, whatever the machine does.
+  ManualClock clock;
+  RecordingSink run(clock.function());
+  ManualDriveConfig timing;  // the defaults: keys lapse after 300 ms; holds of 0.6 s, renewed after 0.2 s
+  timing.clock = clock.function();
   GuiService gui(config(), run.sink(), timing);
   PanelClient panel(gui.server().port());
-  // Keys held for about half a second, a message every 100 ms.
-  const auto keys_from = Clock::now();
-  for (int i = 0; i < 5; ++i) {
+  const auto keys_from = clock.now();
+  panel.drive(4, 30, 30);
+  // The first key sends the hold at once.
+  ASSERT_TRUE(eventually([&] { return !run.drives(4).empty(); }));
+  EXPECT_EQ(run.snapshot().front().request.args, (std::vector<std::string>{"4", "30", "30", "0.6"}));
+  EXPECT_EQ(run.snapshot().front().at, keys_from);
+  // Keys held for 400 ms, a message every 100 ms.
+  for (unsigned i = 1; i <= 4; ++i) {
+    clock.advance(100ms);
     panel.drive(4, 30, 30);
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    ASSERT_TRUE(eventually([&] { return gui.counters().drive_messages == i + 1; }));
   }
-  const auto keys_until = Clock::now();
-  ASSERT_TRUE(eventually([&] {
-    const auto d = run.drives(4);
-    return !d.empty() && d.back() == "0 0";
-  }));
-  const auto calls = run.snapshot();
-  ASSERT_FALSE(calls.empty());
-  EXPECT_EQ(calls.front().request.args, (std::vector<std::string>{"4", "30", "30", "0.6"}));
-  EXPECT_LT(calls.front().at - keys_from, std::chrono::milliseconds(500));  // at once, not at a tick
-  // The stop came after the keys' timeout, as one of the holds (not a release).
-  Clock::time_point stopped_at{};
-  for (const auto& c : calls) {
-    if (c.request.args.at(1) == "0") {
-      stopped_at = c.at;
-      break;
-    }
-  }
-  EXPECT_GE(stopped_at - keys_until, std::chrono::milliseconds(200));
-  EXPECT_EQ(gui.counters().drive_stops, 0u);
+  const auto keys_until = clock.now();
+  // Up to the keys' timeout the robot drives on (its hold renewed); a moment past it, it stops.
+  clock.advance(300ms);
+  gui.tick();
+  EXPECT_EQ(run.drives(4).back(), "30 30");
+  clock.advance(1ms);
+  gui.tick();
+  EXPECT_EQ(run.drives(4).back(), "0 0");
+  EXPECT_EQ(run.snapshot().back().at - keys_until, 301ms);
+  EXPECT_EQ(gui.counters().drive_stops, 0u);  // a hold of speed 0, not a release
   // Still held: the hold is renewed standing until it is released.
   const std::size_t before = run.drives(4).size();
-  ASSERT_TRUE(eventually([&] { return run.drives(4).size() >= before + 2; }));
+  for (int i = 0; i < 2; ++i) {
+    clock.advance(200ms);
+    gui.tick();
+  }
+  EXPECT_EQ(run.drives(4).size(), before + 2);
   for (const std::string& d : run.drives(4)) {
     EXPECT_TRUE(d == "30 30" || d == "0 0") << d;
   }
   EXPECT_EQ(run.drives(4).back(), "0 0");
   panel.publish(2, {{"id", 4}, {"release", true}});
   ASSERT_TRUE(eventually([&] { return gui.counters().drive_stops == 1u; }));
-  // Given back: nothing more is sent for it.
+  // Given back: nothing more is sent for it, however long the service looks.
   const std::size_t released = run.drives(4).size();
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  clock.advance(10s);
+  gui.tick();
   EXPECT_EQ(run.drives(4).size(), released);
   EXPECT_EQ(run.drives(4).back(), "0 0");
 }
@@ -243,13 +255,18 @@ TEST(GuiService, AnotherClientTakesTheRobotOverAndTheFirstIsToldSo) {
 }
 
 TEST(GuiService, TheRunsRefusalOfADriveIsToldToTheDriverOnce) {
-  RecordingSink run;
-  GuiService gui(config(), run.sink());
+  ManualClock clock;
+  RecordingSink run(clock.function());
+  ManualDriveConfig timing;
+  timing.clock = clock.function();
+  GuiService gui(config(), run.sink(), timing);
   PanelClient panel(gui.server().port());
   panel.hear_replies();
-  for (int i = 0; i < 6; ++i) {
+  for (unsigned i = 0; i < 6; ++i) {
     panel.drive(99, 10, 10);
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    ASSERT_TRUE(eventually([&] { return gui.counters().drive_messages == i + 1; }));
+    clock.advance(100ms);
+    gui.tick();
   }
   // Refused holds keep reaching the run (which may change its mind: a paused run resumes)...
   ASSERT_TRUE(eventually([&] { return run.drives(99).size() >= 3; }));

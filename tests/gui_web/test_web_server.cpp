@@ -24,6 +24,7 @@
 
 #include "agents/builtin_controllers.hpp"
 #include "gui_web/web_server.hpp"
+#include "support/eventually.hpp"
 #include "ws_test_client.hpp"
 
 namespace rilbed::gui_web {
@@ -31,6 +32,7 @@ namespace {
 
 using namespace rilbed::gui_web::testing;
 using nlohmann::json;
+using rilbed::testing::eventually;
 namespace asio = boost::asio;
 
 foxglove::Channel poses_channel() {
@@ -172,11 +174,8 @@ TEST(WebServer, GreetsSubscribesAndSendsData) {
   EXPECT_EQ(adv["channels"][0]["topic"], "/rilbed/poses");
   // Subscription id 0 is the client's first.
   client.send_text({{"op", "subscribe"}, {"subscriptions", {{{"id", 0}, {"channelId", poses}}}}});
-  for (int i = 0; i < 200 && server.counters().messages_sent == 0; ++i) {
-    server.publish(poses, 1'000'000'000ULL + i,
-                   std::make_shared<const std::string>(R"({"n":)" + std::to_string(i) + "}"));
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
+  ASSERT_TRUE(eventually([&] { return server.subscribed(poses); }));
+  server.publish(poses, 1'000'000'000ULL, std::make_shared<const std::string>(R"({"n":0})"));
   const auto data = std::get<std::string>(client.next());
   ASSERT_GE(data.size(), 13u);
   EXPECT_EQ(static_cast<unsigned char>(data[0]), 0x01);
@@ -301,8 +300,7 @@ TEST(WebServer, ClientMessagesReachTheOwnerAndBadOnesGetAStatus) {
       EXPECT_EQ(big.ws.reason().code, websocket::close_code::too_big);
     }
   }
-  for (int i = 0; i < 200 && strict.clients() > 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  EXPECT_EQ(strict.clients(), 0u);  // its socket closed
+  EXPECT_TRUE(eventually([&] { return strict.clients() == 0; }));  // its socket closed
   Client after;
   EXPECT_EQ(after.connect(strict.port(), "/ws?token=" + kToken), 101);
 }
@@ -320,8 +318,7 @@ TEST(WebServer, FiftyClientsAndOneThatNeverReadsHoldsUpNobody) {
     clients.back()->next_json();
     clients.back()->send_text({{"op", "subscribe"}, {"subscriptions", {{{"id", 5}, {"channelId", channel}}}}});
   }
-  for (int i = 0; i < 200 && server.clients() < 50; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  EXPECT_EQ(server.clients(), 50u);
+  ASSERT_TRUE(eventually([&] { return server.clients() == 50u; }));
   // Client 0 never reads again; the others read as they go. 2,000 messages of 16 kB: 32 MB
   // for each client, far beyond what the stalled one's socket and queue hold.
   const std::string blob(16 * 1024, 'x');
@@ -340,13 +337,12 @@ TEST(WebServer, FiftyClientsAndOneThatNeverReadsHoldsUpNobody) {
     });
   }
   // Wait until every subscription is in (a message reaches each reader).
-  for (int i = 0; i < 500; ++i) {
+  ASSERT_TRUE(eventually([&] {
     server.publish(channel, 1, std::make_shared<const std::string>("{}"));
     bool all = true;
     for (int k = 1; k < 50; ++k) all = all && got[k] > 0;
-    if (all) break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+    return all;
+  }));
   const auto payload = std::make_shared<const std::string>(blob);
   const auto start = std::chrono::steady_clock::now();
   for (int i = 0; i < 2000; ++i) server.publish(channel, 2, payload);
@@ -355,13 +351,12 @@ TEST(WebServer, FiftyClientsAndOneThatNeverReadsHoldsUpNobody) {
   const auto last = std::make_shared<const std::string>("{\"last\":true}");
   std::vector<int> before(50);
   for (int k = 1; k < 50; ++k) before[k] = got[k];
-  for (int i = 0; i < 3000; ++i) {
+  eventually([&] {
     server.publish(channel, 3, last);
     bool all = true;
     for (int k = 1; k < 50; ++k) all = all && got[k] > before[k];
-    if (all) break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+    return all;
+  });
   for (int k = 1; k < 50; ++k) EXPECT_GT(got[k].load(), before[k]) << "client " << k;
   stop = true;
   for (int k = 1; k < 50; ++k) {

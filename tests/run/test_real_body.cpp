@@ -172,7 +172,9 @@ TEST_F(RealBodyTest, ARobotLostByTheCameraIsStoppedAndResumesWhenSeenAgain) {
   world_.step(200'000);
   body_->drive({-20, 20});
   EXPECT_EQ(body_->health(), "unseen");
-  std::this_thread::sleep_for(50ms);
+  // The drive became a stop at once: that is what the link was asked to send.
+  EXPECT_EQ(body_->link().wished_speeds(), (serial::WheelSpeeds{0, 0}));
+  ASSERT_TRUE(eventually([&] { return body_->link().acknowledged_speeds() == serial::WheelSpeeds{0, 0}; }));
   EXPECT_EQ(emulator_->last_speeds(), (serial::WheelSpeeds{0, 0}));
 
   // Seen again: driving resumes.

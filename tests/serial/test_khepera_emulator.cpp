@@ -16,6 +16,7 @@
 
 #include "serial/khepera_emulator.hpp"
 #include "support/eventually.hpp"
+#include "support/manual_clock.hpp"
 
 using namespace rilbed::serial;
 using namespace std::chrono_literals;
@@ -25,6 +26,7 @@ namespace fs = std::filesystem;
 namespace {
 
 using rilbed::testing::eventually;
+using rilbed::testing::ManualClock;
 
 // A client end of the emulator's pty, in raw mode, closed on destruction.
 class RawClient {
@@ -111,33 +113,36 @@ TEST(KheperaEmulator, AnswersAsTheFirmwareDoes) {
 }
 
 TEST(KheperaEmulator, DrivesExactArcsAndCountsPulses) {
+  // On a clock of the test's own: 200 ms of driving is 200 ms, whatever the machine does.
+  ManualClock clock;
   EmulatorConfig config;
   config.initial_pose = Pose2{{0.5, 0.25}, 0.0};
+  config.clock = clock.function();
   KheperaEmulator emulator(config);
   RawClient robot(emulator.device_path());
   ASSERT_TRUE(robot.ok());
   EXPECT_EQ(robot.ask("D,20,20\r"), "d\r\n");
   EXPECT_EQ(emulator.last_speeds(), (WheelSpeeds{20, 20}));
-  std::this_thread::sleep_for(200ms);
+  clock.advance(200ms);
   EXPECT_EQ(robot.ask("D,0,0\r"), "d\r\n");
   const Pose2 straight = emulator.true_pose();
   const auto counters = emulator.counters();
-  // Straight ahead along +x, as far as the counters say (1 pulse = 0.08 mm); about
-  // 0.16 m/s * 0.2 s, bounded generously.
+  // Straight ahead along +x: 20 units of 8 mm/s for 0.2 s, as far as the counters say
+  // (1 pulse = 0.08 mm).
   EXPECT_EQ(counters.left_pulses, counters.right_pulses);
+  EXPECT_NEAR(straight.position_m.x - 0.5, 20 * 0.008 * 0.2, 1e-9);
   EXPECT_NEAR(straight.position_m.x - 0.5, counters.left_pulses * 0.08e-3, 0.1e-3);
-  EXPECT_GT(straight.position_m.x - 0.5, 0.02);
   EXPECT_NEAR(straight.position_m.y, 0.25, 1e-9);
   EXPECT_NEAR(straight.heading_rad, 0.0, 1e-9);
   // Stopped means stopped.
-  std::this_thread::sleep_for(50ms);
+  clock.advance(50ms);
   EXPECT_NEAR(emulator.true_pose().position_m.x, straight.position_m.x, 1e-12);
 
   // Spinning in place: the heading turns by (right - left travel) / wheel base; the
   // centre stays put.
   EXPECT_EQ(robot.ask("G,0,0\r"), "g\r\n");
   EXPECT_EQ(robot.ask("D,-10,10\r"), "d\r\n");
-  std::this_thread::sleep_for(150ms);
+  clock.advance(150ms);
   EXPECT_EQ(robot.ask("D,0,0\r"), "d\r\n");
   const Pose2 spun = emulator.true_pose();
   const auto turned = emulator.counters();
@@ -145,6 +150,7 @@ TEST(KheperaEmulator, DrivesExactArcsAndCountsPulses) {
   EXPECT_GT(turned.right_pulses, 0);
   const double expected_turn = (turned.right_pulses - turned.left_pulses) * 0.08e-3 / 0.053;
   EXPECT_NEAR(spun.heading_rad, expected_turn, 2 * 0.08e-3 / 0.053);  // counters are rounded to pulses
+  EXPECT_NEAR(spun.heading_rad, 2 * 10 * 0.008 * 0.15 / 0.053, 1e-9);
   EXPECT_NEAR(spun.position_m.x, straight.position_m.x, 1e-9);
   EXPECT_NEAR(spun.position_m.y, straight.position_m.y, 1e-9);
   EXPECT_EQ(robot.ask("E\r"), "e,0,0\r\n");

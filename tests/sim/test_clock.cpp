@@ -8,11 +8,13 @@
 #include <thread>
 
 #include "sim/clock.hpp"
+#include "support/eventually.hpp"
 
 using namespace rilbed::sim;
 using rilbed::TimeUs;
 using namespace std::chrono_literals;
 using WallClock = std::chrono::steady_clock;
+using rilbed::testing::eventually;
 
 TEST(FastClock, JumpsToEachDeadline) {
   FastClock clock;
@@ -76,8 +78,8 @@ TEST(RealTimeClock, SetFactorWhileWaitingTakesEffect) {
   const auto wall_start = WallClock::now();
   // 20 s of simulated time at factor 1 would take 20 s.
   auto waiting = std::async(std::launch::async, [&] { return clock.wait_until(20'000'000); });
-  std::this_thread::sleep_for(20ms);
-  clock.set_factor(1000.0);  // the rest takes about 20 ms
+  ASSERT_TRUE(eventually([&] { return clock.waiters() == 1; }));  // asleep in its wait
+  clock.set_factor(1000.0);                                       // the rest takes about 20 ms
   EXPECT_EQ(waiting.get(), WaitResult::kReached);
   EXPECT_LT(WallClock::now() - wall_start, 10s);
   EXPECT_GE(clock.now_us(), 20'000'000);
@@ -112,7 +114,9 @@ TEST(RealTimeClock, PauseFreezesTimeAndWaits) {
     done.store(true);
     return result;
   });
-  std::this_thread::sleep_for(50ms);
+  // Asleep in its wait although its deadline (1 us of wall time) has long passed: the
+  // pause holds it.
+  ASSERT_TRUE(eventually([&] { return clock.waiters() == 1; }));
   EXPECT_FALSE(done.load());
   EXPECT_EQ(clock.now_us(), frozen_us);
   clock.resume();
@@ -126,7 +130,7 @@ TEST(RealTimeClock, NotifyWakesAWaitEarly) {
   clock.start(0);
   const auto wall_start = WallClock::now();
   auto waiting = std::async(std::launch::async, [&] { return clock.wait_until(100'000'000); });
-  std::this_thread::sleep_for(20ms);
+  ASSERT_TRUE(eventually([&] { return clock.waiters() == 1; }));  // woken, not told before it waited
   clock.notify();
   EXPECT_EQ(waiting.get(), WaitResult::kWoken);
   EXPECT_LT(WallClock::now() - wall_start, 10s);
@@ -147,7 +151,7 @@ TEST(RealTimeClock, StopEndsEveryWait) {
   clock.start(0);
   auto first = std::async(std::launch::async, [&] { return clock.wait_until(kInfinity); });
   auto second = std::async(std::launch::async, [&] { return clock.wait_until(50'000'000); });
-  std::this_thread::sleep_for(20ms);
+  ASSERT_TRUE(eventually([&] { return clock.waiters() == 2; }));  // both asleep
   clock.stop();
   EXPECT_EQ(first.get(), WaitResult::kStopped);
   EXPECT_EQ(second.get(), WaitResult::kStopped);

@@ -348,7 +348,9 @@ TEST(Coordinator, InjectFromAnotherThreadWakesARealTimeRun) {
   // Once the starter has fired the run has begun and nothing is scheduled: the
   // coordinator sleeps until the injection wakes it.
   ASSERT_TRUE(eventually([&] { return last_step_us.load() == 10 * kMs; }));
-  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  // Asleep in the clock, and well after the last step (so that the delivery's time tells
+  // the clock's from the last step's).
+  ASSERT_TRUE(eventually([&] { return clock.waiters() == 1 && clock.now_us() >= 30 * kMs; }));
   const TimeUs injected_at_least_us = clock.now_us();
   coordinator.inject(command, 42);
   const bool arrived = eventually([&] { return delivered.load() == 1; });
@@ -371,7 +373,7 @@ TEST(Coordinator, StopEndsAnEndlessRealTimeRun) {
   Coordinator coordinator(sink, clock);
   const auto wall_start = std::chrono::steady_clock::now();
   std::thread runner([&] { coordinator.run_until(kInfinity); });
-  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_TRUE(eventually([&] { return clock.waiters() == 1; }));  // the run sleeps in its clock
   coordinator.stop();
   runner.join();
   EXPECT_LT(std::chrono::steady_clock::now() - wall_start, std::chrono::seconds(2));
