@@ -1,4 +1,4 @@
-// rilbed web panel benchmark (issue 17): what viewers of a run cost it and what they get.
+// rilbed web panel benchmark: what viewers of a run cost it and what they get.
 //
 // A real-time run (factor 1) of N wandering Kheperas (sim-bench's scenario, 100 by default)
 // is published as `rilbed run --gui` publishes it: on the in-process LCM bus, the panel's
@@ -278,7 +278,7 @@ int main(int argc, char** argv) {
                 percentile(m.latency_ms, 0.99), max_of(m.latency_ms), m.latency_ms.size(),
                 percentile(m.cpu_per_wall, 0.5));
   }
-  // The issue's goal: 10 viewers within 5 % of none.
+  // The goal: 10 viewers cost the run within 5 % of none.
   if (measured.contains(0) && measured.contains(10)) {
     const Measured& none = measured[0];
     const Measured& ten = measured[10];

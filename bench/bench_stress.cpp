@@ -1,4 +1,4 @@
-// rilbed on the vision stress set (issue 14): thousands of frames whose every condition is
+// rilbed on the vision stress set: thousands of frames whose every condition is
 // drawn at random from ranges wider than any one lab's (src/vision/stress_scene.hpp), scored
 // full-frame and tracked: recall by marker size, blur, occlusion and floor; wrong IDs, false
 // detections, headings far off; centre and heading accuracy; a bias by code. Then the speed
@@ -306,7 +306,7 @@ int main(int argc, char** argv) {
   print_bucket_rows("tracked", tracked.outcomes(), floors);
 
   // ------------------------------------------------------------ targets
-  std::printf("\n## Issue 14's targets\n\n| target | full-frame | tracked |\n| --- | ---: | ---: |\n");
+  std::printf("\n## The stress set's targets\n\n| target | full-frame | tracked |\n| --- | ---: | ---: |\n");
   auto target_row = [&](const char* name, const std::function<std::string(const rv::StressTally&)>& value) {
     std::printf("| %s | %s | %s |\n", name, value(full).c_str(), value(tracked).c_str());
   };

@@ -3,7 +3,7 @@
 //
 // Prints Markdown: the machine, how it measured, Table 1 (speed and recall with 8 and
 // 64 markers of equal printed size), Table 2 (rilbed's centre and heading accuracy by
-// marker size) and the targets of the issue beside the measurements (printed, never
+// marker size) and the targets beside the measurements (printed, never
 // asserted: this is a report, not a test).
 //
 // Everything measured runs single-threaded: OpenCV with setNumThreads(0) and OpenCL
@@ -849,7 +849,7 @@ int main(int argc, char** argv) {
   std::printf("\n");
 
   // ---------------------------------------------------------------- targets
-  std::printf("## Targets from the issue (printed, not asserted)\n\n");
+  std::printf("## Targets (printed, not asserted)\n\n");
   std::printf(
       "Speed ratios are given on wall-time and on CPU-time medians; the verdict uses CPU time, which other "
       "processes on a shared machine do not inflate (long calls are preempted more often than short ones, which "

@@ -38,7 +38,7 @@ fi
 export GLIBC_TUNABLES=glibc.malloc.mmap_threshold=67108864:glibc.malloc.trim_threshold=268435456
 "$BUILD_DIR/bench_vision" "$@"
 
-# The vision stress set (issue 14): 500 random scenes (2,000 frames) from a fresh seed,
+# The vision stress set: 500 random scenes (2,000 frames) from a fresh seed,
 # full-frame and tracked, and the search's cost on plain and textured floors beside
 # AprilTag and ArUco. Its seed is printed; pass it back to see the same frames.
 echo
@@ -61,7 +61,7 @@ for mode in distributed central; do
   echo "  (whole command: $(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.1f", b - a }') s)"
 done
 
-# Agents in other processes (issue 18): time per lock-step quantum over the paper's grid,
+# Agents in other processes: time per lock-step quantum over the paper's grid,
 # on loopback multicast inside a private network namespace (nothing leaves the machine),
 # then again with 10 % of the packets dropped by nftables (quanta on 7667, answers on 7668).
 echo

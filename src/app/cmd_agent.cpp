@@ -1,7 +1,7 @@
 // `rilbed agent --scenario FILE --ids 3,4 --lcm URL`: runs those robots' controllers in this
-// process, for whichever run of that scenario on the bus lists them as remote (issue 18).
-// The controllers are built from the scenario exactly as `rilbed run` builds them, afresh
-// for each run; the run sends their inputs each control step and applies their answers.
+// process, for whichever run of that scenario on the bus lists them as remote (processes of their own, here or on other
+// machines). The controllers are built from the scenario exactly as `rilbed run` builds them, afresh for each run; the
+// run sends their inputs each control step and applies their answers.
 #include <signal.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>

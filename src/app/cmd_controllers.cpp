@@ -14,8 +14,8 @@ void add_controllers_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "controllers", "List the controllers a scenario can name, with their parameters (units, defaults, ranges)");
   cmd->add_flag("--json", *json,
-                "Print JSON (a list of {name, summary, sensors, params: [{name, unit, default, min, max, summary}]}) "
-                "instead of tables");
+                "Print JSON instead of tables: a list of {name, summary, sensors, required_sensors, wants_team, "
+                "concurrent, origin, params: [{name, unit, default, min, max, summary, required, integer}]}");
   cmd->callback([json] {
     const auto registry = agents::default_controllers();
     if (*json) {

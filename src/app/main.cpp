@@ -1,4 +1,4 @@
-// rilbed: the command line. Thin subcommands over the modules; see README.md.
+// rilbed: the command line. Thin subcommands over the modules; see docs/ for the manual.
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 #include <opencv2/core/utils/logger.hpp>
@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     // CLI11 prints the reason (or the help, exit 0); a bad option is exit 2 whatever
-    // CLI11's own code for it (105 for a file that does not exist), as README promises.
+    // CLI11's own code for it (105 for a file that does not exist), as docs/README.md promises.
     const int code = app.exit(e);
     return code == 0 ? 0 : rilbed::app::kExitUsage;
   } catch (const std::exception& e) {

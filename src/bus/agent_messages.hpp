@@ -1,4 +1,4 @@
-// The agent exchange's messages (issue 18) to and from rilbed's own types: a controller's
+// The agent exchange's messages to and from rilbed's own types: a controller's
 // input (sensors, pose, the team broadcast) and its output, exact to the bit, so that a
 // controller stepped in another process decides exactly as it would in the run's.
 #pragma once

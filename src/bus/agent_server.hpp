@@ -1,4 +1,4 @@
-// The agent process's side of the agent exchange over LCM (issue 18; `rilbed agent`):
+// The agent process's side of the agent exchange over LCM (`rilbed agent`):
 // it runs some robots' controllers for whichever run sends it quanta. See remote_agents.hpp
 // for the protocol. A controller here is the same code as in the run's process; only
 // where it runs differs.

@@ -57,7 +57,7 @@ struct Channels {
   std::string vision = "RILBED_VISION";    ///< rilbed::vision_settings_t, before each status_t of a run with a camera
   std::string console = "RILBED_CONSOLE";  ///< rilbed::console_command_t, from consoles
   std::string console_reply = "RILBED_CONSOLE_REPLY";  ///< rilbed::console_reply_t, the run's answers
-  std::string agent_hello = "RILBED_AGENT_HELLO";      ///< rilbed::agent_hello_t, from agent processes (issue 18)
+  std::string agent_hello = "RILBED_AGENT_HELLO";      ///< rilbed::agent_hello_t, from agent processes
   std::string quantum = "RILBED_QUANTUM";              ///< rilbed::quantum_t, the run's quanta to agent processes
   std::string quantum_reply = "RILBED_QUANTUM_REPLY";  ///< rilbed::quantum_reply_t, their answers
   /// The same names behind `prefix`.

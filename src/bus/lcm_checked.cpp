@@ -228,7 +228,7 @@ void fields(Walk& w, const rilbed::sensor_layout_t*) {
   w.skip(static_cast<std::size_t>(robots) * 2 * 4);
 }
 
-// The agent exchange (issue 18).
+// The agent exchange (processes of their own, here or on other machines).
 void fields(Walk& w, const rilbed::agent_hello_t*) {
   w.string();
   w.string();

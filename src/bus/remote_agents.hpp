@@ -1,4 +1,4 @@
-// The run's side of the agent exchange over LCM (issue 18): the robots whose controllers
+// The run's side of the agent exchange over LCM: the robots whose controllers
 // run in `rilbed agent` processes, on this machine or others of the LAN.
 //
 // Each agent process announces itself (agent_hello_t, with its robots). At each control

@@ -1,5 +1,5 @@
 // A fixed set of worker threads that run one loop's iterations at a time, split into
-// contiguous chunks (issue 19: `--threads N` steps the world on N threads). The caller's
+// contiguous chunks (`--threads N` steps the world on N threads). The caller's
 // thread works too, so a pool of N threads starts N - 1.
 #pragma once
 

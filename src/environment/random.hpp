@@ -8,7 +8,7 @@
 // robot's noise at each instant comes from a generator keyed by (run seed, robot id,
 // time, purpose). What a robot reads then does not depend on which other robots sensed
 // before it, in what order, or on which thread, so a run stepped on N threads gives the
-// same result as on one (issue 19).
+// same result as on one.
 #pragma once
 
 #include <array>

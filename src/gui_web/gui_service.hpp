@@ -81,7 +81,8 @@ struct ManualDriveConfig {
   std::function<std::chrono::steady_clock::time_point()> clock;
 };
 
-/// Camera frames at most this often to the viewers (the limit: 10 per second).
+/// Camera frames at most this often to the viewers (more would cost the run's thread, for a view that does not need
+/// them).
 inline constexpr double kMaxCameraFps = 10.0;
 
 /// What the service counted.

@@ -1,4 +1,4 @@
-// Controllers that run outside the run's process (issue 18): in other processes or on
+// Controllers that run outside the run's process: in other processes or on
 // other machines, reached in time quanta (paper 000 section 6.1). The run hands each
 // remote robot's input to an AgentExchange at the robot's control step and, once every
 // agent of that instant has stepped, asks it for the answers of the whole quantum. The

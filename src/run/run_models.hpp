@@ -176,10 +176,10 @@ class TeamBroadcaster final : public sim::AtomicModel<TimeUs> {  // state: time 
 };
 
 /// Sends each control instant's quantum to the remote controllers and applies their
-/// answers (issue 18). Added after every AgentModel, with the same period and first step,
-/// so that at each control instant every agent has submitted its input before the
-/// exchange, and the answers drive the bodies before anything later in the instant (the
-/// central coordinator, the monitor) reads them. State: time to the next quantum.
+/// answers (processes of their own, here or on other machines). Added after every AgentModel, with the same period and
+/// first step, so that at each control instant every agent has submitted its input before the exchange, and the answers
+/// drive the bodies before anything later in the instant (the central coordinator, the monitor) reads them. State: time
+/// to the next quantum.
 class QuantumModel final : public sim::AtomicModel<TimeUs> {
  public:
   /// `exchange` and the agents must outlive the model; `agents` are every AgentModel of

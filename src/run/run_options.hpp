@@ -52,7 +52,7 @@ struct RunOptions {
   /// Attached while the run runs, so that another thread (a console) can pause, resume,
   /// change the real-time factor or end it; may be null. Must outlive the call.
   RunControl* control = nullptr;
-  /// The controllers that run in other processes or on other machines (issue 18): each
+  /// The controllers that run in other processes or on other machines: each
   /// robot it serves is stepped through it, one quantum per control instant. May be null
   /// (every controller in this process). Must outlive the call.
   AgentExchange* remote_agents = nullptr;

@@ -1,4 +1,4 @@
-// Where a simulation run's time goes (issue 19): what `rilbed sim-bench` prints.
+// Where a simulation run's time goes: what `rilbed sim-bench` prints.
 #pragma once
 
 namespace rilbed::run {

@@ -92,7 +92,7 @@ struct RobotSpec {
 };
 
 /// A whole scenario.
-/// Where the robots' controllers run (the `agents:` block; issue 18). Without it, every
+/// Where the robots' controllers run (the `agents:` block). Without it, every
 /// controller runs in the run's own process.
 struct AgentsSpec {
   /// `rilbed agent` processes that `rilbed run` starts on this machine, the remote robots

@@ -1,4 +1,4 @@
-// The vision stress set (issue 14): scenes whose every imaging condition is drawn at random
+// The vision stress set: scenes whose every imaging condition is drawn at random
 // from a range wider than any one lab's, so that the detector is measured on footage
 // nobody tuned it to. One scene is one camera, floor, light and clutter, and a short clip
 // of its robots driving; its ground truth says, per marker, where its centre projects, which

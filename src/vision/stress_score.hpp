@@ -2,7 +2,7 @@
 // marker (found, where, which way) and every detection that is not a marker's own (a wrong
 // ID, a false detection on the floor or its clutter, a heading far off), with summaries by
 // marker size, blur, occlusion and ID. bench/bench_stress prints them; the stress CTest
-// holds them to issue 14's targets.
+// holds them to the stress set's targets (README of bench/).
 #pragma once
 
 #include <functional>

@@ -1,4 +1,4 @@
-// The agent exchange over LCM (issue 18), in one process on the in-process bus: the
+// The agent exchange over LCM, in one process on the in-process bus: the
 // run's side (RemoteAgents) and an agent process's side (AgentServer) share one memq
 // instance, so the run's waits hand the quanta to the server on the same thread. A convoy
 // stepped through the exchange follows the in-process convoy exactly; a process that stops

@@ -1,4 +1,4 @@
-// End-to-end tests of agents in other processes (issue 18): `rilbed run` with a scenario's
+// End-to-end tests of agents in other processes: `rilbed run` with a scenario's
 // `agents:` block and `rilbed agent` processes, on a multicast bus inside a private network
 // namespace (lcm_namespace.hpp), with and without 10 % packet loss. A lock-step run gives
 // the in-process run's folder byte for byte; an agent process killed mid-run is found lost

@@ -172,7 +172,7 @@ TEST(KheperaCli, InfoPrintsVersionsProximityAndCounters) {
   EXPECT_NE(rest.find("last speed 0 0"), std::string::npos) << rest;
 }
 
-// A peer whose firmware words its replies otherwise (the report that opened issue 15: a
+// A peer whose firmware words its replies otherwise (as a lab reported it: a
 // Khepera answering `b,5.02,5.01`), with every other difference too: the real binary
 // talks to it as to K-Team's firmware.
 TEST(KheperaCli, WorksWithARobotWhoseFirmwareDiffers) {

@@ -1,4 +1,4 @@
-// End-to-end tests of a run on a lossy LCM bus (issue 16): `rilbed watch` and `rilbed
+// End-to-end tests of a run on a lossy LCM bus: `rilbed watch` and `rilbed
 // console` with 10 % of LCM's packets dropped, and a watcher that stalls. Everything runs
 // inside a private network namespace (`unshare -n`, loopback with multicast), where an
 // nftables rule on the input hook drops one UDP packet to LCM's port in ten at random:

@@ -1,4 +1,4 @@
-// Fuzz target for the agent exchange's messages (issue 18; src/bus/remote_agents.hpp,
+// Fuzz target for the agent exchange's messages (src/bus/remote_agents.hpp,
 // src/bus/agent_server.hpp): the first input byte picks who hears the rest, as it would
 // come off the bus from anyone on the multicast group:
 //   0: an agent process (a real AgentServer) on RILBED_QUANTUM, its controllers stand-ins

@@ -25,6 +25,7 @@
 #include "bus/lcm_checked.hpp"
 #include "bus/lcm_console.hpp"
 #include "run/run_control.hpp"
+#include "vision/vision_settings.hpp"
 
 namespace {
 

@@ -14,10 +14,10 @@
 namespace rilbed::run {
 namespace {
 
+using agents::ControlInput;
 using agents::ControllerContext;
 using agents::ControllerEntry;
 using agents::ControllerRegistry;
-using agents::ControlInput;
 using agents::ControlOutput;
 
 // A controller of the test's own: turns on the spot at a rate it is given.
@@ -82,7 +82,8 @@ TEST(RegisteredController, IsParsedBuiltListedAndServed) {
   EXPECT_NEAR(r.trajectory.back().pose.position_m.x, 0.5, 1e-3);
   EXPECT_GT(std::abs(wrap_rad_pi(r.trajectory.back().pose.heading_rad)), 0.5);
   // `rilbed controllers` and the web editor's JSON list it with its parameter.
-  EXPECT_NE(agents::controllers_table(*registry).find("| `spinner` | `turn_radps` | rad/s | 1 | 0 to 5 | how fast it turns |"),
+  EXPECT_NE(agents::controllers_table(*registry).find(
+                "| `spinner` | `turn_radps` | rad/s | 1 | 0 to 5 | how fast it turns |"),
             std::string::npos);
   const nlohmann::ordered_json json = agents::controllers_json(*registry);
   const auto entry = std::find_if(json.begin(), json.end(), [](const auto& e) { return e["name"] == "spinner"; });

@@ -22,7 +22,7 @@ std::string slurp(const std::filesystem::path& p) {
   return s.str();
 }
 
-// The acceptance: convoy_sim forms in at least 95 of 100 seeds in each mode, and
+// What a convoy must do: convoy_sim forms in at least 95 of 100 seeds in each mode, and
 // no two robots ever overlap.
 void expect_convoy_forms(ConvoyMode mode) {
   Scenario s = shipped("convoy_sim");

@@ -1,8 +1,8 @@
-// The vision stress set (issue 14) held to its targets: 60 scenes (240 frames) whose every
+// The vision stress set held to its targets: 60 scenes (240 frames) whose every
 // condition is drawn at random from wide ranges (src/vision/stress_scene.hpp), scored
 // full-frame and tracked. The seed is not one any threshold was tuned on; draw a new one
 // whenever a threshold changes (bench/bench_stress --seed S runs thousands of frames from
-// any seed and prints the whole table). Every bound below is the issue's own target, but
+// any seed and prints the whole table). Every bound below is the stress set's own target, but
 // for the two that 240 frames cannot resolve (kHeld* below).
 #include <gtest/gtest.h>
 
@@ -34,7 +34,7 @@ constexpr bool kSanitized = false;
 #endif
 constexpr int kScenes = kSanitized ? 12 : 60;
 
-// Two of issue 14's targets are held here at a level below the target, for want of frames
+// Two of the stress set's targets are held here at a level below the target, for want of frames
 // rather than of accuracy. On a fresh seed of 2,000 frames (bench_stress) recall at 24-32
 // px is 0.951 full-frame and 0.964 tracked, and the worst ID's mean heading error 0.11
 // degrees. But marker sizes, blur and floor are drawn per scene, so these 60 scenes hold
@@ -88,7 +88,7 @@ std::string describe(const StressTally& t) {
 
 // One test for both modes: the scenes are rendered once (CTest runs each test in a process
 // of its own).
-TEST(StressSet, FullFrameAndTrackedHoldIssue14sTargetsOrTheLevelReached) {
+TEST(StressSet, FullFrameAndTrackedHoldTheirTargetsOrTheLevelReached) {
   for (const bool tracked : {false, true}) {
     SCOPED_TRACE(tracked ? "tracked" : "full-frame");
     const StressTally& t = tracked ? tallies().tracked : tallies().full;

@@ -1,5 +1,5 @@
 #!/usr/bin/env node
-// The web panel in a real browser (issue 17): Debian's Chromium, driven by playwright-core,
+// The web panel in a real browser: Debian's Chromium, driven by playwright-core,
 // against `rilbed run --gui` with emulated real robots.
 //
 //   node web/tests/browser_test.js RILBED MIXED_SCENARIO SIM_SCENARIO [ARTEFACT_DIR]

@@ -1,5 +1,5 @@
 #!/usr/bin/env node
-// The web panel's server as a Foxglove client sees it (issue 17), with the client the
+// The web panel's server as a Foxglove client sees it, with the client the
 // panel's tests and Foxglove's own tools use: @foxglove/ws-protocol over the `ws` package.
 //
 //   node web/tests/protocol_test.js RILBED SCENARIO

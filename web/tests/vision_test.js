@@ -1,5 +1,5 @@
 #!/usr/bin/env node
-// The web panel's vision settings (issue 17: threshold, contrast, marker size limits,
+// The web panel's vision settings (threshold, contrast, marker size limits,
 // brightness, their effect visible live) in a real browser: Debian's Chromium, driven by
 // playwright-core, against `rilbed run --gui` with emulated real robots and its emulated
 // overhead camera. The settings are the run's Foxglove parameters (vision.brightness,
