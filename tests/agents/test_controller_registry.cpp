@@ -4,29 +4,12 @@
 
 #include "agents/builtin_controllers.hpp"
 #include "agents/controller_registry.hpp"
+#include "support/spinner_controller.hpp"
 
 namespace rilbed::agents {
 namespace {
 
-// A controller of the test's own: turns on the spot at a rate it is given.
-class Spinner final : public Controller {
- public:
-  explicit Spinner(double turn_radps) : turn_radps_(turn_radps) {}
-  ControlOutput step(const ControlInput&) override { return {wheels_from_twist(0.0, turn_radps_), "spin"}; }
-
- private:
-  double turn_radps_;
-};
-
-ControllerEntry spinner_entry() {
-  ControllerEntry e;
-  e.name = "spinner";
-  e.summary = "turns on the spot";
-  e.params = {{"turn_radps", "rad/s", 1.0, false, 0.0, 5.0, false, "how fast it turns"}};
-  e.origin = "the test";
-  e.make = [](const ControllerContext& c) { return std::make_unique<Spinner>(c.params.get("turn_radps")); };
-  return e;
-}
+using rilbed::testing::spinner_entry;
 
 TEST(ControllerRegistry, ParametersAreCheckedForRangeWholeNumbersAndPresence) {
   const auto registry = default_controllers();

@@ -10,35 +10,13 @@
 #include "agents/controller_registry.hpp"
 #include "run/scenario.hpp"
 #include "run/simulation.hpp"
+#include "support/spinner_controller.hpp"
 
 namespace rilbed::run {
 namespace {
 
-using agents::ControlInput;
-using agents::ControllerContext;
-using agents::ControllerEntry;
 using agents::ControllerRegistry;
-using agents::ControlOutput;
-
-// A controller of the test's own: turns on the spot at a rate it is given.
-class Spinner final : public agents::Controller {
- public:
-  explicit Spinner(double turn_radps) : turn_radps_(turn_radps) {}
-  ControlOutput step(const ControlInput&) override { return {agents::wheels_from_twist(0.0, turn_radps_), "spin"}; }
-
- private:
-  double turn_radps_;
-};
-
-ControllerEntry spinner_entry() {
-  ControllerEntry e;
-  e.name = "spinner";
-  e.summary = "turns on the spot";
-  e.params = {{"turn_radps", "rad/s", 1.0, false, 0.0, 5.0, false, "how fast it turns"}};
-  e.origin = "the test";
-  e.make = [](const ControllerContext& c) { return std::make_unique<Spinner>(c.params.get("turn_radps")); };
-  return e;
-}
+using rilbed::testing::spinner_entry;
 
 std::shared_ptr<const ControllerRegistry> with_spinner() {
   ControllerRegistry r = agents::builtin_controllers();
