@@ -309,7 +309,7 @@ void place_or_throw(SessionParts& p, const SessionOptions& o, const SessionOutpu
   const run::PlacementResult r = run::place_real_robots(*p.real, targets, po);
   if (!r.ok) {
     p.batch_aborted.store(true);
-    throw std::runtime_error("seed " + std::to_string(seed) + ": " + r.error);
+    throw std::runtime_error(r.error);  // the batch names the seed
   }
   if (!r.offset_m.empty()) {
     std::string offsets;
