@@ -29,8 +29,12 @@ function parseEntry(e, k) {
   for (const key of ['sensors', 'required_sensors']) {
     if (!isStringList(e[key] ?? [])) throw new Error(`${where}: ${key} is not a list of names`);
   }
+  if (!(e.library === undefined || e.library === null || (isString(e.library) && e.library.startsWith('/')))) {
+    throw new Error(`${where}: library is ${JSON.stringify(e.library)}, not an absolute path or null`);
+  }
   return {
     name: e.name, summary: isString(e.summary) ? e.summary : '', origin: isString(e.origin) ? e.origin : '',
+    library: e.library ?? null,
     sensors: e.sensors ?? [], required_sensors: e.required_sensors ?? [],
     wants_team: e.wants_team === true, concurrent: e.concurrent === true,
     params: e.params.map((p) => parseParam(p, where)),
@@ -47,6 +51,48 @@ export class ControllerRegistry {
 
   // The entry of controller `name`, or undefined.
   find(name) { return this.byName.get(name); }
+
+  // The entry a robot's controller names ({name, library}, scenario.js's controllerRef):
+  // the one of that name if it comes from that plug-in library, or from none when no
+  // library is given; else undefined. Names are unique in a registry, but a name alone does
+  // not name a library's controller: the scenario parser refuses it.
+  match(ref) {
+    const c = ref?.name ? this.find(ref.name) : undefined;
+    if (!c) return undefined;
+    if (!c.library || !ref.library) return !c.library && !ref.library ? c : undefined;
+    return sameLibrary(c.library, ref.library) ? c : undefined;
+  }
+
+  // The entries from plug-in library `path` (as a scenario gives it).
+  fromLibrary(path) { return this.entries.filter((e) => e.library && sameLibrary(e.library, path)); }
+
+  // The plug-in libraries' paths, each once.
+  get libraries() { return [...new Set(this.entries.map((e) => e.library).filter(Boolean))]; }
+}
+
+// A path with `.`, `..` and doubled slashes taken out, as C++'s lexically_normal does.
+function normalPath(path) {
+  const absolute = path.startsWith('/');
+  const out = [];
+  for (const part of path.split('/')) {
+    if (part === '' || part === '.') continue;
+    if (part !== '..') out.push(part);
+    else if (out.length && out[out.length - 1] !== '..') out.pop();
+    else if (!absolute) out.push(part); // (above / is / itself)
+  }
+  return (absolute ? '/' : '') + out.join('/');
+}
+
+// Whether plug-in library `given`, as a scenario writes it, can be `registered`, the
+// absolute path the registry has. The parser makes a relative path absolute from the
+// scenario file's folder, which the page is not told (a file opened in a browser comes
+// without one): so a relative path matches a registered one that ends with it, past its
+// leading `..`s, and only an absolute one must be the same path.
+export function sameLibrary(registered, given) {
+  const r = normalPath(registered), g = normalPath(given);
+  if (g.startsWith('/')) return r === g;
+  const tail = g.replace(/^(?:\.\.\/)*(?:\.\.$)?/, '');
+  return tail !== '' && r.endsWith(`/${tail}`);
 }
 
 // The registry from controllers.json's parsed JSON; throws, saying what is wrong, when it
@@ -81,6 +127,17 @@ export async function loadRegistry(fetchImpl = globalThis.fetch, url = REGISTRY_
   }
   return parseRegistry(json);
 }
+
+// A plug-in library's file name, which the editor's lists show beside its controllers'
+// names so that a person sees which are a library's, and which library's (the whole path,
+// too long for a list, is in their titles).
+export const libraryFile = (path) => path.split('/').filter(Boolean).pop() ?? path;
+
+// A controller as the editor's lists name it: "wander", "braitenberg_cpp (braitenberg_cpp.so)".
+export const controllerLabel = (c) => (c.library ? `${c.name} (${libraryFile(c.library)})` : c.name);
+
+// What a controller's option says when a person hovers it: its summary, and its library.
+export const controllerTitle = (c) => (c.library ? `${c.summary} (from ${c.library})` : c.summary);
 
 // A number as the C++ writes it in its messages: whole ones without a point.
 export const numberText = (v) => (Number.isInteger(v) ? String(v) : String(Number(v.toPrecision(6))));

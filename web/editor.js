@@ -1,7 +1,9 @@
 // rilbed's scenario editor: place, move, rotate and delete robots, obstacles, tracks and
 // beacons on a canvas of the field, and save the scenario YAML that `rilbed run` reads
 // (scenarios/README.md is the contract). The controllers, their parameters and the sensors
-// they need come from the server's registry (controllers.json), never from a list here.
+// they need come from the server's registry (controllers.json), never from a list here:
+// rilbed's own, named by name, and those of the run's plug-in libraries, named
+// `{library: PATH, name: NAME}`.
 //
 // The editor edits the parsed YAML object itself (`ed.doc`), never a model of its own:
 // whatever it does not show (camera, safety, sensors, a real robot's link, moving
@@ -12,18 +14,18 @@
 // "Start from this run" builds a scenario from what the live page holds (app.js's
 // window.rilbed.run: /rilbed/world and /rilbed/poses); "Poses from run" puts the run's
 // current poses into the scenario being edited.
-import { load, dump, visit, COLLECTION_STYLE, VISIT_SKIP } from './node_modules/js-yaml/dist/js-yaml.mjs';
 import { prepareCanvas } from './canvas.js';
 import { degToRad, headingDeg, radToDeg } from './angles.js';
 import { centroid, distToSegment, pointInPolygon } from './geometry.js';
 import { formatIds, parseIds } from './ids.js';
 import { editorLayout, toField, toPx } from './projection.js';
-import { loadRegistry, numberText, paramDescription } from './controller_registry.js';
+import { controllerLabel, controllerTitle, loadRegistry, numberText, paramDescription } from './controller_registry.js';
 import {
-  DEFAULT_CONTROLLER, DEFAULT_FIELD, ROBOT_RADIUS_M, controllerOf, entryIds, isNum, isPoint, isPose, listOf,
-  obstaclePoints, robotHasSensor, robotItems as robotItemsOf, scenarioField, trackPoints,
+  DEFAULT_CONTROLLER, DEFAULT_FIELD, ROBOT_RADIUS_M, controllerRef, controllerValue, entryIds, isNum, isPoint, isPose,
+  listOf, obstaclePoints, robotHasSensor, robotItems as robotItemsOf, scenarioField, trackPoints,
 } from './scenario.js';
 import { findProblems as scenarioProblems } from './scenario_checks.js';
+import { readScenarioText, scenarioText as yamlText } from './scenario_yaml.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -102,57 +104,8 @@ function uniqueName(key, stem) {
 }
 
 // ------------------------------------------------------------------ YAML
-// Short collections in flow style (`[0.3, 0.3]`, `{width_m: 1.5, height_m: 1.2}`), as
-// the shipped scenarios are written; lists of points always on one line.
-function flowLength(n) {
-  if (n.kind === 'scalar') return n.value.length + (/[\s:,[\]{}#'"]|^$/.test(n.value) ? 2 : 0);
-  if (n.kind === 'sequence') return 2 + n.items.reduce((a, it) => a + flowLength(it) + 2, 0);
-  if (n.kind === 'mapping') return 2 + n.items.reduce((a, it) => a + flowLength(it.key) + 2 + flowLength(it.value) + 2, 0);
-  return 10;
-}
-const scalarsOnly = (n) => n.kind === 'scalar' || (n.kind === 'sequence' && n.items.every((i) => i.kind === 'scalar'));
-const FLOW_WIDTH = 120;
-function toYaml(doc) {
-  const block = new WeakSet(); // the items of a list whose items do not all fit a line each
-  const fits = (node, depth) => flowLength(node) + 2 * depth + 24 <= FLOW_WIDTH;
-  return dump(doc, {
-    lineWidth: -1, noRefs: true,
-    transform: (docs) => visit(docs, (node, c) => {
-      if ((node.kind !== 'sequence' && node.kind !== 'mapping') || c.depth === 0 || block.has(node)) return undefined;
-      const points = node.kind === 'sequence' && node.items.length > 0 && node.items.every((i) => i.kind === 'sequence' && i.items.every((j) => j.kind === 'scalar'));
-      const leaves = node.kind === 'mapping' && node.items.every((i) => scalarsOnly(i.value));
-      const listOfCollections = node.kind === 'sequence' && node.items.some((i) => i.kind !== 'scalar') && !points;
-      if (listOfCollections) {
-        // One style for all the items of a list: each on a line if each fits, else all in block style.
-        const flowItem = (i) => i.kind === 'scalar' || (i.kind === 'mapping' && i.items.every((k) => scalarsOnly(k.value))) || fits(i, c.depth + 1);
-        if (!node.items.every(flowItem)) for (const i of node.items) block.add(i);
-        return undefined;
-      }
-      if (points || leaves || fits(node, c.depth)) {
-        node.style = COLLECTION_STYLE.FLOW;
-        return VISIT_SKIP;
-      }
-      return undefined;
-    }),
-  });
-}
-function sameValue(a, b) {
-  if (a === b) return true;
-  if (typeof a !== typeof b || a === null || b === null || typeof a !== 'object') return false;
-  if (Array.isArray(a) !== Array.isArray(b)) return false;
-  const ka = Object.keys(a), kb = Object.keys(b);
-  return ka.length === kb.length && ka.every((k) => Object.prototype.hasOwnProperty.call(b, k) && sameValue(a[k], b[k]));
-}
-function scenarioText() {
-  let text;
-  try {
-    text = toYaml(ed.doc);
-    if (!sameValue(load(text), JSON.parse(JSON.stringify(ed.doc)))) text = dump(ed.doc, { lineWidth: -1, noRefs: true });
-  } catch {
-    text = dump(ed.doc, { lineWidth: -1, noRefs: true });
-  }
-  return ed.header + text;
-}
+// What is saved: the document in the shipped scenarios' style, after the loaded file's header.
+const scenarioText = () => yamlText(ed.doc, ed.header);
 
 // ------------------------------------------------------------------ changes and undo
 function checkpoint() {
@@ -228,11 +181,12 @@ function removeRobot(index, id) {
   if (!rest.length) robots.splice(index, 1);
   else robots[index] = rest.length === 1 ? renameKey(robots[index], 'ids', 'id', rest[0]) : renameKey(robots[index], 'ids', 'ids', formatIds(rest));
 }
-// A controller given a parameter it does not take stops the run, so a change of controller
-// drops them; a sensor the new controller requires is added with its defaults.
-function setController(e, name) {
-  e.controller = name;
-  const c = controllers.registry?.find(name);
+// Entry e runs registry entry `c`: a plug-in library's named {library, name} with the
+// registry's absolute path, which holds wherever the file is saved. A controller given a
+// parameter it does not take stops the run, so a change of controller drops them; a sensor
+// the new controller requires is added with its defaults.
+function setController(e, c) {
+  e.controller = controllerValue(c);
   dropParamsNotTaken(e, c);
   addRequiredSensors(e, c);
 }
@@ -290,7 +244,7 @@ function newRobot(x, y) {
   if ($('editor-new-kind').value === 'real') e.kind = 'real';
   e.pose = null;
   setPose(e, [x, y, Number($('editor-new-robot-theta').value) || 0]);
-  const controller = $('editor-new-controller').value;
+  const controller = controllers.registry?.find($('editor-new-controller').value);
   if (controller) setController(e, controller); // (none to choose when the list did not load: the scenario's default)
   const robots = ensureList('robots');
   robots.push(e);
@@ -501,20 +455,14 @@ function posesFromRun() {
 
 // ------------------------------------------------------------------ load and save
 function loadText(text, name) {
-  let doc;
+  let read;
   try {
-    doc = load(text);
+    read = readScenarioText(text);
   } catch (e) {
-    status(`${name}: not valid YAML: ${String(e.message).split('\n')[0]}`, true);
+    status(`${name}: ${e.message}`, true);
     return;
   }
-  if (!doc || typeof doc !== 'object' || Array.isArray(doc)) {
-    status(`${name}: not a scenario (a mapping of keys is expected)`, true);
-    return;
-  }
-  // The file's leading comment lines (what it is, how to run it) are kept on save.
-  const header = (/^(?:[ \t]*#[^\n]*\n|[ \t]*\n)*/.exec(text)[0] || '').replace(/\s*$/, '');
-  setDoc(doc, header ? `${header}\n` : '', '');
+  setDoc(read.doc, read.header, ''); // (the file's leading comment lines are kept on save)
   status(`Loaded ${name}: ${robotItems().length} robots, ${list('obstacles').length} obstacles, ` +
     `${list('tracks').length} tracks, ${list('beacons').length} beacons.`);
   ed.loadedName = name;
@@ -779,7 +727,13 @@ function drawRobot(r, u, v, radius, isSelected, inTray = false) {
   }
   ctx.fillStyle = '#111'; ctx.font = '11px system-ui';
   if (inTray) { ctx.textAlign = 'center'; ctx.fillText(String(r.id), u, v + 4); ctx.textAlign = 'start'; }
-  else ctx.fillText(`${r.id}${r.e?.controller && r.e.controller !== DEFAULT_CONTROLLER ? ` ${r.e.controller}` : ''}`, u + radius + 3, v - radius - 1);
+  else ctx.fillText(`${r.id}${controllerTag(r.e)}`, u + radius + 3, v - radius - 1);
+}
+// What a robot's label says after its ID: its controller's name, unless it runs the default.
+function controllerTag(e) {
+  const ref = controllerRef(e);
+  if (!ref?.name) return ' ?';
+  return ref.library || ref.name !== DEFAULT_CONTROLLER ? ` ${ref.name}` : '';
 }
 
 // ------------------------------------------------------------------ pointer and keys
@@ -998,14 +952,34 @@ for (const r of document.querySelectorAll('input[name="editor-tool"]')) {
 // Each row: {label, get, set, type, options, step, ...}; a change is one undo step.
 let formRows = [];
 function numberField(label, get, set, step = 0.001, extra = {}) { return { label, get, set, type: 'number', step, ...extra }; }
-// The robot's controller: one of the registry's (and the entry's own if rilbed does not
-// know it, flagged in the problems); none to choose while the list has not loaded.
+// The robot's controller: one of the registry's, shown with its plug-in library's file name
+// if it has one, its name as value (unique in a registry); or, when the registry has not the
+// entry's own (flagged in the problems), that one too, kept as loaded. Its value is AS_LOADED,
+// not its name: that may be a registry entry's of another library, or a built-in's. None to
+// choose while the list has not loaded.
+const AS_LOADED = '';
 function controllerRow(e) {
-  const current = () => controllerOf(e());
-  const names = controllers.registry?.names ?? [];
-  const options = names.includes(current()) ? names : [...names, current()];
-  const titles = Object.fromEntries(options.map((n) => [n, controllers.registry?.find(n)?.summary ?? 'not a controller rilbed knows']));
-  return { label: 'controller', type: 'select', options, titles, disabled: !controllers.registry, get: current, set: (v) => setController(e(), v) };
+  const registry = controllers.registry;
+  const entries = registry?.entries ?? [];
+  const current = () => registry?.match(controllerRef(e()))?.name ?? AS_LOADED;
+  const options = entries.map((c) => c.name);
+  const labels = Object.fromEntries(entries.map((c) => [c.name, controllerLabel(c)]));
+  const titles = Object.fromEntries(entries.map((c) => [c.name, controllerTitle(c)]));
+  if (current() === AS_LOADED) {
+    options.push(AS_LOADED);
+    [labels[AS_LOADED], titles[AS_LOADED]] = ownController(e(), registry);
+  }
+  return {
+    label: 'controller', type: 'select', options, labels, titles, disabled: !registry, get: current,
+    set: (v) => { const c = registry?.find(v); if (c) setController(e(), c); },
+  };
+}
+// The label and title of a robot's controller the registry does not have, as loaded.
+function ownController(e, registry) {
+  const ref = controllerRef(e);
+  const label = ref ? controllerLabel(ref) : JSON.stringify(e.controller);
+  if (!registry) return [label, 'the list of controllers did not load'];
+  return [label, `not a controller of the registry${ref?.library ? ` (${ref.name} of ${ref.library})` : ''}: kept as loaded`];
 }
 // One parameter of the robot's controller: a number input with its unit, its default as
 // the placeholder and its range; emptied, the parameter is left out (its default applies).
@@ -1039,7 +1013,7 @@ function formFor(s) {
       rows.push(numberField('y_m', () => e().pose[1], (v) => setPose(e(), [e().pose[0], v, e().pose[2]])));
       rows.push(numberField('theta_deg', () => e().pose[2], (v) => setPose(e(), [e().pose[0], e().pose[1], v]), 1));
     }
-    const entry = controllers.registry?.find(controllerOf(e()));
+    const entry = controllers.registry?.match(controllerRef(e()));
     if (entry?.params.length) rows.push({ type: 'heading', label: `parameters of ${entry.name}` }, ...entry.params.map((p) => paramRow(e, p)));
     const shown = ['id', 'ids', 'kind', 'controller', 'pose', ...(entry ? ['params'] : [])];
     const kept = Object.keys(e()).filter((k) => !shown.includes(k));
@@ -1130,7 +1104,7 @@ function formRow(row) {
 function selectInput(row, apply) {
   const sel = document.createElement('select');
   for (const o of row.options) {
-    const option = new Option(o, o);
+    const option = new Option(row.labels?.[o] ?? o, o);
     if (row.titles?.[o]) option.title = row.titles[o];
     sel.append(option);
   }
@@ -1245,7 +1219,11 @@ function showControllersState() {
 function fillNewRobotControllers() {
   const select = $('editor-new-controller');
   const entries = controllers.registry?.entries ?? [];
-  select.replaceChildren(...entries.map((c) => { const o = new Option(c.name, c.name); o.title = c.summary; return o; }));
+  select.replaceChildren(...entries.map((c) => {
+    const o = new Option(controllerLabel(c), c.name);
+    o.title = controllerTitle(c);
+    return o;
+  }));
   if (entries.some((c) => c.name === DEFAULT_CONTROLLER)) select.value = DEFAULT_CONTROLLER;
   select.disabled = !entries.length;
 }

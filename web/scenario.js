@@ -51,7 +51,22 @@ export function robotItems(doc) {
 export const obstaclePoints = (o) => (Array.isArray(o?.polygon) ? o.polygon.filter(isPoint) : []);
 export const trackPoints = (t) => (Array.isArray(t?.points) ? t.points.filter(isPoint) : []);
 
-export const controllerOf = (e) => e?.controller ?? DEFAULT_CONTROLLER;
+const isText = (v) => typeof v === 'string' && v !== '';
+
+// A robot entry's controller as {name, library}: a name alone (library null) names one of
+// rilbed's own, `{library: PATH, name: NAME}` one of a plug-in library's, PATH as the file
+// gives it (relative to the scenario file, or absolute). null when it names none: a list, or
+// a mapping without both texts (scenario_checks.js says what is wrong with it).
+export function controllerRef(e) {
+  const v = e?.controller ?? DEFAULT_CONTROLLER;
+  if (typeof v !== 'object') return { name: String(v), library: null };
+  return !Array.isArray(v) && isText(v.library) && isText(v.name) ? { name: v.name, library: v.library } : null;
+}
+
+// What a robot entry's `controller:` says for registry entry `c`: its name, or for a
+// plug-in library's controller the mapping the scenario parser asks for (a bare name would
+// not tell rilbed run which file to load it from).
+export const controllerValue = (c) => (c.library ? { library: c.library, name: c.name } : c.name);
 
 // Whether a robot with this `sensors:` mapping has sensor `name` (a name of the registry's
 // `sensors` lists), as robot_has_sensor decides: the IR ring and the odometer unless turned

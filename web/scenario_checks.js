@@ -4,9 +4,9 @@
 // and beacons. Each problem is a sentence naming the item.
 import { formatIds } from './ids.js';
 import { distToSegment, pointInPolygon } from './geometry.js';
-import { numberText, rangeText, withUnit } from './controller_registry.js';
+import { controllerLabel, numberText, rangeText, withUnit } from './controller_registry.js';
 import {
-  ROBOT_RADIUS_M, controllerOf, entryIds, isNum, listOf, obstaclePoints, robotHasSensor, robotItems, scenarioField,
+  ROBOT_RADIUS_M, controllerRef, entryIds, isNum, listOf, obstaclePoints, robotHasSensor, robotItems, scenarioField,
   trackPoints,
 } from './scenario.js';
 
@@ -38,15 +38,49 @@ export function paramsProblems(c, params) {
   return out;
 }
 
-// The problems of robot entry `e` with the registry: an unknown controller, its params, the
-// sensors the controller requires.
+// The problems of a `controller: {library: PATH, name: NAME}` mapping's own keys, in the
+// scenario parser's words: it takes those two, and needs both.
+function controllerMappingProblems(v) {
+  const out = Object.keys(v).filter((k) => k !== 'library' && k !== 'name')
+    .map((k) => `controller.${k}: unknown key (allowed here: library, name)`);
+  if (typeof v.library !== 'string' || !v.library) out.push("controller.library: give the plug-in library's path, relative to the scenario file");
+  if (typeof v.name !== 'string' || !v.name) out.push("controller.name: give the name of one of the library's controllers");
+  return out;
+}
+
+// Why the registry has no entry for controller reference `ref` (scenario.js's controllerRef),
+// naming what it does have: for a name alone, every controller; for a library's, the
+// library's, or else the libraries there are.
+function unknownController(ref, registry) {
+  if (!ref.library) {
+    const c = registry.find(ref.name);
+    // (The parser's words: a name alone does not say which file to load it from.)
+    if (c) return `'${ref.name}' comes from the plug-in library ${c.library}: name it as {library: PATH, name: ${ref.name}}`;
+    return `unknown controller '${ref.name}' (rilbed knows ${registry.entries.map(controllerLabel).join(', ')})`;
+  }
+  const held = registry.fromLibrary(ref.library).map((c) => c.name);
+  const others = registry.libraries;
+  const known = held.length ? `it holds ${held.join(', ')}`
+    : others.length ? `the registry has none of its controllers; its plug-in libraries: ${others.join(', ')}`
+      : 'the registry has no plug-in library';
+  return `unknown controller '${ref.name}' of plug-in library ${ref.library} (${known})`;
+}
+
+// The problems of robot entry `e` with the registry: a controller it does not have (by name,
+// or of a plug-in library), its params, the sensors the controller requires.
 export function controllerProblems(e, registry) {
-  const name = controllerOf(e);
-  const c = registry.find(name);
-  if (!c) return [`unknown controller '${name}' (rilbed knows ${registry.names.join(', ')})`];
+  const v = e.controller;
+  if (v && typeof v === 'object' && !Array.isArray(v)) {
+    const shape = controllerMappingProblems(v);
+    if (shape.length) return shape;
+  }
+  const ref = controllerRef(e);
+  if (!ref) return ["controller must be a controller's name or {library: PATH, name: NAME}"];
+  const c = registry.match(ref);
+  if (!c) return [unknownController(ref, registry)];
   const out = paramsProblems(c, e.params);
   for (const s of c.required_sensors) {
-    if (!robotHasSensor(e.sensors, s)) out.push(`${name} needs sensors: ${s}`);
+    if (!robotHasSensor(e.sensors, s)) out.push(`${c.name} needs sensors: ${s}`);
   }
   return out;
 }
@@ -67,7 +101,8 @@ function robotProblems(doc, registry) {
   });
   if (listOf(doc, 'robots').some((e) => e?.kind === 'real') && !doc.camera) out.push('camera: real robots need a camera.');
   // The convoy's own rule (scenarios/README.md): agent k follows agent k-1.
-  const convoy = robots.filter((r) => controllerOf(r.e) === 'convoy').map((r) => r.id).sort((a, b) => a - b);
+  const isConvoy = (ref) => ref?.name === 'convoy' && !ref.library;
+  const convoy = robots.filter((r) => isConvoy(controllerRef(r.e))).map((r) => r.id).sort((a, b) => a - b);
   if (convoy.some((id, k) => id !== k + 1)) out.push(`convoy robots must be numbered 1..N; they are ${formatIds(convoy)}.`);
   return out;
 }

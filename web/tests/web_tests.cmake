@@ -55,10 +55,11 @@ rilbed_web_test(web_editor e2e 300 "Node, the npm packages and Chromium"
 
 # The page's pure helpers in Node (unit/*.test.mjs, node's test runner): the projection, ID
 # lists, angles, geometry, the scenario checks against a controller registry fixture, the
-# Foxglove client against a stand-in WebSocket. Node alone: no npm package, no build, no
-# browser. node --test runs in that folder and finds its *.test.mjs there itself, since a
-# folder given as an argument is searched by Node 20 but taken for a test file by Node 22.
-rilbed_web_test(web_unit web 120 "Node" WORKING_DIRECTORY ${_web_tests}/unit --test)
+# scenario's YAML read and written (with web/node_modules' js-yaml, as the page does), the
+# Foxglove client against a stand-in WebSocket. No build, no browser. node --test runs in
+# that folder and finds its *.test.mjs there itself, since a folder given as an argument is
+# searched by Node 20 but taken for a test file by Node 22.
+rilbed_web_test(web_unit web 120 "Node and the npm packages" WORKING_DIRECTORY ${_web_tests}/unit --test)
 
 # ESLint over the web panel's JavaScript (lint.js with eslint.config.js: eslint's
 # recommended rules and a few that catch bugs, over web/*.js and web/tests/).

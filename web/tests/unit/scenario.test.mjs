@@ -1,7 +1,7 @@
 // Reading a scenario object (web/scenario.js) as rilbed run reads it.
 import test from 'node:test';
 import assert from 'node:assert/strict';
-import { controllerOf, entryIds, robotHasSensor, robotItems, scenarioField } from '../../scenario.js';
+import { controllerRef, controllerValue, entryIds, robotHasSensor, robotItems, scenarioField } from '../../scenario.js';
 
 test('the field: its size, the defaults for what is missing or not above 0, its walls', () => {
   assert.deepEqual(scenarioField({ field: { width_m: 2, height_m: 1, walls: false } }), { w: 2, h: 1, walls: false });
@@ -31,8 +31,27 @@ test('robotItems: a placed robot per single entry with a pose, a tray robot per 
 });
 
 test('a robot without controller: runs the scenario default', () => {
-  assert.equal(controllerOf({}), 'convoy');
-  assert.equal(controllerOf({ controller: 'wander' }), 'wander');
+  assert.deepEqual(controllerRef({}), { name: 'convoy', library: null });
+  assert.deepEqual(controllerRef({ controller: null }), { name: 'convoy', library: null });
+  assert.deepEqual(controllerRef({ controller: 'wander' }), { name: 'wander', library: null });
+});
+
+test('a plug-in library\'s controller, {library, name}: read with the path as the file gives it', () => {
+  assert.deepEqual(controllerRef({ controller: { library: 'build/braitenberg_cpp.so', name: 'braitenberg_cpp' } }),
+    { name: 'braitenberg_cpp', library: 'build/braitenberg_cpp.so' });
+  // A mapping without both texts, or a list, names none (the checks say why).
+  assert.equal(controllerRef({ controller: { name: 'braitenberg' } }), null);
+  assert.equal(controllerRef({ controller: { library: '/x.so', name: 3 } }), null);
+  assert.equal(controllerRef({ controller: {} }), null);
+  assert.equal(controllerRef({ controller: ['wander'] }), null);
+  assert.deepEqual(controllerRef({ controller: 42 }), { name: '42', library: null }); // (the parser reads a scalar as text)
+});
+
+test('controllerValue: rilbed\'s own by name, a library\'s as {library, name}, the library first as in the examples', () => {
+  assert.equal(controllerValue({ name: 'wander', library: null }), 'wander');
+  const v = controllerValue({ name: 'braitenberg_cpp', library: '/abs/braitenberg_cpp.so', params: [] });
+  assert.deepEqual(v, { library: '/abs/braitenberg_cpp.so', name: 'braitenberg_cpp' });
+  assert.deepEqual(Object.keys(v), ['library', 'name']);
 });
 
 test('robotHasSensor as robot_has_sensor: defaults on, lists need an element, the pose always', () => {

@@ -4,7 +4,7 @@ import test from 'node:test';
 import assert from 'node:assert/strict';
 import { parseRegistry } from '../../controller_registry.js';
 import { controllerProblems, findProblems, paramsProblems } from '../../scenario_checks.js';
-import { REGISTRY_JSON } from './registry_fixture.mjs';
+import { C_LIBRARY, CPP_LIBRARY, LIBRARY_REGISTRY_JSON, REGISTRY_JSON } from './registry_fixture.mjs';
 
 const registry = parseRegistry(JSON.parse(JSON.stringify(REGISTRY_JSON)));
 const sweeper = registry.find('sweeper');
@@ -108,4 +108,67 @@ test('obstacles, tracks and beacons', () => {
     'obstacle 1 needs at least 3 points.', 'track 1 needs at least 2 points.', 'beacon 1: aperture_deg must be in (0, 360].',
     'beacon 1 is defined twice.', 'beacon 2: range_m must be above 0.',
   ]);
+});
+
+// ---------------------------------------------------------------- plug-in libraries
+// A run's registry with two libraries' controllers, which a scenario names {library, name}.
+const withLibraries = parseRegistry(JSON.parse(JSON.stringify(LIBRARY_REGISTRY_JSON)));
+const cpp = (library = CPP_LIBRARY, name = 'braitenberg_cpp') => ({ library, name });
+
+test('library controllers, by absolute path or relative to the file, with their params: no problem', () => {
+  const doc = scenario([
+    { ids: '1-2', pose: 'random' },
+    { id: 3, pose: [0.5, 0.5, 0], controller: cpp(), params: { gain: 2, speed_mps: 0.1 } },
+    { id: 4, pose: [0.8, 0.5, 0], controller: cpp('build/braitenberg_cpp.so'), params: { gain: 0 } },
+    { ids: '5-6', controller: { library: '../../build/plugins/braitenberg.so', name: 'braitenberg' } },
+    { id: 7, controller: 'wander' },
+  ]);
+  assert.deepEqual(findProblems(doc, withLibraries), []);
+});
+
+test('a library controller\'s params and sensors are checked against its own registry entry', () => {
+  assert.deepEqual(controllerProblems({ controller: cpp() }, withLibraries), ["controller braitenberg_cpp needs parameter 'gain' (how hard it turns away)"]);
+  assert.deepEqual(controllerProblems({ controller: cpp(), params: { gain: 11, lanes: 2 } }, withLibraries), [
+    'params.gain must be 0 to 10, not 11', "controller braitenberg_cpp has no parameter 'lanes' (it takes gain, speed_mps)",
+  ]);
+  assert.deepEqual(controllerProblems({ controller: cpp(), params: { gain: 1 }, sensors: { proximity: false } }, withLibraries),
+    ['braitenberg_cpp needs sensors: proximity']);
+});
+
+test('a library controller the registry does not have is unknown, named with its library and what that holds', () => {
+  assert.deepEqual(controllerProblems({ controller: cpp(CPP_LIBRARY, 'braitenberg') }, withLibraries),
+    [`unknown controller 'braitenberg' of plug-in library ${CPP_LIBRARY} (it holds braitenberg_cpp)`]);
+  assert.deepEqual(controllerProblems({ controller: cpp('/elsewhere/braitenberg_cpp.so') }, withLibraries),
+    [`unknown controller 'braitenberg_cpp' of plug-in library /elsewhere/braitenberg_cpp.so (the registry has none of its controllers; its plug-in libraries: ${CPP_LIBRARY}, ${C_LIBRARY})`]);
+  assert.deepEqual(controllerProblems({ controller: cpp('plugins/braitenberg_cpp.so') }, withLibraries),
+    [`unknown controller 'braitenberg_cpp' of plug-in library plugins/braitenberg_cpp.so (the registry has none of its controllers; its plug-in libraries: ${CPP_LIBRARY}, ${C_LIBRARY})`]);
+  // A library does not name a built-in, and a registry without libraries says so.
+  assert.deepEqual(controllerProblems({ controller: cpp(CPP_LIBRARY, 'wander') }, withLibraries),
+    [`unknown controller 'wander' of plug-in library ${CPP_LIBRARY} (it holds braitenberg_cpp)`]);
+  const doc = scenario([{ id: 1, pose: 'random', controller: cpp() }]);
+  assert.deepEqual(findProblems(doc, registry),
+    [`robots[0]: unknown controller 'braitenberg_cpp' of plug-in library ${CPP_LIBRARY} (the registry has no plug-in library).`]);
+});
+
+test('a library controller named by its name alone is refused as the parser does, and unknown names list library ones', () => {
+  assert.deepEqual(controllerProblems({ controller: 'braitenberg_cpp', params: { gain: 1 } }, withLibraries),
+    [`'braitenberg_cpp' comes from the plug-in library ${CPP_LIBRARY}: name it as {library: PATH, name: braitenberg_cpp}`]);
+  assert.deepEqual(controllerProblems({ controller: 'track_follow' }, withLibraries),
+    ["unknown controller 'track_follow' (rilbed knows convoy, wander, sweeper, braitenberg_cpp (braitenberg_cpp.so), braitenberg (braitenberg.so))"]);
+});
+
+test('a controller mapping needs a library and a name, and takes nothing else; a list names nothing', () => {
+  assert.deepEqual(controllerProblems({ controller: { name: 'braitenberg_cpp' } }, withLibraries),
+    ["controller.library: give the plug-in library's path, relative to the scenario file"]);
+  assert.deepEqual(controllerProblems({ controller: { library: CPP_LIBRARY, name: '' } }, withLibraries),
+    ["controller.name: give the name of one of the library's controllers"]);
+  assert.deepEqual(controllerProblems({ controller: { ...cpp(), params: { gain: 1 } } }, withLibraries),
+    ['controller.params: unknown key (allowed here: library, name)']);
+  assert.deepEqual(controllerProblems({ controller: ['wander'] }, withLibraries),
+    ["controller must be a controller's name or {library: PATH, name: NAME}"]);
+});
+
+test('a library controller is no convoy robot, whatever its IDs', () => {
+  const doc = scenario([{ ids: '1-2' }, { ids: '5-6', controller: cpp(C_LIBRARY, 'braitenberg') }]);
+  assert.deepEqual(findProblems(doc, withLibraries), []);
 });
