@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # What the tools settle about rilbed's C++, checked (CTest `code_style`):
-#  - every C and C++ file of src/, tests/ and bench/ is as clang-format (.clang-format)
+#  - every C and C++ file of src/, tests/, bench/, sdk/ and examples/ is as clang-format (.clang-format)
 #    leaves it;
 #  - .clang-tidy's two rules (enumerators kCamelCase; no function in src/app, src/run,
 #    src/agents and src/session longer than 120 lines), by tools/style_checks.py in a
@@ -11,7 +11,8 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
 status=0
 mapfile -t files < <(git ls-files 'src/*.cpp' 'src/*.hpp' 'src/*.h' 'src/*.c' 'tests/*.cpp' 'tests/*.hpp' \
-                                  'bench/*.cpp' 'bench/*.hpp' 2>/dev/null)
+                                  'bench/*.cpp' 'bench/*.hpp' 'tests/*.c' 'sdk/*.h' 'sdk/*.hpp' 'examples/*.c' \
+                                  'examples/*.cpp' 2>/dev/null)
 if ((${#files[@]} == 0)); then
   echo "check_style: no files listed (not a git checkout?)" >&2
   exit 1

@@ -1,8 +1,11 @@
 #include "agents/builtin_controllers.hpp"
 
+#include <filesystem>
+#include <stdexcept>
+
 #include "agents/basic_controllers.hpp"
-#include "agents/c_controller.hpp"
 #include "agents/convoy.hpp"
+#include "agents/library_controllers.hpp"
 
 namespace rilbed::agents {
 
@@ -111,15 +114,29 @@ ControllerEntry goto_entry() {
   return e;
 }
 
-ControllerEntry c_entry(const std::string& name) {
-  const rilbed_c_controller* controller = find_c_controller(name);
+// rilbed's own C controller, a plug-in library built beside rilbed from the example that
+// docs/write-a-controller.md shows; loaded the first time a robot needs it.
+ControllerEntry braitenberg_entry() {
   ControllerEntry e;
-  e.name = "c:" + name;
-  e.summary = "a C controller built into rilbed (src/agents/c_controllers/" + name +
-              ".c), reading and driving its robot through rilbed_controller.h's register map";
+  e.name = "c:braitenberg";
+  e.summary =
+      "a Braitenberg wanderer written in C against rilbed_controller.h's register map "
+      "(examples/controllers/braitenberg_c, the plug-in library plugins/braitenberg.so beside rilbed)";
   e.sensors = {"proximity", "odometer", "range_finders", "track", "beacon_finder", "pose"};
   e.concurrent = false;
-  e.make = [controller](const ControllerContext&) { return std::make_unique<CControllerAdapter>(*controller); };
+  e.make = [](const ControllerContext& context) {
+    static const core::Result<ControllerEntry> loaded = []() -> core::Result<ControllerEntry> {
+      const std::filesystem::path path = builtin_plugin_directory() / "braitenberg.so";
+      core::Result<std::vector<ControllerEntry>> entries = load_library_controllers(path);
+      if (!entries) return core::Failure{entries.error()};
+      for (ControllerEntry& entry : *entries) {
+        if (entry.name == "braitenberg") return std::move(entry);
+      }
+      return core::Failure{"plug-in library " + path.string() + " holds no controller 'braitenberg'"};
+    }();
+    if (!loaded) throw std::invalid_argument(loaded.error());
+    return loaded->make(context);
+  };
   return e;
 }
 
@@ -140,7 +157,7 @@ ControllerRegistry builtin_controllers() {
   r.add(track_follow_entry());
   r.add(beacon_homing_entry());
   r.add(goto_entry());
-  for (const std::string& name : c_controller_names()) r.add(c_entry(name));
+  r.add(braitenberg_entry());
   r.add(none_entry());
   return r;
 }

@@ -4,10 +4,6 @@
 #include <cmath>
 #include <stdexcept>
 
-extern "C" {
-extern const rilbed_c_controller rilbed_braitenberg_controller;
-}
-
 namespace rilbed::agents {
 
 namespace {
@@ -57,16 +53,18 @@ void RegisterMap::set(std::uint32_t address, std::int32_t value) {
   words_[address] = value;
 }
 
-const rilbed_c_controller* find_c_controller(std::string_view name) {
-  for (const rilbed_c_controller* c : {&rilbed_braitenberg_controller}) {
-    if (name == c->name) return c;
-  }
-  return nullptr;
+const rilbed_host& plugin_host() {
+  static const rilbed_host host = {
+      RILBED_ABI_VERSION,
+      [](std::uint32_t address) { return current_registers ? current_registers->peek(address) : 0; },
+      [](std::uint32_t address, std::int32_t value) {
+        if (current_registers) current_registers->poke(address, value);
+      }};
+  return host;
 }
 
-std::vector<std::string> c_controller_names() { return {rilbed_braitenberg_controller.name}; }
-
-CControllerAdapter::CControllerAdapter(const rilbed_c_controller& controller) : controller_(controller) {
+CControllerAdapter::CControllerAdapter(const rilbed_c_controller& controller, std::shared_ptr<const void> library)
+    : library_(std::move(library)), controller_(controller) {
   if (!controller.step) throw std::invalid_argument("C controller has no step function");
 }
 
@@ -131,14 +129,3 @@ void CControllerAdapter::finish() {
 }
 
 }  // namespace rilbed::agents
-
-extern "C" {
-
-int32_t rilbed_peek(uint32_t address) {
-  return rilbed::agents::current_registers ? rilbed::agents::current_registers->peek(address) : 0;
-}
-
-void rilbed_poke(uint32_t address, int32_t value) {
-  if (rilbed::agents::current_registers) rilbed::agents::current_registers->poke(address, value);
-}
-}

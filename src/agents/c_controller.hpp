@@ -1,16 +1,20 @@
-// Runs a C controller written against rilbed_controller.h (peek/poke on a register map)
-// as a rilbed Controller: fills the robot's registers from its ControlInput before each
-// call and reads the motor registers back after.
+// Runs a C controller written against rilbed/rilbed_controller.h (peek/poke on a register
+// map) as a rilbed Controller: fills the robot's registers from its ControlInput before
+// each call and reads the motor registers back after. The controllers come from plug-in
+// libraries (library_controllers.hpp); rilbed lends each library the peek and poke of
+// plugin_host().
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "agents/controller.hpp"
-#include "agents/rilbed_controller.h"
+#include "rilbed/rilbed_controller.h"
 
 namespace rilbed::agents {
 
@@ -32,19 +36,20 @@ class RegisterMap {
   int rejected_writes_ = 0;
 };
 
-/// The C controllers built into rilbed, by name (`braitenberg`). nullptr if unknown.
-const rilbed_c_controller* find_c_controller(std::string_view name);
-/// Names of the built-in C controllers.
-std::vector<std::string> c_controller_names();
+/// What rilbed lends every plug-in library (rilbed/plugin.h): peek and poke on the
+/// register map of the robot whose C controller is being called on this thread (0 and
+/// nothing outside such a call). Lives as long as the program.
+const rilbed_host& plugin_host();
 
 /// Adapter from a C controller to the Controller interface; one per robot. The C
 /// controller's functions are called with this robot's register map current (per
 /// thread), so several robots may share one C controller.
 class CControllerAdapter final : public Controller {
  public:
-  /// `controller` must outlive the adapter (the built-ins are static). Throws
+  /// `controller` must stay valid while `library` lives (what keeps the library it comes
+  /// from loaded; null for one that lives as long as the program). Throws
   /// std::invalid_argument if it has no step function.
-  explicit CControllerAdapter(const rilbed_c_controller& controller);
+  explicit CControllerAdapter(const rilbed_c_controller& controller, std::shared_ptr<const void> library = {});
   ~CControllerAdapter() override;
   ControlOutput step(const ControlInput& input) override;
   /// Calls cleanup once (also done by the destructor if the run did not).
@@ -56,6 +61,7 @@ class CControllerAdapter final : public Controller {
 
  private:
   void load_inputs(const ControlInput& input);
+  std::shared_ptr<const void> library_;
   const rilbed_c_controller& controller_;
   RegisterMap registers_;
   bool initialised_ = false;

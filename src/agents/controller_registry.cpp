@@ -180,6 +180,7 @@ nlohmann::ordered_json controllers_json(const ControllerRegistry& registry) {
                     {"wants_team", e.wants_team},
                     {"concurrent", e.concurrent},
                     {"origin", e.origin},
+                    {"library", e.library.empty() ? Json(nullptr) : Json(e.library)},
                     {"params", params}});
   }
   return list;

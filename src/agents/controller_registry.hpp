@@ -88,7 +88,10 @@ struct ControllerEntry {
   bool wants_team = false;                    ///< it reads the team broadcast (Controller::wants_team)
   bool concurrent = true;                     ///< its steps may run beside others' (Controller::concurrent)
   std::string origin = "built in";            ///< where it came from: "built in", a library's or file's path
-  ControllerFactory make;                     ///< makes one; must be set
+  /// The plug-in library's absolute path, for a controller a scenario names with
+  /// `controller: {library: ..., name: ...}`; empty for one named by its name alone.
+  std::string library;
+  ControllerFactory make;  ///< makes one; must be set
 
   /// The entry's parameter `name`, or nullptr.
   const ParamSpec* param(std::string_view name) const;
@@ -128,7 +131,8 @@ class ControllerRegistry {
 
 /// The registry as `rilbed controllers --json` prints it and the web server serves it: a
 /// list of objects with `name`, `summary`, `sensors`, `required_sensors`, `wants_team`,
-/// `concurrent`, `origin` and `params`, each parameter `{name, unit, default, min, max,
+/// `concurrent`, `origin`, `library` (null unless it comes from a plug-in library) and
+/// `params`, each parameter `{name, unit, default, min, max,
 /// summary, required, integer}` (`default`, `min`, `max` null where there is none).
 nlohmann::ordered_json controllers_json(const ControllerRegistry& registry);
 

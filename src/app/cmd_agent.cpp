@@ -160,7 +160,14 @@ int agent_command(const AgentArgs& args) {
                 args.url.empty() ? "LCM's default bus" : args.url.c_str());
     std::fflush(stdout);
   }
-  server.serve(interrupt.flag());
+  try {
+    server.serve(interrupt.flag());
+  } catch (const std::exception& e) {
+    // A controller that failed (a plug-in's step that threw): this process ends, and the
+    // run finds it lost and stops its robots.
+    spdlog::error("agent: {}", e.what());
+    return kExitFailure;
+  }
   if (!args.quiet) {
     const auto& c = server.counters();
     std::printf("agent %s: %lld run(s), %lld steps, %lld repeated answers, %lld quanta skipped\n",

@@ -1,24 +1,66 @@
-// `rilbed controllers [--json]`: the controllers a scenario can name, with their
-// parameters, from the one registry the parser and the run use.
+// `rilbed controllers [--json] [--library PATH]...`: the controllers a scenario can name,
+// with their parameters, from the one registry the parser and the run use; or what
+// plug-in libraries hold.
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "agents/builtin_controllers.hpp"
+#include "agents/library_controllers.hpp"
 #include "app/commands.hpp"
 
 namespace rilbed::app {
 
+namespace {
+
+struct ControllersArgs {
+  bool json = false;
+  std::vector<std::string> libraries;
+};
+
+// The registry to print: rilbed's own, or the controllers of the libraries given alone.
+std::optional<agents::ControllerRegistry> registry_to_print(const ControllersArgs& args) {
+  if (args.libraries.empty()) return *agents::default_controllers();
+  agents::ControllerRegistry registry;
+  for (const std::string& path : args.libraries) {
+    core::Result<std::vector<agents::ControllerEntry>> entries = agents::load_library_controllers(path);
+    if (!entries) {
+      std::fprintf(stderr, "controllers: %s\n", entries.error().c_str());
+      return std::nullopt;
+    }
+    for (agents::ControllerEntry& e : *entries) {
+      try {
+        registry.add(std::move(e));
+      } catch (const std::invalid_argument& error) {
+        std::fprintf(stderr, "controllers: %s\n", error.what());
+        return std::nullopt;
+      }
+    }
+  }
+  return registry;
+}
+
+}  // namespace
+
 void add_controllers_command(CLI::App& app) {
-  auto json = std::make_shared<bool>(false);
+  auto args = std::make_shared<ControllersArgs>();
   CLI::App* cmd = app.add_subcommand(
       "controllers", "List the controllers a scenario can name, with their parameters (units, defaults, ranges)");
-  cmd->add_flag("--json", *json,
+  cmd->add_flag("--json", args->json,
                 "Print JSON instead of tables: a list of {name, summary, sensors, required_sensors, wants_team, "
-                "concurrent, origin, params: [{name, unit, default, min, max, summary, required, integer}]}");
-  cmd->callback([json] {
-    const auto registry = agents::default_controllers();
-    if (*json) {
+                "concurrent, origin, library, params: [{name, unit, default, min, max, summary, required, integer}]}");
+  cmd->add_option("--library", args->libraries,
+                  "List what this plug-in library holds instead (repeatable); a scenario names one of its "
+                  "controllers as {library: PATH, name: NAME}");
+  cmd->callback([args] {
+    const std::optional<agents::ControllerRegistry> registry = registry_to_print(*args);
+    if (!registry) {
+      exit_code() = 1;
+      return;
+    }
+    if (args->json) {
       std::cout << agents::controllers_json(*registry).dump(2) << '\n';
     } else {
       std::cout << agents::controllers_table(*registry);

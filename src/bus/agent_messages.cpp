@@ -2,10 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <mutex>
-#include <set>
 #include <string>
 
+#include "agents/behaviour_names.hpp"
 #include "bus/lcm_bus.hpp"
 #include "bus/lcm_conversion.hpp"
 
@@ -43,7 +42,7 @@ rilbed::team_member_t to_lcm(const agents::TeamMessage& member) {
 }
 
 agents::TeamMessage from_lcm(const rilbed::team_member_t& m) {
-  return {m.id, Pose2{{m.x_m, m.y_m}, m.theta_rad}, intern_behaviour(m.behaviour), m.utime};
+  return {m.id, Pose2{{m.x_m, m.y_m}, m.theta_rad}, agents::intern_behaviour(m.behaviour), m.utime};
 }
 
 rilbed::agent_output_t to_lcm(const run::RemoteOutput& output) {
@@ -63,7 +62,7 @@ run::RemoteOutput from_lcm(const rilbed::agent_output_t& m) {
   out.robot_id = m.id;
   out.output.wheels = {std::clamp<int>(m.left_units, -agents::kMaxWheelUnits, agents::kMaxWheelUnits),
                        std::clamp<int>(m.right_units, -agents::kMaxWheelUnits, agents::kMaxWheelUnits)};
-  out.output.behaviour = intern_behaviour(m.behaviour);
+  out.output.behaviour = agents::intern_behaviour(m.behaviour);
   out.done = m.done;
   return out;
 }
@@ -86,23 +85,6 @@ bool plausible(const rilbed::quantum_t& q) {
     if (!(finite(m.x_m) && finite(m.y_m) && finite(m.theta_rad))) return false;
   }
   return true;
-}
-
-std::string_view intern_behaviour(std::string_view name) {
-  constexpr std::size_t kMaxLength = 64, kMaxNames = 1024;
-  // Nodes of a std::set never move: a view of one stays valid for the program's life. The
-  // names rilbed's own controllers use are there from the start, so that a peer sending
-  // junk names cannot make them "other".
-  static std::mutex mutex;
-  static std::set<std::string, std::less<>> names = {"idle",  "console", "lost",   "search",  "follow", "wait",
-                                                     "avoid", "unknown", "cruise", "arrived", "home",   "placed",
-                                                     "yield", "place",   "align",  "c0",      "c1",     "c2",
-                                                     "c3",    "c4",      "c5",     "c6",      "c7",     "c?"};
-  if (name.size() > kMaxLength) return "other";
-  std::lock_guard lock(mutex);
-  if (const auto it = names.find(name); it != names.end()) return *it;
-  if (names.size() >= kMaxNames) return "other";
-  return *names.emplace(name).first;
 }
 
 }  // namespace rilbed::bus

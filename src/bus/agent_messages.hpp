@@ -23,11 +23,11 @@ rilbed::agent_input_t to_lcm(const agents::ControlInput& input);
 agents::ControlInput from_lcm(const rilbed::agent_input_t& message, TimeUs t_us);
 
 rilbed::team_member_t to_lcm(const agents::TeamMessage& member);
-/// Its behaviour interned (see intern_behaviour).
+/// Its behaviour interned (agents::intern_behaviour).
 agents::TeamMessage from_lcm(const rilbed::team_member_t& message);
 
 rilbed::agent_output_t to_lcm(const run::RemoteOutput& output);
-/// Wheel speeds clamped to +-kMaxWheelUnits; the behaviour interned.
+/// Wheel speeds clamped to +-kMaxWheelUnits; the behaviour interned (agents::intern_behaviour).
 run::RemoteOutput from_lcm(const rilbed::agent_output_t& message);
 
 /// Whether every input of a quantum from the network is one a controller can be handed:
@@ -35,11 +35,5 @@ run::RemoteOutput from_lcm(const rilbed::agent_output_t& message);
 /// in 0..kProximityMax, track values not negative. (lcm-gen's decoder takes any bits; a NaN
 /// pose would reach a controller's arithmetic.)
 bool plausible(const rilbed::quantum_t& quantum);
-
-/// A behaviour name from the network as a string that lives as long as the program (as
-/// ControlOutput::behaviour must): the same view for the same name. Names are kept up to
-/// 64 bytes and at most 1,024 distinct ones, the names of rilbed's own controllers among
-/// them from the start; beyond that (a peer sending junk) "other".
-std::string_view intern_behaviour(std::string_view name);
 
 }  // namespace rilbed::bus

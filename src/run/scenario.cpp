@@ -4,11 +4,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <sstream>
 
 #include "agents/builtin_controllers.hpp"
+#include "agents/library_controllers.hpp"
 #include "core/id_list.hpp"
 #include "environment/shapes.hpp"
 
@@ -251,30 +254,105 @@ std::optional<Pose2> read_pose(const Reader& r, std::size_t robots) {
   return Pose2{{v[0], v[1]}, deg_to_rad(v[2])};
 }
 
+// The registry a scenario's robots are read against: the one given, and the controllers
+// of the plug-in libraries its robots name (`controller: {library: ..., name: ...}`),
+// added to a copy of it the first time each library is met.
+class ScenarioControllers {
+ public:
+  explicit ScenarioControllers(std::shared_ptr<const agents::ControllerRegistry> base) : base_(std::move(base)) {}
+  const agents::ControllerRegistry& registry() const { return extended_ ? *extended_ : *base_; }
+  // The registry with every library's controllers, for the scenario to carry.
+  std::shared_ptr<const agents::ControllerRegistry> result() const {
+    return extended_ ? std::make_shared<const agents::ControllerRegistry>(*extended_) : base_;
+  }
+  // The entry `name` of the library at `path` (already absolute), loading the library the
+  // first time; a problem is reported against `r`'s `controller` key.
+  const agents::ControllerEntry& from_library(const Reader& r, const std::filesystem::path& path,
+                                              const std::string& name) {
+    if (loaded_.insert(path.string()).second) add_library(r, path);
+    const agents::ControllerEntry* entry = registry().find(name);
+    if (!entry || entry->library != path.string()) {
+      std::vector<std::string> held;
+      for (const agents::ControllerEntry& e : registry().entries()) {
+        if (e.library == path.string()) held.push_back(e.name);
+      }
+      std::string list;
+      for (const std::string& h : held) list += (list.empty() ? "" : ", ") + h;
+      r.fail_key("controller", "plug-in library " + path.string() + " holds no controller '" + name + "' (it holds " +
+                                   (list.empty() ? std::string("none") : list) + ")");
+    }
+    return *entry;
+  }
+
+ private:
+  void add_library(const Reader& r, const std::filesystem::path& path) {
+    core::Result<std::vector<agents::ControllerEntry>> entries = agents::load_library_controllers(path);
+    if (!entries) r.fail_key("controller", entries.error());
+    if (!extended_) extended_ = *base_;
+    for (agents::ControllerEntry& e : *entries) {
+      try {
+        extended_->add(std::move(e));
+      } catch (const std::invalid_argument& error) {
+        r.fail_key("controller", error.what());
+      }
+    }
+  }
+
+  std::shared_ptr<const agents::ControllerRegistry> base_;
+  std::optional<agents::ControllerRegistry> extended_;
+  std::set<std::string> loaded_;
+};
+
+// The entry a robot's `controller` names: a name of the registry, or a plug-in library's
+// controller, `{library: PATH, name: NAME}` with PATH relative to the scenario file.
+const agents::ControllerEntry& read_controller_name(const Reader& r, ScenarioControllers& controllers,
+                                                    ControllerSpec& spec) {
+  if (r.has("controller") && r.get("controller").IsMap()) {
+    const Reader c = r.child("controller");
+    c.allow({"library", "name"});
+    const std::string library = c.text("library", "");
+    spec.name = c.text("name", "");
+    if (library.empty()) c.fail_key("library", "give the plug-in library's path, relative to the scenario file");
+    if (spec.name.empty()) c.fail_key("name", "give the name of one of the library's controllers");
+    const std::filesystem::path base = std::filesystem::path(r.source()).parent_path();
+    std::error_code ec;
+    const std::filesystem::path path = std::filesystem::absolute(base / library, ec).lexically_normal();
+    spec.library = path.string();
+    return controllers.from_library(r, path, spec.name);
+  }
+  spec.name = r.text("controller", "convoy");
+  const agents::ControllerEntry* controller = controllers.registry().find(spec.name);
+  if (!controller) {
+    r.fail_key("controller",
+               "unknown controller '" + spec.name + "' (known: " + controllers.registry().names_text() +
+                   "; `rilbed controllers` lists them; a plug-in library's: {library: PATH, name: NAME})");
+  }
+  if (!controller->library.empty()) {
+    r.fail_key("controller", "'" + spec.name + "' comes from the plug-in library " + controller->library +
+                                 ": name it as {library: PATH, name: " + spec.name + "}");
+  }
+  return *controller;
+}
+
 // `controller` and `params`, checked against the controller's registry entry; the entry,
 // for the robot's sensors to be checked against.
-const agents::ControllerEntry& read_controller(const Reader& r, const agents::ControllerRegistry& controllers,
+const agents::ControllerEntry& read_controller(const Reader& r, ScenarioControllers& controllers,
                                                ControllerSpec& spec) {
-  spec.name = r.text("controller", "convoy");
-  const agents::ControllerEntry* controller = controllers.find(spec.name);
-  if (!controller) {
-    r.fail_key("controller", "unknown controller '" + spec.name + "' (known: " + controllers.names_text() +
-                                 "; `rilbed controllers` lists them)");
-  }
+  const agents::ControllerEntry& controller = read_controller_name(r, controllers, spec);
   if (!r.has("params")) {
-    if (const auto problem = agents::check_params(*controller, {})) r.fail_key("controller", problem->problem);
-    return *controller;
+    if (const auto problem = agents::check_params(controller, {})) r.fail_key("controller", problem->problem);
+    return controller;
   }
   const Reader p = r.child("params");
   for (const auto& kv : r.get("params")) {
     const std::string key = kv.first.as<std::string>();
     spec.params[key] = p.number(key, 0.0);
   }
-  if (const auto problem = agents::check_params(*controller, spec.params)) {
+  if (const auto problem = agents::check_params(controller, spec.params)) {
     if (problem->key.empty()) r.fail_key("params", problem->problem);
     p.fail_key(problem->key, problem->problem);
   }
-  return *controller;
+  return controller;
 }
 
 environment::WheelNoiseConfig read_noise(const Reader& n) {
@@ -337,7 +415,7 @@ LinkSpec read_link(const Reader& l, const YAML::Node& at) {
 }
 
 // Every robot entry, each of one robot (`id`) or several alike (`ids`), sorted by ID.
-std::vector<RobotSpec> read_robots(const Reader& top, const agents::ControllerRegistry& controllers) {
+std::vector<RobotSpec> read_robots(const Reader& top, ScenarioControllers& controllers) {
   const YAML::Node list = top.get("robots");
   if (!list || !list.IsSequence() || list.size() == 0) top.fail_key("robots", "must be a non-empty list of robots");
   std::vector<RobotSpec> robots;
@@ -552,8 +630,7 @@ AgentsSpec read_agents(const Reader& top, const std::vector<RobotSpec>& robots) 
   return spec;
 }
 
-Scenario read_scenario(const YAML::Node& root, const std::string& source,
-                       const agents::ControllerRegistry& controllers) {
+Scenario read_scenario(const YAML::Node& root, const std::string& source, ScenarioControllers& controllers) {
   Scenario s;
   const Reader top(root, source, "");
   top.allow({"name", "description", "mode", "field", "timing", "duration_s", "convoy", "obstacles", "tracks", "beacons",
@@ -598,8 +675,9 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& source_
   }
   if (!root || root.IsNull()) throw ScenarioError(source_name + ": the scenario is empty");
   try {
-    Scenario scenario = read_scenario(root, source_name, *controllers);
-    scenario.controllers = std::move(controllers);
+    ScenarioControllers registry(std::move(controllers));
+    Scenario scenario = read_scenario(root, source_name, registry);
+    scenario.controllers = registry.result();
     return scenario;
   } catch (const YAML::Exception& e) {
     throw ScenarioError(source_name + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);

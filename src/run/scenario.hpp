@@ -76,6 +76,9 @@ struct ControllerSpec {
   /// An entry of the scenario's controller registry (`rilbed controllers` lists them):
   /// "convoy", "wander", ..., "none" (stands still).
   std::string name = "convoy";
+  /// The plug-in library it comes from, an absolute path (`controller: {library: PATH,
+  /// name: NAME}`, PATH relative to the scenario file); empty for a name of the registry.
+  std::string library;
   std::map<std::string, double> params;  ///< the entry's parameters, checked against it
 };
 

@@ -41,42 +41,17 @@
 #include <utility>
 #include <vector>
 
+#include "core/result.hpp"
 #include "environment/sensor_readings.hpp"
 
 namespace rilbed::serial {
 
 // ---------------------------------------------------------------- results
 
-/// The reason a Result holds no value: what was wrong, in words a user can act on.
-struct Failure {
-  std::string reason;
-};
-
-/// A value or the reason there is none (std::expected's role; C++20 has none). Bad bytes
-/// from a robot are ordinary input, so decoding returns this rather than throwing.
-template <typename T>
-class Result {
- public:
-  /// A success holding `value`.
-  Result(T value) : value_(std::move(value)) {}  // NOLINT(google-explicit-constructor): `return value;`
-  /// A failure holding `failure.reason`.
-  Result(Failure failure) : error_(std::move(failure.reason)) {}  // NOLINT(google-explicit-constructor)
-
-  /// true when it holds a value.
-  bool ok() const { return value_.has_value(); }
-  explicit operator bool() const { return ok(); }
-  /// The value; only valid when ok().
-  const T& value() const { return *value_; }
-  T& value() { return *value_; }
-  const T& operator*() const { return *value_; }
-  const T* operator->() const { return &*value_; }
-  /// Why there is no value; empty when ok().
-  const std::string& error() const { return error_; }
-
- private:
-  std::optional<T> value_;
-  std::string error_;
-};
+/// Bad bytes from a robot are ordinary input, so decoding returns a core::Result (a value
+/// or the reason there is none) rather than throwing.
+using core::Failure;
+using core::Result;
 
 // ---------------------------------------------------------------- commands
 

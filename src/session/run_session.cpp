@@ -407,8 +407,10 @@ SessionResult run_single(SessionParts& p, const SessionOptions& o, const Session
   try {
     result.runs.push_back(run_seed(p, o, out, p.base));
   } catch (const run::ScenarioError& e) {
+    print_emulated_last_speeds(p, out);  // the run's end stopped them: say so
     return problem(Status::kFailed, e.what());
   } catch (const std::exception& e) {
+    print_emulated_last_speeds(p, out);
     return problem(Status::kFailed, std::string("run failed: ") + e.what());
   }
   out.print(result_line(result.runs.back()));

@@ -117,44 +117,5 @@ TEST(BeaconHomingController, TurnsToTheBeaconAndSearchesWithoutOne) {
   EXPECT_EQ(arrived.wheels, (WheelCommand{0, 0}));
 }
 
-TEST(CController, BraitenbergDrivesThroughTheRegisters) {
-  const rilbed_c_controller* c = find_c_controller("braitenberg");
-  ASSERT_NE(c, nullptr);
-  EXPECT_EQ(find_c_controller("nonesuch"), nullptr);
-  CControllerAdapter robot(*c);
-  ControlOutput open = robot.step(with_proximity({}));
-  EXPECT_EQ(open.wheels, (WheelCommand{10, 10}));
-  EXPECT_EQ(open.behaviour, "c0");
-  ControlOutput left = robot.step(with_proximity({900, 900, 400, 0, 0, 0, 0, 0}));
-  EXPECT_GT(left.wheels.left, left.wheels.right);
-  EXPECT_EQ(left.behaviour, "c1");
-  EXPECT_EQ(robot.registers().peek(RILBED_REG_ID), 3);
-  EXPECT_EQ(robot.registers().peek(RILBED_REG_PROX_0), 900);
-  EXPECT_EQ(robot.registers().peek(RILBED_REG_USER_0), 2);  // init zeroed it, two steps counted
-  robot.finish();
-  EXPECT_EQ(robot.registers().peek(RILBED_REG_MOTOR_LEFT), 0);  // cleanup stopped the motors
-}
-
-TEST(CController, EachRobotHasItsOwnRegisters) {
-  const rilbed_c_controller* c = find_c_controller("braitenberg");
-  CControllerAdapter a(*c), b(*c);
-  for (int i = 0; i < 3; ++i) a.step(with_proximity({}));
-  b.step(with_proximity({}));
-  EXPECT_EQ(a.registers().peek(RILBED_REG_USER_0), 3);
-  EXPECT_EQ(b.registers().peek(RILBED_REG_USER_0), 1);
-}
-
-TEST(RegisterMap, ControllerWritesOnlyWhereAllowed) {
-  RegisterMap r;
-  r.poke(RILBED_REG_PROX_0, 5);
-  r.poke(RILBED_REG_COUNT + 10, 5);
-  EXPECT_EQ(r.peek(RILBED_REG_PROX_0), 0);
-  EXPECT_EQ(r.rejected_writes(), 2);
-  r.poke(RILBED_REG_MOTOR_RIGHT, -40);
-  EXPECT_EQ(r.peek(RILBED_REG_MOTOR_RIGHT), -40);
-  EXPECT_EQ(r.peek(0xFFFFFFFFu), 0);
-  EXPECT_EQ(rilbed_peek(RILBED_REG_ID), 0);  // outside any controller call: no current robot
-}
-
 }  // namespace
 }  // namespace rilbed::agents

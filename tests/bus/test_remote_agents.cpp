@@ -11,6 +11,7 @@
 #include <random>
 #include <thread>
 
+#include "agents/behaviour_names.hpp"
 #include "bus/agent_messages.hpp"
 #include "bus/agent_server.hpp"
 #include "bus/remote_agents.hpp"
@@ -88,16 +89,16 @@ TEST(AgentMessages, AnInputAndAnOutputCrossTheWireExactly) {
 }
 
 TEST(AgentMessages, BehaviourNamesAreInternedAndBounded) {
-  const std::string_view a = intern_behaviour(std::string("search"));
-  const std::string_view b = intern_behaviour(std::string("search"));
+  const std::string_view a = agents::intern_behaviour(std::string("search"));
+  const std::string_view b = agents::intern_behaviour(std::string("search"));
   EXPECT_EQ(a.data(), b.data());  // one string for the program's life
-  EXPECT_EQ(intern_behaviour(std::string(200, 'x')), "other");
-  for (int i = 0; i < 1100; ++i) intern_behaviour("junk" + std::to_string(i));  // a peer sending junk
-  EXPECT_EQ(intern_behaviour("never-seen-before"), "other");
+  EXPECT_EQ(agents::intern_behaviour(std::string(200, 'x')), "other");
+  for (int i = 0; i < 1100; ++i) agents::intern_behaviour("junk" + std::to_string(i));  // a peer sending junk
+  EXPECT_EQ(agents::intern_behaviour("never-seen-before"), "other");
   // rilbed's own names still come back as themselves.
-  EXPECT_EQ(intern_behaviour("search").data(), a.data());
-  EXPECT_EQ(intern_behaviour("wait"), "wait");
-  EXPECT_EQ(intern_behaviour("follow"), "follow");
+  EXPECT_EQ(agents::intern_behaviour("search").data(), a.data());
+  EXPECT_EQ(agents::intern_behaviour("wait"), "wait");
+  EXPECT_EQ(agents::intern_behaviour("follow"), "follow");
 }
 
 // A convoy run whose controllers all run in an AgentServer on the same memq bus.

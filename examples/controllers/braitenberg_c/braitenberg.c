@@ -1,7 +1,12 @@
 /* A Braitenberg wanderer written as embedded C against rilbed's register map: it reads
  * the eight proximity registers and writes the two motor registers, nothing else. The
- * same source builds for a microcontroller whose peek/poke read the real hardware. */
-#include "agents/rilbed_controller.h"
+ * controller itself (braitenberg_init, _step, _cleanup) builds unchanged for a
+ * microcontroller whose rilbed_peek and rilbed_poke read the real hardware; the last
+ * lines make it a rilbed plug-in library. rilbed's own `c:braitenberg` is this file, built
+ * beside rilbed; docs/write-a-controller.md walks through it. */
+#include <stddef.h>
+
+#include <rilbed/rilbed_controller.h>
 
 /* Weights from each proximity sensor to each wheel, per 1023 of reading (sensor 0 is on
  * the left): an obstacle on the left speeds the left wheel and slows the right one. */
@@ -37,5 +42,13 @@ static void braitenberg_cleanup(void) {
   rilbed_poke(RILBED_REG_MOTOR_RIGHT, 0);
 }
 
-const rilbed_c_controller rilbed_braitenberg_controller = {"braitenberg", braitenberg_init, braitenberg_step,
-                                                           braitenberg_cleanup};
+/* The plug-in library: the ABI version and rilbed's peek and poke (once per library), and
+ * the list of the controllers it holds, ended by NULL. */
+RILBED_DEFINE_PLUGIN();
+
+static const rilbed_c_controller braitenberg = {"braitenberg", braitenberg_init, braitenberg_step, braitenberg_cleanup};
+
+const rilbed_c_controller* const* rilbed_controllers(void) {
+  static const rilbed_c_controller* const list[] = {&braitenberg, NULL};
+  return list;
+}
