@@ -9,6 +9,7 @@ set(RILBED_SDK_HEADERS
   plugin.h
   rilbed_controller.h
   controller.hpp
+  sensor_model.h
 )
 foreach(header IN LISTS RILBED_SDK_HEADERS)
   configure_file(${CMAKE_CURRENT_SOURCE_DIR}/sdk/include/rilbed/${header} ${RILBED_SDK_DIR}/include/rilbed/${header} COPYONLY)

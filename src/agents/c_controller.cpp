@@ -25,7 +25,7 @@ class CurrentRegisters {
 
 bool controller_writable(std::uint32_t address) {
   return address == RILBED_REG_MOTOR_LEFT || address == RILBED_REG_MOTOR_RIGHT || address == RILBED_REG_BEHAVIOUR ||
-         (address >= RILBED_REG_USER_0 && address < RILBED_REG_COUNT);
+         (address >= RILBED_REG_USER_0 && address < RILBED_REG_USER_0 + 256);
 }
 
 constexpr std::string_view kBehaviourNames[] = {"c0", "c1", "c2", "c3", "c4", "c5", "c6", "c7"};
@@ -96,6 +96,14 @@ void CControllerAdapter::load_inputs(const ControlInput& input) {
     r.set(RILBED_REG_BEACON_0 + 2 * i, s.beacons[i].id);
     r.set(RILBED_REG_BEACON_0 + 2 * i + 1, saturate(rad_to_deg(s.beacons[i].bearing_rad) * 1000));
   }
+  std::uint32_t values = 0;
+  for (const environment::ModelReading& m : s.models) {
+    for (const double v : m.values) {
+      if (values == 256) break;
+      r.set(RILBED_REG_MODEL_0 + values++, saturate(v * 1000));
+    }
+  }
+  r.set(RILBED_REG_MODEL_COUNT, static_cast<std::int32_t>(values));
   r.set(RILBED_REG_POSE_VALID, input.pose ? 1 : 0);
   if (input.pose) {
     r.set(RILBED_REG_POSE_X_MM, saturate(input.pose->position_m.x * 1000));

@@ -85,7 +85,11 @@ bool robot_has_sensor(const environment::SensorSuiteConfig& sensors, std::string
   if (name == "proximity") return sensors.proximity.has_value();
   if (name == "range_finders") return !sensors.range_finders.empty();
   if (name == "beacon_finder") return sensors.beacon_finder.has_value();
-  if (name == "track") return !sensors.track_sensors.empty();
+  if (name == "track") {
+    return !sensors.track_sensors.empty() ||
+           std::any_of(sensors.models.begin(), sensors.models.end(),
+                       [](const environment::SensorModelMount& m) { return m.model && m.model->provides_track(); });
+  }
   if (name == "odometer") return sensors.odometer;
   return name == "pose";
 }

@@ -179,6 +179,13 @@ class ClassController final : public Controller {
     raw_.beacon_count = static_cast<std::uint32_t>(beacons_.size());
     raw_.team = team_.data();
     raw_.team_count = static_cast<std::uint32_t>(team_.size());
+    models_.clear();
+    for (const environment::ModelReading& m : s.models) {
+      // The names are the mounts' (NUL-terminated std::strings of the run's sensor models).
+      models_.push_back({m.name.data(), m.values.data(), static_cast<std::uint32_t>(m.values.size())});
+    }
+    raw_.models = models_.data();
+    raw_.model_count = static_cast<std::uint32_t>(models_.size());
   }
 
   std::shared_ptr<const PluginLibrary> library_;
@@ -194,6 +201,7 @@ class ClassController final : public Controller {
   std::vector<std::int32_t> track_;
   std::vector<rilbed_beacon> beacons_;
   std::vector<rilbed_team_member> team_;
+  std::vector<rilbed_model_reading> models_;
 };
 
 // One robot's controller of class `c`: its parameters as the class's create() takes them.

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "app/commands.hpp"
+#include "app/sim_bench_sensors.hpp"
 #include "bus/lcm_bus.hpp"
 #include "bus/run_publisher.hpp"
 #include "core/id_list.hpp"
@@ -33,6 +34,7 @@ struct BenchArgs {
   std::vector<std::string> lcm_urls;  // also time each count with the run published on each of these buses
   bool no_split = false;              // leave the run's parts untimed (RunOptions::profile)
   std::string threads = "1";          // thread counts to time each robot count with
+  std::string sensor_plugin;          // also time a plug-in sensor model against the built-in one
 };
 
 // The process's peak resident set so far, MB (getrusage; Linux reports kilobytes).
@@ -338,7 +340,17 @@ int bench_command(const BenchArgs& args) {
     spdlog::error("--lcm times the bus on one thread: give it without --threads");
     return kExitUsage;
   }
-  return SimBench(args, counts.ids, thread_counts.ids).run();
+  const int status = SimBench(args, counts.ids, thread_counts.ids).run();
+  if (status != 0 || args.sensor_plugin.empty()) return status;
+  SensorBenchOptions sensors;
+  sensors.library = args.sensor_plugin;
+  sensors.robots = counts.ids;
+  sensors.seconds = args.seconds;
+  sensors.physics_step_ms = args.physics_step_ms;
+  sensors.density_per_m2 = args.density_per_m2;
+  sensors.seed = args.seed;
+  sensors.repeat = args.repeat;
+  return run_sensor_bench(sensors);
 }
 
 }  // namespace
@@ -368,6 +380,9 @@ void add_sim_bench_command(CLI::App& app) {
                   "Thread counts to time each robot count with, a list (e.g. 1,2): the world and the agents stepped on "
                   "that many threads; every count must give the same trajectories")
       ->default_val(args->threads);
+  cmd->add_option("--sensor-plugin", args->sensor_plugin,
+                  "Also time each count with three track elements per robot, built in and from this plug-in library's "
+                  "track_element (examples/sensors/track_sensor), and print them side by side");
   cmd->add_flag("--no-split", args->no_split,
                 "Do not time the runs' parts (sensing, behaviours, integration, collisions, recording): the table of "
                 "where the time goes is left out, and the clock reads with it");

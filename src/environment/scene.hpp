@@ -9,6 +9,7 @@
 #include <span>
 
 #include "environment/body.hpp"
+#include "environment/mobile_pose.hpp"
 #include "environment/moving_obstacle.hpp"
 #include "environment/segment_index.hpp"
 #include "environment/spatial_grid.hpp"
@@ -25,6 +26,8 @@ struct Scene {
   std::span<const MovingObstacle> movers;  ///< by index
   std::span<const BeaconConfig> beacons;   ///< the map's, in its order
   double max_body_radius_m = 0.0;          ///< largest robot radius, to widen grid queries
+  /// Every robot and moving obstacle now, for sensor models; empty unless a robot carries one.
+  std::span<const MobilePose> mobiles = {};
 
   /// Calls visitor.disc(centre, radius_m) and visitor.segment(a, b) for every surface
   /// that may come within reach_m of p: robots (except slot `exclude_body`), wall and

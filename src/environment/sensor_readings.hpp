@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include "core/geometry.hpp"
@@ -51,6 +52,12 @@ struct OdometryReading {
   std::int64_t right_pulses = 0;
 };
 
+/// One sensor model's readings (a plug-in's, sensor_model.hpp), under its mount's name.
+struct ModelReading {
+  std::string_view name;       ///< the mount's name; valid while the run's scenario lives
+  std::vector<double> values;  ///< as many as the model writes
+};
+
 /// Everything one robot sensed at one instant. Sensors a robot does not carry are left
 /// empty (empty vectors, nullopt).
 struct SensorReadings {
@@ -60,6 +67,7 @@ struct SensorReadings {
   std::vector<BeaconSighting> beacons;       ///< beacons in view of the direction finder
   std::vector<int> track;                    ///< one value per track sensor, 0..its max value
   std::optional<OdometryReading> odometry;   ///< wheel counters
+  std::vector<ModelReading> models;          ///< sensor models' readings, in mount order (not those providing track)
 };
 
 }  // namespace rilbed::environment

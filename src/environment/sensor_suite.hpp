@@ -2,7 +2,9 @@
 // reads all of them at once into a SensorReadings.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,6 +13,7 @@
 #include "environment/beacon_finder.hpp"
 #include "environment/proximity_sensor.hpp"
 #include "environment/range_finder.hpp"
+#include "environment/sensor_model.hpp"
 #include "environment/track_sensor.hpp"
 
 namespace rilbed::environment {
@@ -23,6 +26,7 @@ struct SensorSuiteConfig {
   std::optional<BeaconFinderConfig> beacon_finder;               ///< nullopt: none
   std::vector<TrackSensorConfig> track_sensors;                  ///< elements, in reading order
   bool odometer = true;                                          ///< report the wheel counters
+  std::vector<SensorModelMount> models;                          ///< sensor models (plug-ins'), in mount order
   bool operator==(const SensorSuiteConfig&) const = default;
 };
 
@@ -41,9 +45,11 @@ class SensorSuite {
              NoiseRng& rng, SensorReadings& out) const {
     sense(scene, body, pose, Vec2{std::cos(pose.heading_rad), std::sin(pose.heading_rad)}, odometry, t_us, rng, out);
   }
-  /// As above, with the heading's unit vector (cos, sin of pose.heading_rad) given.
+  /// As above, with the heading's unit vector (cos, sin of pose.heading_rad) given, and the
+  /// robot's ID for its sensor models (which are called last, in mount order, and may throw
+  /// std::runtime_error).
   void sense(const Scene& scene, int body, Pose2 pose, Vec2 heading, std::optional<OdometryReading> odometry,
-             TimeUs t_us, NoiseRng& rng, SensorReadings& out) const;
+             TimeUs t_us, NoiseRng& rng, SensorReadings& out, int robot_id = 0) const;
 
   /// The IR ring, if carried.
   const std::optional<ProximitySensor>& proximity() const { return proximity_; }
@@ -51,14 +57,25 @@ class SensorSuite {
   const RangeFinders& range_finders() const { return range_finders_; }
   /// The track sensor elements (possibly none), with their footprints.
   const std::vector<TrackSensor>& track_sensors() const { return track_sensors_; }
-  /// Whether its readings may fill any of SensorReadings' lists (ranges, beacons, track).
-  bool has_lists() const { return range_finders_.size() > 0 || beacon_finder_ || !track_sensors_.empty(); }
+  /// The sensor models it carries, in mount order.
+  const std::vector<std::shared_ptr<const SensorModel>>& models() const { return models_; }
+  /// Whether its readings may fill any of SensorReadings' lists (ranges, beacons, track, models).
+  bool has_lists() const {
+    return range_finders_.size() > 0 || beacon_finder_ || !track_sensors_.empty() || !models_.empty();
+  }
+  /// Whether every model it carries may sense for several robots at once.
+  bool models_concurrent() const {
+    return std::all_of(models_.begin(), models_.end(), [](const auto& m) { return m->concurrent(); });
+  }
 
  private:
+  void sense_models(const Scene& scene, Pose2 pose, Vec2 heading, TimeUs t_us, NoiseRng& rng, SensorReadings& out,
+                    int robot_id) const;
   std::optional<ProximitySensor> proximity_;
   RangeFinders range_finders_;
   std::optional<BeaconFinderConfig> beacon_finder_;
   std::vector<TrackSensor> track_sensors_;
+  std::vector<std::shared_ptr<const SensorModel>> models_;
   bool odometer_ = true;
 };
 

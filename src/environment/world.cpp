@@ -95,7 +95,22 @@ std::size_t World::slot(int id) const {
 
 const RobotState& World::robot(int id) const { return robots_[slot(id)]; }
 
-Scene World::scene() const { return Scene{statics_, tracks_, bodies_, grid_, movers_, map_.beacons(), max_radius_m_}; }
+Scene World::scene() const {
+  return Scene{statics_, tracks_, bodies_, grid_, movers_, map_.beacons(), max_radius_m_, mobiles_};
+}
+
+void World::refresh_mobiles() const {
+  if (!has_models_) return;
+  mobiles_.resize(added_order_.size() + movers_.size());
+  for (std::size_t k = 0; k < added_order_.size(); ++k) {
+    const Pose2& p = poses_[k];
+    mobiles_[k] = {added_order_[k], p.position_m.x, p.position_m.y, p.heading_rad};
+  }
+  for (std::size_t m = 0; m < movers_.size(); ++m) {
+    const Vec2 p = movers_[m].position_m();
+    mobiles_[added_order_.size() + m] = {-1 - static_cast<int>(m), p.x, p.y, 0.0};
+  }
+}
 
 void World::check_placement_free(const std::string& what, Vec2 p, double r, int exclude_slot) const {
   const double tol = config_.collision.tolerance_m;
@@ -234,6 +249,8 @@ std::uint32_t World::pooled_suite(const SensorSuiteConfig& config, SensorSuite&&
   for (std::size_t k = suite_configs_.size(); k-- > suite_configs_.size() - look_back;)
     if (suite_configs_[k] == config) return static_cast<std::uint32_t>(k);
   suite_configs_.push_back(config);
+  has_models_ = has_models_ || !suite.models().empty();
+  models_concurrent_ = models_concurrent_ && suite.models_concurrent();
   suite_pool_.push_back(std::move(suite));
   return static_cast<std::uint32_t>(suite_pool_.size() - 1);
 }
@@ -521,7 +538,8 @@ SensorReadings World::sense(int id, TimeUs t_us, NoiseRng& rng) const {
   std::optional<OdometryReading> odometry;
   if (r.kind == RobotKind::kVirtual) odometry = r.odometer();
   SensorReadings out;
-  suite_pool_[suite_of_[s]].sense(scene(), static_cast<int>(s), r.pose, headings_[s], odometry, t_us, rng, out);
+  refresh_mobiles();
+  suite_pool_[suite_of_[s]].sense(scene(), static_cast<int>(s), r.pose, headings_[s], odometry, t_us, rng, out, r.id);
   return out;
 }
 
@@ -540,12 +558,13 @@ void World::sense_into(int id, TimeUs t_us, SensorReadings& out) const {
       out.odometry.reset();
     if (stored.has_lists) {
       const StoredLists& lists = ahead_lists_[added];
-      out.ranges = lists.ranges, out.beacons = lists.beacons, out.track = lists.track;
+      out.ranges = lists.ranges, out.beacons = lists.beacons, out.track = lists.track, out.models = lists.models;
     } else {
-      out.ranges.clear(), out.beacons.clear(), out.track.clear();
+      out.ranges.clear(), out.beacons.clear(), out.track.clear(), out.models.clear();
     }
     return;
   }
+  refresh_mobiles();
   sense_slot(scene(), slot(id), t_us, out);
 }
 
@@ -556,11 +575,13 @@ void World::store_readings(std::size_t added, SensorReadings& readings) {
   if (stored.has_proximity) stored.proximity = *readings.proximity;
   stored.has_odometry = readings.odometry.has_value();
   if (stored.has_odometry) stored.odometry = *readings.odometry;
-  stored.has_lists = !readings.ranges.empty() || !readings.beacons.empty() || !readings.track.empty();
+  stored.has_lists =
+      !readings.ranges.empty() || !readings.beacons.empty() || !readings.track.empty() || !readings.models.empty();
   if (stored.has_lists) {
     // Swapped, not copied: the record's old lists become the scratch's, capacity kept.
     StoredLists& lists = ahead_lists_[added];
     lists.ranges.swap(readings.ranges), lists.beacons.swap(readings.beacons), lists.track.swap(readings.track);
+    lists.models.swap(readings.models);
   }
 }
 
@@ -570,9 +591,11 @@ void World::sense_ahead(TimeUs t_us) {
   const bool lists =
       std::any_of(suite_pool_.begin(), suite_pool_.end(), [](const SensorSuite& x) { return x.has_lists(); });
   ahead_lists_.resize(lists ? robots_.size() : 0);
+  refresh_mobiles();
   const Scene sc = scene();
-  // Slot order is by place (renumber_by_place): a robot's neighbours were just read.
-  for_robot_slots([&](std::size_t begin, std::size_t end) {
+  // Slot order is by place (renumber_by_place): a robot's neighbours were just read. A
+  // sensor model that may not sense for two robots at once keeps the sweep on one thread.
+  auto sweep = [&](std::size_t begin, std::size_t end) {
     SensorReadings readings;  // this thread's, reused (its lists keep their capacity)
     for (std::size_t s = begin; s < end; ++s) {
       // The store is in the agents' order, so each robot's record is far from the last
@@ -584,7 +607,12 @@ void World::sense_ahead(TimeUs t_us) {
       sense_slot(sc, s, t_us, readings);
       store_readings(added_of_slot_[s], readings);
     }
-  });
+  };
+  if (models_concurrent_) {
+    for_robot_slots(sweep);
+  } else {
+    sweep(0, robots_.size());
+  }
   ahead_t_us_ = t_us;
   ahead_valid_ = true;
 }
@@ -640,11 +668,12 @@ void World::sense_slot(const Scene& scene, std::size_t s, TimeUs t_us, SensorRea
   std::optional<OdometryReading> odometry;
   if (r.kind == RobotKind::kVirtual) odometry = r.odometer();
   NoiseRng rng = NoiseRng::keyed(config_.noise_seed, r.id, t_us, NoisePurpose::kSensing);
-  suite_pool_[suite_of_[s]].sense(scene, static_cast<int>(s), r.pose, headings_[s], odometry, t_us, rng, out);
+  suite_pool_[suite_of_[s]].sense(scene, static_cast<int>(s), r.pose, headings_[s], odometry, t_us, rng, out, r.id);
 }
 
 void World::sense_all(TimeUs t_us, std::vector<SensorReadings>& out) const {
   out.resize(robots_.size());
+  refresh_mobiles();
   const Scene sc = scene();
   for (std::size_t s = 0; s < robots_.size(); ++s) sense_slot(sc, s, t_us, out[s]);
 }

@@ -304,9 +304,15 @@ class World {
     std::vector<RangeReading> ranges;
     std::vector<BeaconSighting> beacons;
     std::vector<int> track;
+    std::vector<ModelReading> models;
   };
   // Packs `readings` as robot (added index) `added`'s record.
   void store_readings(std::size_t added, SensorReadings& readings);
+  // mobiles_ from the robots' and moving obstacles' poses, when a robot carries a sensor model.
+  void refresh_mobiles() const;
+  mutable std::vector<MobilePose> mobiles_;  // what sensor models see of every mobile object (scene().mobiles)
+  bool has_models_ = false;                  // some suite carries a sensor model
+  bool models_concurrent_ = true;            // every suite's models may sense for two robots at once
   std::vector<StoredReadings> ahead_;
   std::vector<StoredLists> ahead_lists_;      // by added index; empty unless a suite has lists
   std::vector<std::uint32_t> added_of_slot_;  // per slot: its robot's index in added_order_

@@ -6,14 +6,17 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <set>
 #include <sstream>
 
 #include "agents/builtin_controllers.hpp"
 #include "agents/library_controllers.hpp"
+#include "agents/library_sensor_models.hpp"
 #include "core/id_list.hpp"
 #include "environment/shapes.hpp"
+#include "run/sensor_parameters.hpp"
 
 namespace rilbed::run {
 
@@ -143,9 +146,81 @@ TimeUs milliseconds(const Reader& r, const std::string& key, TimeUs fallback_us)
   return us;
 }
 
-environment::SensorSuiteConfig read_sensors(const Reader& r) {
+// The sensor models a scenario's robots mount (`sensors: {models: [...]}`): their libraries
+// loaded once each, their parameter files read and checked, each mount made (its model's
+// create(), with the scenario's static map and control period) once per robot entry.
+class ScenarioSensors {
+ public:
+  ScenarioSensors(const std::string& source, const Scenario& scenario)
+      : base_(std::filesystem::path(source).parent_path()), scenario_(scenario) {}
+
+  environment::SensorModelMount mount(const Reader& m) {
+    m.allow({"library", "name", "parameters", "mount_x_m", "mount_y_m", "mount_yaw_deg", "as"});
+    const std::string library = m.text("library", "");
+    const std::string name = m.text("name", "");
+    if (library.empty()) m.fail_key("library", "give the plug-in library's path, relative to the scenario file");
+    if (name.empty()) m.fail_key("name", "give the name of one of the library's sensor models");
+    const agents::SensorModelEntry& entry = model(m, resolved(library), name);
+    ParameterFile file{"(no parameter file)", {}};
+    if (m.has("parameters")) {
+      const std::filesystem::path path = resolved(m.text("parameters", ""));
+      core::Result<ParameterFile> read = read_parameter_file(path);
+      if (!read) m.fail_key("parameters", read.error());
+      file = *read;
+    }
+    core::Result<std::vector<double>> values = parameter_values(entry, file);
+    if (!values) m.fail_key("parameters", values.error());
+    agents::SensorMount mount{m.text("as", entry.name),       *values,
+                              m.number("mount_x_m", 0.0),     m.number("mount_y_m", 0.0),
+                              m.number("mount_yaw_deg", 0.0), m.has("parameters") ? file.source : std::string()};
+    core::Result<std::shared_ptr<const environment::SensorModel>> made =
+        agents::mount_sensor_model(entry, mount, static_map(m), scenario_.control_period_us);
+    if (!made) m.fail_key("name", made.error());
+    return {*made};
+  }
+
+ private:
+  std::filesystem::path resolved(const std::string& path) const {
+    std::error_code ec;
+    return std::filesystem::absolute(base_ / path, ec).lexically_normal();
+  }
+  const agents::SensorModelEntry& model(const Reader& m, const std::filesystem::path& path, const std::string& name) {
+    auto it = libraries_.find(path.string());
+    if (it == libraries_.end()) {
+      core::Result<std::vector<agents::SensorModelEntry>> loaded = agents::load_library_sensor_models(path);
+      if (!loaded) m.fail_key("library", loaded.error());
+      it = libraries_.emplace(path.string(), std::move(*loaded)).first;
+    }
+    std::string held;
+    for (const agents::SensorModelEntry& e : it->second) {
+      if (e.name == name) return e;
+      held += (held.empty() ? "" : ", ") + e.name;
+    }
+    m.fail_key("name", "plug-in library " + path.string() + " holds no sensor model '" + name + "' (it holds " +
+                           (held.empty() ? std::string("none") : held) + ")");
+  }
+
+  // The scenario's static map as the models' create() sees it, made once.
+  const environment::StaticMap& static_map(const Reader& m) {
+    if (!map_) {
+      try {
+        map_.emplace(scenario_.map);
+      } catch (const std::invalid_argument& e) {
+        m.fail_key("name", std::string("the scenario's map is not usable: ") + e.what());
+      }
+    }
+    return *map_;
+  }
+
+  std::filesystem::path base_;
+  const Scenario& scenario_;
+  std::map<std::string, std::vector<agents::SensorModelEntry>> libraries_;
+  std::optional<environment::StaticMap> map_;
+};
+
+environment::SensorSuiteConfig read_sensors(const Reader& r, ScenarioSensors& models) {
   environment::SensorSuiteConfig s;
-  r.allow({"proximity", "range_finders", "beacon_finder", "track", "odometer"});
+  r.allow({"proximity", "range_finders", "beacon_finder", "track", "odometer", "models"});
   if (r.has("proximity")) {
     const YAML::Node n = r.get("proximity");
     if (n.IsScalar()) {
@@ -211,6 +286,19 @@ environment::SensorSuiteConfig read_sensors(const Reader& r) {
     }
   }
   s.odometer = r.boolean("odometer", s.odometer);
+  if (r.has("models")) {
+    const YAML::Node list = r.get("models");
+    if (!list.IsSequence()) r.fail_key("models", "must be a list of sensor model mounts");
+    std::set<std::string> names;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const Reader m(list[i], r.source(), r.join("models") + "[" + std::to_string(i) + "]");
+      s.models.push_back(models.mount(m));
+      const environment::SensorModel& model = *s.models.back().model;
+      if (!model.provides_track() && !names.insert(model.name()).second) {
+        m.fail_key("name", "a second mount called '" + model.name() + "' on this robot: give one `as: OTHER_NAME`");
+      }
+    }
+  }
   return s;
 }
 
@@ -415,7 +503,7 @@ LinkSpec read_link(const Reader& l, const YAML::Node& at) {
 }
 
 // Every robot entry, each of one robot (`id`) or several alike (`ids`), sorted by ID.
-std::vector<RobotSpec> read_robots(const Reader& top, ScenarioControllers& controllers) {
+std::vector<RobotSpec> read_robots(const Reader& top, ScenarioControllers& controllers, ScenarioSensors& sensors) {
   const YAML::Node list = top.get("robots");
   if (!list || !list.IsSequence() || list.size() == 0) top.fail_key("robots", "must be a non-empty list of robots");
   std::vector<RobotSpec> robots;
@@ -430,7 +518,7 @@ std::vector<RobotSpec> read_robots(const Reader& top, ScenarioControllers& contr
     base.pose = read_pose(r, ids.size());
     const agents::ControllerEntry& controller = read_controller(r, controllers, base.controller);
     if (r.has("noise")) base.noise = read_noise(r.child("noise"));
-    if (r.has("sensors")) base.sensors = read_sensors(r.child("sensors"));
+    if (r.has("sensors")) base.sensors = read_sensors(r.child("sensors"), sensors);
     if (const auto sensor = agents::missing_sensor(controller, base.sensors)) {
       r.fail_key(r.has("sensors") ? "sensors" : "controller",
                  base.controller.name + " needs `sensors: " + *sensor + ":` (see scenarios/README.md)");
@@ -640,7 +728,8 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source, Scenar
   s.duration_s = top.positive("duration_s", s.duration_s);
   read_convoy(top, s);
   read_map_lists(top, source, s);
-  s.robots = read_robots(top, controllers);
+  ScenarioSensors sensors(source, s);
+  s.robots = read_robots(top, controllers, sensors);
   if (top.has("camera")) s.camera = read_camera(top);
   if (top.has("safety")) {
     const Reader f = top.child("safety");

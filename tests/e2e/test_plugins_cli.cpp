@@ -21,6 +21,7 @@ namespace fs = std::filesystem;
 
 const fs::path kSdk = fs::path(RILBED_BINARY).parent_path() / "sdk";
 const fs::path kExamples = fs::path(RILBED_SOURCE_DIR) / "examples" / "controllers";
+const fs::path kSensorExamples = fs::path(RILBED_SOURCE_DIR) / "examples" / "sensors";
 
 std::string quoted(const fs::path& p) {
   std::string q = "'";  // piece by piece: GCC 12's false -Wrestrict (PR 105329)
@@ -39,9 +40,9 @@ int shell_in(const fs::path& dir, const std::string& command, std::string& log) 
 }
 
 // The example folder `name` copied into `scratch`, as a lab copies it to start its own.
-fs::path copy_example(const fs::path& scratch, const std::string& name) {
+fs::path copy_example(const fs::path& scratch, const std::string& name, const fs::path& from = kExamples) {
   const fs::path to = scratch / name;
-  fs::copy(kExamples / name, to, fs::copy_options::recursive);
+  fs::copy(from / name, to, fs::copy_options::recursive);
   fs::remove_all(to / "build");
   return to;
 }
@@ -134,6 +135,50 @@ TEST(PluginsCli, TheExamplesBuildOutOfTreeAgainstTheSdkAndRun) {
     const fs::path in_process = scratch / (example == c ? "c" : "cpp");
     EXPECT_EQ(read_file(in_process / "trajectories.csv"), read_file(out / "trajectories.csv")) << example;
   }
+  fs::remove_all(scratch);
+}
+
+// The track sensor rebuilt as a plug-in outside rilbed: scenarios/track_following.yaml with
+// its elements from the library gives the built-in's trajectories byte for byte, seed for
+// seed, also when its parameter file is YAML; a wrong parameter file is refused with its
+// file, line and key.
+TEST(PluginsCli, ThePluginTrackSensorGivesTheBuiltInsRunByteForByte) {
+  const fs::path scratch = scratch_dir("sensor_plugin");
+  const fs::path example = copy_example(scratch, "track_sensor", kSensorExamples);
+  cmake_build(example);
+  const std::string builtin = shipped_scenario_arg("track_following");
+  for (const int seed : {1, 2}) {
+    const std::string tail = " --fast --seed " + std::to_string(seed) + " --duration 30 --out ";
+    const CommandResult b = run_rilbed("run " + builtin + tail + quoted(scratch / ("builtin" + std::to_string(seed))));
+    ASSERT_EQ(b.exit_code, 0) << b.err;
+    const CommandResult p = run_rilbed("run " + quoted(example / "track_following.yaml") + tail +
+                                       quoted(scratch / ("plugin" + std::to_string(seed))));
+    ASSERT_EQ(p.exit_code, 0) << p.err;
+    const std::string trajectories = read_file(scratch / ("builtin" + std::to_string(seed)) / "trajectories.csv");
+    EXPECT_NE(trajectories.find(",follow"), std::string::npos);  // the robots found the tape
+    EXPECT_EQ(trajectories, read_file(scratch / ("plugin" + std::to_string(seed)) / "trajectories.csv")) << seed;
+  }
+  // The same parameters as YAML.
+  std::ofstream(example / "element.yaml") << "Sensor:\n  Height: 8\n  Inclination: 0\n  Cone Angle: 30\n"
+                                             "  Precision: 16\n  Coverage: 15\n  Max Value: 255\n  Error Level: 5\n";
+  std::string yaml = read_file(example / "track_following.yaml");
+  for (std::size_t at; (at = yaml.find("element.txt")) != std::string::npos;) yaml.replace(at, 11, "element.yaml");
+  std::ofstream(example / "yaml.yaml") << yaml;
+  const CommandResult y = run_rilbed("run " + quoted(example / "yaml.yaml") + " --fast --seed 1 --duration 30 --out " +
+                                     quoted(scratch / "yaml"));
+  ASSERT_EQ(y.exit_code, 0) << y.err;
+  EXPECT_EQ(read_file(scratch / "builtin1" / "trajectories.csv"), read_file(scratch / "yaml" / "trajectories.csv"));
+
+  std::ofstream(example / "bad.txt") << "Sensor = {\n    Height = 8\n    Cone Angel = 30\n}\n";
+  std::string bad = read_file(example / "track_following.yaml");
+  for (std::size_t at; (at = bad.find("element.txt")) != std::string::npos;) bad.replace(at, 11, "bad.txt");
+  std::ofstream(example / "bad.yaml") << bad;
+  const CommandResult refused = run_rilbed("run " + quoted(example / "bad.yaml") + " --fast");
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find("robots[0].sensors.models[0].parameters: " + (example / "bad.txt").string() +
+                             ":3: Cone Angel: the sensor model track_element has no such parameter"),
+            std::string::npos)
+      << refused.err;
   fs::remove_all(scratch);
 }
 

@@ -11,6 +11,7 @@
 #   fuzz_foxglove_messages
 #   fuzz_agent_messages
 #   fuzz_plugin_answers
+#   fuzz_sensor_parameters
 # All have the label `fuzz`: `ctest -L fuzz` runs only them, `ctest -LE fuzz` all but them.
 # Without clang++ or libFuzzer, configuring says so and the fuzz tests show as disabled.
 
@@ -24,7 +25,7 @@ find_program(RILBED_FUZZ_CXX NAMES clang++ clang++-14 DOC "clang++ for the fuzz 
 set(_fuzz_dir ${CMAKE_CURRENT_LIST_DIR})
 set(_fuzz_bin ${CMAKE_BINARY_DIR}/fuzz)
 set(_fuzz_targets fuzz_khepera_reply fuzz_scenario fuzz_lcm_messages fuzz_lcm_log fuzz_console_command fuzz_foxglove_messages
-    fuzz_agent_messages fuzz_plugin_answers)
+    fuzz_agent_messages fuzz_plugin_answers fuzz_sensor_parameters)
 # Seeds per target, read but never written (the fuzzer adds to the first corpus folder
 # only, the working one in the build tree). The scenarios ship with the project.
 set(_fuzz_seeds_fuzz_khepera_reply ${_fuzz_dir}/corpus/khepera_reply)
@@ -35,6 +36,7 @@ set(_fuzz_seeds_fuzz_console_command ${_fuzz_dir}/corpus/console_command)
 set(_fuzz_seeds_fuzz_foxglove_messages ${_fuzz_dir}/corpus/foxglove_messages)
 set(_fuzz_seeds_fuzz_agent_messages ${_fuzz_dir}/corpus/agent_messages)
 set(_fuzz_seeds_fuzz_plugin_answers ${_fuzz_dir}/corpus/plugin_answers)
+set(_fuzz_seeds_fuzz_sensor_parameters ${_fuzz_dir}/corpus/sensor_parameters)
 set(_fuzz_dict_fuzz_khepera_reply ${_fuzz_dir}/khepera_reply.dict)
 set(_fuzz_dict_fuzz_scenario ${_fuzz_dir}/scenario.dict)
 set(_fuzz_dict_fuzz_lcm_messages ${_fuzz_dir}/lcm_messages.dict)
@@ -43,6 +45,7 @@ set(_fuzz_dict_fuzz_console_command ${_fuzz_dir}/console_command.dict)
 set(_fuzz_dict_fuzz_foxglove_messages ${_fuzz_dir}/foxglove_messages.dict)
 set(_fuzz_dict_fuzz_agent_messages ${_fuzz_dir}/agent_messages.dict)
 set(_fuzz_dict_fuzz_plugin_answers ${_fuzz_dir}/plugin_answers.dict)
+set(_fuzz_dict_fuzz_sensor_parameters ${_fuzz_dir}/sensor_parameters.dict)
 
 # Can clang++ link a fuzzer? (On Debian libFuzzer comes apart, in libclang-rt-14-dev.)
 set(_fuzz_problem "")

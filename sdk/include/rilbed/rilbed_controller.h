@@ -51,7 +51,10 @@ enum rilbed_register {
   RILBED_REG_MOTOR_RIGHT = 0x81,       /* RW: right wheel speed */
   RILBED_REG_BEHAVIOUR = 0x82,         /* RW: behaviour code shown in the run's records (0 = "c0", ... 7 = "c7") */
   RILBED_REG_USER_0 = 0x100,           /* RW: 256 words of per-robot memory, 0x100..0x1FF */
-  RILBED_REG_COUNT = 0x200             /* one past the last address */
+  RILBED_REG_MODEL_COUNT = 0x200,      /* R: number of sensor-model values at RILBED_REG_MODEL_0.. (up to 256) */
+  RILBED_REG_MODEL_0 = 0x210,          /* R: the sensor models' values (rilbed/sensor_model.h), mount after mount,
+                                          in thousandths (value x 1000, rounded); track-providing ones are in TRACK */
+  RILBED_REG_COUNT = 0x310             /* one past the last address */
 };
 
 /* Value at `address` of the current robot's register map; 0 for an address outside it

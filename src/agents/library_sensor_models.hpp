@@ -1,0 +1,81 @@
+// Sensor models from plug-in libraries (rilbed/sensor_model.h): a library's models,
+// checked like any input, and one mounted on a robot as an environment::SensorModel that
+// the world calls through the model's C functions. The mounted model keeps its library
+// loaded and destroys its instance ("clean-up") when the last robot carrying it is gone.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "agents/plugin_library.hpp"
+#include "core/result.hpp"
+#include "core/time.hpp"
+#include "environment/sensor_model.hpp"
+#include "environment/static_map.hpp"
+#include "rilbed/sensor_model.h"
+
+namespace rilbed::agents {
+
+/// One key of a model's parameter file.
+struct SensorParamSpec {
+  std::string key;                      ///< as the model writes it: "Cone Angle"
+  std::string unit;                     ///< "mm", "deg", "%"; "" for a count
+  std::string summary;                  ///< one line of what it means
+  std::optional<double> default_value;  ///< nullopt: the file must give it
+  bool integer = false;                 ///< whole numbers only
+  double min = -HUGE_VAL;               ///< inclusive
+  double max = HUGE_VAL;                ///< inclusive
+};
+
+/// A parameter file's key as the models' keys are matched: lower case, spaces and
+/// hyphens as underscores, runs of them as one ("Cone Angle" and "cone_angle" alike).
+std::string sensor_param_key(std::string_view key);
+
+/// A library's sensor model, checked, ready to be mounted.
+struct SensorModelEntry {
+  std::string name;
+  std::string summary;
+  std::string origin;  ///< the library's path
+  std::vector<SensorParamSpec> params;
+  std::size_t value_count = 1;
+  bool provides_track = false;
+  bool concurrent = true;
+  std::shared_ptr<const PluginLibrary> library;  ///< null in tests of a model that lives as long as the program
+  const rilbed_sensor_model* model = nullptr;
+  /// The spec of the parameter whose key is `key` (any spelling sensor_param_key() matches), or nullptr.
+  const SensorParamSpec* param(std::string_view key) const;
+};
+
+/// Every sensor model the library at `path` holds. A failure names the library and the
+/// cause (PluginLibrary::open's, no rilbed_sensor_models(), a NULL list, an entry that
+/// is unusable, two models of one name).
+core::Result<std::vector<SensorModelEntry>> load_library_sensor_models(const std::filesystem::path& path);
+
+/// `model` checked: ABI version, name, summary, parameters (keys unique as matched, at
+/// most 64, defaults finite and in range), 1..64 values, `provides` NULL or "track", its
+/// three functions.
+core::Result<SensorModelEntry> sensor_model_entry(const rilbed_sensor_model& model,
+                                                  std::shared_ptr<const PluginLibrary> library,
+                                                  const std::string& origin);
+
+/// Where and how one robot carries a model.
+struct SensorMount {
+  std::string name;                  ///< what its readings are called (default: the model's name)
+  std::vector<double> param_values;  ///< one per entry parameter, in the entry's order, defaults filled in
+  double mount_x_m = 0.0;            ///< forward of the robot's centre
+  double mount_y_m = 0.0;            ///< left of it
+  double mount_yaw_deg = 0.0;        ///< counter-clockwise from its forward direction
+  std::string parameter_file;        ///< where the values came from, for messages
+};
+
+/// The model mounted: its create() ("register") called with the mount, the static world
+/// of `map` and the control period. A failure names the model, the library and the file.
+core::Result<std::shared_ptr<const environment::SensorModel>> mount_sensor_model(const SensorModelEntry& entry,
+                                                                                 const SensorMount& mount,
+                                                                                 const environment::StaticMap& map,
+                                                                                 TimeUs quantum_us);
+
+}  // namespace rilbed::agents
