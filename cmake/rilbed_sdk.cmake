@@ -10,6 +10,7 @@ set(RILBED_SDK_HEADERS
   rilbed_controller.h
   controller.hpp
   sensor_model.h
+  actuator_model.h
 )
 foreach(header IN LISTS RILBED_SDK_HEADERS)
   configure_file(${CMAKE_CURRENT_SOURCE_DIR}/sdk/include/rilbed/${header} ${RILBED_SDK_DIR}/include/rilbed/${header} COPYONLY)

@@ -31,58 +31,6 @@ core::Result<std::string> model_text(const char* text, const std::string& what, 
   return std::string(text, n);
 }
 
-core::Result<SensorParamSpec> model_param(const rilbed_sensor_param& p, const std::string& what) {
-  core::Result<std::string> key = model_text(p.key, what + " key", 64);
-  if (!key) return core::Failure{key.error()};
-  if (sensor_param_key(*key).empty()) return core::Failure{what + " key is empty"};
-  const std::string who = what + " '" + *key + "'";
-  core::Result<std::string> unit = model_text(p.unit, who + " unit", 32);
-  core::Result<std::string> summary = model_text(p.summary, who + " summary");
-  if (!unit) return core::Failure{unit.error()};
-  if (!summary) return core::Failure{summary.error()};
-  if (std::isnan(p.min) || std::isnan(p.max) || !(p.min <= p.max)) return core::Failure{who + " has no usable range"};
-  SensorParamSpec spec{*key, *unit, *summary, std::nullopt, p.integer != 0, p.min, p.max};
-  if (p.has_default) {
-    if (!std::isfinite(p.default_value) || p.default_value < p.min || p.default_value > p.max)
-      return core::Failure{who + " has a default that is not a finite number in its range"};
-    if (spec.integer && p.default_value != std::floor(p.default_value))
-      return core::Failure{who + " is whole but its default is not"};
-    spec.default_value = p.default_value;
-  }
-  return spec;
-}
-
-// The static world as create() gets it, with the arrays it points into.
-struct StaticWorldView {
-  std::vector<rilbed_segment> segments;
-  std::vector<rilbed_track_segment> tracks;
-  rilbed_static_world raw{};
-
-  explicit StaticWorldView(const environment::StaticMap& map) {
-    const environment::FieldConfig& f = map.field();
-    if (f.boundary_walls) {
-      const double w = f.width_m, h = f.height_m;
-      segments = {{0, 0, w, 0}, {w, 0, w, h}, {w, h, 0, h}, {0, h, 0, 0}};
-    }
-    for (const environment::ObstacleConfig& o : map.obstacles()) {
-      for (std::size_t i = 0, n = o.vertices_m.size(); i < n; ++i) {
-        const Vec2 a = o.vertices_m[i], b = o.vertices_m[(i + 1) % n];
-        segments.push_back({a.x, a.y, b.x, b.y});
-      }
-    }
-    for (const environment::TrackConfig& t : map.tracks()) {
-      const std::size_t n = t.points_m.size();
-      for (std::size_t i = 0; i + 1 < n + (t.closed ? 1 : 0); ++i) {
-        const Vec2 a = t.points_m[i], b = t.points_m[(i + 1) % n];
-        tracks.push_back({a.x, a.y, b.x, b.y, 0.5 * t.width_m});
-      }
-    }
-    raw = {f.width_m,       f.height_m,
-           segments.data(), static_cast<std::uint32_t>(segments.size()),
-           tracks.data(),   static_cast<std::uint32_t>(tracks.size())};
-  }
-};
-
 std::int32_t scene_on_track(const void* scene, double x_m, double y_m) {
   return static_cast<const environment::Scene*>(scene)->on_track({x_m, y_m}) ? 1 : 0;
 }
@@ -157,6 +105,67 @@ class LibrarySensorModel final : public environment::SensorModel {
 
 }  // namespace
 
+core::Result<SensorParamSpec> model_param_spec(const rilbed_sensor_param& p, const std::string& what) {
+  core::Result<std::string> key = model_text(p.key, what + " key", 64);
+  if (!key) return core::Failure{key.error()};
+  if (sensor_param_key(*key).empty()) return core::Failure{what + " key is empty"};
+  const std::string who = what + " '" + *key + "'";
+  core::Result<std::string> unit = model_text(p.unit, who + " unit", 32);
+  core::Result<std::string> summary = model_text(p.summary, who + " summary");
+  if (!unit) return core::Failure{unit.error()};
+  if (!summary) return core::Failure{summary.error()};
+  if (std::isnan(p.min) || std::isnan(p.max) || !(p.min <= p.max)) return core::Failure{who + " has no usable range"};
+  SensorParamSpec spec{*key, *unit, *summary, std::nullopt, p.integer != 0, p.min, p.max};
+  if (p.has_default) {
+    if (!std::isfinite(p.default_value) || p.default_value < p.min || p.default_value > p.max)
+      return core::Failure{who + " has a default that is not a finite number in its range"};
+    if (spec.integer && p.default_value != std::floor(p.default_value))
+      return core::Failure{who + " is whole but its default is not"};
+    spec.default_value = p.default_value;
+  }
+  return spec;
+}
+
+StaticWorldView::StaticWorldView(const environment::StaticMap& map) {
+  const environment::FieldConfig& f = map.field();
+  if (f.boundary_walls) {
+    const double w = f.width_m, h = f.height_m;
+    segments = {{0, 0, w, 0}, {w, 0, w, h}, {w, h, 0, h}, {0, h, 0, 0}};
+  }
+  for (const environment::ObstacleConfig& o : map.obstacles()) {
+    for (std::size_t i = 0, n = o.vertices_m.size(); i < n; ++i) {
+      const Vec2 a = o.vertices_m[i], b = o.vertices_m[(i + 1) % n];
+      segments.push_back({a.x, a.y, b.x, b.y});
+    }
+  }
+  for (const environment::TrackConfig& t : map.tracks()) {
+    const std::size_t n = t.points_m.size();
+    for (std::size_t i = 0; i + 1 < n + (t.closed ? 1 : 0); ++i) {
+      const Vec2 a = t.points_m[i], b = t.points_m[(i + 1) % n];
+      tracks.push_back({a.x, a.y, b.x, b.y, 0.5 * t.width_m});
+    }
+  }
+  raw = {f.width_m,       f.height_m,
+         segments.data(), static_cast<std::uint32_t>(segments.size()),
+         tracks.data(),   static_cast<std::uint32_t>(tracks.size())};
+}
+
+core::Result<std::vector<SensorParamSpec>> model_param_specs(const rilbed_sensor_param* params, std::uint32_t count,
+                                                             const std::string& who) {
+  if (count > kMaxParams) return core::Failure{who + " has more than 64 parameters"};
+  if (count > 0 && !params) return core::Failure{who + " has parameters but their list is NULL"};
+  std::vector<SensorParamSpec> specs;
+  std::set<std::string> keys;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    core::Result<SensorParamSpec> p = model_param_spec(params[i], who + " parameter " + std::to_string(i));
+    if (!p) return core::Failure{p.error()};
+    if (!keys.insert(sensor_param_key(p->key)).second)
+      return core::Failure{who + " names parameter '" + p->key + "' twice"};
+    specs.push_back(*p);
+  }
+  return specs;
+}
+
 std::string sensor_param_key(std::string_view key) {
   std::string out;
   bool gap = false;
@@ -196,8 +205,6 @@ core::Result<SensorModelEntry> sensor_model_entry(const rilbed_sensor_model& m,
   core::Result<std::string> summary = model_text(m.summary, who + " summary");
   if (!summary) return core::Failure{summary.error()};
   if (!m.create || !m.sense || !m.destroy) return core::Failure{who + " lacks its create, sense or destroy function"};
-  if (m.param_count > kMaxParams) return core::Failure{who + " has more than 64 parameters"};
-  if (m.param_count > 0 && !m.params) return core::Failure{who + " has parameters but their list is NULL"};
   if (m.value_count < 1 || m.value_count > kMaxValues) return core::Failure{who + " must write 1 to 64 values"};
   SensorModelEntry e;
   e.name = *name;
@@ -213,14 +220,9 @@ core::Result<SensorModelEntry> sensor_model_entry(const rilbed_sensor_model& m,
     if (*provides != "track") return core::Failure{who + " provides '" + *provides + "': only \"track\" or NULL"};
     e.provides_track = true;
   }
-  std::set<std::string> keys;
-  for (std::uint32_t i = 0; i < m.param_count; ++i) {
-    core::Result<SensorParamSpec> p = model_param(m.params[i], who + " parameter " + std::to_string(i));
-    if (!p) return core::Failure{p.error()};
-    if (!keys.insert(sensor_param_key(p->key)).second)
-      return core::Failure{who + " names parameter '" + p->key + "' twice"};
-    e.params.push_back(*p);
-  }
+  core::Result<std::vector<SensorParamSpec>> params = model_param_specs(m.params, m.param_count, who);
+  if (!params) return core::Failure{params.error()};
+  e.params = std::move(*params);
   return e;
 }
 

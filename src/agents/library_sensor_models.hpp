@@ -34,6 +34,23 @@ struct SensorParamSpec {
 /// hyphens as underscores, runs of them as one ("Cone Angle" and "cone_angle" alike).
 std::string sensor_param_key(std::string_view key);
 
+/// A model's declared parameter keys checked (printable ASCII, ranges ordered, defaults
+/// finite, in range and whole where they must be, no key twice as matched, at most 64);
+/// `who` names the model in the failure. Sensor and actuator models share them.
+core::Result<std::vector<SensorParamSpec>> model_param_specs(const rilbed_sensor_param* params, std::uint32_t count,
+                                                             const std::string& who);
+
+/// The static world of `map` as a model's create() gets it, with the arrays it points
+/// into (valid while this lives).
+struct StaticWorldView {
+  explicit StaticWorldView(const environment::StaticMap& map);
+  StaticWorldView(const StaticWorldView&) = delete;
+  StaticWorldView& operator=(const StaticWorldView&) = delete;
+  std::vector<rilbed_segment> segments;
+  std::vector<rilbed_track_segment> tracks;
+  rilbed_static_world raw{};
+};
+
 /// A library's sensor model, checked, ready to be mounted.
 struct SensorModelEntry {
   std::string name;

@@ -2,10 +2,12 @@
 // counters and the sensors it carries.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <string_view>
 
 #include "core/time.hpp"
+#include "environment/drive_model.hpp"
 #include "environment/kinematics.hpp"
 #include "environment/sensor_suite.hpp"
 
@@ -28,6 +30,8 @@ struct RobotConfig {
   double wheel_base_m = kKheperaWheelBase_m;
   WheelNoiseConfig noise;     ///< virtual robots only
   SensorSuiteConfig sensors;  ///< virtual sensors (fed by the world for either kind)
+  /// Virtual robots: how the wheels move (a plug-in's); null: the differential drive with `noise`.
+  std::shared_ptr<const DriveModelFactory> drive;
 };
 
 /// A robot's wheel commands, pulses per 10 ms (1 unit = 8 mm/s), in [-127, 127].

@@ -167,6 +167,15 @@ void World::add_robot(const RobotConfig& c) {
   SensorSuite suite(c.sensors, what);  // validates the sensors
   if (c.kind == RobotKind::kVirtual) check_placement_free(what, c.pose.position_m, c.radius_m, -1);
 
+  // The robot's drive first: a model that refuses it leaves the world as it was.
+  std::unique_ptr<DriveModel> drive;
+  if (c.drive && c.kind == RobotKind::kVirtual) {
+    try {
+      drive = c.drive->make(c.id, c.wheel_base_m);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(what + ": " + e.what());
+    }
+  }
   RobotState state;
   state.id = c.id;
   state.kind = c.kind;
@@ -183,7 +192,7 @@ void World::add_robot(const RobotConfig& c) {
     const std::size_t want = std::max<std::size_t>(16, 2 * s);
     robots_.reserve(want), bodies_.reserve(want), ids_.reserve(want), suite_of_.reserve(want), motion_.reserve(want);
     headings_.reserve(want), added_order_.reserve(want), added_of_slot_.reserve(want), poses_.reserve(want);
-    commands_.reserve(want);
+    commands_.reserve(want), drives_.reserve(want);
     slot_of_.reserve(want);
   }
   robots_.push_back(std::move(state));
@@ -193,6 +202,8 @@ void World::add_robot(const RobotConfig& c) {
   added_order_.push_back(c.id);
   poses_.push_back(robots_.back().pose);
   commands_.emplace_back();
+  drives_.push_back(std::move(drive));
+  drives_concurrent_ = drives_concurrent_ && (!c.drive || c.drive->concurrent());
   suite_of_.push_back(pooled_suite(c.sensors, std::move(suite)));
   motion_.emplace_back();
   slot_of_.emplace(c.id, s);
@@ -218,7 +229,8 @@ void World::remove_robot(int id) {
   added_order_[place] = last_added;
   poses_[place] = poses_.back();
   commands_[place] = commands_.back();
-  added_order_.pop_back(), poses_.pop_back(), commands_.pop_back();
+  drives_[place] = std::move(drives_.back());
+  added_order_.pop_back(), poses_.pop_back(), commands_.pop_back(), drives_.pop_back();
   const std::size_t last = robots_.size() - 1;
   if (s != last) {
     robots_[s] = std::move(robots_[last]);
@@ -378,11 +390,16 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us) {
   std::mutex max_mutex;
   double max_travel_m = 0.0;
   step_wheels_mps_.resize(robots_.size());
-  for_robot_slots([&](std::size_t begin, std::size_t end) {
+  auto wheels = [&](std::size_t begin, std::size_t end) {
     const double travel_m = start_wheels(begin, end, dt_s);
     std::lock_guard lock(max_mutex);
     max_travel_m = std::max(max_travel_m, travel_m);
-  });
+  };
+  if (drives_concurrent_) {
+    for_robot_slots(wheels);
+  } else {
+    wheels(0, robots_.size());  // a drive model that may not run for two robots at once
+  }
   for (const MovingObstacle& m : movers_) max_travel_m = std::max(max_travel_m, m.velocity_mps().norm() * dt_s);
 
   constexpr double kMaxSubsteps = 100000.0;
@@ -438,6 +455,16 @@ double World::start_wheels(std::size_t begin, std::size_t end, double dt_s) {
     const WheelUnits command = commands_[added_of_slot_[i]];
     const double left_cmd = speed_units_to_mps(command.left);
     const double right_cmd = speed_units_to_mps(command.right);
+    if (DriveModel* drive = drives_[added_of_slot_[i]].get()) {
+      NoiseRng rng = NoiseRng::keyed(config_.noise_seed, r.id, t_us_, NoisePurpose::kWheels);
+      const DriveOutput out =
+          drive->drive({t_us_, r.id, r.pose, dt_s, command.left, command.right, {left_cmd, right_cmd}, rng});
+      r.left_wheel_travel_m += out.counted_mps.x * dt_s;
+      r.right_wheel_travel_m += out.counted_mps.y * dt_s;
+      max_travel_m = std::max(max_travel_m, std::abs(0.5 * (out.ground_mps.x + out.ground_mps.y)) * dt_s);
+      step_wheels_mps_[i] = out.ground_mps;
+      continue;
+    }
     double left_gain = 1.0 + r.noise.left_bias, right_gain = 1.0 + r.noise.right_bias;
     if (r.noise.slip_sd > 0.0) {
       NoiseRng rng = NoiseRng::keyed(config_.noise_seed, r.id, t_us_, NoisePurpose::kWheels);

@@ -318,6 +318,9 @@ class World {
   std::vector<std::uint32_t> added_of_slot_;  // per slot: its robot's index in added_order_
   std::vector<Pose2> poses_;                  // each robot's pose, by index in added_order_
   std::vector<WheelUnits> commands_;          // each robot's wheel commands, by index in added_order_
+  std::vector<std::unique_ptr<DriveModel>>
+      drives_;                     // each robot's drive model, by index in added_order_; null: built in
+  bool drives_concurrent_ = true;  // every drive model may run for two robots at once
   TimeUs ahead_t_us_ = 0;
   bool ahead_valid_ = false;
   long steps_ = 0;

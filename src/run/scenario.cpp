@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "agents/builtin_controllers.hpp"
+#include "agents/library_actuator_models.hpp"
 #include "agents/library_controllers.hpp"
 #include "agents/library_sensor_models.hpp"
 #include "core/id_list.hpp"
@@ -179,6 +180,42 @@ class ScenarioSensors {
     return {*made};
   }
 
+  // A robot entry's `actuator:`: the model's factory, its parameters checked.
+  std::shared_ptr<const environment::DriveModelFactory> actuator(const Reader& a) {
+    a.allow({"library", "name", "parameters"});
+    const std::string library = a.text("library", "");
+    const std::string name = a.text("name", "");
+    if (library.empty()) a.fail_key("library", "give the plug-in library's path, relative to the scenario file");
+    if (name.empty()) a.fail_key("name", "give the name of one of the library's actuator models");
+    const std::filesystem::path path = resolved(library);
+    auto it = actuators_.find(path.string());
+    if (it == actuators_.end()) {
+      core::Result<std::vector<agents::ActuatorModelEntry>> loaded = agents::load_library_actuator_models(path);
+      if (!loaded) a.fail_key("library", loaded.error());
+      it = actuators_.emplace(path.string(), std::move(*loaded)).first;
+    }
+    const agents::ActuatorModelEntry* entry = nullptr;
+    std::string held;
+    for (const agents::ActuatorModelEntry& e : it->second) {
+      if (e.name == name) entry = &e;
+      held += (held.empty() ? "" : ", ") + e.name;
+    }
+    if (!entry) {
+      a.fail_key("name", "plug-in library " + path.string() + " holds no actuator model '" + name + "' (it holds " +
+                             (held.empty() ? std::string("none") : held) + ")");
+    }
+    ParameterFile file{"(no parameter file)", {}};
+    if (a.has("parameters")) {
+      core::Result<ParameterFile> read = read_parameter_file(resolved(a.text("parameters", "")));
+      if (!read) a.fail_key("parameters", read.error());
+      file = *read;
+    }
+    core::Result<std::vector<double>> values = parameter_values("actuator model " + entry->name, entry->params, file);
+    if (!values) a.fail_key("parameters", values.error());
+    return agents::actuator_factory(*entry, *values, static_map(a), scenario_.physics_step_us,
+                                    a.has("parameters") ? file.source : std::string());
+  }
+
  private:
   std::filesystem::path resolved(const std::string& path) const {
     std::error_code ec;
@@ -215,6 +252,7 @@ class ScenarioSensors {
   std::filesystem::path base_;
   const Scenario& scenario_;
   std::map<std::string, std::vector<agents::SensorModelEntry>> libraries_;
+  std::map<std::string, std::vector<agents::ActuatorModelEntry>> actuators_;
   std::optional<environment::StaticMap> map_;
 };
 
@@ -510,7 +548,7 @@ std::vector<RobotSpec> read_robots(const Reader& top, ScenarioControllers& contr
   std::set<int> seen;
   for (std::size_t i = 0; i < list.size(); ++i) {
     const Reader r(list[i], top.source(), "robots[" + std::to_string(i) + "]");
-    r.allow({"id", "ids", "kind", "pose", "controller", "params", "noise", "sensors", "link"});
+    r.allow({"id", "ids", "kind", "pose", "controller", "params", "noise", "sensors", "link", "actuator"});
     RobotSpec base;
     base.line = list[i].Mark().line + 1;
     const std::vector<int> ids = read_robot_ids(r, list[i]);
@@ -518,6 +556,12 @@ std::vector<RobotSpec> read_robots(const Reader& top, ScenarioControllers& contr
     base.pose = read_pose(r, ids.size());
     const agents::ControllerEntry& controller = read_controller(r, controllers, base.controller);
     if (r.has("noise")) base.noise = read_noise(r.child("noise"));
+    if (r.has("actuator")) {
+      if (base.kind == environment::RobotKind::kReal)
+        r.fail_key("actuator", "a real robot's wheels are its own: only a virtual robot takes an actuator model");
+      if (r.has("noise")) r.fail_key("actuator", "give either `noise` (the built-in drive's) or `actuator`, not both");
+      base.drive = sensors.actuator(r.child("actuator"));
+    }
     if (r.has("sensors")) base.sensors = read_sensors(r.child("sensors"), sensors);
     if (const auto sensor = agents::missing_sensor(controller, base.sensors)) {
       r.fail_key(r.has("sensors") ? "sensors" : "controller",

@@ -89,6 +89,9 @@ struct RobotSpec {
   std::optional<Pose2> pose;  ///< nullopt: a random free pose drawn from the run's seed
   ControllerSpec controller;
   environment::WheelNoiseConfig noise;
+  /// Virtual robots: its wheels' model from a plug-in library (`actuator:`); null: the
+  /// built-in differential drive with `noise`.
+  std::shared_ptr<const environment::DriveModelFactory> drive;
   environment::SensorSuiteConfig sensors;
   std::optional<LinkSpec> link;  ///< real robots only
   int line = 0;                  ///< where it was defined, for messages

@@ -129,13 +129,26 @@ core::Result<ParameterFile> read_parameter_file(const std::filesystem::path& pat
 }
 
 core::Result<std::vector<double>> parameter_values(const agents::SensorModelEntry& model, const ParameterFile& file) {
+  return parameter_values("sensor model " + model.name, model.params, file);
+}
+
+core::Result<std::vector<double>> parameter_values(const std::string& model,
+                                                   const std::vector<agents::SensorParamSpec>& params,
+                                                   const ParameterFile& file) {
+  auto declared = [&](const std::string& key) -> const agents::SensorParamSpec* {
+    const std::string wanted = agents::sensor_param_key(key);
+    for (const agents::SensorParamSpec& p : params) {
+      if (agents::sensor_param_key(p.key) == wanted) return &p;
+    }
+    return nullptr;
+  };
   for (const ParameterEntry& e : file.entries) {
-    const agents::SensorParamSpec* p = model.param(e.key);
+    const agents::SensorParamSpec* p = declared(e.key);
     if (!p) {
       std::string keys;
-      for (const agents::SensorParamSpec& q : model.params) keys += (keys.empty() ? "" : ", ") + q.key;
-      return core::Failure{at(file.source, e.line) + e.key + ": the sensor model " + model.name +
-                           " has no such parameter (it takes " + (keys.empty() ? std::string("none") : keys) + ")"};
+      for (const agents::SensorParamSpec& q : params) keys += (keys.empty() ? "" : ", ") + q.key;
+      return core::Failure{at(file.source, e.line) + e.key + ": the " + model + " has no such parameter (it takes " +
+                           (keys.empty() ? std::string("none") : keys) + ")"};
     }
     if (p->integer && e.value != std::floor(e.value))
       return core::Failure{at(file.source, e.line) + e.key + ": must be a whole number"};
@@ -146,7 +159,7 @@ core::Result<std::vector<double>> parameter_values(const agents::SensorModelEntr
     }
   }
   std::vector<double> values;
-  for (const agents::SensorParamSpec& p : model.params) {
+  for (const agents::SensorParamSpec& p : params) {
     const std::string key = agents::sensor_param_key(p.key);
     const auto given = std::find_if(file.entries.begin(), file.entries.end(),
                                     [&](const ParameterEntry& e) { return agents::sensor_param_key(e.key) == key; });
@@ -155,7 +168,7 @@ core::Result<std::vector<double>> parameter_values(const agents::SensorModelEntr
     } else if (p.default_value) {
       values.push_back(*p.default_value);
     } else {
-      return core::Failure{file.source + ": " + p.key + ": missing: the sensor model " + model.name + " needs it" +
+      return core::Failure{file.source + ": " + p.key + ": missing: the " + model + " needs it" +
                            (p.summary.empty() ? std::string() : " (" + p.summary + ")")};
     }
   }

@@ -46,4 +46,10 @@ core::Result<ParameterFile> read_parameter_file(const std::filesystem::path& pat
 /// or not whole where it must be.
 core::Result<std::vector<double>> parameter_values(const agents::SensorModelEntry& model, const ParameterFile& file);
 
+/// As above, for any model's declared keys (an actuator model's); `model` names it in
+/// messages ("actuator model differential_drive").
+core::Result<std::vector<double>> parameter_values(const std::string& model,
+                                                   const std::vector<agents::SensorParamSpec>& params,
+                                                   const ParameterFile& file);
+
 }  // namespace rilbed::run

@@ -125,6 +125,7 @@ void Run::make_bodies(const RealBodyFactory& real_bodies) {
     rc.pose = poses[i];
     rc.noise = spec.noise;
     rc.sensors = spec.sensors;
+    rc.drive = spec.drive;
     try {
       world_.add_robot(rc);
     } catch (const std::invalid_argument& e) {

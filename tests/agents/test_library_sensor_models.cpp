@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "agents/c_controller.hpp"
+#include "agents/library_actuator_models.hpp"
 #include "agents/library_controllers.hpp"
 #include "agents/library_sensor_models.hpp"
 #include "environment/world.hpp"
@@ -173,6 +174,73 @@ TEST(LibrarySensorModels, AFailingModelNamesItselfAndTheRobot) {
                         "the lens is cracked"),
               std::string::npos)
         << what;
+  }
+}
+
+// Actuator models: each robot's own instance turns its commands into its wheels' speeds,
+// and the world drives the arc they make; a failing or absurd one names itself and the robot.
+TEST(LibraryActuatorModels, EachRobotsDriveTurnsItsCommandsIntoMotion) {
+  auto entries = load_library_actuator_models(kLibrary);
+  ASSERT_TRUE(entries) << entries.error();
+  ASSERT_EQ(entries->size(), 2u);
+  EXPECT_EQ(entries->at(0).name, "reverse");
+  EXPECT_FALSE(entries->at(1).concurrent);
+  EXPECT_NE(load_library_actuator_models(std::filesystem::path(RILBED_TEST_PLUGIN_DIR) / "test_classes.so")
+                .error()
+                .find("does not export rilbed_actuator_models()"),
+            std::string::npos);
+  rilbed_actuator_model lame = *entries->at(0).model;
+  lame.drive = nullptr;
+  EXPECT_NE(actuator_model_entry(lame, nullptr, "x.so").error().find("lacks its create, drive or destroy"),
+            std::string::npos);
+
+  const environment::StaticMap map(field());
+  environment::World world(field());
+  environment::RobotConfig r;
+  r.id = 4;
+  r.pose = Pose2{{1.0, 0.3}, 0.0};
+  r.drive = actuator_factory(entries->at(0), {0.5}, map, 20'000, "gain.txt");
+  world.add_robot(r);
+  world.set_wheel_speeds(4, 10, 10);  // 8 cm/s ahead, commanded
+  world.step(1'000'000);
+  EXPECT_NEAR(world.pose(4).position_m.x, 1.0 - 0.5 * 0.08, 1e-9);  // backwards at half the speed
+  EXPECT_EQ(world.robot(4).odometer().left_pulses, 0);              // it counted nothing
+
+  r.id = 13;
+  r.pose = Pose2{{1.6, 0.7}, 0.0};
+  try {
+    world.add_robot(r);
+    FAIL() << "robot 13 was added";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("actuator model reverse (" + kLibrary.string() +
+                                         ") of robot 13: cannot be made: robot 13 has no wheels"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(world.has_robot(13));
+
+  r.id = 5;
+  r.pose = Pose2{{0.5, 0.3}, 0.0};
+  r.drive = actuator_factory(entries->at(1), {1500}, map, 20'000, "");
+  world.add_robot(r);
+  world.set_wheel_speeds(5, 99, 10);
+  try {
+    world.step(100'000);
+    FAIL() << "a NaN speed was taken";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("of robot 5: its step at t = 1000 ms gave a wheel speed that is not a finite"),
+              std::string::npos)
+        << e.what();
+  }
+  world.set_wheel_speeds(5, 10, 10);
+  world.step(1'000'000);  // the failed step was not taken: this one starts at 1000 ms
+  try {
+    world.step(1'000'000);
+    FAIL() << "the drive did not fail";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("of robot 5: its step at t = 2000 ms failed: the motor burnt out"),
+              std::string::npos)
+        << e.what();
   }
 }
 

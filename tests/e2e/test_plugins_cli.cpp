@@ -22,6 +22,7 @@ namespace fs = std::filesystem;
 const fs::path kSdk = fs::path(RILBED_BINARY).parent_path() / "sdk";
 const fs::path kExamples = fs::path(RILBED_SOURCE_DIR) / "examples" / "controllers";
 const fs::path kSensorExamples = fs::path(RILBED_SOURCE_DIR) / "examples" / "sensors";
+const fs::path kActuatorExamples = fs::path(RILBED_SOURCE_DIR) / "examples" / "actuators";
 
 std::string quoted(const fs::path& p) {
   std::string q = "'";  // piece by piece: GCC 12's false -Wrestrict (PR 105329)
@@ -179,6 +180,38 @@ TEST(PluginsCli, ThePluginTrackSensorGivesTheBuiltInsRunByteForByte) {
                              ":3: Cone Angel: the sensor model track_element has no such parameter"),
             std::string::npos)
       << refused.err;
+  fs::remove_all(scratch);
+}
+
+// The built-in differential drive with slip rebuilt as an actuator plug-in: wander.yaml with
+// robots 1-5's wheels from it gives the built-in's trajectories byte for byte; an actuator
+// on a real robot, or beside `noise`, is refused where the scenario gives it.
+TEST(PluginsCli, ThePluginDifferentialDriveGivesTheBuiltInsRunByteForByte) {
+  const fs::path scratch = scratch_dir("actuator_plugin");
+  const fs::path example = copy_example(scratch, "differential_drive", kActuatorExamples);
+  cmake_build(example);
+  for (const int seed : {1, 3}) {
+    const std::string tail = " --fast --seed " + std::to_string(seed) + " --duration 30 --out ";
+    const std::string b = "builtin" + std::to_string(seed), p = "plugin" + std::to_string(seed);
+    ASSERT_EQ(run_rilbed("run " + shipped_scenario_arg("wander") + tail + quoted(scratch / b)).exit_code, 0);
+    const CommandResult run = run_rilbed("run " + quoted(example / "wander.yaml") + tail + quoted(scratch / p));
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    EXPECT_EQ(read_file(scratch / b / "trajectories.csv"), read_file(scratch / p / "trajectories.csv")) << seed;
+  }
+  const std::string actuator = "    actuator: {library: " + (example / "build" / "differential_drive.so").string() +
+                               ", name: differential_drive}\n";
+  std::ofstream(scratch / "real.yaml") << "camera: {emulate: true}\nrobots:\n  - id: 1\n    kind: real\n"
+                                          "    link: {emulate: true}\n"
+                                       << actuator;
+  const CommandResult real = run_rilbed("run " + quoted(scratch / "real.yaml") + " --duration 1 --no-place");
+  EXPECT_EQ(real.exit_code, 1);
+  EXPECT_NE(real.err.find("real.yaml:6: robots[0].actuator: a real robot's wheels are its own"), std::string::npos)
+      << real.err;
+  std::ofstream(scratch / "both.yaml") << "robots:\n  - id: 1\n    noise: {slip_sd: 0.1}\n" << actuator;
+  const CommandResult both = run_rilbed("run " + quoted(scratch / "both.yaml") + " --fast --duration 1");
+  EXPECT_EQ(both.exit_code, 1);
+  EXPECT_NE(both.err.find("give either `noise` (the built-in drive's) or `actuator`, not both"), std::string::npos)
+      << both.err;
   fs::remove_all(scratch);
 }
 

@@ -4,11 +4,16 @@
  *                   parameters, and how many mobile objects it was told of; plus one
  *                   uniform draw times its Noise parameter
  *   "failing"       a reading that fails at and after its "Fail At" (ms)
- *   "cone"          provides "track": one value, its "Level" parameter */
+ *   "cone"          provides "track": one value, its "Level" parameter
+ * and actuator models:
+ *   "reverse"       drives each wheel backwards at its "Gain" times the command; counts nothing
+ *   "runaway"       fails at and after its "Fail At" (ms), and before that gives NaN when the
+ *                   command is 99 units */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
+#include <rilbed/actuator_model.h>
 #include <rilbed/sensor_model.h>
 
 typedef struct point_model {
@@ -88,6 +93,55 @@ static const rilbed_sensor_model failing = {
 static const rilbed_sensor_model cone = {
     RILBED_ABI_VERSION, "cone",    "a track reading of its level", kConeParams, 1, 1, "track", 1, fail_create,
     cone_sense,         free_model};
+
+static const rilbed_actuator_param kReverseParams[] = {{"Gain", "", "speed per command", 1.0, 1, 0, 0.0, 10.0}};
+
+static void* reverse_create(const rilbed_actuator_setup* setup, char* error, uint32_t error_size) {
+  if (setup->robot_id == 13) {
+    snprintf(error, error_size, "robot 13 has no wheels");
+    return NULL;
+  }
+  double* gain = malloc(sizeof(double));
+  *gain = setup->param_values[0] * (setup->wheel_base_m > 0.0 ? 1.0 : 0.0);
+  return gain;
+}
+
+static int32_t reverse_drive(void* model, const rilbed_drive_call* call, rilbed_drive_output* out, char* error,
+                             uint32_t error_size) {
+  (void)error, (void)error_size;
+  const double gain = *(const double*)model;
+  out->left_mps = -gain * call->left_command_mps;
+  out->right_mps = -gain * call->right_command_mps;
+  out->left_counted_mps = out->right_counted_mps = 0.0;
+  return 0;
+}
+
+static int32_t runaway_drive(void* model, const rilbed_drive_call* call, rilbed_drive_output* out, char* error,
+                             uint32_t error_size) {
+  if ((double)call->t_us >= *(const double*)model * 1000.0) {
+    snprintf(error, error_size, "the motor burnt out");
+    return 1;
+  }
+  if (call->left_units == 99) out->left_mps = NAN;
+  return 0;
+}
+
+static void* runaway_create(const rilbed_actuator_setup* setup, char* error, uint32_t error_size) {
+  (void)error, (void)error_size;
+  double* at = malloc(sizeof(double));
+  *at = setup->param_values[0];
+  return at;
+}
+
+static const rilbed_actuator_model reverse = {RILBED_ABI_VERSION, "reverse",     "backwards", kReverseParams, 1, 1,
+                                              reverse_create,     reverse_drive, free_model};
+static const rilbed_actuator_model runaway = {RILBED_ABI_VERSION, "runaway",     "fails",   kFailParams, 1, 0,
+                                              runaway_create,     runaway_drive, free_model};
+
+const rilbed_actuator_model* const* rilbed_actuator_models(void) {
+  static const rilbed_actuator_model* const list[] = {&reverse, &runaway, NULL};
+  return list;
+}
 
 const rilbed_sensor_model* const* rilbed_sensor_models(void) {
   static const rilbed_sensor_model* const list[] = {&beacon_range, &failing, &cone, NULL};

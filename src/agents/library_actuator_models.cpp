@@ -1,0 +1,165 @@
+#include "agents/library_actuator_models.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+namespace rilbed::agents {
+
+namespace {
+
+constexpr std::size_t kMaxModels = 4096;
+
+core::Result<std::string> printable_text(const char* text, const std::string& what, std::size_t limit) {
+  if (!text) return core::Failure{what + " is NULL"};
+  const std::size_t n = strnlen(text, limit + 1);
+  if (n > limit) return core::Failure{what + " is longer than " + std::to_string(limit) + " bytes"};
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 || c > 0x7e) return core::Failure{what + " holds a byte that is not printable ASCII"};
+  }
+  return std::string(text, n);
+}
+
+double rng_normal(void* rng) { return environment::fast_normal(*static_cast<environment::NoiseRng*>(rng)); }
+double rng_uniform(void* rng) { return environment::uniform01(*static_cast<environment::NoiseRng*>(rng)); }
+
+// One robot's drive: its instance of the model.
+class LibraryDrive final : public environment::DriveModel {
+ public:
+  LibraryDrive(std::shared_ptr<const PluginLibrary> library, const rilbed_actuator_model& model, void* instance,
+               std::string who)
+      : library_(std::move(library)), model_(model), instance_(instance), who_(std::move(who)) {}
+  ~LibraryDrive() override { model_.destroy(instance_); }
+  LibraryDrive(const LibraryDrive&) = delete;
+  LibraryDrive& operator=(const LibraryDrive&) = delete;
+
+  environment::DriveOutput drive(const environment::DriveCall& c) override {
+    const rilbed_drive_call call{c.t_us, c.robot_id,   c.pose.position_m.x, c.pose.position_m.y, c.pose.heading_rad,
+                                 c.dt_s, c.left_units, c.right_units,       c.command_mps.x,     c.command_mps.y,
+                                 &c.rng, &rng_normal,  &rng_uniform};
+    rilbed_drive_output out{c.command_mps.x, c.command_mps.y, c.command_mps.x, c.command_mps.y};
+    char error[512] = {0};
+    if (model_.drive(instance_, &call, &out, error, sizeof error) != 0) {
+      error[sizeof error - 1] = '\0';
+      throw std::runtime_error(who_ + ": its step at t = " + std::to_string(c.t_us / 1000) +
+                               " ms failed: " + (error[0] ? error : "(no message)"));
+    }
+    for (const double v : {out.left_mps, out.right_mps, out.left_counted_mps, out.right_counted_mps}) {
+      // A speed no Khepera-sized robot reaches, or not a number, is the model's mistake.
+      if (!std::isfinite(v) || std::abs(v) > 100.0) {
+        throw std::runtime_error(who_ + ": its step at t = " + std::to_string(c.t_us / 1000) +
+                                 " ms gave a wheel speed that is not a finite number within 100 m/s");
+      }
+    }
+    return {{out.left_mps, out.right_mps}, {out.left_counted_mps, out.right_counted_mps}};
+  }
+
+ private:
+  std::shared_ptr<const PluginLibrary> library_;
+  const rilbed_actuator_model& model_;
+  void* instance_;
+  std::string who_;
+};
+
+class LibraryDriveFactory final : public environment::DriveModelFactory {
+ public:
+  LibraryDriveFactory(const ActuatorModelEntry& entry, std::vector<double> values, const environment::StaticMap& map,
+                      TimeUs step_us, std::string parameter_file)
+      : library_(entry.library),
+        model_(*entry.model),
+        name_(entry.name),
+        origin_(entry.origin),
+        concurrent_(entry.concurrent),
+        values_(std::move(values)),
+        world_(std::make_unique<StaticWorldView>(map)),
+        step_us_(step_us),
+        parameter_file_(std::move(parameter_file)) {}
+
+  std::unique_ptr<environment::DriveModel> make(int robot_id, double wheel_base_m) const override {
+    const rilbed_actuator_setup setup{robot_id,
+                                      static_cast<std::uint32_t>(values_.size()),
+                                      values_.data(),
+                                      wheel_base_m,
+                                      step_us_,
+                                      &world_->raw,
+                                      parameter_file_.c_str()};
+    char error[512] = {0};
+    void* instance = model_.create(&setup, error, sizeof error);
+    error[sizeof error - 1] = '\0';
+    const std::string who = "actuator model " + name_ + " (" + origin_ + ") of robot " + std::to_string(robot_id);
+    if (!instance) throw std::invalid_argument(who + ": cannot be made: " + (error[0] ? error : "(no message)"));
+    return std::make_unique<LibraryDrive>(library_, model_, instance, who);
+  }
+  bool concurrent() const override { return concurrent_; }
+
+ private:
+  std::shared_ptr<const PluginLibrary> library_;
+  const rilbed_actuator_model& model_;
+  std::string name_;
+  std::string origin_;
+  bool concurrent_;
+  std::vector<double> values_;
+  std::unique_ptr<StaticWorldView> world_;
+  TimeUs step_us_;
+  std::string parameter_file_;
+};
+
+}  // namespace
+
+core::Result<ActuatorModelEntry> actuator_model_entry(const rilbed_actuator_model& m,
+                                                      std::shared_ptr<const PluginLibrary> library,
+                                                      const std::string& origin) {
+  const std::string what = origin + ": actuator model";
+  if (m.abi_version != RILBED_ABI_VERSION) {
+    return core::Failure{what + " was built against rilbed's SDK ABI version " + std::to_string(m.abi_version) +
+                         ", this rilbed loads version " + std::to_string(RILBED_ABI_VERSION)};
+  }
+  core::Result<std::string> name = printable_text(m.name, what + " name", 128);
+  if (!name) return core::Failure{name.error()};
+  if (name->empty() || name->find_first_of(" ,:{}[]#\"'") != std::string::npos)
+    return core::Failure{what + " name '" + *name + "' is empty or holds a space or YAML punctuation"};
+  const std::string who = what + " '" + *name + "'";
+  core::Result<std::string> summary = printable_text(m.summary, who + " summary", 4096);
+  if (!summary) return core::Failure{summary.error()};
+  if (!m.create || !m.drive || !m.destroy) return core::Failure{who + " lacks its create, drive or destroy function"};
+  core::Result<std::vector<SensorParamSpec>> params = model_param_specs(m.params, m.param_count, who);
+  if (!params) return core::Failure{params.error()};
+  return ActuatorModelEntry{*name, *summary, origin, std::move(*params), m.concurrent != 0, std::move(library), &m};
+}
+
+core::Result<std::vector<ActuatorModelEntry>> load_library_actuator_models(const std::filesystem::path& path) {
+  core::Result<std::shared_ptr<const PluginLibrary>> opened = PluginLibrary::open(path);
+  if (!opened) return core::Failure{opened.error()};
+  const std::shared_ptr<const PluginLibrary>& library = *opened;
+  const std::string origin = library->path().string();
+  using List = const rilbed_actuator_model* const* (*)();
+  auto list = reinterpret_cast<List>(library->symbol("rilbed_actuator_models"));
+  if (!list) {
+    return core::Failure{"plug-in library " + origin +
+                         ": does not export rilbed_actuator_models(), so it holds no actuator model"};
+  }
+  const rilbed_actuator_model* const* models = list();
+  if (!models) return core::Failure{"plug-in library " + origin + ": rilbed_actuator_models() returned NULL"};
+  std::vector<ActuatorModelEntry> entries;
+  for (std::size_t i = 0; models[i]; ++i) {
+    if (i >= kMaxModels) return core::Failure{"plug-in library " + origin + ": more than 4096 actuator models"};
+    core::Result<ActuatorModelEntry> e = actuator_model_entry(*models[i], library, origin);
+    if (!e) return core::Failure{e.error()};
+    for (const ActuatorModelEntry& before : entries) {
+      if (before.name == e->name)
+        return core::Failure{"plug-in library " + origin + ": holds two actuator models named '" + e->name + "'"};
+    }
+    entries.push_back(std::move(*e));
+  }
+  return entries;
+}
+
+std::shared_ptr<const environment::DriveModelFactory> actuator_factory(const ActuatorModelEntry& entry,
+                                                                       std::vector<double> param_values,
+                                                                       const environment::StaticMap& map,
+                                                                       TimeUs step_us, std::string parameter_file) {
+  return std::make_shared<LibraryDriveFactory>(entry, std::move(param_values), map, step_us, std::move(parameter_file));
+}
+
+}  // namespace rilbed::agents
