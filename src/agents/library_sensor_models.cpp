@@ -18,6 +18,7 @@ constexpr std::size_t kMaxText = 4096;
 constexpr std::uint32_t kMaxParams = 64;
 constexpr std::uint32_t kMaxValues = 64;
 constexpr std::size_t kMaxModels = 4096;
+constexpr std::uint32_t kMarksPerCall = 32;  // room a model gets to draw, per robot and call
 
 core::Result<std::string> model_text(const char* text, const std::string& what, std::size_t limit = kMaxText) {
   if (!text) return core::Failure{what + " is NULL"};
@@ -60,6 +61,7 @@ class LibrarySensorModel final : public environment::SensorModel {
 
   void sense(const environment::SensorModelCall& c, std::span<double> values) const override {
     std::uint32_t mark_count = 0;
+    rilbed_mark marks[kMarksPerCall];
     const rilbed_sense_call call{c.t_us,
                                  c.robot_id,
                                  c.pose.position_m.x,
@@ -74,8 +76,8 @@ class LibrarySensorModel final : public environment::SensorModel {
                                  &c.rng,
                                  &rng_normal,
                                  &rng_uniform,
-                                 nullptr,
-                                 0,
+                                 c.marks ? marks : nullptr,
+                                 c.marks ? kMarksPerCall : 0u,
                                  &mark_count};
     std::fill(values.begin(), values.end(), 0.0);
     char error[512] = {0};
@@ -84,6 +86,7 @@ class LibrarySensorModel final : public environment::SensorModel {
       throw std::runtime_error(who_ + " of robot " + std::to_string(c.robot_id) + ": its reading at t = " +
                                std::to_string(c.t_us / 1000) + " ms failed: " + (error[0] ? error : "(no message)"));
     }
+    if (c.marks) keep_marks(marks, std::min(mark_count, kMarksPerCall), *c.marks);
     for (double& v : values) {
       if (!std::isfinite(v)) {
         throw std::runtime_error(who_ + " of robot " + std::to_string(c.robot_id) + ": its reading at t = " +
@@ -93,6 +96,24 @@ class LibrarySensorModel final : public environment::SensorModel {
   }
 
  private:
+  // The marks a call drew that a display can draw: known shapes, finite, within 100 m of
+  // the robot (anything else is dropped, not an error: marks are for the eye only).
+  static void keep_marks(const rilbed_mark* marks, std::uint32_t count, std::vector<environment::SensorMark>& out) {
+    for (std::uint32_t i = 0; i < count; ++i) {
+      const rilbed_mark& m = marks[i];
+      const bool circle = m.shape == RILBED_MARK_CIRCLE, line = m.shape == RILBED_MARK_LINE;
+      auto near = [](double v) { return std::isfinite(v) && std::abs(v) <= 100.0; };
+      if (!(circle || line) || !near(m.x_m) || !near(m.y_m)) continue;
+      if (circle && !(near(m.radius_m) && m.radius_m > 0.0)) continue;
+      if (line && !(near(m.x2_m) && near(m.y2_m))) continue;
+      out.push_back({circle ? environment::SensorMark::Shape::kCircle : environment::SensorMark::Shape::kLine,
+                     {m.x_m, m.y_m},
+                     {line ? m.x2_m : 0.0, line ? m.y2_m : 0.0},
+                     circle ? m.radius_m : 0.0,
+                     m.rgba});
+    }
+  }
+
   std::shared_ptr<const PluginLibrary> library_;
   const rilbed_sensor_model& model_;
   void* instance_;

@@ -15,18 +15,9 @@
 #include "environment/mobile_pose.hpp"
 #include "environment/random.hpp"
 #include "environment/scene.hpp"
+#include "environment/sensor_readings.hpp"
 
 namespace rilbed::environment {
-
-/// A shape a model draws for the displays, in the robot's frame (metres, x forward, y left).
-struct SensorMark {
-  enum class Shape : std::uint8_t { kCircle, kLine };
-  Shape shape = Shape::kCircle;
-  Vec2 a_m;                          ///< the circle's centre, or the line's start
-  Vec2 b_m;                          ///< the line's end
-  double radius_m = 0.0;             ///< the circle's radius
-  std::uint32_t rgba = 0xffffffffu;  ///< 0xRRGGBBAA
-};
 
 /// Everything one call of a model sees. Valid during the call only.
 struct SensorModelCall {

@@ -58,6 +58,17 @@ struct ModelReading {
   std::vector<double> values;  ///< as many as the model writes
 };
 
+/// A shape a sensor model drew for the displays (paper 000 §8.3), in the robot's frame
+/// (metres, x forward, y left).
+struct SensorMark {
+  enum class Shape : std::uint8_t { kCircle, kLine };
+  Shape shape = Shape::kCircle;
+  Vec2 a_m;                          ///< the circle's centre, or the line's start
+  Vec2 b_m;                          ///< the line's end
+  double radius_m = 0.0;             ///< the circle's radius
+  std::uint32_t rgba = 0xffffffffu;  ///< 0xRRGGBBAA
+};
+
 /// Everything one robot sensed at one instant. Sensors a robot does not carry are left
 /// empty (empty vectors, nullopt).
 struct SensorReadings {
@@ -68,6 +79,7 @@ struct SensorReadings {
   std::vector<int> track;                    ///< one value per track sensor, 0..its max value
   std::optional<OdometryReading> odometry;   ///< wheel counters
   std::vector<ModelReading> models;          ///< sensor models' readings, in mount order (not those providing track)
+  std::vector<SensorMark> marks;             ///< what its sensor models drew, when the world collects marks
 };
 
 }  // namespace rilbed::environment

@@ -29,7 +29,7 @@ SensorSuite::SensorSuite(const SensorSuiteConfig& config, const std::string& wha
 }
 
 void SensorSuite::sense(const Scene& scene, int body, Pose2 pose, Vec2 heading, std::optional<OdometryReading> odometry,
-                        TimeUs t_us, NoiseRng& rng, SensorReadings& out, int robot_id) const {
+                        TimeUs t_us, NoiseRng& rng, SensorReadings& out, int robot_id, bool marks) const {
   out.t_us = t_us;
   if (proximity_) {
     if (!out.proximity) out.proximity.emplace();
@@ -51,18 +51,19 @@ void SensorSuite::sense(const Scene& scene, int body, Pose2 pose, Vec2 heading, 
     out.odometry = *odometry;
   else
     out.odometry.reset();
-  sense_models(scene, pose, heading, t_us, rng, out, robot_id);
+  sense_models(scene, pose, heading, t_us, rng, out, robot_id, marks);
 }
 
 void SensorSuite::sense_models(const Scene& scene, Pose2 pose, Vec2 heading, TimeUs t_us, NoiseRng& rng,
-                               SensorReadings& out, int robot_id) const {
+                               SensorReadings& out, int robot_id, bool marks) const {
   std::size_t listed = 0;
   for (const auto& model : models_) {
     if (!model->provides_track()) ++listed;
   }
   out.models.resize(listed);
+  out.marks.clear();
   if (models_.empty()) return;
-  const SensorModelCall call{scene, scene.mobiles, t_us, robot_id, pose, heading, rng, nullptr};
+  const SensorModelCall call{scene, scene.mobiles, t_us, robot_id, pose, heading, rng, marks ? &out.marks : nullptr};
   std::size_t next = 0;
   for (const auto& model : models_) {
     if (model->provides_track()) {

@@ -47,9 +47,9 @@ class SensorSuite {
   }
   /// As above, with the heading's unit vector (cos, sin of pose.heading_rad) given, and the
   /// robot's ID for its sensor models (which are called last, in mount order, and may throw
-  /// std::runtime_error).
+  /// std::runtime_error) and whether they draw (`marks`, into out.marks).
   void sense(const Scene& scene, int body, Pose2 pose, Vec2 heading, std::optional<OdometryReading> odometry,
-             TimeUs t_us, NoiseRng& rng, SensorReadings& out, int robot_id = 0) const;
+             TimeUs t_us, NoiseRng& rng, SensorReadings& out, int robot_id = 0, bool marks = false) const;
 
   /// The IR ring, if carried.
   const std::optional<ProximitySensor>& proximity() const { return proximity_; }
@@ -70,7 +70,7 @@ class SensorSuite {
 
  private:
   void sense_models(const Scene& scene, Pose2 pose, Vec2 heading, TimeUs t_us, NoiseRng& rng, SensorReadings& out,
-                    int robot_id) const;
+                    int robot_id, bool marks) const;
   std::optional<ProximitySensor> proximity_;
   RangeFinders range_finders_;
   std::optional<BeaconFinderConfig> beacon_finder_;

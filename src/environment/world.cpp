@@ -566,7 +566,8 @@ SensorReadings World::sense(int id, TimeUs t_us, NoiseRng& rng) const {
   if (r.kind == RobotKind::kVirtual) odometry = r.odometer();
   SensorReadings out;
   refresh_mobiles();
-  suite_pool_[suite_of_[s]].sense(scene(), static_cast<int>(s), r.pose, headings_[s], odometry, t_us, rng, out, r.id);
+  suite_pool_[suite_of_[s]].sense(scene(), static_cast<int>(s), r.pose, headings_[s], odometry, t_us, rng, out, r.id,
+                                  collect_marks_);
   return out;
 }
 
@@ -586,8 +587,9 @@ void World::sense_into(int id, TimeUs t_us, SensorReadings& out) const {
     if (stored.has_lists) {
       const StoredLists& lists = ahead_lists_[added];
       out.ranges = lists.ranges, out.beacons = lists.beacons, out.track = lists.track, out.models = lists.models;
+      out.marks = lists.marks;
     } else {
-      out.ranges.clear(), out.beacons.clear(), out.track.clear(), out.models.clear();
+      out.ranges.clear(), out.beacons.clear(), out.track.clear(), out.models.clear(), out.marks.clear();
     }
     return;
   }
@@ -602,13 +604,13 @@ void World::store_readings(std::size_t added, SensorReadings& readings) {
   if (stored.has_proximity) stored.proximity = *readings.proximity;
   stored.has_odometry = readings.odometry.has_value();
   if (stored.has_odometry) stored.odometry = *readings.odometry;
-  stored.has_lists =
-      !readings.ranges.empty() || !readings.beacons.empty() || !readings.track.empty() || !readings.models.empty();
+  stored.has_lists = !readings.ranges.empty() || !readings.beacons.empty() || !readings.track.empty() ||
+                     !readings.models.empty() || !readings.marks.empty();
   if (stored.has_lists) {
     // Swapped, not copied: the record's old lists become the scratch's, capacity kept.
     StoredLists& lists = ahead_lists_[added];
     lists.ranges.swap(readings.ranges), lists.beacons.swap(readings.beacons), lists.track.swap(readings.track);
-    lists.models.swap(readings.models);
+    lists.models.swap(readings.models), lists.marks.swap(readings.marks);
   }
 }
 
@@ -695,7 +697,8 @@ void World::sense_slot(const Scene& scene, std::size_t s, TimeUs t_us, SensorRea
   std::optional<OdometryReading> odometry;
   if (r.kind == RobotKind::kVirtual) odometry = r.odometer();
   NoiseRng rng = NoiseRng::keyed(config_.noise_seed, r.id, t_us, NoisePurpose::kSensing);
-  suite_pool_[suite_of_[s]].sense(scene, static_cast<int>(s), r.pose, headings_[s], odometry, t_us, rng, out, r.id);
+  suite_pool_[suite_of_[s]].sense(scene, static_cast<int>(s), r.pose, headings_[s], odometry, t_us, rng, out, r.id,
+                                  collect_marks_);
 }
 
 void World::sense_all(TimeUs t_us, std::vector<SensorReadings>& out) const {

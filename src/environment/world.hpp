@@ -91,6 +91,9 @@ class World {
   void add_robot(const RobotConfig& config);
   /// Removes a robot. Throws std::invalid_argument for an unknown id.
   void remove_robot(int id);
+  /// Whether sensor models draw what they see (SensorReadings::marks): for displays only,
+  /// off by default.
+  void set_collect_marks(bool on) { collect_marks_ = on; }
   /// Whether a robot with this id is in the world.
   bool has_robot(int id) const { return slot_of_.contains(id); }
   /// The robot with this id. Throws std::invalid_argument for an unknown id. The
@@ -305,6 +308,7 @@ class World {
     std::vector<BeaconSighting> beacons;
     std::vector<int> track;
     std::vector<ModelReading> models;
+    std::vector<SensorMark> marks;
   };
   // Packs `readings` as robot (added index) `added`'s record.
   void store_readings(std::size_t added, SensorReadings& readings);
@@ -312,6 +316,7 @@ class World {
   void refresh_mobiles() const;
   mutable std::vector<MobilePose> mobiles_;  // what sensor models see of every mobile object (scene().mobiles)
   bool has_models_ = false;                  // some suite carries a sensor model
+  bool collect_marks_ = false;               // sensor models draw (set_collect_marks)
   bool models_concurrent_ = true;            // every suite's models may sense for two robots at once
   std::vector<StoredReadings> ahead_;
   std::vector<StoredLists> ahead_lists_;      // by added index; empty unless a suite has lists

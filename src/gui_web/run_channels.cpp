@@ -21,6 +21,8 @@ json number() { return {{"type", "number"}}; }
 json integer() { return {{"type", "integer"}}; }
 json text() { return {{"type", "string"}}; }
 json boolean() { return {{"type", "boolean"}}; }
+// A sensor model's mark (environment::SensorMark), robot frame.
+json mark_schema();
 json array_of(const json& items) { return {{"type", "array"}, {"items", items}}; }
 json object_of(const json& properties) { return {{"type", "object"}, {"properties", properties}}; }
 
@@ -50,6 +52,27 @@ json entity(TimeUs t_us, const std::string& id) {
           {"triangles", json::array()},
           {"texts", json::array()},
           {"models", json::array()}};
+}
+
+json mark_schema() {
+  return object_of({{"shape", text()},
+                    {"x_m", number()},
+                    {"y_m", number()},
+                    {"radius_m", number()},
+                    {"x2_m", number()},
+                    {"y2_m", number()},
+                    {"rgba", integer()}});
+}
+
+json mark_json(const environment::SensorMark& m) {
+  const bool circle = m.shape == environment::SensorMark::Shape::kCircle;
+  return {{"shape", circle ? "circle" : "line"},
+          {"x_m", m.a_m.x},
+          {"y_m", m.a_m.y},
+          {"radius_m", m.radius_m},
+          {"x2_m", m.b_m.x},
+          {"y2_m", m.b_m.y},
+          {"rgba", m.rgba}};
 }
 
 json line(const std::vector<Vec2>& points, bool loop, double thickness_m, const json& c) {
@@ -212,14 +235,19 @@ RunChannels::RunChannels(WebServer& server) : server_(server) {
                                     {{"id", integer()}, {"left_units", integer()}, {"right_units", integer()}}))}})));
   sensors_ = server_.add_channel(channel(
       "/rilbed/sensors", "rilbed.sensors",
-      object_schema("rilbed.sensors", {{"t_s", number()},
-                                       {"robots", array_of(object_of({{"id", integer()},
-                                                                      {"proximity", array_of(integer())},
-                                                                      {"range_m", array_of(number())},
-                                                                      {"range_hit", array_of(boolean())},
-                                                                      {"beacon_id", array_of(integer())},
-                                                                      {"beacon_bearing_rad", array_of(number())},
-                                                                      {"track", array_of(integer())}}))}})));
+      object_schema(
+          "rilbed.sensors",
+          {{"t_s", number()},
+           {"robots",
+            array_of(object_of({{"id", integer()},
+                                {"proximity", array_of(integer())},
+                                {"range_m", array_of(number())},
+                                {"range_hit", array_of(boolean())},
+                                {"beacon_id", array_of(integer())},
+                                {"beacon_bearing_rad", array_of(number())},
+                                {"track", array_of(integer())},
+                                {"models", array_of(object_of({{"name", text()}, {"values", array_of(number())}}))},
+                                {"marks", array_of(mark_schema())}}))}})));
   detections_ = server_.add_channel(
       channel("/rilbed/detections", "rilbed.detections",
               object_schema("rilbed.detections", {{"t_s", number()},
@@ -356,8 +384,35 @@ json RunChannels::status_json(const run::StatusReport& s) {
           {"frames", s.frames}};
 }
 
+namespace {
+
+// A robot's sensor marks as lines in the field frame: a circle as a loop of 16 points.
+void add_marks(json& entity, const Pose2& robot, const std::vector<environment::SensorMark>& marks) {
+  const double c = std::cos(robot.heading_rad), s = std::sin(robot.heading_rad);
+  auto field = [&](Vec2 p) {
+    return Vec2{robot.position_m.x + c * p.x - s * p.y, robot.position_m.y + s * p.x + c * p.y};
+  };
+  for (const environment::SensorMark& m : marks) {
+    const json colour = color(((m.rgba >> 24) & 0xff) / 255.0, ((m.rgba >> 16) & 0xff) / 255.0,
+                              ((m.rgba >> 8) & 0xff) / 255.0, (m.rgba & 0xff) / 255.0);
+    std::vector<Vec2> points;
+    if (m.shape == environment::SensorMark::Shape::kLine) {
+      points = {field(m.a_m), field(m.b_m)};
+    } else {
+      for (int k = 0; k < 16; ++k) {
+        const double a = 2.0 * kPi * k / 16;
+        points.push_back(field({m.a_m.x + m.radius_m * std::cos(a), m.a_m.y + m.radius_m * std::sin(a)}));
+      }
+    }
+    entity["lines"].push_back(line(points, m.shape == environment::SensorMark::Shape::kCircle, 0.001, colour));
+  }
+}
+
+}  // namespace
+
 json RunChannels::scene_json(TimeUs t_us, std::span<const run::PoseReport> poses,
-                             const std::optional<run::WorldReport>& world) {
+                             const std::optional<run::WorldReport>& world,
+                             const std::map<int, std::vector<environment::SensorMark>>& marks) {
   json entities = json::array();
   if (world) {
     json field = entity(t_us, "field");
@@ -390,6 +445,7 @@ json RunChannels::scene_json(TimeUs t_us, std::span<const run::PoseReport> poses
                           {"scale_invariant", true},
                           {"color", color(0, 0, 0)},
                           {"text", std::to_string(p.id) + " " + std::string(p.behaviour)}});
+    if (const auto it = marks.find(p.id); it != marks.end()) add_marks(e, p.pose, it->second);
     entities.push_back(std::move(e));
   }
   return {{"deletions", json::array()}, {"entities", entities}};
@@ -492,15 +548,27 @@ void RunChannels::on_poses(TimeUs t_us, std::span<const run::PoseReport> poses) 
     }
     if (server_.subscribed(scene_)) {
       std::optional<run::WorldReport> world;
+      std::map<int, std::vector<environment::SensorMark>> marks;
       {
         std::lock_guard lock(l.mutex);
         world = l.world;  // 1 Hz's copy, only while someone watches the scene
+        marks = l.marks;
       }
-      send(scene_, t_us, scene_json(t_us, copy, world));
+      send(scene_, t_us, scene_json(t_us, copy, world, marks));
       std::lock_guard lock(l.mutex);
       if (l.poses_t_us == t_us) l.scene_unsent = false;
     }
   });
+}
+
+void RunChannels::keep_marks(std::span<const run::SensorReport> sensors) {
+  if (!server_.subscribed(scene_)) return;
+  std::map<int, std::vector<environment::SensorMark>> marks;
+  for (const auto& r : sensors) {
+    if (r.readings && !r.readings->marks.empty()) marks[r.id] = r.readings->marks;
+  }
+  std::lock_guard lock(latest_->mutex);
+  latest_->marks = std::move(marks);
 }
 
 std::shared_ptr<const std::string> RunChannels::Latest::build(bool scene, std::uint64_t& t_ns) {
@@ -509,7 +577,7 @@ std::shared_ptr<const std::string> RunChannels::Latest::build(bool scene, std::u
   if (!unsent) return nullptr;
   unsent = false;
   t_ns = static_cast<std::uint64_t>(std::max<TimeUs>(0, poses_t_us)) * 1000;
-  const json message = scene ? scene_json(poses_t_us, poses.poses, world) : poses_json(poses_t_us, poses.poses);
+  const json message = scene ? scene_json(poses_t_us, poses.poses, world, marks) : poses_json(poses_t_us, poses.poses);
   return std::make_shared<const std::string>(message.dump(-1, ' ', false, json::error_handler_t::replace));
 }
 
@@ -523,7 +591,20 @@ void RunChannels::on_wheels(TimeUs t_us, std::span<const run::WheelReport> wheel
   });
 }
 
+json RunChannels::models_json(const environment::SensorReadings& s) {
+  json list = json::array();
+  for (const environment::ModelReading& m : s.models) list.push_back({{"name", m.name}, {"values", m.values}});
+  return list;
+}
+
+json RunChannels::marks_json(const environment::SensorReadings& s) {
+  json list = json::array();
+  for (const environment::SensorMark& m : s.marks) list.push_back(mark_json(m));
+  return list;
+}
+
 void RunChannels::on_sensors(TimeUs t_us, std::span<const run::SensorReport> sensors) {
+  keep_marks(sensors);
   if (!server_.subscribed(sensors_)) return;  // nobody would get it
   std::vector<std::pair<int, environment::SensorReadings>> copy;
   copy.reserve(sensors.size());
@@ -546,7 +627,9 @@ void RunChannels::on_sensors(TimeUs t_us, std::span<const run::SensorReport> sen
                         {"range_hit", hits},
                         {"beacon_id", ids},
                         {"beacon_bearing_rad", bearings},
-                        {"track", s.track}});
+                        {"track", s.track},
+                        {"models", models_json(s)},
+                        {"marks", marks_json(s)}});
     }
     send(sensors_, t_us, {{"t_s", seconds(t_us)}, {"robots", robots}});
   });

@@ -25,6 +25,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -69,11 +70,20 @@ class RunChannels final : public run::RunObserver {
   static nlohmann::json poses_json(TimeUs t_us, std::span<const run::PoseReport> poses);
   static nlohmann::json status_json(const run::StatusReport& status);
   /// foxglove.SceneUpdate: every robot as a disc (virtual red, real blue) with its ID and
-  /// behaviour, and the field's boundary, obstacles and tracks as lines.
+  /// behaviour and the marks its sensor models drew (by robot ID, robot frame; drawn as
+  /// lines in the field frame, a circle as a loop of 16 points), and the field's boundary,
+  /// obstacles and tracks as lines.
   static nlohmann::json scene_json(TimeUs t_us, std::span<const run::PoseReport> poses,
-                                   const std::optional<run::WorldReport>& world);
+                                   const std::optional<run::WorldReport>& world,
+                                   const std::map<int, std::vector<environment::SensorMark>>& marks = {});
+  /// A robot's sensor-model readings as the sensors channel carries them: [{name, values}].
+  static nlohmann::json models_json(const environment::SensorReadings& s);
+  /// Its sensor models' marks, robot frame: [{shape, x_m, y_m, radius_m, x2_m, y2_m, rgba}].
+  static nlohmann::json marks_json(const environment::SensorReadings& s);
 
  private:
+  // The latest marks of each robot, for the scene (only while someone watches it).
+  void keep_marks(std::span<const run::SensorReport> sensors);
   // Something to build and publish on the channels' thread.
   struct Job {
     std::uint32_t channel = 0;
@@ -103,7 +113,8 @@ class RunChannels final : public run::RunObserver {
     std::optional<run::WorldReport> world;
     TimeUs poses_t_us = 0;
     OwnedPoses poses;
-    bool poses_unsent = false, scene_unsent = false;  // the last poses were not published on the channel
+    bool poses_unsent = false, scene_unsent = false;            // the last poses were not published on the channel
+    std::map<int, std::vector<environment::SensorMark>> marks;  // each robot's latest sensor marks
     // The latest poses or scene message, or null when what was published last is the latest.
     std::shared_ptr<const std::string> build(bool scene, std::uint64_t& t_ns);
   };

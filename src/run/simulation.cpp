@@ -152,7 +152,9 @@ void Run::add_agents() {
     agents_.push_back(&root_->emplace<AgentModel>(*bodies_[i], std::move(controller), scenario_.control_period_us, 0,
                                                   commanded, options_.remote_agents));
   }
-  // The readings each step are kept for an observer only (the GUI and the bus report them).
+  // The readings each step are kept for an observer only (the GUI and the bus report them),
+  // and so are what sensor models draw.
+  world_.set_collect_marks(options_.observer != nullptr);
   if (!options_.observer) {
     for (AgentModel* a : agents_) a->set_keep_sensors(false);
   }

@@ -126,6 +126,16 @@ TEST(LibrarySensorModels, AMountedModelSensesOnTheWorldsRobots) {
   EXPECT_EQ(s.models[1].name, "noisy");
   EXPECT_GT(s.models[1].values[0], s.models[0].values[0]);  // uniform noise in [0, 0.2)
   ASSERT_EQ(s.track, (std::vector<int>{42}));
+  EXPECT_TRUE(s.marks.empty());  // nobody watches: the models are not asked to draw
+  world.set_collect_marks(true);
+  world.sense_ahead(200'000);
+  const environment::SensorReadings drawn = world.sense(2, 200'000);
+  ASSERT_EQ(drawn.marks.size(), 4u);  // two models, each a circle and a line; the NaN circles dropped
+  EXPECT_EQ(drawn.marks[0].shape, environment::SensorMark::Shape::kCircle);
+  EXPECT_EQ(drawn.marks[0].radius_m, 0.01);
+  EXPECT_EQ(drawn.marks[0].rgba, 0xff0000ffu);
+  EXPECT_EQ(drawn.marks[1].shape, environment::SensorMark::Shape::kLine);
+  EXPECT_EQ(drawn.marks[1].b_m.x, 0.1);
   // The noise comes from the robot's own stream: the same at the same instant, whoever asks.
   environment::World again(field());
   for (int id = 3; id >= 1; --id) {

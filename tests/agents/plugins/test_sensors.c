@@ -49,6 +49,15 @@ static int32_t range_sense(const void* model, const rilbed_sense_call* call, dou
   const point_model* m = model;
   values[0] = hypot(call->x_m - m->x_m, call->y_m - m->y_m) + m->noise * call->uniform(call->noise);
   values[1] = call->mobile_count;
+  if (call->marks && *call->mark_count + 3 <= call->mark_capacity) {
+    /* A circle at its mount, a line 10 cm ahead, and one that no display could draw. */
+    const rilbed_mark circle = {RILBED_MARK_CIRCLE, m->mount_x_m, 0.0, 0.01, 0.0, 0.0, 0xff0000ffu};
+    const rilbed_mark ahead = {RILBED_MARK_LINE, 0.0, 0.0, 0.0, 0.1, 0.0, 0x00ff00ffu};
+    const rilbed_mark junk = {RILBED_MARK_CIRCLE, NAN, 0.0, 0.01, 0.0, 0.0, 0u};
+    call->marks[(*call->mark_count)++] = circle;
+    call->marks[(*call->mark_count)++] = ahead;
+    call->marks[(*call->mark_count)++] = junk;
+  }
   return 0;
 }
 
