@@ -5,6 +5,7 @@ import { prepareCanvas } from './canvas.js';
 import { FoxgloveClient } from './foxglove.js';
 import { wrapRadPi } from './angles.js';
 import { makeProjection } from './projection.js';
+import { marksInField } from './marks.js';
 
 const params = new URLSearchParams(location.search);
 const token = params.get('token') || '';
@@ -34,8 +35,9 @@ const run = {
 // For tests and the curious: what the page holds now.
 // stats: frames drawn, the last draw's milliseconds, frames in the last second, and how the
 // trail layer was drawn (trailsLaid: laid anew for the view; trailsMoved: the layer laid
-// for an earlier view, moved and scaled while the view moves).
-window.rilbed = { run, stats: { frames: 0, drawMs: 0, fps: 0, trailsLaid: 0, trailsMoved: 0 } };
+// for an earlier view, moved and scaled while the view moves); marks: the sensor models'
+// marks the last frame drew.
+window.rilbed = { run, stats: { frames: 0, drawMs: 0, fps: 0, trailsLaid: 0, trailsMoved: 0, marks: 0 } };
 
 // ------------------------------------------------------------------ the connection
 const client = new FoxgloveClient(wsUrl);
@@ -688,6 +690,7 @@ function draw(now) {
   if (run.poses) {
     if (overlays.tracks || overlays.ranges || overlays.beacons || overlays.ir) drawSensors(P);
     if (overlays.robots) drawRobots(P);
+    window.rilbed.stats.marks = overlays.marks ? drawMarks(P) : 0; // over the robots: marks sit inside a robot's outline
   }
   if (overlays.detections && run.detections) drawDetections(P);
   if (plotsDirty) drawPlots();
@@ -900,6 +903,38 @@ function drawRobots(P) {
   if (labels.length > MANY_LABELS && Math.sqrt((P.width * P.height) / labels.length) < LABEL_SPACING_PX) return;
   ctx.fillStyle = '#111'; ctx.font = '12px system-ui';
   for (const [text, x, y] of labels) ctx.fillText(text, x, y);
+}
+
+// The shapes the sensor models drew (each robot's marks from its latest sensors message, so
+// a message without marks clears them), moved to the robot's latest pose. One path per
+// colour, stroked once: a thousand robots' marks are a few calls. A circle keeps at least a
+// pixel's radius, so that millimetre marks stay visible without zoom. Returns how many.
+const MARK_MIN_RADIUS_PX = 1;
+function drawMarks(P) {
+  const paths = new Map(); // CSS colour -> Path2D
+  const path = (css) => { let p = paths.get(css); if (!p) paths.set(css, (p = new Path2D())); return p; };
+  let n = 0;
+  for (const r of run.poses.robots) {
+    const marks = run.sensors.get(r.id)?.marks;
+    if (!marks?.length) continue;
+    const scale = P.affine ? P.affine.ax : P.scaleAt(r.x_m, r.y_m);
+    for (const m of marksInField(marks, r)) {
+      const [u, v] = P.project(m.x_m, m.y_m);
+      if (m.shape === 'circle') {
+        const radius = Math.max(MARK_MIN_RADIUS_PX, m.radius_m * scale);
+        if (!P.onCanvas(u, v, radius + 2)) continue;
+        const p = path(m.css);
+        p.moveTo(u + radius, v); p.arc(u, v, radius, 0, 2 * Math.PI);
+      } else { // not culled: a line may cross the canvas from ends off it
+        const p = path(m.css);
+        p.moveTo(u, v); p.lineTo(...P.project(m.x2_m, m.y2_m));
+      }
+      ++n;
+    }
+  }
+  ctx.lineWidth = 1;
+  for (const [css, p] of paths) { ctx.strokeStyle = css; ctx.stroke(p); }
+  return n;
 }
 
 function drawDetections(P) {
