@@ -8,19 +8,6 @@ namespace rilbed::agents {
 
 namespace {
 
-constexpr std::size_t kMaxModels = 4096;
-
-core::Result<std::string> printable_text(const char* text, const std::string& what, std::size_t limit) {
-  if (!text) return core::Failure{what + " is NULL"};
-  const std::size_t n = strnlen(text, limit + 1);
-  if (n > limit) return core::Failure{what + " is longer than " + std::to_string(limit) + " bytes"};
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto c = static_cast<unsigned char>(text[i]);
-    if (c < 0x20 || c > 0x7e) return core::Failure{what + " holds a byte that is not printable ASCII"};
-  }
-  return std::string(text, n);
-}
-
 double rng_normal(void* rng) { return environment::fast_normal(*static_cast<environment::NoiseRng*>(rng)); }
 double rng_uniform(void* rng) { return environment::uniform01(*static_cast<environment::NoiseRng*>(rng)); }
 
@@ -115,12 +102,10 @@ core::Result<ActuatorModelEntry> actuator_model_entry(const rilbed_actuator_mode
     return core::Failure{what + " was built against rilbed's SDK ABI version " + std::to_string(m.abi_version) +
                          ", this rilbed loads version " + std::to_string(RILBED_ABI_VERSION)};
   }
-  core::Result<std::string> name = printable_text(m.name, what + " name", 128);
+  core::Result<std::string> name = model_name(m.name, what + " name");
   if (!name) return core::Failure{name.error()};
-  if (name->empty() || name->find_first_of(" ,:{}[]#\"'") != std::string::npos)
-    return core::Failure{what + " name '" + *name + "' is empty or holds a space or YAML punctuation"};
   const std::string who = what + " '" + *name + "'";
-  core::Result<std::string> summary = printable_text(m.summary, who + " summary", 4096);
+  core::Result<std::string> summary = model_text(m.summary, who + " summary");
   if (!summary) return core::Failure{summary.error()};
   if (!m.create || !m.drive || !m.destroy) return core::Failure{who + " lacks its create, drive or destroy function"};
   core::Result<std::vector<SensorParamSpec>> params = model_param_specs(m.params, m.param_count, who);
@@ -129,30 +114,8 @@ core::Result<ActuatorModelEntry> actuator_model_entry(const rilbed_actuator_mode
 }
 
 core::Result<std::vector<ActuatorModelEntry>> load_library_actuator_models(const std::filesystem::path& path) {
-  core::Result<std::shared_ptr<const PluginLibrary>> opened = PluginLibrary::open(path);
-  if (!opened) return core::Failure{opened.error()};
-  const std::shared_ptr<const PluginLibrary>& library = *opened;
-  const std::string origin = library->path().string();
-  using List = const rilbed_actuator_model* const* (*)();
-  auto list = reinterpret_cast<List>(library->symbol("rilbed_actuator_models"));
-  if (!list) {
-    return core::Failure{"plug-in library " + origin +
-                         ": does not export rilbed_actuator_models(), so it holds no actuator model"};
-  }
-  const rilbed_actuator_model* const* models = list();
-  if (!models) return core::Failure{"plug-in library " + origin + ": rilbed_actuator_models() returned NULL"};
-  std::vector<ActuatorModelEntry> entries;
-  for (std::size_t i = 0; models[i]; ++i) {
-    if (i >= kMaxModels) return core::Failure{"plug-in library " + origin + ": more than 4096 actuator models"};
-    core::Result<ActuatorModelEntry> e = actuator_model_entry(*models[i], library, origin);
-    if (!e) return core::Failure{e.error()};
-    for (const ActuatorModelEntry& before : entries) {
-      if (before.name == e->name)
-        return core::Failure{"plug-in library " + origin + ": holds two actuator models named '" + e->name + "'"};
-    }
-    entries.push_back(std::move(*e));
-  }
-  return entries;
+  return load_model_list<ActuatorModelEntry, rilbed_actuator_model>(path, "rilbed_actuator_models", "actuator model",
+                                                                    &actuator_model_entry);
 }
 
 std::shared_ptr<const environment::DriveModelFactory> actuator_factory(const ActuatorModelEntry& entry,

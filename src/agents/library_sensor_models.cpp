@@ -14,23 +14,9 @@ namespace rilbed::agents {
 
 namespace {
 
-constexpr std::size_t kMaxText = 4096;
 constexpr std::uint32_t kMaxParams = 64;
 constexpr std::uint32_t kMaxValues = 64;
-constexpr std::size_t kMaxModels = 4096;
 constexpr std::uint32_t kMarksPerCall = 32;  // room a model gets to draw, per robot and call
-
-core::Result<std::string> model_text(const char* text, const std::string& what, std::size_t limit = kMaxText) {
-  if (!text) return core::Failure{what + " is NULL"};
-  const std::size_t n = strnlen(text, limit + 1);
-  if (n > limit) return core::Failure{what + " is longer than " + std::to_string(limit) + " bytes"};
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto c = static_cast<unsigned char>(text[i]);
-    // ASCII only: keys, units and summaries go to terminals, JSON and messages as they are.
-    if (c < 0x20 || c > 0x7e) return core::Failure{what + " holds a byte that is not printable ASCII"};
-  }
-  return std::string(text, n);
-}
 
 std::int32_t scene_on_track(const void* scene, double x_m, double y_m) {
   return static_cast<const environment::Scene*>(scene)->on_track({x_m, y_m}) ? 1 : 0;
@@ -126,6 +112,26 @@ class LibrarySensorModel final : public environment::SensorModel {
 
 }  // namespace
 
+core::Result<std::string> model_text(const char* text, const std::string& what, std::size_t limit) {
+  if (!text) return core::Failure{what + " is NULL"};
+  const std::size_t n = strnlen(text, limit + 1);
+  if (n > limit) return core::Failure{what + " is longer than " + std::to_string(limit) + " bytes"};
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    // ASCII only: keys, units and summaries go to terminals, JSON and messages as they are.
+    if (c < 0x20 || c > 0x7e) return core::Failure{what + " holds a byte that is not printable ASCII"};
+  }
+  return std::string(text, n);
+}
+
+core::Result<std::string> model_name(const char* text, const std::string& what) {
+  core::Result<std::string> name = model_text(text, what, 128);
+  if (!name) return name;
+  if (name->empty() || name->find_first_of(" ,:{}[]#\"'") != std::string::npos)
+    return core::Failure{what + " '" + *name + "' is empty or holds a space or YAML punctuation"};
+  return name;
+}
+
 core::Result<SensorParamSpec> model_param_spec(const rilbed_sensor_param& p, const std::string& what) {
   core::Result<std::string> key = model_text(p.key, what + " key", 64);
   if (!key) return core::Failure{key.error()};
@@ -218,10 +224,8 @@ core::Result<SensorModelEntry> sensor_model_entry(const rilbed_sensor_model& m,
     return core::Failure{what + " was built against rilbed's SDK ABI version " + std::to_string(m.abi_version) +
                          ", this rilbed loads version " + std::to_string(RILBED_ABI_VERSION)};
   }
-  core::Result<std::string> name = model_text(m.name, what + " name", 128);
+  core::Result<std::string> name = model_name(m.name, what + " name");
   if (!name) return core::Failure{name.error()};
-  if (name->empty() || name->find_first_of(" ,:{}[]#\"'") != std::string::npos)
-    return core::Failure{what + " name '" + *name + "' is empty or holds a space or YAML punctuation"};
   const std::string who = what + " '" + *name + "'";
   core::Result<std::string> summary = model_text(m.summary, who + " summary");
   if (!summary) return core::Failure{summary.error()};
@@ -248,30 +252,8 @@ core::Result<SensorModelEntry> sensor_model_entry(const rilbed_sensor_model& m,
 }
 
 core::Result<std::vector<SensorModelEntry>> load_library_sensor_models(const std::filesystem::path& path) {
-  core::Result<std::shared_ptr<const PluginLibrary>> opened = PluginLibrary::open(path);
-  if (!opened) return core::Failure{opened.error()};
-  const std::shared_ptr<const PluginLibrary>& library = *opened;
-  const std::string origin = library->path().string();
-  using List = const rilbed_sensor_model* const* (*)();
-  auto list = reinterpret_cast<List>(library->symbol("rilbed_sensor_models"));
-  if (!list) {
-    return core::Failure{"plug-in library " + origin +
-                         ": does not export rilbed_sensor_models(), so it holds no sensor model"};
-  }
-  const rilbed_sensor_model* const* models = list();
-  if (!models) return core::Failure{"plug-in library " + origin + ": rilbed_sensor_models() returned NULL"};
-  std::vector<SensorModelEntry> entries;
-  for (std::size_t i = 0; models[i]; ++i) {
-    if (i >= kMaxModels) return core::Failure{"plug-in library " + origin + ": more than 4096 sensor models"};
-    core::Result<SensorModelEntry> e = sensor_model_entry(*models[i], library, origin);
-    if (!e) return core::Failure{e.error()};
-    for (const SensorModelEntry& before : entries) {
-      if (before.name == e->name)
-        return core::Failure{"plug-in library " + origin + ": holds two sensor models named '" + e->name + "'"};
-    }
-    entries.push_back(std::move(*e));
-  }
-  return entries;
+  return load_model_list<SensorModelEntry, rilbed_sensor_model>(path, "rilbed_sensor_models", "sensor model",
+                                                                &sensor_model_entry);
 }
 
 core::Result<std::shared_ptr<const environment::SensorModel>> mount_sensor_model(const SensorModelEntry& entry,

@@ -34,6 +34,40 @@ struct SensorParamSpec {
 /// hyphens as underscores, runs of them as one ("Cone Angle" and "cone_angle" alike).
 std::string sensor_param_key(std::string_view key);
 
+/// A C string a library answered, read no further than `limit` bytes: printable ASCII
+/// only (it goes to terminals, JSON and messages as it is). `what` names it in the failure.
+core::Result<std::string> model_text(const char* text, const std::string& what, std::size_t limit = 4096);
+
+/// A model's name as a scenario writes it after `name:`: not empty, no space or YAML punctuation.
+core::Result<std::string> model_name(const char* text, const std::string& what);
+
+/// Every model a library exports as the NULL-terminated list `symbol()` returns (`kind`:
+/// "sensor model", for messages), each read by `check(raw, library, origin)`; names unique.
+template <class Entry, class Raw, class Check>
+core::Result<std::vector<Entry>> load_model_list(const std::filesystem::path& path, const char* symbol,
+                                                 const std::string& kind, Check check) {
+  core::Result<std::shared_ptr<const PluginLibrary>> opened = PluginLibrary::open(path);
+  if (!opened) return core::Failure{opened.error()};
+  const std::shared_ptr<const PluginLibrary>& library = *opened;
+  const std::string who = "plug-in library " + library->path().string();
+  using List = const Raw* const* (*)();
+  auto list = reinterpret_cast<List>(library->symbol(symbol));
+  if (!list) return core::Failure{who + ": does not export " + symbol + "(), so it holds no " + kind};
+  const Raw* const* models = list();
+  if (!models) return core::Failure{who + ": " + symbol + "() returned NULL"};
+  std::vector<Entry> entries;
+  for (std::size_t i = 0; models[i]; ++i) {
+    if (i >= 4096) return core::Failure{who + ": more than 4096 " + kind + "s"};
+    core::Result<Entry> e = check(*models[i], library, library->path().string());
+    if (!e) return core::Failure{e.error()};
+    for (const Entry& before : entries) {
+      if (before.name == e->name) return core::Failure{who + ": holds two " + kind + "s named '" + e->name + "'"};
+    }
+    entries.push_back(std::move(*e));
+  }
+  return entries;
+}
+
 /// A model's declared parameter keys checked (printable ASCII, ranges ordered, defaults
 /// finite, in range and whole where they must be, no key twice as matched, at most 64);
 /// `who` names the model in the failure. Sensor and actuator models share them.
