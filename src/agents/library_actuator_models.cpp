@@ -97,20 +97,14 @@ class LibraryDriveFactory final : public environment::DriveModelFactory {
 core::Result<ActuatorModelEntry> actuator_model_entry(const rilbed_actuator_model& m,
                                                       std::shared_ptr<const PluginLibrary> library,
                                                       const std::string& origin) {
-  const std::string what = origin + ": actuator model";
-  if (m.abi_version != RILBED_ABI_VERSION) {
-    return core::Failure{what + " was built against rilbed's SDK ABI version " + std::to_string(m.abi_version) +
-                         ", this rilbed loads version " + std::to_string(RILBED_ABI_VERSION)};
-  }
-  core::Result<std::string> name = model_name(m.name, what + " name");
-  if (!name) return core::Failure{name.error()};
-  const std::string who = what + " '" + *name + "'";
-  core::Result<std::string> summary = model_text(m.summary, who + " summary");
-  if (!summary) return core::Failure{summary.error()};
+  core::Result<ModelHeader> header = model_header(m.abi_version, m.name, m.summary, origin + ": actuator model");
+  if (!header) return core::Failure{header.error()};
+  const std::string& who = header->who;
   if (!m.create || !m.drive || !m.destroy) return core::Failure{who + " lacks its create, drive or destroy function"};
   core::Result<std::vector<SensorParamSpec>> params = model_param_specs(m.params, m.param_count, who);
   if (!params) return core::Failure{params.error()};
-  return ActuatorModelEntry{*name, *summary, origin, std::move(*params), m.concurrent != 0, std::move(library), &m};
+  return ActuatorModelEntry{header->name,      header->summary,    origin, std::move(*params),
+                            m.concurrent != 0, std::move(library), &m};
 }
 
 core::Result<std::vector<ActuatorModelEntry>> load_library_actuator_models(const std::filesystem::path& path) {

@@ -132,6 +132,20 @@ core::Result<std::string> model_name(const char* text, const std::string& what) 
   return name;
 }
 
+core::Result<ModelHeader> model_header(std::uint32_t abi_version, const char* name, const char* summary,
+                                       const std::string& what) {
+  if (abi_version != RILBED_ABI_VERSION) {
+    return core::Failure{what + " was built against rilbed's SDK ABI version " + std::to_string(abi_version) +
+                         ", this rilbed loads version " + std::to_string(RILBED_ABI_VERSION)};
+  }
+  core::Result<std::string> checked_name = model_name(name, what + " name");
+  if (!checked_name) return core::Failure{checked_name.error()};
+  const std::string who = what + " '" + *checked_name + "'";
+  core::Result<std::string> checked_summary = model_text(summary, who + " summary");
+  if (!checked_summary) return core::Failure{checked_summary.error()};
+  return ModelHeader{*checked_name, *checked_summary, who};
+}
+
 core::Result<SensorParamSpec> model_param_spec(const rilbed_sensor_param& p, const std::string& what) {
   core::Result<std::string> key = model_text(p.key, what + " key", 64);
   if (!key) return core::Failure{key.error()};
@@ -219,21 +233,14 @@ const SensorParamSpec* SensorModelEntry::param(std::string_view key) const {
 core::Result<SensorModelEntry> sensor_model_entry(const rilbed_sensor_model& m,
                                                   std::shared_ptr<const PluginLibrary> library,
                                                   const std::string& origin) {
-  const std::string what = origin + ": sensor model";
-  if (m.abi_version != RILBED_ABI_VERSION) {
-    return core::Failure{what + " was built against rilbed's SDK ABI version " + std::to_string(m.abi_version) +
-                         ", this rilbed loads version " + std::to_string(RILBED_ABI_VERSION)};
-  }
-  core::Result<std::string> name = model_name(m.name, what + " name");
-  if (!name) return core::Failure{name.error()};
-  const std::string who = what + " '" + *name + "'";
-  core::Result<std::string> summary = model_text(m.summary, who + " summary");
-  if (!summary) return core::Failure{summary.error()};
+  core::Result<ModelHeader> header = model_header(m.abi_version, m.name, m.summary, origin + ": sensor model");
+  if (!header) return core::Failure{header.error()};
+  const std::string& who = header->who;
   if (!m.create || !m.sense || !m.destroy) return core::Failure{who + " lacks its create, sense or destroy function"};
   if (m.value_count < 1 || m.value_count > kMaxValues) return core::Failure{who + " must write 1 to 64 values"};
   SensorModelEntry e;
-  e.name = *name;
-  e.summary = *summary;
+  e.name = header->name;
+  e.summary = header->summary;
   e.origin = origin;
   e.value_count = m.value_count;
   e.concurrent = m.concurrent != 0;

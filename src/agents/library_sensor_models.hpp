@@ -41,6 +41,18 @@ core::Result<std::string> model_text(const char* text, const std::string& what, 
 /// A model's name as a scenario writes it after `name:`: not empty, no space or YAML punctuation.
 core::Result<std::string> model_name(const char* text, const std::string& what);
 
+/// What every model of a library starts with, checked.
+struct ModelHeader {
+  std::string name;
+  std::string summary;
+  std::string who;  ///< "ORIGIN: sensor model 'NAME'", for the next messages
+};
+
+/// The ABI version (RILBED_ABI_VERSION), the name (model_name) and the summary (model_text)
+/// of a model; `what` is "ORIGIN: sensor model" or the like.
+core::Result<ModelHeader> model_header(std::uint32_t abi_version, const char* name, const char* summary,
+                                       const std::string& what);
+
 /// Every model a library exports as the NULL-terminated list `symbol()` returns (`kind`:
 /// "sensor model", for messages), each read by `check(raw, library, origin)`; names unique.
 template <class Entry, class Raw, class Check>
