@@ -35,6 +35,30 @@ Contact body_mover_contact(const Body& b, const MovingObstacle& m) {
 
 BodyRef robot_ref(const CollisionScene& s, std::size_t i) { return {BodyKind::kRobot, s.body_ids[i]}; }
 
+// Body b's shape where it is now (its outline placed in `buffer`, or its disc).
+BodyShape shape_of(const CollisionScene& s, const Body& b, OutlineBuffer& buffer) {
+  const BodyOutline* outline = b.outline >= 0 ? &s.outlines[static_cast<std::size_t>(b.outline)] : nullptr;
+  return place_body(b.position_m, b.radius_m, outline, buffer);
+}
+
+// Contact of body i with body j, the normal from j towards i (either with an outline).
+Contact outlined_contact(const CollisionScene& s, const Body& bi, const Body& bj) {
+  OutlineBuffer buffer_i, buffer_j;
+  return shape_shape_contact(shape_of(s, bi, buffer_i), shape_of(s, bj, buffer_j));
+}
+
+Contact robot_segment_contact(const CollisionScene& s, const Body& b, Vec2 a, Vec2 c) {
+  if (b.outline < 0) return disc_segment_contact(b.position_m, b.radius_m, a, c);
+  OutlineBuffer buffer;
+  return shape_segment_contact(shape_of(s, b, buffer), a, c);
+}
+
+Contact robot_mover_contact(const CollisionScene& s, const Body& b, const MovingObstacle& m) {
+  if (b.outline < 0) return body_mover_contact(b, m);
+  OutlineBuffer buffer;
+  return shape_mover_contact(shape_of(s, b, buffer), m);
+}
+
 }  // namespace
 
 CollisionResolver::CollisionResolver(CollisionConfig config) : config_(config) {}
@@ -42,6 +66,15 @@ CollisionResolver::CollisionResolver(CollisionConfig config) : config_(config) {
 void CollisionResolver::begin_step() { contacts_.clear(); }
 
 void CollisionResolver::record(BodyRef a, BodyRef b) { contacts_.push_back({a, b, now_us_}); }
+
+void CollisionResolver::record_robot_pair(const CollisionScene& s, std::size_t i, std::size_t j) {
+  if (s.bodies[i].pushable && s.bodies[j].pushable) {
+    const int a = s.body_ids[i], b = s.body_ids[j];
+    record({BodyKind::kRobot, std::min(a, b)}, {BodyKind::kRobot, std::max(a, b)});
+  } else {
+    record(robot_ref(s, i), robot_ref(s, j));
+  }
+}
 
 void CollisionResolver::mark_moved(CollisionScene& s, std::size_t body) {
   // Its cell at once, not after the pass: a later visit in the same pass then finds it
@@ -145,7 +178,8 @@ bool CollisionResolver::near_another_robot(const CollisionScene& s, std::size_t 
     if (j == i || near) return;
     const Body& bj = s.bodies[j];
     const double sum = bi.radius_m + bj.radius_m + margin;
-    if (distance_sq(bi.position_m, bj.position_m) < sum * sum) near = true;
+    if (distance_sq(bi.position_m, bj.position_m) >= sum * sum) return;
+    near = (bi.outline < 0 && bj.outline < 0) || outlined_contact(s, bi, bj).separation_m < margin;
   });
   return near;
 }
@@ -160,7 +194,7 @@ bool CollisionResolver::near_a_static(const CollisionScene& s, std::size_t i) co
     if (near) return;
     if (b.pushable && path_crosses_segment(b.previous_m, b.position_m, seg.a_m, seg.b_m))
       near = true;
-    else if (disc_segment_contact(b.position_m, b.radius_m, seg.a_m, seg.b_m).separation_m < margin)
+    else if (robot_segment_contact(s, b, seg.a_m, seg.b_m).separation_m < margin)
       near = true;
   });
   return near;
@@ -197,24 +231,30 @@ bool CollisionResolver::robots_vs_robots(CollisionScene& s) {
       const double dist_sq = d.dot(d);
       const double sum = bi.radius_m + bj.radius_m;
       if (dist_sq >= (sum + margin) * (sum + margin)) continue;
-      if (bi.pushable && bj.pushable) {
-        const int a = s.body_ids[i], b = s.body_ids[j];
-        record({BodyKind::kRobot, std::min(a, b)}, {BodyKind::kRobot, std::max(a, b)});
-      } else {
-        record(robot_ref(s, i), robot_ref(s, j));
-      }
-      if (dist_sq >= (sum - tol) * (sum - tol)) continue;
-      const double dist = std::sqrt(dist_sq);
       Vec2 normal{1.0, 0.0};  // from j towards i
-      if (dist > 1e-12) {
-        normal = d / dist;
+      double overlap = 0.0;
+      if (bi.outline < 0 && bj.outline < 0) {
+        record_robot_pair(s, i, j);
+        if (dist_sq >= (sum - tol) * (sum - tol)) continue;
+        const double dist = std::sqrt(dist_sq);
+        if (dist > 1e-12) {
+          normal = d / dist;
+        } else {
+          // Coincident centres: separate along where they came from.
+          const Vec2 back = bi.previous_m - bj.previous_m;
+          const double len = back.norm();
+          if (len > 0.0) normal = back / len;
+        }
+        overlap = sum - dist;
       } else {
-        // Coincident centres: separate along where they came from.
-        const Vec2 back = bi.previous_m - bj.previous_m;
-        const double len = back.norm();
-        if (len > 0.0) normal = back / len;
+        // Within the bounding discs: the outlines decide.
+        const Contact c = outlined_contact(s, bi, bj);
+        if (c.separation_m >= margin) continue;
+        record_robot_pair(s, i, j);
+        if (c.separation_m >= -tol) continue;
+        normal = c.normal;
+        overlap = -c.separation_m;
       }
-      const double overlap = sum - dist;
       if (bj.pushable) {
         bi.position_m = bi.position_m + normal * (0.5 * overlap);
         bj.position_m = bj.position_m - normal * (0.5 * overlap);
@@ -248,7 +288,7 @@ bool CollisionResolver::robots_vs_movers(CollisionScene& s) {
     for (const std::uint32_t jj : robots_in_box_by_id(s, box_around(mover.position_m(), reach))) {
       const auto j = static_cast<std::size_t>(jj);
       Body& b = s.bodies[j];
-      const Contact c = body_mover_contact(b, mover);
+      const Contact c = robot_mover_contact(s, b, mover);
       if (c.separation_m >= margin) continue;
       record(robot_ref(s, j), {BodyKind::kMovingObstacle, static_cast<int>(m)});
       if (c.separation_m >= -tol) continue;
@@ -281,13 +321,18 @@ bool CollisionResolver::robots_vs_statics(CollisionScene& s) {
         // the side it came from, touching.
         const Vec2 n = normal_towards(seg.a_m, seg.b_m, b.previous_m);
         const double signed_dist = (b.position_m - seg.a_m).dot(n);
-        b.position_m = b.position_m + n * (b.radius_m - signed_dist);
+        double reach_m = b.radius_m;
+        if (b.outline >= 0) {
+          OutlineBuffer buffer;
+          reach_m = shape_reach_against(shape_of(s, b, buffer), n);
+        }
+        b.position_m = b.position_m + n * (reach_m - signed_dist);
         record(robot_ref(s, i), seg.owner);
         mark_moved(s, i);
         corrected = true;
         continue;
       }
-      const Contact c = disc_segment_contact(b.position_m, b.radius_m, seg.a_m, seg.b_m);
+      const Contact c = robot_segment_contact(s, b, seg.a_m, seg.b_m);
       if (c.separation_m >= margin) continue;
       record(robot_ref(s, i), seg.owner);
       if (!b.pushable || c.separation_m >= -tol) continue;
@@ -348,14 +393,15 @@ bool CollisionResolver::body_overlaps(const CollisionScene& s, std::size_t i) co
   s.grid.for_each_in_box(box_around(b.position_m, b.radius_m + s.max_body_radius_m), [&](int jj) {
     const auto j = static_cast<std::size_t>(jj);
     if (j == i || overlaps) return;
-    const double sum = b.radius_m + s.bodies[j].radius_m - tol;
-    if (distance_sq(b.position_m, s.bodies[j].position_m) < sum * sum) overlaps = true;
+    const Body& bj = s.bodies[j];
+    const double sum = b.radius_m + bj.radius_m - tol;
+    if (distance_sq(b.position_m, bj.position_m) >= sum * sum) return;
+    overlaps = (b.outline < 0 && bj.outline < 0) || outlined_contact(s, b, bj).separation_m < -tol;
   });
   for (const MovingObstacle& m : s.movers)
-    if (!overlaps && body_mover_contact(b, m).separation_m < -tol) overlaps = true;
+    if (!overlaps && robot_mover_contact(s, b, m).separation_m < -tol) overlaps = true;
   s.statics.for_each_in_box(box_around(b.position_m, b.radius_m), [&](const IndexedSegment& seg) {
-    if (!overlaps && disc_segment_contact(b.position_m, b.radius_m, seg.a_m, seg.b_m).separation_m < -tol)
-      overlaps = true;
+    if (!overlaps && robot_segment_contact(s, b, seg.a_m, seg.b_m).separation_m < -tol) overlaps = true;
   });
   return overlaps;
 }
@@ -365,7 +411,7 @@ bool CollisionResolver::mover_overlaps(const CollisionScene& s, std::size_t m) c
   const double tol = config_.tolerance_m;
   bool overlaps = false;
   s.grid.for_each_in_box(box_around(mover.position_m(), mover.bounding_radius_m() + s.max_body_radius_m), [&](int j) {
-    if (!overlaps && body_mover_contact(s.bodies[static_cast<std::size_t>(j)], mover).separation_m < -tol)
+    if (!overlaps && robot_mover_contact(s, s.bodies[static_cast<std::size_t>(j)], mover).separation_m < -tol)
       overlaps = true;
   });
   s.statics.for_each_in_box(box_around(mover.position_m(), mover.bounding_radius_m()), [&](const IndexedSegment& seg) {
@@ -394,6 +440,7 @@ void CollisionResolver::fall_back(CollisionScene& s) {
       Body& b = s.bodies[i];
       if (!b.pushable || reverted_[i] || !body_overlaps(s, i)) continue;
       b.position_m = b.previous_m;
+      if (b.outline >= 0) s.outlines[static_cast<std::size_t>(b.outline)].turn_back();
       s.grid.move(i, b.position_m);
       pushed_.push_back(static_cast<int>(i));
       reverted_[i] = 1;

@@ -7,6 +7,9 @@
 //   contact normal until it touches. If its centre crossed a segment during the substep
 //   (a fast robot, or a push), it is put back on the side it came from.
 // - Two virtual robots: each moves half the overlap, apart along the line of centres.
+// - Outlines: robots with a convex outline are tested against everything by the
+//   separating-axis test and pushed out along its axis of least overlap, like discs
+//   (translation only: a collision does not turn a robot). Discs keep their own path.
 // - A virtual and a real robot: the virtual one moves the whole overlap; nothing virtual
 //   ever moves a real robot. Two real robots are left alone (the real world decides).
 // - A moving obstacle and a virtual robot: the robot is pushed out. A moving obstacle
@@ -28,6 +31,7 @@
 
 #include "core/worker_pool.hpp"
 #include "environment/body.hpp"
+#include "environment/body_shape.hpp"
 #include "environment/collision_event.hpp"
 #include "environment/moving_obstacle.hpp"
 #include "environment/segment_index.hpp"
@@ -66,6 +70,10 @@ struct CollisionScene {
   /// id order too, so that the results depend on the ids alone, not on how the slots are
   /// numbered (the World renumbers them by place).
   std::span<const std::uint32_t> id_order;
+  /// The outlines bodies point into (Body::outline), turned to their bodies' headings at
+  /// the substep's end (the fallback may turn one back: BodyOutline::turn_back); empty
+  /// when every body is a disc.
+  std::span<BodyOutline> outlines = {};
 };
 
 /// Resolves overlaps and records contact episodes. Keeps scratch buffers between calls
@@ -104,6 +112,7 @@ class CollisionResolver {
   using Pair = std::pair<BodyRef, BodyRef>;
 
   void record(BodyRef a, BodyRef b);
+  void record_robot_pair(const CollisionScene& s, std::size_t i, std::size_t j);
   bool robots_vs_robots(CollisionScene& s);
   bool robots_vs_movers(CollisionScene& s);
   bool robots_vs_statics(CollisionScene& s);

@@ -5,6 +5,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "core/time.hpp"
 #include "environment/drive_model.hpp"
@@ -26,10 +27,13 @@ struct RobotConfig {
   int id = 0;                            ///< unique within the world
   RobotKind kind = RobotKind::kVirtual;  ///< virtual (driven here) or real (observed)
   Pose2 pose;                            ///< initial pose, field frame
-  double radius_m = kKheperaRadius_m;    ///< the body is a disc of this radius
-  double wheel_base_m = kKheperaWheelBase_m;
-  WheelNoiseConfig noise;     ///< virtual robots only
-  SensorSuiteConfig sensors;  ///< virtual sensors (fed by the world for either kind)
+  double radius_m = kKheperaRadius_m;    ///< the body is a disc of this radius (when outline_m is empty)
+  /// A convex outline instead of the disc: robot frame (x forward, y left), metres, the
+  /// centre strictly inside, 3 to kMaxOutlineVertices vertices; empty: the disc.
+  std::vector<Vec2> outline_m;
+  double wheel_base_m = kKheperaWheelBase_m;  ///< between the wheels
+  WheelNoiseConfig noise;                     ///< virtual robots only
+  SensorSuiteConfig sensors;                  ///< virtual sensors (fed by the world for either kind)
   /// Virtual robots: how the wheels move (a plug-in's); null: the differential drive with `noise`.
   std::shared_ptr<const DriveModelFactory> drive;
 };
@@ -53,7 +57,7 @@ struct alignas(64) RobotState {
   /// Real robots: whether the camera has placed it at least once (until then `pose` is
   /// only where the scenario put it).
   bool observed = false;
-  double radius_m = kKheperaRadius_m;         ///< body disc
+  double radius_m = kKheperaRadius_m;         ///< body disc (with an outline: its bounding radius)
   double wheel_base_m = kKheperaWheelBase_m;  ///< between the wheels
   /// Wheel travel counted by the encoders since the counters were last set, metres
   /// (kept in metres so that fractions of a pulse are not lost between steps).

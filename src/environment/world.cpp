@@ -112,41 +112,48 @@ void World::refresh_mobiles() const {
   }
 }
 
-void World::check_placement_free(const std::string& what, Vec2 p, double r, int exclude_slot) const {
+void World::check_placement_free(const std::string& what, Vec2 p, double r, const BodyOutline* outline,
+                                 int exclude_slot) const {
   const double tol = config_.collision.tolerance_m;
+  OutlineBuffer buffer;
+  const BodyShape shape = place_body(p, r, outline, buffer);
   if (map_.field().boundary_walls) {
     const FieldConfig& f = map_.field();
     const char* wall = nullptr;
-    if (p.x - r < -tol)
+    const double left = p.x - shape_reach_against(shape, {1.0, 0.0});
+    const double right = p.x + shape_reach_against(shape, {-1.0, 0.0});
+    const double bottom = p.y - shape_reach_against(shape, {0.0, 1.0});
+    const double top = p.y + shape_reach_against(shape, {0.0, -1.0});
+    if (left < -tol)
       wall = "the left wall";
-    else if (p.x + r > f.width_m + tol)
+    else if (right > f.width_m + tol)
       wall = "the right wall";
-    else if (p.y - r < -tol)
+    else if (bottom < -tol)
       wall = "the bottom wall";
-    else if (p.y + r > f.height_m + tol)
+    else if (top > f.height_m + tol)
       wall = "the top wall";
     if (wall) throw std::invalid_argument(what + ": placed overlapping " + wall);
   }
   if (const int inside = map_.obstacle_containing(p); inside >= 0)
     throw std::invalid_argument(what + ": placed inside obstacle " + std::to_string(inside));
   statics_.for_each_in_box(box_around(p, r), [&](const IndexedSegment& seg) {
-    if (disc_segment_contact(p, r, seg.a_m, seg.b_m).separation_m < -tol)
+    if (shape_segment_contact(shape, seg.a_m, seg.b_m).separation_m < -tol)
       throw std::invalid_argument(what + ": placed overlapping " + to_string(seg.owner));
   });
   grid_.for_each_in_box(box_around(p, r + max_radius_m_), [&](int j) {
     if (j == exclude_slot) return;
     const Body& b = bodies_[static_cast<std::size_t>(j)];
     const double sum = r + b.radius_m - tol;
-    if (distance_sq(p, b.position_m) < sum * sum)
-      throw std::invalid_argument(what + ": placed overlapping robot " +
-                                  std::to_string(ids_[static_cast<std::size_t>(j)]));
+    if (distance_sq(p, b.position_m) >= sum * sum) return;
+    OutlineBuffer other;
+    if ((outline || b.outline >= 0) &&
+        shape_shape_contact(shape, place_body(b.position_m, b.radius_m, outline_of(b), other)).separation_m >= -tol)
+      return;
+    throw std::invalid_argument(what + ": placed overlapping robot " +
+                                std::to_string(ids_[static_cast<std::size_t>(j)]));
   });
   for (std::size_t m = 0; m < movers_.size(); ++m) {
-    const MovingObstacle& mover = movers_[m];
-    const Contact c = mover.shape() == MovingShape::kDisc
-                          ? disc_disc_contact(p, r, mover.position_m(), mover.bounding_radius_m())
-                          : disc_convex_polygon_contact(p, r, mover.world_vertices_m());
-    if (c.separation_m < -tol)
+    if (shape_mover_contact(shape, movers_[m]).separation_m < -tol)
       throw std::invalid_argument(what + ": placed overlapping moving obstacle " + std::to_string(m));
   }
 }
@@ -165,7 +172,17 @@ void World::add_robot(const RobotConfig& c) {
   if (!std::isfinite(n.left_bias) || !std::isfinite(n.right_bias) || n.left_bias <= -1.0 || n.right_bias <= -1.0)
     throw std::invalid_argument(what + ": noise biases must be finite and above -1");
   SensorSuite suite(c.sensors, what);  // validates the sensors
-  if (c.kind == RobotKind::kVirtual) check_placement_free(what, c.pose.position_m, c.radius_m, -1);
+  // An outline replaces the disc: its bounding radius is the body's for the broad phase.
+  BodyOutline outline;
+  double radius_m = c.radius_m, inner_radius_m = c.radius_m;
+  if (!c.outline_m.empty()) {
+    outline.local_m = checked_outline(c.outline_m, what);
+    outline.turn_to({std::cos(c.pose.heading_rad), std::sin(c.pose.heading_rad)});
+    radius_m = outline_bounding_radius_m(outline.local_m);
+    inner_radius_m = outline_inner_radius_m(outline.local_m);
+  }
+  const BodyOutline* placed_outline = c.outline_m.empty() ? nullptr : &outline;
+  if (c.kind == RobotKind::kVirtual) check_placement_free(what, c.pose.position_m, radius_m, placed_outline, -1);
 
   // The robot's drive first: a model that refuses it leaves the world as it was.
   std::unique_ptr<DriveModel> drive;
@@ -181,7 +198,7 @@ void World::add_robot(const RobotConfig& c) {
   state.kind = c.kind;
   state.pose = {c.pose.position_m, wrap_rad_pi(c.pose.heading_rad)};
   state.pose_t_us = t_us_;
-  state.radius_m = c.radius_m;
+  state.radius_m = radius_m;
   state.wheel_base_m = c.wheel_base_m;
   state.noise = c.noise;
   // Grow the parallel arrays first (geometrically, so that adding n robots costs O(n)) so
@@ -196,7 +213,13 @@ void World::add_robot(const RobotConfig& c) {
     slot_of_.reserve(want);
   }
   robots_.push_back(std::move(state));
-  bodies_.push_back({c.pose.position_m, c.pose.position_m, c.radius_m, c.kind == RobotKind::kVirtual});
+  std::int32_t outline_index = -1;
+  if (placed_outline) {
+    outline_index = static_cast<std::int32_t>(outlines_.size());
+    outlines_.push_back(std::move(outline));
+    outline_slots_.push_back(static_cast<std::uint32_t>(s));
+  }
+  bodies_.push_back({c.pose.position_m, c.pose.position_m, radius_m, c.kind == RobotKind::kVirtual, outline_index});
   ids_.push_back(c.id);
   added_of_slot_.push_back(static_cast<std::uint32_t>(added_order_.size()));
   added_order_.push_back(c.id);
@@ -215,8 +238,55 @@ void World::add_robot(const RobotConfig& c) {
   renumber_due_ = true;
   changed();
   // The new radius only (a full refresh made adding n robots cost O(n^2): 7 s for 100,000).
-  max_radius_m_ = s == 0 ? c.radius_m : std::max(max_radius_m_, c.radius_m);
-  min_radius_m_ = s == 0 ? c.radius_m : std::min(min_radius_m_, c.radius_m);
+  max_radius_m_ = s == 0 ? radius_m : std::max(max_radius_m_, radius_m);
+  min_radius_m_ = s == 0 ? inner_radius_m : std::min(min_radius_m_, inner_radius_m);
+}
+
+std::span<const Vec2> World::outline_m(int id) const {
+  const BodyOutline* outline = outline_of(bodies_[slot(id)]);
+  return outline ? std::span<const Vec2>(outline->local_m) : std::span<const Vec2>();
+}
+
+void World::refresh_outline_slots() {
+  outline_slots_.clear();
+  if (outlines_.empty()) return;
+  for (std::size_t i = 0; i < bodies_.size(); ++i)
+    if (bodies_[i].outline >= 0) outline_slots_.push_back(static_cast<std::uint32_t>(i));
+}
+
+void World::turn_outlines(int substeps) {
+  for (const std::uint32_t i : outline_slots_) {
+    const bool mid_step = substeps > 1 && robots_[i].kind == RobotKind::kVirtual;
+    BodyOutline& outline = outlines_[static_cast<std::size_t>(bodies_[i].outline)];
+    outline.begin_substep();
+    outline.turn_to(mid_step ? motion_[i].heading : headings_[i]);
+  }
+}
+
+void World::follow_turned_back_outlines(int substeps) {
+  for (const std::uint32_t i : outline_slots_) {
+    BodyOutline& outline = outlines_[static_cast<std::size_t>(bodies_[i].outline)];
+    if (!outline.turned_back) continue;
+    outline.turned_back = false;
+    if (substeps > 1) {
+      // The rest of the step turns from where the robot was put back.
+      Motion& m = motion_[i];
+      m.heading = outline.heading;
+      m.end_heading_rad -= std::atan2(m.sin_turn, m.cos_turn);
+    }
+    turned_back_.push_back(i);
+  }
+}
+
+void World::finish_turned_back(int substeps) {
+  for (const std::uint32_t i : turned_back_) {
+    RobotState& r = robots_[i];
+    const Vec2 h = substeps > 1 ? motion_[i].heading : outlines_[static_cast<std::size_t>(bodies_[i].outline)].heading;
+    r.pose.heading_rad = wrap_rad_pi(substeps > 1 ? motion_[i].end_heading_rad : std::atan2(h.y, h.x));
+    headings_[i] = h;
+    poses_[added_of_slot_[i]].heading_rad = r.pose.heading_rad;
+  }
+  turned_back_.clear();
 }
 
 void World::remove_robot(int id) {
@@ -251,6 +321,7 @@ void World::remove_robot(int id) {
   renumber_due_ = true;
   changed();
   grid_.rebuild(bodies_.size(), [&](std::size_t i) { return bodies_[i].position_m; });
+  refresh_outline_slots();
   refresh_max_radius();
 }
 
@@ -294,10 +365,11 @@ std::size_t World::added_index(int id) const {
 
 void World::refresh_max_radius() {
   max_radius_m_ = 0.0;
-  min_radius_m_ = bodies_.empty() ? 0.0 : bodies_[0].radius_m;
+  min_radius_m_ = bodies_.empty() ? 0.0 : kNoHit;
   for (const Body& b : bodies_) {
     max_radius_m_ = std::max(max_radius_m_, b.radius_m);
-    min_radius_m_ = std::min(min_radius_m_, b.radius_m);
+    const BodyOutline* outline = outline_of(b);
+    min_radius_m_ = std::min(min_radius_m_, outline ? outline_inner_radius_m(outline->local_m) : b.radius_m);
   }
 }
 
@@ -325,6 +397,7 @@ void World::set_observed_pose(int id, Pose2 pose, TimeUs t_us) {
   headings_[s] = {std::cos(r.pose.heading_rad), std::sin(r.pose.heading_rad)};
   changed();
   bodies_[s].position_m = bodies_[s].previous_m = pose.position_m;
+  if (bodies_[s].outline >= 0) outlines_[static_cast<std::size_t>(bodies_[s].outline)].turn_to(headings_[s]);
   grid_.move(s, pose.position_m);
 }
 
@@ -358,9 +431,8 @@ int World::add_moving_obstacle(const MovingObstacleConfig& config) {
   }
   for (std::size_t j = 0; j < bodies_.size(); ++j) {
     const Body& b = bodies_[j];
-    const Contact c = mover.shape() == MovingShape::kDisc
-                          ? disc_disc_contact(b.position_m, b.radius_m, mover.position_m(), mover.bounding_radius_m())
-                          : disc_convex_polygon_contact(b.position_m, b.radius_m, mover.world_vertices_m());
+    OutlineBuffer buffer;
+    const Contact c = shape_mover_contact(place_body(b.position_m, b.radius_m, outline_of(b), buffer), mover);
     if (c.separation_m < -tol) throw std::invalid_argument(what + ": placed overlapping " + label(ids_[j]));
   }
   movers_.push_back(std::move(mover));
@@ -414,7 +486,7 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us) {
     });
   }
 
-  CollisionScene cs{bodies_, ids_, grid_, statics_, movers_, max_radius_m_, id_order_};
+  CollisionScene cs{bodies_, ids_, grid_, statics_, movers_, max_radius_m_, id_order_, outlines_};
   resolver_.begin_step();
   const TimeUs end_t_us = t_us_ + dt_us;
   for (int k = 0; k < substeps; ++k) {
@@ -428,10 +500,13 @@ std::span<const CollisionEvent> World::step(TimeUs dt_us) {
     } else {
       for_robot_slots([&](std::size_t begin, std::size_t end) { move_substep(begin, end, last, end_t_us); });
     }
+    if (!outline_slots_.empty()) turn_outlines(substeps);
     const Clock::time_point resolving = Clock::now();
     resolver_.resolve(cs, t_us_ + dt_us * (k + 1) / substeps);
+    if (!outline_slots_.empty()) follow_turned_back_outlines(substeps);
     collisions_s += std::chrono::duration<double>(Clock::now() - resolving).count();
   }
+  if (!turned_back_.empty()) finish_turned_back(substeps);
   for (const int pushed : resolver_.pushed()) {
     const auto i = static_cast<std::size_t>(pushed);
     if (robots_[i].kind != RobotKind::kVirtual) continue;  // (the resolver pushes none: they are not pushable)
@@ -684,6 +759,7 @@ void World::renumber_by_place() {
     if (!set_dense_slot(ids_[k], static_cast<std::int32_t>(k))) slot_of_[ids_[k]] = k;
   }
   grid_.rebuild(n, [&](std::size_t i) { return bodies_[i].position_m; });
+  refresh_outline_slots();
   // The collision resolver's order: by id, whatever the slots.
   std::sort(keys.begin(), keys.end(), [](const RenumberKey& a, const RenumberKey& b) { return a.id < b.id; });
   id_order_.resize(n);
@@ -714,7 +790,8 @@ WorldSnapshot World::snapshot() const {
   snap.robots.reserve(robots_.size());
   for (std::size_t k = 0; k < added_order_.size(); ++k) {
     const RobotState& r = robot(added_order_[k]);
-    snap.robots.push_back({r.id, r.kind, r.pose, r.radius_m, commands_[k].left, commands_[k].right});
+    snap.robots.push_back({r.id, r.kind, r.pose, r.radius_m, commands_[k].left, commands_[k].right, {}});
+    if (const BodyOutline* outline = outline_of(bodies_[slot(r.id)])) snap.robots.back().outline_m = outline->local_m;
   }
   for (const MovingObstacle& m : movers_)
     snap.moving_obstacles.push_back(
@@ -744,22 +821,25 @@ double World::overlap_of(std::size_t i) const {
   double worst = 0.0;
   const Body& b = bodies_[i];
   if (!b.pushable) return worst;
+  OutlineBuffer buffer;
+  const BodyShape shape = place_body(b.position_m, b.radius_m, outline_of(b), buffer);
   grid_.for_each_in_box(box_around(b.position_m, b.radius_m + max_radius_m_), [&](int jj) {
     const auto j = static_cast<std::size_t>(jj);
     if (j == i) return;
-    const double gap = std::sqrt(distance_sq(b.position_m, bodies_[j].position_m)) - b.radius_m - bodies_[j].radius_m;
+    const Body& other = bodies_[j];
+    double gap = std::sqrt(distance_sq(b.position_m, other.position_m)) - b.radius_m - other.radius_m;
+    if (gap < 0.0 && (b.outline >= 0 || other.outline >= 0)) {
+      OutlineBuffer other_buffer;
+      gap = shape_shape_contact(shape, place_body(other.position_m, other.radius_m, outline_of(other), other_buffer))
+                .separation_m;
+    }
     worst = std::max(worst, -gap);
   });
   statics_.for_each_in_box(box_around(b.position_m, b.radius_m), [&](const IndexedSegment& seg) {
-    worst = std::max(worst, -disc_segment_contact(b.position_m, b.radius_m, seg.a_m, seg.b_m).separation_m);
+    worst = std::max(worst, -shape_segment_contact(shape, seg.a_m, seg.b_m).separation_m);
   });
   if (map_.obstacle_containing(b.position_m) >= 0) worst = std::max(worst, b.radius_m);
-  for (const MovingObstacle& m : movers_) {
-    const Contact c = m.shape() == MovingShape::kDisc
-                          ? disc_disc_contact(b.position_m, b.radius_m, m.position_m(), m.bounding_radius_m())
-                          : disc_convex_polygon_contact(b.position_m, b.radius_m, m.world_vertices_m());
-    worst = std::max(worst, -c.separation_m);
-  }
+  for (const MovingObstacle& m : movers_) worst = std::max(worst, -shape_mover_contact(shape, m).separation_m);
   return worst;
 }
 

@@ -91,6 +91,9 @@ class World {
   void add_robot(const RobotConfig& config);
   /// Removes a robot. Throws std::invalid_argument for an unknown id.
   void remove_robot(int id);
+  /// Robot `id`'s outline in its own frame (counter-clockwise), or empty for a disc.
+  /// Throws std::invalid_argument for an unknown id.
+  std::span<const Vec2> outline_m(int id) const;
   /// Whether sensor models draw what they see (SensorReadings::marks): for displays only,
   /// off by default.
   void set_collect_marks(bool on) { collect_marks_ = on; }
@@ -210,7 +213,20 @@ class World {
   std::size_t slot(int id) const;
   void sense_slot(const Scene& scene, std::size_t s, TimeUs t_us, SensorReadings& out) const;
   std::string label(int id) const { return "robot " + std::to_string(id); }
-  void check_placement_free(const std::string& what, Vec2 position_m, double radius_m, int exclude_slot) const;
+  // `outline`: the body's outline turned to its heading, or null for the disc.
+  void check_placement_free(const std::string& what, Vec2 position_m, double radius_m, const BodyOutline* outline,
+                            int exclude_slot) const;
+  // Turns every outline to its robot's heading after a substep's move (`substeps`: the
+  // step's count, which says where virtual robots' current headings are).
+  void turn_outlines(int substeps);
+  void refresh_outline_slots();
+  // After a substep's resolution: robots whose outline the fallback turned back turn back
+  // too (the rest of the step from there); finish_turned_back sets their step-end poses.
+  void follow_turned_back_outlines(int substeps);
+  void finish_turned_back(int substeps);
+  const BodyOutline* outline_of(const Body& b) const {
+    return b.outline >= 0 ? &outlines_[static_cast<std::size_t>(b.outline)] : nullptr;
+  }
   void refresh_max_radius();
   // Sets robot `id`'s slot in the dense table (-1: none); false when the id has no
   // entry there (too large, or negative), and the hash map must hold its slot.
@@ -281,7 +297,12 @@ class World {
   };
   std::vector<IdEntry> by_id_;
   double max_radius_m_ = 0.0;
-  double min_radius_m_ = 0.0;
+  double min_radius_m_ = 0.0;  // the smallest body's inner radius (a disc's radius), for substeps
+  // Outlines (Body::outline indexes them; a removed robot's stays unused) and the slots
+  // of the bodies that have one, in slot order.
+  std::vector<BodyOutline> outlines_;
+  std::vector<std::uint32_t> outline_slots_;
+  std::vector<std::uint32_t> turned_back_;  // this step's, by slot (maybe more than once)
   std::vector<MovingObstacle> movers_;
   CollisionResolver resolver_;
   WorldStepTimes step_times_;

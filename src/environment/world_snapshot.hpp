@@ -16,9 +16,10 @@ struct RobotSnapshot {
   int id = 0;                            ///< robot id
   RobotKind kind = RobotKind::kVirtual;  ///< virtual or real
   Pose2 pose;                            ///< field frame
-  double radius_m = 0.0;                 ///< body disc
+  double radius_m = 0.0;                 ///< body disc (with an outline: its bounding radius)
   int left_speed_units = 0;              ///< commanded
   int right_speed_units = 0;
+  std::vector<Vec2> outline_m;  ///< convex outline, robot frame, counter-clockwise; empty: the disc
 };
 
 /// One moving obstacle as displays need it.
