@@ -72,6 +72,10 @@ std::shared_ptr<serial::KheperaLink> RealRobots::connect(const run::RobotSpec& s
   if (!spec.link) throw run::ScenarioError(where + ": a real robot needs a link");
   serial::LinkConfig config;
   config.model = model_named(spec.link->model, where);
+  // The robot's own parts where its model file gives them (the emulator moves with them).
+  config.model.wheel_base_m = spec.body.wheel_base_m;
+  if (spec.link->speed_unit_mps) config.model.speed_unit_mps = *spec.link->speed_unit_mps;
+  if (spec.link->counter_pulse_m) config.model.counter_pulse_m = *spec.link->counter_pulse_m;
   config.baud = static_cast<unsigned>(spec.link->baud);
   // Messages name the robot as well as the port (the link names the port).
   if (log_) {

@@ -16,129 +16,17 @@
 #include "agents/library_controllers.hpp"
 #include "agents/library_sensor_models.hpp"
 #include "core/id_list.hpp"
+#include "environment/body_shape.hpp"
 #include "environment/shapes.hpp"
+#include "run/robot_description.hpp"
 #include "run/sensor_parameters.hpp"
+#include "run/yaml_reader.hpp"
 
 namespace rilbed::run {
 
 namespace {
 
-// (Vec2 is rilbed::Vec2)
-
-// Reads one YAML mapping with strict checks; every error names file, line and key.
-class Reader {
- public:
-  Reader(const YAML::Node& node, std::string source, std::string path)
-      : node_(node), source_(std::move(source)), path_(std::move(path)) {
-    if (!node_.IsMap()) fail(node_, "expected a mapping of keys");
-  }
-  [[noreturn]] void fail(const YAML::Node& at, const std::string& what) const {
-    const int line = at.Mark().line >= 0 ? at.Mark().line + 1 : 0;
-    throw ScenarioError(source_ + ":" + std::to_string(line) + ": " + (path_.empty() ? "(top level)" : path_) + ": " +
-                        what);
-  }
-  [[noreturn]] void fail_key(const std::string& key, const std::string& what) const {
-    throw ScenarioError(source_ + ":" + std::to_string(line_of(key)) + ": " + join(key) + ": " + what);
-  }
-
-  // Every key must be one of `allowed`.
-  void allow(std::initializer_list<const char*> allowed) const {
-    for (const auto& kv : node_) {
-      const std::string key = kv.first.as<std::string>();
-      if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
-        std::string list;
-        for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-        throw ScenarioError(source_ + ":" + std::to_string(kv.first.Mark().line + 1) + ": " + join(key) +
-                            ": unknown key (allowed here: " + list + ")");
-      }
-    }
-  }
-  bool has(const std::string& key) const { return static_cast<bool>(node_[key]); }
-  YAML::Node get(const std::string& key) const { return node_[key]; }
-  std::string join(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
-  int line_of(const std::string& key) const {
-    for (const auto& kv : node_) {
-      if (kv.first.as<std::string>() == key) return kv.first.Mark().line + 1;
-    }
-    return node_.Mark().line + 1;
-  }
-  Reader child(const std::string& key) const { return Reader(node_[key], source_, join(key)); }
-  const std::string& source() const { return source_; }
-
-  double number(const std::string& key, double fallback) const {
-    if (!has(key)) return fallback;
-    return as_number(node_[key], key);
-  }
-  double positive(const std::string& key, double fallback) const {
-    const double v = number(key, fallback);
-    if (!(v > 0.0)) fail_key(key, "must be greater than 0");
-    return v;
-  }
-  double non_negative(const std::string& key, double fallback) const {
-    const double v = number(key, fallback);
-    if (!(v >= 0.0)) fail_key(key, "must not be negative");
-    return v;
-  }
-  int integer(const std::string& key, int fallback) const {
-    if (!has(key)) return fallback;
-    const double v = as_number(node_[key], key);
-    if (v != std::floor(v) || std::abs(v) > 1e9) fail_key(key, "must be a whole number");
-    return static_cast<int>(v);
-  }
-  bool boolean(const std::string& key, bool fallback) const {
-    if (!has(key)) return fallback;
-    try {
-      return node_[key].as<bool>();
-    } catch (const YAML::Exception&) {
-      fail_key(key, "must be true or false");
-    }
-  }
-  std::string text(const std::string& key, const std::string& fallback) const {
-    if (!has(key)) return fallback;
-    if (!node_[key].IsScalar()) fail_key(key, "must be a text value");
-    return node_[key].as<std::string>();
-  }
-  Vec2 point(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsSequence() || n.size() != 2) fail_key(key, "must be a point [x_m, y_m]");
-    return {as_number(n[0], key), as_number(n[1], key)};
-  }
-  /// A list of text values (a single one counts as a list of one).
-  std::vector<std::string> words(const std::string& key) const {
-    const YAML::Node n = node_[key];
-    std::vector<std::string> out;
-    if (n.IsScalar()) return {n.as<std::string>()};
-    if (!n.IsSequence()) fail_key(key, "must be a list of text values");
-    for (const auto& w : n) {
-      if (!w.IsScalar()) fail_key(key, "must be a list of text values");
-      out.push_back(w.as<std::string>());
-    }
-    return out;
-  }
-  std::vector<Vec2> points(const std::string& key) const {
-    const YAML::Node n = node_[key];
-    if (!n || !n.IsSequence()) fail_key(key, "must be a list of points [[x_m, y_m], ...]");
-    std::vector<Vec2> out;
-    for (const auto& p : n) out.push_back(point(p, key));
-    return out;
-  }
-
- private:
-  double as_number(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsScalar()) fail_key(key, "must be a number");
-    double v = 0.0;
-    try {
-      v = n.as<double>();
-    } catch (const YAML::Exception&) {
-      fail_key(key, "must be a number, not '" + n.as<std::string>() + "'");
-    }
-    if (!std::isfinite(v)) fail_key(key, "must be a finite number");
-    return v;
-  }
-
-  YAML::Node node_;
-  std::string source_;
-  std::string path_;
-};
+using yaml_detail::Reader;
 
 TimeUs milliseconds(const Reader& r, const std::string& key, TimeUs fallback_us) {
   const double ms = r.positive(key, static_cast<double>(fallback_us) / 1000.0);
@@ -152,8 +40,7 @@ TimeUs milliseconds(const Reader& r, const std::string& key, TimeUs fallback_us)
 // create(), with the scenario's static map and control period) once per robot entry.
 class ScenarioSensors {
  public:
-  ScenarioSensors(const std::string& source, const Scenario& scenario)
-      : base_(std::filesystem::path(source).parent_path()), scenario_(scenario) {}
+  explicit ScenarioSensors(const Scenario& scenario) : scenario_(scenario) {}
 
   environment::SensorModelMount mount(const Reader& m) {
     m.allow({"library", "name", "parameters", "mount_x_m", "mount_y_m", "mount_yaw_deg", "as"});
@@ -161,10 +48,10 @@ class ScenarioSensors {
     const std::string name = m.text("name", "");
     if (library.empty()) m.fail_key("library", "give the plug-in library's path, relative to the scenario file");
     if (name.empty()) m.fail_key("name", "give the name of one of the library's sensor models");
-    const agents::SensorModelEntry& entry = model(m, resolved(library), name);
+    const agents::SensorModelEntry& entry = model(m, resolved(m, library), name);
     ParameterFile file{"(no parameter file)", {}};
     if (m.has("parameters")) {
-      const std::filesystem::path path = resolved(m.text("parameters", ""));
+      const std::filesystem::path path = resolved(m, m.text("parameters", ""));
       core::Result<ParameterFile> read = read_parameter_file(path);
       if (!read) m.fail_key("parameters", read.error());
       file = *read;
@@ -187,7 +74,7 @@ class ScenarioSensors {
     const std::string name = a.text("name", "");
     if (library.empty()) a.fail_key("library", "give the plug-in library's path, relative to the scenario file");
     if (name.empty()) a.fail_key("name", "give the name of one of the library's actuator models");
-    const std::filesystem::path path = resolved(library);
+    const std::filesystem::path path = resolved(a, library);
     auto it = actuators_.find(path.string());
     if (it == actuators_.end()) {
       core::Result<std::vector<agents::ActuatorModelEntry>> loaded = agents::load_library_actuator_models(path);
@@ -206,7 +93,7 @@ class ScenarioSensors {
     }
     ParameterFile file{"(no parameter file)", {}};
     if (a.has("parameters")) {
-      core::Result<ParameterFile> read = read_parameter_file(resolved(a.text("parameters", "")));
+      core::Result<ParameterFile> read = read_parameter_file(resolved(a, a.text("parameters", "")));
       if (!read) a.fail_key("parameters", read.error());
       file = *read;
     }
@@ -217,9 +104,10 @@ class ScenarioSensors {
   }
 
  private:
-  std::filesystem::path resolved(const std::string& path) const {
+  // Relative to the file `r` reads (a scenario, or a robot model file it names).
+  static std::filesystem::path resolved(const Reader& r, const std::string& path) {
     std::error_code ec;
-    return std::filesystem::absolute(base_ / path, ec).lexically_normal();
+    return std::filesystem::absolute(std::filesystem::path(r.source()).parent_path() / path, ec).lexically_normal();
   }
   const agents::SensorModelEntry& model(const Reader& m, const std::filesystem::path& path, const std::string& name) {
     auto it = libraries_.find(path.string());
@@ -249,7 +137,6 @@ class ScenarioSensors {
     return *map_;
   }
 
-  std::filesystem::path base_;
   const Scenario& scenario_;
   std::map<std::string, std::vector<agents::SensorModelEntry>> libraries_;
   std::map<std::string, std::vector<agents::ActuatorModelEntry>> actuators_;
@@ -540,6 +427,20 @@ LinkSpec read_link(const Reader& l, const YAML::Node& at) {
   return link;
 }
 
+// The robot model file a robot entry names (`model:`), or the built-in Khepera II. Its
+// errors are the model file's, after where the scenario named it.
+RobotDescription read_model(const Reader& r, ScenarioSensors& sensors) {
+  if (!r.has("model")) return {};
+  const std::string name = r.text("model", "");
+  core::Result<std::filesystem::path> file = find_robot_model(name, std::filesystem::path(r.source()).parent_path());
+  if (!file) r.fail_key("model", file.error());
+  try {
+    return read_robot_description(*file, [&](const Reader& block) { return read_sensors(block, sensors); });
+  } catch (const ScenarioError& e) {
+    r.fail_key("model", e.what());
+  }
+}
+
 // Every robot entry, each of one robot (`id`) or several alike (`ids`), sorted by ID.
 std::vector<RobotSpec> read_robots(const Reader& top, ScenarioControllers& controllers, ScenarioSensors& sensors) {
   const YAML::Node list = top.get("robots");
@@ -548,9 +449,14 @@ std::vector<RobotSpec> read_robots(const Reader& top, ScenarioControllers& contr
   std::set<int> seen;
   for (std::size_t i = 0; i < list.size(); ++i) {
     const Reader r(list[i], top.source(), "robots[" + std::to_string(i) + "]");
-    r.allow({"id", "ids", "kind", "pose", "controller", "params", "noise", "sensors", "link", "actuator"});
+    r.allow({"id", "ids", "kind", "pose", "model", "body", "wheels", "controller", "params", "noise", "sensors", "link",
+             "actuator"});
     RobotSpec base;
     base.line = list[i].Mark().line + 1;
+    const RobotDescription model = read_model(r, sensors);
+    base.body = model.body;
+    if (model.sensors) base.sensors = *model.sensors;
+    read_body_parts(r, base.body);
     const std::vector<int> ids = read_robot_ids(r, list[i]);
     base.kind = read_kind(r);
     base.pose = read_pose(r, ids.size());
@@ -570,6 +476,9 @@ std::vector<RobotSpec> read_robots(const Reader& top, ScenarioControllers& contr
     if (r.has("link")) {
       if (base.kind != environment::RobotKind::kReal) r.fail_key("link", "only a robot of kind real has a link");
       base.link = read_link(r.child("link"), r.get("link"));
+      if (!r.child("link").has("model") && model.link.model) base.link->model = *model.link.model;
+      base.link->speed_unit_mps = model.link.speed_unit_mps;
+      base.link->counter_pulse_m = model.link.counter_pulse_m;
     } else if (base.kind == environment::RobotKind::kReal) {
       r.fail(list[i], "a robot of kind real needs a `link` ({port: /dev/ttyUSB0, baud: 38400} or {emulate: true})");
     }
@@ -772,7 +681,7 @@ Scenario read_scenario(const YAML::Node& root, const std::string& source, Scenar
   s.duration_s = top.positive("duration_s", s.duration_s);
   read_convoy(top, s);
   read_map_lists(top, source, s);
-  ScenarioSensors sensors(source, s);
+  ScenarioSensors sensors(s);
   s.robots = read_robots(top, controllers, sensors);
   if (top.has("camera")) s.camera = read_camera(top);
   if (top.has("safety")) {
@@ -879,7 +788,11 @@ class PlacedPoints {
 
 std::vector<Pose2> draw_initial_poses(const Scenario& scenario, std::mt19937_64& rng, double clearance_m) {
   const environment::FieldConfig& field = scenario.map.field;
-  const double radius = environment::kKheperaRadius_m;
+  // Apart by the largest body's bounding disc (a Khepera's, in a swarm of Kheperas).
+  double radius = 0.0;
+  for (const RobotSpec& r : scenario.robots)
+    radius = std::max(
+        radius, r.body.outline_m.empty() ? r.body.radius_m : environment::outline_bounding_radius_m(r.body.outline_m));
   const double margin = radius + clearance_m;
   std::vector<Pose2> poses(scenario.robots.size());
   const double spacing_m = 2 * radius + clearance_m;

@@ -22,6 +22,7 @@
 #include "environment/robot_state.hpp"
 #include "environment/sensor_suite.hpp"
 #include "environment/static_map.hpp"
+#include "run/robot_description.hpp"
 #include "serial/khepera_emulator.hpp"
 #include "vision/vision_settings.hpp"
 
@@ -54,6 +55,10 @@ struct LinkSpec {
   /// Faults the emulated robot injects (emulate only: `faults:`): reply delay, dropped,
   /// garbled and corrupted replies, an unplug and a replug.
   serial::EmulatorFaults faults;
+  /// The firmware's speed units where the robot's model file gives them (other gearing or
+  /// wheels than the protocol's robot); none: the protocol's own.
+  std::optional<double> speed_unit_mps;
+  std::optional<double> counter_pulse_m;
 };
 
 /// The overhead camera of a run with real robots.
@@ -93,6 +98,9 @@ struct RobotSpec {
   /// built-in differential drive with `noise`.
   std::shared_ptr<const environment::DriveModelFactory> drive;
   environment::SensorSuiteConfig sensors;
+  /// Its body and wheels: a robot model file's (`model:`) with the entry's `body:` and
+  /// `wheels:` over it; by default a Khepera II.
+  RobotBody body;
   std::optional<LinkSpec> link;  ///< real robots only
   int line = 0;                  ///< where it was defined, for messages
 };

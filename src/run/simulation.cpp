@@ -123,6 +123,9 @@ void Run::make_bodies(const RealBodyFactory& real_bodies) {
     rc.id = spec.id;
     rc.kind = spec.kind;
     rc.pose = poses[i];
+    rc.radius_m = spec.body.radius_m;
+    rc.outline_m = spec.body.outline_m;
+    rc.wheel_base_m = spec.body.wheel_base_m;
     rc.noise = spec.noise;
     rc.sensors = spec.sensors;
     rc.drive = spec.drive;
