@@ -71,6 +71,7 @@ Channels Channels::with_prefix(const std::string& prefix) {
   c.camera = prefix + c.camera;
   c.vision = prefix + c.vision;
   c.sensor_layout = prefix + c.sensor_layout;
+  c.robot_bodies = prefix + c.robot_bodies;
   return c;
 }
 

@@ -228,6 +228,22 @@ void fields(Walk& w, const rilbed::sensor_layout_t*) {
   w.skip(static_cast<std::size_t>(robots) * 2 * 4);
 }
 
+void fields(Walk& w, const rilbed::robot_body_t*) {
+  w.string();
+  w.f64();
+  const std::int32_t vertices = w.count(w.i32(), 2 * 8);
+  w.skip(static_cast<std::size_t>(vertices) * 2 * 8);
+  w.f64();
+  w.f64();
+}
+void fields(Walk& w, const rilbed::robot_bodies_t*) {
+  w.i64();
+  const std::int32_t bodies = w.count(w.i32(), 4 + 1 + 8 + 4 + 2 * 8);  // the smallest body: an empty name, a disc
+  for (std::int32_t k = 0; k < bodies && w.ok(); ++k) fields(w, static_cast<const rilbed::robot_body_t*>(nullptr));
+  const std::int32_t robots = w.count(w.i32(), 2 * 4);
+  w.skip(static_cast<std::size_t>(robots) * 2 * 4);
+}
+
 // The agent exchange (processes of their own, here or on other machines).
 void fields(Walk& w, const rilbed::agent_hello_t*) {
   w.string();
@@ -303,6 +319,7 @@ template bool well_formed<rilbed::detections_t>(const void*, std::size_t);
 template bool well_formed<rilbed::frame_t>(const void*, std::size_t);
 template bool well_formed<rilbed::camera_t>(const void*, std::size_t);
 template bool well_formed<rilbed::sensor_layout_t>(const void*, std::size_t);
+template bool well_formed<rilbed::robot_bodies_t>(const void*, std::size_t);
 template bool well_formed<rilbed::vision_settings_t>(const void*, std::size_t);
 template bool well_formed<rilbed::agent_hello_t>(const void*, std::size_t);
 template bool well_formed<rilbed::quantum_t>(const void*, std::size_t);

@@ -25,6 +25,7 @@
 #include "rilbed/poses_t.hpp"
 #include "rilbed/quantum_reply_t.hpp"
 #include "rilbed/quantum_t.hpp"
+#include "rilbed/robot_bodies_t.hpp"
 #include "rilbed/sensor_layout_t.hpp"
 #include "rilbed/sensors_t.hpp"
 #include "rilbed/status_t.hpp"

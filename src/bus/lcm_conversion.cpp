@@ -1,6 +1,7 @@
 #include "bus/lcm_conversion.hpp"
 
 #include "bus/lcm_checked.hpp"
+#include "environment/body_shape.hpp"
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -214,6 +215,66 @@ rilbed::sensor_layout_t sensor_layout(TimeUs t_us, const run::WorldReport& world
   }
   m.num_robots = static_cast<std::int32_t>(m.robot_ids.size());
   return m;
+}
+
+rilbed::robot_bodies_t robot_bodies(TimeUs t_us, const run::WorldReport& world) {
+  rilbed::robot_bodies_t m;
+  m.utime = t_us;
+  for (const run::BodyDrawing& b : world.bodies) {
+    rilbed::robot_body_t out;
+    out.name = b.name;
+    out.radius_m = b.outline_m.empty() ? b.radius_m : environment::outline_bounding_radius_m(b.outline_m);
+    for (const Vec2& v : b.outline_m) {
+      out.outline_x_m.push_back(v.x);
+      out.outline_y_m.push_back(v.y);
+    }
+    out.num_outline = static_cast<std::int32_t>(b.outline_m.size());
+    out.wheel_base_m = b.wheel_base_m;
+    out.wheel_radius_m = b.wheel_radius_m;
+    m.bodies.push_back(std::move(out));
+  }
+  m.num_bodies = static_cast<std::int32_t>(m.bodies.size());
+  for (const auto& [id, index] : world.body_of) {
+    m.robot_ids.push_back(id);
+    m.body_of.push_back(index);
+  }
+  m.num_robots = static_cast<std::int32_t>(m.robot_ids.size());
+  return m;
+}
+
+core::Result<std::pair<std::vector<run::BodyDrawing>, std::map<int, int>>> from_lcm(const rilbed::robot_bodies_t& m) {
+  std::vector<run::BodyDrawing> bodies;
+  auto positive = [](double v, double most) { return std::isfinite(v) && v > 0.0 && v <= most; };
+  for (std::size_t k = 0; k < m.bodies.size(); ++k) {
+    const rilbed::robot_body_t& b = m.bodies[k];
+    const std::string which = "body " + std::to_string(k);
+    if (!positive(b.radius_m, 1.0))
+      return core::Failure{which + " has a radius of " + std::to_string(b.radius_m) + " m"};
+    if (!positive(b.wheel_base_m, 2.0) || !positive(b.wheel_radius_m, 0.5))
+      return core::Failure{which + " has wheels of base " + std::to_string(b.wheel_base_m) + " m, radius " +
+                           std::to_string(b.wheel_radius_m) + " m"};
+    run::BodyDrawing out{b.name, b.radius_m, {}, b.wheel_base_m, b.wheel_radius_m};
+    if (b.num_outline > 0) {
+      std::vector<Vec2> outline;
+      for (std::int32_t v = 0; v < b.num_outline; ++v) outline.push_back({b.outline_x_m[v], b.outline_y_m[v]});
+      try {
+        out.outline_m = environment::checked_outline(std::move(outline), which);
+      } catch (const std::invalid_argument& e) {
+        return core::Failure{e.what()};
+      }
+      if (environment::outline_bounding_radius_m(out.outline_m) > 1.0)
+        return core::Failure{which + " reaches beyond 1 m"};
+    }
+    bodies.push_back(std::move(out));
+  }
+  std::map<int, int> of;
+  for (std::size_t k = 0; k < m.robot_ids.size(); ++k) {
+    if (m.body_of[k] < 0 || m.body_of[k] >= m.num_bodies)
+      return core::Failure{"robot " + std::to_string(m.robot_ids[k]) + " has body " + std::to_string(m.body_of[k]) +
+                           " of " + std::to_string(m.num_bodies)};
+    of[m.robot_ids[k]] = m.body_of[k];
+  }
+  return std::pair{std::move(bodies), std::move(of)};
 }
 
 rilbed::frame_t to_lcm(TimeUs t_us, std::int64_t frame, const cv::Mat& image, int quality) {

@@ -14,11 +14,13 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include "core/result.hpp"
 #include "rilbed/camera_t.hpp"
 #include "rilbed/detections_t.hpp"
 #include "rilbed/event_t.hpp"
 #include "rilbed/frame_t.hpp"
 #include "rilbed/poses_t.hpp"
+#include "rilbed/robot_bodies_t.hpp"
 #include "rilbed/sensor_layout_t.hpp"
 #include "rilbed/sensors_t.hpp"
 #include "rilbed/status_t.hpp"
@@ -60,5 +62,10 @@ run::WorldReport from_lcm(const rilbed::world_t& message);
 run::StatusReport from_lcm(const rilbed::status_t& message);
 /// The robots' sensor geometry (from a world's sensor_geometries and sensor_geometry_of).
 rilbed::sensor_layout_t sensor_layout(TimeUs t_us, const run::WorldReport& world);
+/// The robots' bodies of a world report (its `bodies` and `body_of`).
+rilbed::robot_bodies_t robot_bodies(TimeUs t_us, const run::WorldReport& world);
+/// A robot_bodies_t's bodies and which robot has which, or the reason it is unusable (a
+/// body with a bad radius, wheels or outline, a robot naming a body it does not have).
+core::Result<std::pair<std::vector<run::BodyDrawing>, std::map<int, int>>> from_lcm(const rilbed::robot_bodies_t& m);
 
 }  // namespace rilbed::bus

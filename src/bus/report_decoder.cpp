@@ -51,6 +51,8 @@ std::optional<std::string> RunReportDecoder::decode(const std::string& channel, 
     world.camera = camera_;
     world.sensor_geometries = sensor_geometries_;
     world.sensor_geometry_of = sensor_geometry_of_;
+    world.bodies = bodies_;
+    world.body_of = body_of_;
     observer_.on_world(m.utime, world);
   } else if (channel == channels_.sensor_layout) {
     rilbed::sensor_layout_t m;
@@ -87,6 +89,13 @@ std::optional<std::string> RunReportDecoder::decode(const std::string& channel, 
     }
     sensor_geometries_ = std::move(geometries);
     sensor_geometry_of_ = std::move(of);
+  } else if (channel == channels_.robot_bodies) {
+    rilbed::robot_bodies_t m;
+    if (!decode_checked(data, size, m)) return bad("robot_bodies_t");
+    auto bodies = from_lcm(m);
+    if (!bodies) return channel + ": " + bodies.error();
+    bodies_ = std::move(bodies->first);
+    body_of_ = std::move(bodies->second);
   } else if (channel == channels_.vision) {
     rilbed::vision_settings_t m;
     if (!decode_checked(data, size, m)) return bad("vision_settings_t");

@@ -49,6 +49,8 @@ class RunReportDecoder {
   std::optional<run::CameraReport> camera_;             // the last camera_t, for the next world_t
   std::vector<run::SensorGeometry> sensor_geometries_;  // the last sensor_layout_t, for the next world_t
   std::map<int, int> sensor_geometry_of_;
+  std::vector<run::BodyDrawing> bodies_;  // the last robot_bodies_t, for the next world_t
+  std::map<int, int> body_of_;
   std::optional<vision::VisionSettings> vision_;  // the last vision_settings_t, for the next status_t
 };
 

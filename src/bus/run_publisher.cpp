@@ -163,6 +163,7 @@ void LcmRunPublisher::on_world(TimeUs t_us, const run::WorldReport& world) {
   // The camera first: a viewer draws the world over the camera's frames.
   if (world.camera) publish(channels_.camera, to_lcm(t_us, *world.camera));
   if (!world.sensor_geometries.empty()) publish(channels_.sensor_layout, sensor_layout(t_us, world));
+  if (!world.bodies.empty()) publish(channels_.robot_bodies, robot_bodies(t_us, world));
   publish(channels_.world, to_lcm(t_us, world));
 }
 

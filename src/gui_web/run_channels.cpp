@@ -118,12 +118,20 @@ std::string scene_schema() {
                                 {"head_length", number()},
                                 {"head_diameter", number()},
                                 {"color", color_s}});
+  const json triangles = object_of({{"pose", pose_s},
+                                    {"points", array_of(vec3)},
+                                    {"color", color_s},
+                                    {"colors", array_of(color_s)},
+                                    {"indices", array_of(integer())}});
+  const json cube = object_of({{"pose", pose_s}, {"size", vec3}, {"color", color_s}});
   const json entity_s = object_of({{"timestamp", time_s},
                                    {"frame_id", text()},
                                    {"id", text()},
                                    {"lifetime", time_s},
                                    {"frame_locked", boolean()},
                                    {"cylinders", array_of(cylinder)},
+                                   {"triangles", array_of(triangles)},
+                                   {"cubes", array_of(cube)},
                                    {"texts", array_of(text_s)},
                                    {"lines", array_of(line_s)},
                                    {"arrows", array_of(arrow)}});
@@ -196,6 +204,11 @@ RunChannels::RunChannels(WebServer& server) : server_(server) {
                    {"robots",
                     array_of(object_of({{"id", integer()},
                                         {"real", boolean()},
+                                        {"body", object_of({{"name", text()},
+                                                            {"radius_m", number()},
+                                                            {"outline", polyline},
+                                                            {"wheel_base_m", number()},
+                                                            {"wheel_radius_m", number()}})},
                                         {"sensors", object_of({{"ir_range_m", number()},
                                                                {"ranges", array_of(object_of({{"mount_rad", number()},
                                                                                               {"opening_rad", number()},
@@ -328,9 +341,20 @@ json RunChannels::world_json(TimeUs t_us, const run::WorldReport& w) {
                           {"beacon_fov_rad", g.beacon_fov_rad},
                           {"tracks", tracks}});
   }
+  std::vector<json> bodies;
+  for (const run::BodyDrawing& b : w.bodies) {
+    bodies.push_back({{"name", b.name},
+                      {"radius_m", b.radius_m},
+                      {"outline", points(b.outline_m)},
+                      {"wheel_base_m", b.wheel_base_m},
+                      {"wheel_radius_m", b.wheel_radius_m}});
+  }
   json robots = json::array();
   for (const int id : w.robot_ids) {
     json robot = {{"id", id}, {"real", w.field.real_robot_ids.contains(id)}};
+    if (const auto b = w.body_of.find(id);
+        b != w.body_of.end() && b->second >= 0 && static_cast<std::size_t>(b->second) < bodies.size())
+      robot["body"] = bodies[static_cast<std::size_t>(b->second)];
     const auto it = w.sensor_geometry_of.find(id);
     if (it != w.sensor_geometry_of.end() && it->second >= 0 &&
         static_cast<std::size_t>(it->second) < geometries.size()) {
@@ -408,6 +432,45 @@ void add_marks(json& entity, const Pose2& robot, const std::vector<environment::
   }
 }
 
+// A robot's body at `at`: its disc as a cylinder 20 mm high, or its outline as a prism
+// (a top face of triangles 20 mm up, and the outline's edge), and its two wheels.
+void add_body(json& e, const Pose2& at, const run::BodyDrawing& body, const json& c) {
+  const double x = at.position_m.x, y = at.position_m.y, h = at.heading_rad;
+  constexpr double kHeight_m = 0.02;
+  if (body.outline_m.empty()) {
+    const double d = 2 * body.radius_m;
+    e["cylinders"].push_back({{"pose", pose(x, y, kHeight_m / 2, h)},
+                              {"size", point(d, d, kHeight_m)},
+                              {"bottom_scale", 1.0},
+                              {"top_scale", 1.0},
+                              {"color", c}});
+  } else {
+    const double ch = std::cos(h), sh = std::sin(h);
+    std::vector<Vec2> field;
+    for (const Vec2& v : body.outline_m) field.push_back({x + ch * v.x - sh * v.y, y + sh * v.x + ch * v.y});
+    json top = json::array();
+    for (std::size_t k = 1; k + 1 < field.size(); ++k) {  // a fan: the outline is convex
+      for (const Vec2& v : {field[0], field[k], field[k + 1]}) top.push_back(point(v.x, v.y, kHeight_m));
+    }
+    e["triangles"].push_back({{"pose", pose(0, 0, 0, 0)},
+                              {"points", top},
+                              {"color", c},
+                              {"colors", json::array()},
+                              {"indices", json::array()}});
+    json edge = line(field, true, 0.002, color(0.1, 0.1, 0.1));
+    for (json& pt : edge["points"]) pt["z"] = kHeight_m;
+    e["lines"].push_back(std::move(edge));
+  }
+  // The wheels: discs on edge, across the axle at the wheel base's ends.
+  for (const double side : {-0.5, 0.5}) {
+    const double wx = x - std::sin(h) * side * body.wheel_base_m, wy = y + std::cos(h) * side * body.wheel_base_m;
+    const double d = 2 * body.wheel_radius_m;
+    e["cubes"].push_back({{"pose", pose(wx, wy, body.wheel_radius_m, h)},
+                          {"size", point(d, 0.004, d)},
+                          {"color", color(0.15, 0.15, 0.15)}});
+  }
+}
+
 }  // namespace
 
 json RunChannels::scene_json(TimeUs t_us, std::span<const run::PoseReport> poses,
@@ -423,16 +486,18 @@ json RunChannels::scene_json(TimeUs t_us, std::span<const run::PoseReport> poses
       field["lines"].push_back(line(ps, false, width_m, color(0.2, 0.2, 0.2, 0.6)));
     entities.push_back(std::move(field));
   }
-  constexpr double kDiameter_m = 0.055;  // a Khepera
+  const run::BodyDrawing khepera;  // what a robot without a published body is
   for (const auto& p : poses) {
     json e = entity(t_us, "robot " + std::to_string(p.id));
     const json c = p.real ? color(0.15, 0.35, 0.9, p.seen ? 0.9 : 0.4) : color(0.9, 0.15, 0.15, 0.8);
     const double x = p.pose.position_m.x, y = p.pose.position_m.y;
-    e["cylinders"].push_back({{"pose", pose(x, y, 0.01, p.pose.heading_rad)},
-                              {"size", point(kDiameter_m, kDiameter_m, 0.02)},
-                              {"bottom_scale", 1.0},
-                              {"top_scale", 1.0},
-                              {"color", c}});
+    const run::BodyDrawing* body = &khepera;
+    if (world) {
+      if (const auto b = world->body_of.find(p.id);
+          b != world->body_of.end() && b->second >= 0 && static_cast<std::size_t>(b->second) < world->bodies.size())
+        body = &world->bodies[static_cast<std::size_t>(b->second)];
+    }
+    add_body(e, p.pose, *body, c);
     e["arrows"].push_back({{"pose", pose(x, y, 0.025, p.pose.heading_rad)},
                            {"shaft_length", 0.03},
                            {"shaft_diameter", 0.006},

@@ -97,6 +97,17 @@ struct SensorGeometry {
   bool operator==(const SensorGeometry&) const = default;
 };
 
+/// A robot's body as viewers draw it: its disc, or its convex outline (robot frame: x
+/// forward, y left, metres, counter-clockwise), and its wheels.
+struct BodyDrawing {
+  std::string name = "khepera2";  ///< the robot model's name
+  double radius_m = 0.0275;       ///< the disc (when outline_m is empty)
+  std::vector<Vec2> outline_m;    ///< empty: the disc
+  double wheel_base_m = 0.053;
+  double wheel_radius_m = 0.00764;
+  bool operator==(const BodyDrawing&) const = default;
+};
+
 /// The world a run takes place in.
 struct WorldReport {
   std::optional<CameraReport> camera;  ///< runs with a camera
@@ -108,6 +119,10 @@ struct WorldReport {
   FieldDrawing field;          ///< size, obstacles, tracks, beacons, which robots are real
   bool walls = true;           ///< the field's edges are walls
   std::vector<int> robot_ids;  ///< every robot, in ID order
+  /// Distinct bodies, and each robot's (robot ID -> index); may be empty (a recording or
+  /// a publisher from before bodies were published: draw Kheperas).
+  std::vector<BodyDrawing> bodies;
+  std::map<int, int> body_of;
 };
 
 /// The run's state.

@@ -49,6 +49,10 @@ WorldReport world_report(const Scenario& scenario, const std::vector<int>& real_
     auto it = std::find(w.sensor_geometries.begin(), w.sensor_geometries.end(), g);
     if (it == w.sensor_geometries.end()) it = w.sensor_geometries.insert(it, g);
     w.sensor_geometry_of[r.id] = static_cast<int>(it - w.sensor_geometries.begin());
+    const BodyDrawing b{r.body.name, r.body.radius_m, r.body.outline_m, r.body.wheel_base_m, r.body.wheel_radius_m};
+    auto body = std::find(w.bodies.begin(), w.bodies.end(), b);
+    if (body == w.bodies.end()) body = w.bodies.insert(body, b);
+    w.body_of[r.id] = static_cast<int>(body - w.bodies.begin());
   }
   return w;
 }

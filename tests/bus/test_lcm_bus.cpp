@@ -380,3 +380,64 @@ TEST(LcmBus, WheelsSensorsAndDetectionsSurviveTheBus) {
 
 }  // namespace
 }  // namespace rilbed::bus
+
+namespace rilbed::bus {
+namespace {
+
+template <typename Message>
+std::vector<std::uint8_t> encoded(const Message& m) {
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
+  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+// Robots' bodies reach a viewer with the next world_t; one that cannot be drawn is refused.
+TEST(LcmBus, RobotBodiesTravelBeforeTheWorldAndBadOnesAreRefused) {
+  struct Got final : run::RunObserver {
+    run::WorldReport world;
+    int worlds = 0;
+    void on_world(TimeUs, const run::WorldReport& w) override {
+      world = w;
+      ++worlds;
+    }
+  } got;
+  const Channels channels;
+  RunReportDecoder decoder(channels, got);
+  run::WorldReport w;
+  w.robot_ids = {1, 2, 3};
+  w.bodies = {run::BodyDrawing{},
+              run::BodyDrawing{
+                  "square", 0.0, {{0.035, 0.035}, {-0.035, 0.035}, {-0.035, -0.035}, {0.035, -0.035}}, 0.06, 0.016}};
+  w.body_of = {{1, 0}, {2, 1}, {3, 1}};
+  const auto bodies = encoded(robot_bodies(5, w));
+  ASSERT_FALSE(decoder.decode(channels.robot_bodies, bodies.data(), bodies.size()));
+  const auto world = encoded(to_lcm(5, w));
+  ASSERT_FALSE(decoder.decode(channels.world, world.data(), world.size()));
+  ASSERT_EQ(got.worlds, 1);
+  ASSERT_EQ(got.world.bodies.size(), 2u);
+  EXPECT_EQ(got.world.bodies[1].name, "square");
+  EXPECT_EQ(got.world.bodies[1].outline_m, w.bodies[1].outline_m);
+  EXPECT_NEAR(got.world.bodies[1].radius_m, 0.035 * std::sqrt(2.0), 1e-15);  // the outline's bounding disc
+  EXPECT_EQ(got.world.bodies[0], w.bodies[0]);
+  EXPECT_EQ(got.world.body_of, w.body_of);
+
+  rilbed::robot_bodies_t bad = robot_bodies(6, w);
+  std::swap(bad.bodies[1].outline_x_m[0], bad.bodies[1].outline_x_m[1]);  // a bow tie
+  auto bytes = encoded(bad);
+  auto problem = decoder.decode(channels.robot_bodies, bytes.data(), bytes.size());
+  ASSERT_TRUE(problem);
+  EXPECT_NE(problem->find("RILBED_ROBOT_BODIES: body 1: outline crosses itself"), std::string::npos) << *problem;
+  bad = robot_bodies(6, w);
+  bad.body_of[2] = 2;
+  bytes = encoded(bad);
+  problem = decoder.decode(channels.robot_bodies, bytes.data(), bytes.size());
+  ASSERT_TRUE(problem);
+  EXPECT_NE(problem->find("robot 3 has body 2 of 2"), std::string::npos) << *problem;
+  bad = robot_bodies(6, w);
+  bad.bodies[0].radius_m = -1.0;
+  bytes = encoded(bad);
+  EXPECT_TRUE(decoder.decode(channels.robot_bodies, bytes.data(), bytes.size()));
+}
+
+}  // namespace
+}  // namespace rilbed::bus

@@ -37,6 +37,7 @@
 #include "bus/lcm_checked.hpp"
 #include "bus/lcm_conversion.hpp"
 #include "bus/report_decoder.hpp"
+#include "environment/shapes.hpp"
 #include "touching_observer.hpp"
 
 namespace {
@@ -58,9 +59,9 @@ std::string g_channel;  // the channel of the input being checked, for the repor
 const std::vector<std::string>& channel_names() {
   static const std::vector<std::string> names = [] {
     const bus::Channels c = bus::Channels::with_prefix("");
-    return std::vector<std::string>{c.poses,         c.events,  c.status,        c.world,  c.summary,
-                                    c.wheels,        c.sensors, c.detections,    c.frames, c.camera,
-                                    c.sensor_layout, c.vision,  "RILBED_UNKNOWN"};
+    return std::vector<std::string>{c.poses,         c.events,  c.status,       c.world,         c.summary,
+                                    c.wheels,        c.sensors, c.detections,   c.frames,        c.camera,
+                                    c.sensor_layout, c.vision,  c.robot_bodies, "RILBED_UNKNOWN"};
   }();
   return names;
 }
@@ -77,6 +78,7 @@ enum Pick {
   kCamera,
   kSensorLayout,
   kVision,
+  kRobotBodies,
   kUnknown,
   kPicks
 };
@@ -98,6 +100,11 @@ bool has_nul(const rilbed::frame_t& m) { return has_nul(m.format); }
 bool has_nul(const rilbed::camera_t& m) { return has_nul(m.source); }
 bool has_nul(const rilbed::vision_settings_t&) { return false; }
 bool has_nul(const rilbed::sensor_layout_t&) { return false; }
+bool has_nul(const rilbed::robot_bodies_t& m) {
+  for (const rilbed::robot_body_t& b : m.bodies)
+    if (has_nul(b.name)) return true;
+  return false;
+}
 bool has_nul(const rilbed::poses_t& m) {
   for (const rilbed::robot_pose_t& r : m.robots) {
     if (has_nul(r.behaviour) || has_nul(r.health)) return true;
@@ -478,6 +485,31 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         for (const auto& element : out.track_points_m) points += element.size();
         FUZZ_CHECK(points == in.track_sensor.size());
       }
+      break;
+    }
+    case kRobotBodies: {
+      // Accepted exactly when the bytes are a robot_bodies_t whose bodies are drawable (a
+      // radius and wheels in range, no outline or a convex one around the centre) and whose
+      // robots name bodies it has; the next world carries them.
+      rilbed::robot_bodies_t m;
+      if (problem && refused_before_decoding<rilbed::robot_bodies_t>(message, length)) break;
+      const bool readable = generated_decode(message, length, m);
+      const bool usable = readable && static_cast<bool>(bus::from_lcm(m));
+      FUZZ_CHECK(usable == !problem);
+      if (problem) break;
+      check_round_trip(m, message, length);
+      rilbed::world_t world;
+      std::vector<std::uint8_t> bytes(static_cast<std::size_t>(world.getEncodedSize()));
+      FUZZ_CHECK(world.encode(bytes.data(), 0, static_cast<int>(bytes.size())) > 0);
+      FUZZ_CHECK(!decoder.decode(bus::Channels::with_prefix("").world, bytes.data(), bytes.size()));
+      const run::WorldReport& w = seen.last_world;
+      FUZZ_CHECK(w.bodies.size() == m.bodies.size());
+      for (const run::BodyDrawing& b : w.bodies) {
+        FUZZ_CHECK(b.radius_m > 0.0 && b.wheel_base_m > 0.0 && b.wheel_radius_m > 0.0);
+        FUZZ_CHECK(b.outline_m.empty() || environment::polygon_signed_area(b.outline_m) > 0.0);
+      }
+      for (const auto& [id, index] : w.body_of)
+        FUZZ_CHECK(index >= 0 && static_cast<std::size_t>(index) < w.bodies.size());
       break;
     }
     case kUnknown:
