@@ -2,6 +2,7 @@
 
 #include <stdlib.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <system_error>
@@ -135,7 +136,15 @@ std::vector<vision::SceneMarker> RealRobots::emulated_markers() const {
   std::vector<vision::SceneMarker> out;
   for (const auto& [id, emulator] : emulators_) {
     const Pose2 p = emulator->true_pose();
-    out.push_back({id, p.position_m.x, p.position_m.y, p.heading_rad, 0.05});
+    vision::SceneMarker m{id, p.position_m.x, p.position_m.y, p.heading_rad, 0.05};
+    // The robot under its marker, as its body is described (the camera renders its top).
+    const auto spec = std::find_if(scenario_.robots.begin(), scenario_.robots.end(),
+                                   [&](const run::RobotSpec& r) { return r.id == id; });
+    if (spec != scenario_.robots.end()) {
+      m.body_radius_m = spec->body.radius_m;
+      for (const Vec2& v : spec->body.outline_m) m.body_outline_m.emplace_back(v.x, v.y);
+    }
+    out.push_back(std::move(m));
   }
   return out;
 }

@@ -320,6 +320,47 @@ cv::Rect projected_box(const CameraModel& cam, double x, double y, double half, 
 
 }  // namespace
 
+void SyntheticCamera::draw_body(cv::Mat& reflectance, const SceneMarker& m) const {
+  double reach = m.body_radius_m;
+  for (const cv::Point2d& v : m.body_outline_m) reach = std::max(reach, std::hypot(v.x, v.y));
+  if (reach <= 0.0) return;
+  const cv::Rect box = projected_box(camera_, m.x_m, m.y_m, reach, reflectance.size());
+  const int s = std::max(1, conditions_.supersample);
+  const double c = std::cos(m.theta_rad), sn = std::sin(m.theta_rad);
+  const std::vector<cv::Point2d>& poly = m.body_outline_m;
+  // Inside a convex counter-clockwise outline: left of every edge (either orientation is
+  // accepted: the sign of the first edge's turn decides).
+  double orientation = 0.0;
+  for (std::size_t k = 0; k < poly.size(); ++k) {
+    const cv::Point2d a = poly[k], b = poly[(k + 1) % poly.size()];
+    orientation += a.x * b.y - b.x * a.y;
+  }
+  auto inside = [&](double lx, double ly) {
+    if (poly.empty()) return std::hypot(lx, ly) <= m.body_radius_m;
+    for (std::size_t k = 0; k < poly.size(); ++k) {
+      const cv::Point2d a = poly[k], b = poly[(k + 1) % poly.size()];
+      const double cross = (b.x - a.x) * (ly - a.y) - (b.y - a.y) * (lx - a.x);
+      if (cross * orientation < 0.0) return false;
+    }
+    return true;
+  };
+  for (int v = box.y; v < box.y + box.height; ++v) {
+    float* row = reflectance.ptr<float>(v);
+    for (int u = box.x; u < box.x + box.width; ++u) {
+      int covered = 0;
+      for (int j = 0; j < s; ++j) {
+        for (int i = 0; i < s; ++i) {
+          const cv::Point2d f = field_at(u + (i + 0.5) / s - 0.5, v + (j + 0.5) / s - 0.5);
+          const double dx = f.x - m.x_m, dy = f.y - m.y_m;
+          covered += inside(c * dx + sn * dy, -sn * dx + c * dy) ? 1 : 0;
+        }
+      }
+      if (covered == 0) continue;
+      row[u] = static_cast<float>((covered * m.body_grey + (s * s - covered) * row[u]) / (s * s));
+    }
+  }
+}
+
 void SyntheticCamera::draw_marker(cv::Mat& reflectance, const SceneMarker& m) const {
   const double radius = m.diameter_m / 2.0;
   const cv::Rect box = projected_box(camera_, m.x_m, m.y_m, radius, reflectance.size());
@@ -422,6 +463,7 @@ cv::Mat motion_blur_kernel(double length_px, double angle_rad) {
 cv::Mat SyntheticCamera::render(const std::vector<SceneMarker>& markers, cv::RNG& rng,
                                 const std::vector<Clutter>& over) const {
   cv::Mat reflectance = floor_.clone();
+  for (const SceneMarker& m : markers) draw_body(reflectance, m);  // bodies first: a marker sits on its robot
   for (const SceneMarker& m : markers) draw_marker(reflectance, m);
   for (const Clutter& c : over) draw_clutter(reflectance, c);
   cv::Mat radiance = reflectance.mul(light_);

@@ -47,10 +47,19 @@ std::vector<cv::Point2d> undistorted_pixels(const CameraModel& camera);
 
 /// One marked robot in the scene.
 struct SceneMarker {
+  /// A marker alone on the floor (what most scenes hold); a body is set after.
+  SceneMarker(int id_ = 1, double x = 0.0, double y = 0.0, double theta = 0.0, double diameter = 0.05)
+      : id(id_), x_m(x), y_m(y), theta_rad(theta), diameter_m(diameter) {}
   int id = 1;
   double x_m = 0.0, y_m = 0.0;
   double theta_rad = 0.0;  ///< heading, CCW from field +x
   double diameter_m = 0.05;
+  /// The robot's body beneath the marker, as the camera sees its top: a convex outline in
+  /// the robot frame (x forward, y left, metres, around the marker's centre), or (outline
+  /// empty) a disc of body_radius_m; neither (the default): the marker alone on the floor.
+  std::vector<cv::Point2d> body_outline_m;
+  double body_radius_m = 0.0;
+  double body_grey = 150.0;  ///< reflectance of the body's top, 0..255 (a mid-grey plastic)
 };
 
 /// Things on the floor that are not markers and must never get an ID (and, drawn after
@@ -136,6 +145,7 @@ class SyntheticCamera {
  private:
   cv::Point2d field_at(double u, double v) const;  // bilinear in the per-pixel maps
   void draw_marker(cv::Mat& reflectance, const SceneMarker& m) const;
+  void draw_body(cv::Mat& reflectance, const SceneMarker& m) const;
   void draw_clutter(cv::Mat& reflectance, const Clutter& c) const;
   void add_floor_texture();  // conditions_.floor_texture onto floor_
 

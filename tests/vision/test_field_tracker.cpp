@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include <cmath>
 
 #include "vision/emulated_camera.hpp"
@@ -39,6 +41,57 @@ TEST(EmulatedCamera, RobotsAreFoundWhereTheyAre) {
     }
   }
   EXPECT_LT(std::sqrt(heading_sq / count), 1.0);  // RMS, degrees
+}
+
+// Robots' bodies are rendered beneath their markers (a disc, or an outline that turns with
+// the robot), and the markers on them are found as well as on the bare floor.
+TEST(EmulatedCamera, RobotsAreRenderedWithTheirBodiesAndStillFound) {
+  EmulatedCameraConfig quiet;
+  quiet.conditions.noise_sigma = 0.0;
+  EmulatedOverheadCamera camera(1.5, 1.2, MarkerFamily::six_ucp(), quiet);
+  FieldTracker tracker(MarkerFamily::six_ucp(), {1, 2, 3, 4}, camera.calibration());
+  const std::vector<cv::Point2d> square = {{0.035, 0.035}, {-0.035, 0.035}, {-0.035, -0.035}, {0.035, -0.035}};
+  const std::vector<cv::Point2d> wedge = {{0.065, 0.0}, {-0.025, 0.035}, {-0.025, -0.035}};
+  std::vector<SceneMarker> bare;
+  for (int i = 0; i < 4; ++i) bare.push_back({i + 1, 0.3 + 0.3 * i, 0.4 + 0.15 * i, deg_to_rad(50.0 * i + 10.0), 0.05});
+  std::vector<SceneMarker> bodies = bare;
+  bodies[0].body_radius_m = 0.0275;  // a Khepera
+  bodies[1].body_radius_m = 0.035;   // an e-puck
+  bodies[2].body_outline_m = square;
+  bodies[3].body_outline_m = wedge;
+  const cv::Mat without = camera.render(bare), with = camera.render(bodies);
+  const auto seen = tracker.process(with);
+  ASSERT_EQ(seen.size(), 4u);
+  for (const FieldObservation& o : seen) {
+    const SceneMarker& m = bodies[static_cast<std::size_t>(o.id - 1)];
+    EXPECT_NEAR(o.pose.position_m.x, m.x_m, 0.002) << o.id;
+    EXPECT_NEAR(o.pose.position_m.y, m.y_m, 0.002) << o.id;
+    EXPECT_NEAR(wrap_deg_180(rad_to_deg(o.pose.heading_rad - m.theta_rad)), 0.0, 3.0) << o.id;
+  }
+  // The pixels the bodies changed: more for the e-puck than the Khepera, and fewer for the
+  // square than for the disc around it (its bounding disc, 49.5 mm).
+  cv::Mat changed;
+  cv::absdiff(with, without, changed);
+  cv::cvtColor(changed, changed, cv::COLOR_BGR2GRAY);
+  auto changed_near = [&](const SceneMarker& m) {
+    const cv::Mat one = camera.render({m});
+    SceneMarker alone = m;
+    alone.body_outline_m.clear();
+    alone.body_radius_m = 0.0;
+    cv::Mat d;
+    cv::absdiff(one, camera.render({alone}), d);
+    cv::cvtColor(d, d, cv::COLOR_BGR2GRAY);
+    return cv::countNonZero(d > 2);
+  };
+  const int khepera = changed_near(bodies[0]), epuck = changed_near(bodies[1]), sq = changed_near(bodies[2]);
+  SceneMarker round = bodies[2];
+  round.body_outline_m.clear();
+  round.body_radius_m = 0.035 * std::sqrt(2.0);
+  EXPECT_GT(khepera, 0);
+  EXPECT_GT(epuck, 2 * khepera);
+  EXPECT_LT(sq, changed_near(round));
+  EXPECT_GT(changed_near(bodies[3]), 0);
+  EXPECT_GT(cv::countNonZero(changed > 2), khepera + epuck + sq);
 }
 
 TEST(EmulatedCamera, FramesOfAnotherSizeAreRefused) {
