@@ -35,6 +35,7 @@ struct BenchArgs {
   bool no_split = false;              // leave the run's parts untimed (RunOptions::profile)
   std::string threads = "1";          // thread counts to time each robot count with
   std::string sensor_plugin;          // also time a plug-in sensor model against the built-in one
+  std::string robot_model;            // every robot with this robot model file's body and wheels
 };
 
 // The process's peak resident set so far, MB (getrusage; Linux reports kilobytes).
@@ -49,6 +50,14 @@ run::Scenario bench_scenario(int robots, const BenchArgs& args) {
   run::Scenario s = run::wandering_scenario(robots, args.seconds, args.physics_step_ms, args.density_per_m2);
   s.name = "sim-bench-" + std::to_string(robots);
   s.source = "(sim-bench)";
+  if (!args.robot_model.empty()) {
+    const core::Result<std::filesystem::path> file = run::find_robot_model(args.robot_model, ".");
+    if (!file) throw run::ScenarioError("--robot-model: " + file.error());
+    // Its body and wheels; the sensors stay the bench's IR ring, for the same work per robot.
+    const run::RobotDescription d = run::read_robot_description(
+        *file, [](const run::yaml_detail::Reader&) { return environment::SensorSuiteConfig{}; });
+    for (run::RobotSpec& r : s.robots) r.body = d.body;
+  }
   return s;
 }
 
@@ -383,6 +392,9 @@ void add_sim_bench_command(CLI::App& app) {
   cmd->add_option("--sensor-plugin", args->sensor_plugin,
                   "Also time each count with three track elements per robot, built in and from this plug-in library's "
                   "track_element (examples/sensors/track_sensor), and print them side by side");
+  cmd->add_option("--robot-model", args->robot_model,
+                  "Every robot with this robot model's body and wheels (a file, or a shipped model's name: square, "
+                  "epuck); its sensors stay the bench's IR ring. Default: Kheperas");
   cmd->add_flag("--no-split", args->no_split,
                 "Do not time the runs' parts (sensing, behaviours, integration, collisions, recording): the table of "
                 "where the time goes is left out, and the clock reads with it");

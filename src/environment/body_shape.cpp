@@ -6,26 +6,6 @@
 
 namespace rilbed::environment {
 
-void BodyOutline::turn_to(Vec2 h) {
-  heading = h;
-  offsets_m.resize(local_m.size());
-  for (std::size_t k = 0; k < local_m.size(); ++k) {
-    const Vec2 v = local_m[k];
-    offsets_m[k] = {h.x * v.x - h.y * v.y, h.y * v.x + h.x * v.y};
-  }
-}
-
-void BodyOutline::begin_substep() {
-  start_offsets_m = offsets_m;
-  start_heading = heading;
-}
-
-void BodyOutline::turn_back() {
-  offsets_m = start_offsets_m;
-  heading = start_heading;
-  turned_back = true;
-}
-
 std::vector<Vec2> checked_outline(std::vector<Vec2> outline_m, const std::string& what) {
   const std::string head = what + ": outline ";
   if (outline_m.size() < 3 || outline_m.size() > kMaxOutlineVertices)
@@ -65,8 +45,12 @@ double outline_inner_radius_m(std::span<const Vec2> outline_m) {
 
 BodyShape place_body(Vec2 centre_m, double radius_m, const BodyOutline* outline, OutlineBuffer& buffer) {
   if (!outline) return {centre_m, radius_m, {}};
-  const std::size_t n = std::min(outline->offsets_m.size(), buffer.size());
-  for (std::size_t k = 0; k < n; ++k) buffer[k] = centre_m + outline->offsets_m[k];
+  const std::size_t n = std::min(outline->local_m.size(), buffer.size());
+  const Vec2 h = outline->heading;
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec2 v = outline->local_m[k];
+    buffer[k] = {centre_m.x + h.x * v.x - h.y * v.y, centre_m.y + h.y * v.x + h.x * v.y};
+  }
   return {centre_m, radius_m, std::span<const Vec2>(buffer.data(), n)};
 }
 

@@ -21,23 +21,28 @@ inline constexpr std::size_t kMaxOutlineVertices = 32;
 
 /// A convex outline in the robot's frame (x forward, y left, metres), counter-clockwise,
 /// with the robot's centre (its wheel axle's middle) strictly inside.
+/// The outline is placed where it is needed (place_body, on the caller's stack), from its
+/// heading: turning a robot costs a store, not a vertex each.
 struct BodyOutline {
-  std::vector<Vec2> local_m;    ///< robot frame, as configured (made counter-clockwise)
-  std::vector<Vec2> offsets_m;  ///< local_m turned to the body's current heading: field frame, from the centre
-  Vec2 heading{1.0, 0.0};       ///< the current heading's cosine and sine
+  std::vector<Vec2> local_m;  ///< robot frame, as configured (made counter-clockwise)
+  Vec2 heading{1.0, 0.0};     ///< the body's current heading: cosine and sine
   /// The substep's start: where the resolver's fallback puts an outline back, since a
   /// body put back at its start place with its new heading may overlap (a disc may not).
-  std::vector<Vec2> start_offsets_m;
   Vec2 start_heading{1.0, 0.0};
   /// Set by turn_back(); the world turns its robot back too, and clears it.
   bool turned_back = false;
 
-  /// Turns the outline to the heading whose cosine and sine are `h` (a unit vector).
-  void turn_to(Vec2 h);
-  /// Starts a substep: the current heading becomes the start.
-  void begin_substep();
+  /// Starts a substep that ends at heading `h` (a unit vector): the current heading
+  /// becomes the start.
+  void turn_to(Vec2 h) {
+    start_heading = heading;
+    heading = h;
+  }
   /// Back to the substep's start heading (the resolver's fallback).
-  void turn_back();
+  void turn_back() {
+    heading = start_heading;
+    turned_back = true;
+  }
 };
 
 /// Checks an outline and returns it counter-clockwise: 3 to kMaxOutlineVertices finite

@@ -177,7 +177,7 @@ void World::add_robot(const RobotConfig& c) {
   double radius_m = c.radius_m, inner_radius_m = c.radius_m;
   if (!c.outline_m.empty()) {
     outline.local_m = checked_outline(c.outline_m, what);
-    outline.turn_to({std::cos(c.pose.heading_rad), std::sin(c.pose.heading_rad)});
+    outline.heading = outline.start_heading = {std::cos(c.pose.heading_rad), std::sin(c.pose.heading_rad)};
     radius_m = outline_bounding_radius_m(outline.local_m);
     inner_radius_m = outline_inner_radius_m(outline.local_m);
   }
@@ -258,7 +258,6 @@ void World::turn_outlines(int substeps) {
   for (const std::uint32_t i : outline_slots_) {
     const bool mid_step = substeps > 1 && robots_[i].kind == RobotKind::kVirtual;
     BodyOutline& outline = outlines_[static_cast<std::size_t>(bodies_[i].outline)];
-    outline.begin_substep();
     outline.turn_to(mid_step ? motion_[i].heading : headings_[i]);
   }
 }
@@ -397,7 +396,10 @@ void World::set_observed_pose(int id, Pose2 pose, TimeUs t_us) {
   headings_[s] = {std::cos(r.pose.heading_rad), std::sin(r.pose.heading_rad)};
   changed();
   bodies_[s].position_m = bodies_[s].previous_m = pose.position_m;
-  if (bodies_[s].outline >= 0) outlines_[static_cast<std::size_t>(bodies_[s].outline)].turn_to(headings_[s]);
+  if (bodies_[s].outline >= 0) {
+    BodyOutline& outline = outlines_[static_cast<std::size_t>(bodies_[s].outline)];
+    outline.heading = outline.start_heading = headings_[s];
+  }
   grid_.move(s, pose.position_m);
 }
 
