@@ -88,7 +88,8 @@ int gui_command(const GuiArgs& args) {
   for (const std::string* c :
        {&run_channels.world, &run_channels.poses, &run_channels.events, &run_channels.status, &run_channels.summary,
         &run_channels.wheels, &run_channels.sensors, &run_channels.detections, &run_channels.camera,
-        &run_channels.frames, &run_channels.sensor_layout, &run_channels.robot_bodies, &run_channels.vision}) {
+        &run_channels.frames, &run_channels.sensor_layout, &run_channels.robot_bodies, &run_channels.sensor_models,
+        &run_channels.vision}) {
     subscriptions.push_back(
         std::make_unique<bus::LcmSubscription>(*lcm, *c, [&](const std::string& ch, const void* d, std::size_t n) {
           if (const auto problem = decoder.decode(ch, d, n)) {

@@ -72,6 +72,7 @@ Channels Channels::with_prefix(const std::string& prefix) {
   c.vision = prefix + c.vision;
   c.sensor_layout = prefix + c.sensor_layout;
   c.robot_bodies = prefix + c.robot_bodies;
+  c.sensor_models = prefix + c.sensor_models;
   return c;
 }
 

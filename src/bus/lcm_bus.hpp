@@ -55,6 +55,9 @@ struct Channels {
   std::string camera = "RILBED_CAMERA";          ///< rilbed::camera_t, before each world_t of a run with a camera
   std::string sensor_layout = "RILBED_SENSOR_LAYOUT";  ///< rilbed::sensor_layout_t, before each world_t
   std::string robot_bodies = "RILBED_ROBOT_BODIES";    ///< rilbed::robot_bodies_t, before each world_t
+  /// rilbed::sensor_models_t, before a control step's sensors_t when a robot's sensor
+  /// models read or drew something
+  std::string sensor_models = "RILBED_SENSOR_MODELS";
   std::string vision = "RILBED_VISION";    ///< rilbed::vision_settings_t, before each status_t of a run with a camera
   std::string console = "RILBED_CONSOLE";  ///< rilbed::console_command_t, from consoles
   std::string console_reply = "RILBED_CONSOLE_REPLY";  ///< rilbed::console_reply_t, the run's answers

@@ -244,6 +244,22 @@ void fields(Walk& w, const rilbed::robot_bodies_t*) {
   w.skip(static_cast<std::size_t>(robots) * 2 * 4);
 }
 
+void fields(Walk& w, const rilbed::sensor_models_t*) {
+  w.i64();
+  const std::int32_t robots = w.count(w.i32(), 4 + 2 + 2);  // a robot with neither readings nor marks
+  for (std::int32_t r = 0; r < robots && w.ok(); ++r) {
+    w.i32();
+    const std::int32_t readings = w.count(w.i16(), 4 + 1 + 2);  // an empty name, no values
+    for (std::int32_t k = 0; k < readings && w.ok(); ++k) {
+      w.string();
+      const std::int32_t values = w.count(w.i16(), 8);
+      w.skip(static_cast<std::size_t>(values) * 8);
+    }
+    const std::int32_t marks = w.count(w.i16(), 1 + 5 * 8 + 4);
+    w.skip(static_cast<std::size_t>(marks) * (1 + 5 * 8 + 4));
+  }
+}
+
 // The agent exchange (processes of their own, here or on other machines).
 void fields(Walk& w, const rilbed::agent_hello_t*) {
   w.string();
@@ -320,6 +336,7 @@ template bool well_formed<rilbed::frame_t>(const void*, std::size_t);
 template bool well_formed<rilbed::camera_t>(const void*, std::size_t);
 template bool well_formed<rilbed::sensor_layout_t>(const void*, std::size_t);
 template bool well_formed<rilbed::robot_bodies_t>(const void*, std::size_t);
+template bool well_formed<rilbed::sensor_models_t>(const void*, std::size_t);
 template bool well_formed<rilbed::vision_settings_t>(const void*, std::size_t);
 template bool well_formed<rilbed::agent_hello_t>(const void*, std::size_t);
 template bool well_formed<rilbed::quantum_t>(const void*, std::size_t);

@@ -27,6 +27,7 @@
 #include "rilbed/quantum_t.hpp"
 #include "rilbed/robot_bodies_t.hpp"
 #include "rilbed/sensor_layout_t.hpp"
+#include "rilbed/sensor_models_t.hpp"
 #include "rilbed/sensors_t.hpp"
 #include "rilbed/status_t.hpp"
 #include "rilbed/summary_t.hpp"

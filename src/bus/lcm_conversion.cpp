@@ -128,6 +128,77 @@ void fill(rilbed::sensors_t& m, TimeUs t_us, std::span<const run::SensorReport> 
   for (std::size_t i = 0; i < sensors.size(); ++i) fill(m.robots[i], sensors[i].id, *sensors[i].readings);
 }
 
+bool fill(rilbed::sensor_models_t& m, TimeUs t_us, std::span<const run::SensorReport> sensors) {
+  m.utime = t_us;
+  m.robots.clear();
+  for (const run::SensorReport& s : sensors) {
+    const environment::SensorReadings& r = *s.readings;
+    if (r.models.empty() && r.marks.empty()) continue;
+    rilbed::robot_models_t out;
+    out.id = s.id;
+    for (const environment::ModelReading& model : r.models) {
+      rilbed::model_reading_t reading;
+      reading.name = std::string(model.name);
+      reading.values = model.values;
+      reading.num_values = static_cast<std::int16_t>(reading.values.size());
+      out.readings.push_back(std::move(reading));
+    }
+    out.num_readings = static_cast<std::int16_t>(out.readings.size());
+    for (const environment::SensorMark& mark : r.marks) {
+      rilbed::sensor_mark_t x;
+      x.shape = mark.shape == environment::SensorMark::Shape::kCircle ? 0 : 1;
+      x.x_m = mark.a_m.x;
+      x.y_m = mark.a_m.y;
+      x.radius_m = mark.radius_m;
+      x.x2_m = mark.b_m.x;
+      x.y2_m = mark.b_m.y;
+      x.rgba = static_cast<std::int32_t>(mark.rgba);
+      out.marks.push_back(x);
+    }
+    out.num_marks = static_cast<std::int16_t>(out.marks.size());
+    m.robots.push_back(std::move(out));
+  }
+  m.num_robots = static_cast<std::int32_t>(m.robots.size());
+  return !m.robots.empty();
+}
+
+std::optional<std::string> merge_models(const rilbed::robot_models_t& m, environment::SensorReadings& readings,
+                                        std::set<std::string, std::less<>>& names) {
+  constexpr std::size_t kMostValues = 64, kLongestName = 64, kMostNames = 1024;
+  std::vector<environment::ModelReading> models;
+  for (const rilbed::model_reading_t& r : m.readings) {
+    const bool printable = std::all_of(r.name.begin(), r.name.end(), [](char c) { return c >= 0x20 && c < 0x7f; });
+    if (r.name.empty() || r.name.size() > kLongestName || !printable)
+      return "a model reading's name is empty, longer than 64 bytes or not printable ASCII";
+    if (r.values.size() > kMostValues)
+      return "model '" + r.name + "' has " + std::to_string(r.values.size()) + " values";
+    if (!std::all_of(r.values.begin(), r.values.end(), [](double v) { return std::isfinite(v); }))
+      return "model '" + r.name + "' has a value that is not finite";
+    auto name = names.find(r.name);
+    if (name == names.end()) {
+      // A hostile stream of new names must not grow the decoder without bound.
+      if (names.size() >= kMostNames) return "more than 1024 distinct model names";
+      name = names.insert(r.name).first;
+    }
+    models.push_back({*name, r.values});
+  }
+  std::vector<environment::SensorMark> marks;
+  for (const rilbed::sensor_mark_t& x : m.marks) {
+    if (x.shape != 0 && x.shape != 1) return "a mark of shape " + std::to_string(x.shape);
+    for (const double v : {x.x_m, x.y_m, x.radius_m, x.x2_m, x.y2_m})
+      if (!std::isfinite(v)) return "a mark that is not finite";
+    if (x.radius_m < 0.0) return "a circle of negative radius";
+    marks.push_back({x.shape == 0 ? environment::SensorMark::Shape::kCircle : environment::SensorMark::Shape::kLine,
+                     {x.x_m, x.y_m},
+                     {x.x2_m, x.y2_m},
+                     x.radius_m,
+                     static_cast<std::uint32_t>(x.rgba)});
+  }
+  readings.models = std::move(models);
+  readings.marks = std::move(marks);
+  return std::nullopt;
+}
+
 rilbed::detections_t to_lcm(const run::FrameReport& f) {
   rilbed::detections_t m;
   m.utime = f.t_us;

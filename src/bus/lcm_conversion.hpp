@@ -7,6 +7,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <span>
 #include <string>
 #include <vector>
@@ -22,6 +23,7 @@
 #include "rilbed/poses_t.hpp"
 #include "rilbed/robot_bodies_t.hpp"
 #include "rilbed/sensor_layout_t.hpp"
+#include "rilbed/sensor_models_t.hpp"
 #include "rilbed/sensors_t.hpp"
 #include "rilbed/status_t.hpp"
 #include "rilbed/summary_t.hpp"
@@ -44,6 +46,16 @@ rilbed::world_t to_lcm(TimeUs t_us, const run::WorldReport& world);
 rilbed::summary_t to_lcm(TimeUs t_us, const nlohmann::json& summary);
 void fill(rilbed::wheels_t& message, TimeUs t_us, std::span<const run::WheelReport> wheels);
 void fill(rilbed::sensors_t& message, TimeUs t_us, std::span<const run::SensorReport> sensors);
+/// The robots' sensor-model readings and marks (robots with neither left out); false when
+/// no robot has any (nothing to publish).
+bool fill(rilbed::sensor_models_t& message, TimeUs t_us, std::span<const run::SensorReport> sensors);
+/// One robot's model readings and marks into `readings` (its models and marks replaced),
+/// their names interned in `names` (which must outlive `readings`), or the reason the
+/// message is unusable: a name that is empty, longer than 64 bytes or not printable ASCII,
+/// more than 64 values, a value or a mark that is not finite, a negative radius, a shape
+/// other than 0 or 1.
+std::optional<std::string> merge_models(const rilbed::robot_models_t& message, environment::SensorReadings& readings,
+                                        std::set<std::string, std::less<>>& names);
 /// One robot's readings (counts beyond the wire's int8/int16 are cut; a robot carries a
 /// handful of each sensor).
 void fill(rilbed::robot_sensors_t& message, int id, const environment::SensorReadings& readings);

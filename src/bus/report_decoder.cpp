@@ -89,6 +89,10 @@ std::optional<std::string> RunReportDecoder::decode(const std::string& channel, 
     }
     sensor_geometries_ = std::move(geometries);
     sensor_geometry_of_ = std::move(of);
+  } else if (channel == channels_.sensor_models) {
+    rilbed::sensor_models_t m;
+    if (!decode_checked(data, size, m)) return bad("sensor_models_t");
+    models_ = std::move(m);
   } else if (channel == channels_.robot_bodies) {
     rilbed::robot_bodies_t m;
     if (!decode_checked(data, size, m)) return bad("robot_bodies_t");
@@ -126,11 +130,26 @@ std::optional<std::string> RunReportDecoder::decode(const std::string& channel, 
     if (!decode_checked(data, size, m)) return bad("sensors_t");
     readings_.resize(m.robots.size());
     sensors_.clear();
+    std::map<int, std::size_t> slot_of;
     for (std::size_t i = 0; i < m.robots.size(); ++i) {
       readings_[i] = from_lcm(m.robots[i], m.utime);
       sensors_.push_back({m.robots[i].id, &readings_[i]});
+      slot_of.emplace(m.robots[i].id, i);
     }
+    // The models' readings and marks of the same step (sent just before), robot by robot;
+    // a robot's bad ones are left out, and said so, and the step's sensors still go on.
+    std::optional<std::string> problem;
+    if (models_ && models_->utime == m.utime) {
+      for (const rilbed::robot_models_t& r : models_->robots) {
+        const auto slot = slot_of.find(r.id);
+        if (slot == slot_of.end()) continue;  // a robot this step does not report
+        if (auto why = merge_models(r, readings_[slot->second], model_names_); why && !problem)
+          problem = channels_.sensor_models + ": robot " + std::to_string(r.id) + ": " + *why;
+      }
+    }
+    models_.reset();
     observer_.on_sensors(m.utime, sensors_);
+    return problem;
   } else if (channel == channels_.detections) {
     rilbed::detections_t m;
     if (!decode_checked(data, size, m)) return bad("detections_t");

@@ -8,6 +8,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <span>
 #include <string>
 #include <vector>
@@ -15,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bus/lcm_bus.hpp"
+#include "rilbed/sensor_models_t.hpp"
 #include "rilbed/status_t.hpp"
 #include "run/run_observer.hpp"
 
@@ -49,7 +51,9 @@ class RunReportDecoder {
   std::optional<run::CameraReport> camera_;             // the last camera_t, for the next world_t
   std::vector<run::SensorGeometry> sensor_geometries_;  // the last sensor_layout_t, for the next world_t
   std::map<int, int> sensor_geometry_of_;
-  std::vector<run::BodyDrawing> bodies_;  // the last robot_bodies_t, for the next world_t
+  std::vector<run::BodyDrawing> bodies_;            // the last robot_bodies_t, for the next world_t
+  std::optional<rilbed::sensor_models_t> models_;   // the last sensor_models_t, for the sensors_t of its utime
+  std::set<std::string, std::less<>> model_names_;  // what readings_' model names view
   std::map<int, int> body_of_;
   std::optional<vision::VisionSettings> vision_;  // the last vision_settings_t, for the next status_t
 };

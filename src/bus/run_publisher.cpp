@@ -181,6 +181,8 @@ void LcmRunPublisher::on_wheels(TimeUs t_us, std::span<const run::WheelReport> w
 
 void LcmRunPublisher::on_sensors(TimeUs t_us, std::span<const run::SensorReport> sensors) {
   if (!heard()) return;
+  // The models' readings and marks first: a viewer joins them to the sensors_t by utime.
+  if (fill(models_message_, t_us, sensors)) publish(channels_.sensor_models, models_message_);
   fill(sensors_message_, t_us, sensors);
   publish(channels_.sensors, sensors_message_);
 }

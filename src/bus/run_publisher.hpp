@@ -105,6 +105,7 @@ class LcmRunPublisher final : public run::RunObserver {
   rilbed::poses_t poses_message_;
   rilbed::wheels_t wheels_message_;
   rilbed::sensors_t sensors_message_;
+  rilbed::sensor_models_t models_message_;
   std::unique_ptr<Fanout> fanout_;  // the local subscribers
   std::unique_ptr<RunReportDecoder> local_decoder_;
   std::atomic<int> bus_subscribers_{0};

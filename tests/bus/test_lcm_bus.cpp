@@ -441,3 +441,69 @@ TEST(LcmBus, RobotBodiesTravelBeforeTheWorldAndBadOnesAreRefused) {
 
 }  // namespace
 }  // namespace rilbed::bus
+
+namespace rilbed::bus {
+namespace {
+
+// Sensor models' readings and marks travel just before their step's sensors_t and come back
+// on the robots they belong to; a bad one is left out, said so, and the step still arrives.
+TEST(LcmBus, SensorModelReadingsAndMarksJoinTheirStep) {
+  struct Got final : run::RunObserver {
+    std::vector<std::pair<int, environment::SensorReadings>> sensors;
+    void on_sensors(TimeUs, std::span<const run::SensorReport> s) override {
+      sensors.clear();
+      for (const auto& r : s) sensors.emplace_back(r.id, *r.readings);
+    }
+  } got;
+  const Channels channels;
+  RunReportDecoder decoder(channels, got);
+  environment::SensorReadings seeing;
+  seeing.track = {40};
+  seeing.models.push_back({"to_goal", {0.25, -3.0}});
+  seeing.marks.push_back({environment::SensorMark::Shape::kCircle, {0.02, 0.0}, {}, 0.004, 0x20c0f0ffu});
+  seeing.marks.push_back({environment::SensorMark::Shape::kLine, {0.0, 0.0}, {0.1, 0.05}, 0.0, 0xff0000ffu});
+  const environment::SensorReadings plain;
+  const std::vector<run::SensorReport> step = {{1, &plain}, {4, &seeing}};
+  rilbed::sensor_models_t models;
+  ASSERT_TRUE(fill(models, 900'000, step));
+  ASSERT_EQ(models.num_robots, 1);  // robot 1 has none
+  rilbed::sensors_t sensors;
+  fill(sensors, 900'000, step);
+  auto send = [&](const std::string& channel, const auto& message) {
+    const auto bytes = encoded(message);
+    return decoder.decode(channel, bytes.data(), bytes.size());
+  };
+  ASSERT_FALSE(send(channels.sensor_models, models));
+  ASSERT_FALSE(send(channels.sensors, sensors));
+  ASSERT_EQ(got.sensors.size(), 2u);
+  EXPECT_TRUE(got.sensors[0].second.models.empty());
+  const environment::SensorReadings& back = got.sensors[1].second;
+  ASSERT_EQ(back.models.size(), 1u);
+  EXPECT_EQ(back.models[0].name, "to_goal");
+  EXPECT_EQ(back.models[0].values, seeing.models[0].values);
+  ASSERT_EQ(back.marks.size(), 2u);
+  EXPECT_EQ(back.marks[1].shape, environment::SensorMark::Shape::kLine);
+  EXPECT_EQ(back.marks[1].b_m.y, 0.05);
+  EXPECT_EQ(back.marks[0].rgba, 0x20c0f0ffu);
+  EXPECT_EQ(back.track, seeing.track);
+  // The next step without models has none: they belong to their utime only.
+  fill(sensors, 1'000'000, step);
+  ASSERT_FALSE(send(channels.sensors, sensors));
+  EXPECT_TRUE(got.sensors[1].second.models.empty() && got.sensors[1].second.marks.empty());
+  // A value that is not finite: that robot's models are left out, the step still arrives.
+  fill(models, 1'100'000, step);
+  models.robots[0].readings[0].values[1] = std::nan("");
+  fill(sensors, 1'100'000, step);
+  ASSERT_FALSE(send(channels.sensor_models, models));
+  const auto problem = send(channels.sensors, sensors);
+  ASSERT_TRUE(problem);
+  EXPECT_NE(problem->find("RILBED_SENSOR_MODELS: robot 4: model 'to_goal' has a value that is not finite"),
+            std::string::npos)
+      << *problem;
+  ASSERT_EQ(got.sensors.size(), 2u);
+  EXPECT_TRUE(got.sensors[1].second.models.empty());
+  EXPECT_EQ(got.sensors[1].second.track, seeing.track);
+}
+
+}  // namespace
+}  // namespace rilbed::bus

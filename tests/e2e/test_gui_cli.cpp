@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -71,6 +72,49 @@ TEST(GuiCli, ServesARunOnTheBusAndSendsItsConsoleCommands) {
   EXPECT_NE(probe.find(R"(/rilbed/console_reply {"accepted":true)"), std::string::npos) << probe;
   EXPECT_NE(probe.find(R"("reason":"pause")"), std::string::npos) << probe;
   EXPECT_NE(read_file(dir / "run" / "events.csv").find(",console,0,0,paused by "), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+// What a robot is and what its sensor models see reach a panel in another process: square
+// robots' outlines on /rilbed/world (robot_bodies_t on the bus), a plug-in model's readings
+// and marks on /rilbed/sensors (sensor_models_t).
+TEST(GuiCli, BodiesAndSensorModelMarksReachAPanelOnTheBus) {
+  SKIP_WITHOUT_NAMESPACES();
+  const auto dir = scratch_dir("gui_cli_models");
+  std::ofstream(dir / "point.txt") << "Sensor = {\nTarget X = 1.0\nTarget Y = 0.5\nNoise = 0\n}\n";
+  const std::string library = (fs::path(RILBED_BINARY).parent_path() / "test_plugins" / "test_sensors.so").string();
+  std::ofstream(dir / "squares.yaml") << "name: squares\nfield: {width_m: 1.5, height_m: 1.2}\nrobots:\n"
+                                         "  - ids: 1-3\n    model: square\n    controller: wander\n"
+                                         "    sensors:\n      proximity: {}\n      models:\n"
+                                         "        - {library: " +
+                                             library + ", name: beacon_range, parameters: point.txt}\n";
+  const int status = in_namespace(
+      dir, gui_on_the_bus_script("squares.yaml --realtime --duration 120",
+                                 "\"$P2\" \"ws://$HOSTPORT/ws?token=$TOKEN\" --topics /rilbed/world,/rilbed/sensors "
+                                 "--count 12 --timeout 60 > probe.txt 2>&1; echo \"probe $?\" >> codes.txt\n"));
+  ASSERT_EQ(status, 0) << read_file(dir / "ns.log");
+  const std::string codes = read_file(dir / "codes.txt"), probe = read_file(dir / "probe.txt");
+  for (const char* line : {"probe 0", "exit 0", "run 0", "gui 0"})
+    EXPECT_NE(codes.find(line), std::string::npos) << line << "\n" << codes << probe << read_file(dir / "gui.err");
+  bool outline = false, marks = false, readings = false;
+  std::istringstream lines(probe);
+  for (std::string line; std::getline(lines, line);) {
+    const auto space = line.find(' ');
+    if (space == std::string::npos || line.find('{') != space + 1) continue;
+    const auto message = nlohmann::json::parse(line.substr(space + 1));
+    for (const auto& robot : message["robots"]) {
+      if (line.rfind("/rilbed/world ", 0) == 0 && robot.contains("body"))
+        outline = outline || robot["body"]["outline"].size() == 4u;
+      if (line.rfind("/rilbed/sensors ", 0) == 0) {
+        // The model's two marks (a third, not finite, is dropped at the source).
+        marks = marks || robot["marks"].size() == 2u;
+        for (const auto& m : robot["models"]) readings = readings || m["name"] == "beacon_range";
+      }
+    }
+  }
+  EXPECT_TRUE(outline) << probe;
+  EXPECT_TRUE(marks) << probe;
+  EXPECT_TRUE(readings) << probe;
   std::filesystem::remove_all(dir);
 }
 

@@ -61,7 +61,7 @@ const std::vector<std::string>& channel_names() {
     const bus::Channels c = bus::Channels::with_prefix("");
     return std::vector<std::string>{c.poses,         c.events,  c.status,       c.world,         c.summary,
                                     c.wheels,        c.sensors, c.detections,   c.frames,        c.camera,
-                                    c.sensor_layout, c.vision,  c.robot_bodies, "RILBED_UNKNOWN"};
+                                    c.sensor_layout, c.vision,  c.robot_bodies, c.sensor_models, "RILBED_UNKNOWN"};
   }();
   return names;
 }
@@ -79,6 +79,7 @@ enum Pick {
   kSensorLayout,
   kVision,
   kRobotBodies,
+  kSensorModels,
   kUnknown,
   kPicks
 };
@@ -100,6 +101,12 @@ bool has_nul(const rilbed::frame_t& m) { return has_nul(m.format); }
 bool has_nul(const rilbed::camera_t& m) { return has_nul(m.source); }
 bool has_nul(const rilbed::vision_settings_t&) { return false; }
 bool has_nul(const rilbed::sensor_layout_t&) { return false; }
+bool has_nul(const rilbed::sensor_models_t& m) {
+  for (const rilbed::robot_models_t& r : m.robots)
+    for (const rilbed::model_reading_t& reading : r.readings)
+      if (has_nul(reading.name)) return true;
+  return false;
+}
 bool has_nul(const rilbed::robot_bodies_t& m) {
   for (const rilbed::robot_body_t& b : m.bodies)
     if (has_nul(b.name)) return true;
@@ -510,6 +517,36 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       }
       for (const auto& [id, index] : w.body_of)
         FUZZ_CHECK(index >= 0 && static_cast<std::size_t>(index) < w.bodies.size());
+      break;
+    }
+    case kSensorModels: {
+      // Taken whenever the bytes are a sensor_models_t; the sensors_t of its utime carries
+      // each of its robots' readings and marks, or says why a robot's are left out.
+      rilbed::sensor_models_t m;
+      if (problem && refused_before_decoding<rilbed::sensor_models_t>(message, length)) break;
+      const bool readable = generated_decode(message, length, m);
+      FUZZ_CHECK(readable == !problem);
+      if (problem) break;
+      check_round_trip(m, message, length);
+      rilbed::sensors_t step;
+      step.utime = m.utime;
+      std::set<std::int32_t> ids;
+      for (const rilbed::robot_models_t& r : m.robots)
+        if (ids.insert(r.id).second) step.robots.emplace_back().id = r.id;
+      step.num_robots = static_cast<std::int32_t>(step.robots.size());
+      std::vector<std::uint8_t> bytes(static_cast<std::size_t>(step.getEncodedSize()));
+      FUZZ_CHECK(step.encode(bytes.data(), 0, static_cast<int>(bytes.size())) > 0);
+      const auto merged = decoder.decode(bus::Channels::with_prefix("").sensors, bytes.data(), bytes.size());
+      FUZZ_CHECK(seen.calls.sensors == 1);
+      // Every entry is merged in turn (a robot's later entry replaces its earlier one): the
+      // step says so exactly when one of them is bad.
+      bool any_bad = false;
+      for (const rilbed::robot_models_t& r : m.robots) {
+        environment::SensorReadings scratch;
+        std::set<std::string, std::less<>> names;
+        any_bad = any_bad || bus::merge_models(r, scratch, names).has_value();
+      }
+      FUZZ_CHECK(any_bad == merged.has_value());
       break;
     }
     case kUnknown:
