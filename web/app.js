@@ -6,12 +6,12 @@ import { FoxgloveClient } from './foxglove.js';
 import { wrapRadPi } from './angles.js';
 import { makeProjection } from './projection.js';
 import { marksInField } from './marks.js';
+import { KHEPERA_BODY, bodyOnCanvas, reachAlong, robotBody } from './body.js';
 
 const params = new URLSearchParams(location.search);
 const token = params.get('token') || '';
 const wsUrl = `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/ws?token=${encodeURIComponent(token)}`;
 
-const ROBOT_DIAMETER_M = 0.055; // a Khepera
 const IR_ANGLES_RAD = [90, 45, 10, -10, -45, -90, -170, 170].map((d) => (d * Math.PI) / 180);
 const IR_COS = IR_ANGLES_RAD.map(Math.cos), IR_SIN = IR_ANGLES_RAD.map(Math.sin);
 const IR_RANGE_M = 0.05; // what the IR ring sees; a reading of 1023 is touching
@@ -27,6 +27,7 @@ const $ = (id) => document.getElementById(id);
 const run = {
   world: null, status: null, poses: null, sensors: new Map(), detections: null,
   calibration: null, image: null, imageStamp: null, ended: false,
+  bodies: new Map(), // id -> the robot's body as drawn (body.js's robotBody), from the world; a Khepera's if none
   trails: new Map(), // id -> [[x, y], ...] newest last
   history: new Map(), // id -> [[t, x, y], ...] every HISTORY_PERIOD_S
   formation: new Map(), // id -> [[t, d], ...]
@@ -36,8 +37,9 @@ const run = {
 // stats: frames drawn, the last draw's milliseconds, frames in the last second, and how the
 // trail layer was drawn (trailsLaid: laid anew for the view; trailsMoved: the layer laid
 // for an earlier view, moved and scaled while the view moves); marks: the sensor models'
-// marks the last frame drew.
-window.rilbed = { run, stats: { frames: 0, drawMs: 0, fps: 0, trailsLaid: 0, trailsMoved: 0, marks: 0 } };
+// marks the last frame drew; outlines and wheels: how many robots the last frame drew with
+// their outline (not a disc) and with their wheels. bodyOf(id): robot id's body as drawn.
+window.rilbed = { run, stats: { frames: 0, drawMs: 0, fps: 0, trailsLaid: 0, trailsMoved: 0, marks: 0, outlines: 0, wheels: 0 } };
 
 // ------------------------------------------------------------------ the connection
 const client = new FoxgloveClient(wsUrl);
@@ -67,7 +69,7 @@ client.subscribe(['/rilbed/world', '/rilbed/status', '/rilbed/poses', '/rilbed/s
   '/rilbed/events', '/rilbed/summary', '/rilbed/console_reply', '/rilbed/camera', '/rilbed/camera_calibration']);
 client.onMessage = (topic, tNs, m) => {
   switch (topic) {
-    case '/rilbed/world': run.world = m; fillRobotChoices(); $('scenario').textContent = m.scenario; break;
+    case '/rilbed/world': run.world = m; run.bodies = bodiesOf(m); fillRobotChoices(); $('scenario').textContent = m.scenario; break;
     case '/rilbed/status': onStatus(m); break;
     case '/rilbed/poses': onPoses(m); break;
     case '/rilbed/sensors': for (const r of m.robots) run.sensors.set(r.id, r); break;
@@ -81,6 +83,21 @@ client.onMessage = (topic, tNs, m) => {
   }
   requestDraw();
 };
+
+// Each robot's body (robot ID -> body.js's robotBody) from a world message: robots with
+// the same body share one, a robot without one is a Khepera.
+function bodiesOf(world) {
+  const out = new Map(), alike = new Map();
+  for (const r of world.robots || []) {
+    const key = r.body ? JSON.stringify(r.body) : '';
+    let body = alike.get(key);
+    if (!body) alike.set(key, (body = key ? robotBody(r.body) : KHEPERA_BODY));
+    out.set(r.id, body);
+  }
+  return out;
+}
+const bodyOf = (id) => run.bodies.get(id) || KHEPERA_BODY;
+window.rilbed.bodyOf = bodyOf;
 
 function onStatus(s) {
   const reset = run.status && s.t_s < run.status.t_s - 1e-9; // a reset starts over at 0
@@ -687,6 +704,7 @@ function draw(now) {
   }
   if (run.world && overlays.field) drawField(P);
   if (overlays.trails) drawTrails(P);
+  window.rilbed.stats.outlines = window.rilbed.stats.wheels = 0; // (drawRobots counts them)
   if (run.poses) {
     if (overlays.tracks || overlays.ranges || overlays.beacons || overlays.ir) drawSensors(P);
     if (overlays.robots) drawRobots(P);
@@ -870,39 +888,69 @@ function drawTrails(P) {
 
 const MANY_LABELS = 200, LABEL_SPACING_PX = 60;
 
-// The virtual robots (all alike) are one path stroked once, then every label: a thousand
-// robots are a few calls, not thousands. Robots off the canvas are not drawn.
+// Each robot is its body (body.js): its disc or its outline turned to its heading, its two
+// wheels as dark rectangles under it, and its heading mark. The virtual robots are one path
+// stroked once, the wheels one path filled once, then every label: a thousand robots are a
+// few calls, not thousands. Robots off the canvas are not drawn.
+const WHEEL_CSS = 'rgba(40,40,40,0.85)';
 function drawRobots(P) {
-  const virtual = new Path2D();
-  const labels = [];
-  ctx.lineWidth = 2;
+  const virtual = new Path2D(), wheels = new Path2D();
+  const shown = [], labels = [];
+  let outlines = 0, wheeled = 0;
   for (const r of run.poses.robots) {
+    const body = bodyOf(r.id);
+    const scale = P.affine ? P.affine.ax : P.scaleAt(r.x_m, r.y_m);
     const [u, v] = P.project(r.x_m, r.y_m);
-    const radius = Math.max(3, (ROBOT_DIAMETER_M / 2) * (P.affine ? P.affine.ax : P.scaleAt(r.x_m, r.y_m)));
+    const radius = Math.max(3, body.radius_m * scale);
     if (!P.onCanvas(u + 120, v, radius + 130)) continue; // nor its label (right of it) on the canvas
-    const [hu, hv] = P.project(r.x_m + Math.cos(r.theta_rad) * ROBOT_DIAMETER_M * 0.6, r.y_m + Math.sin(r.theta_rad) * ROBOT_DIAMETER_M * 0.6);
-    if (r.real) {
-      // A real robot is where the camera says: a square, faint when unseen.
-      ctx.strokeStyle = r.seen ? '#2456c7' : 'rgba(36,86,199,0.4)';
-      ctx.setLineDash(r.seen ? [] : [4, 3]);
-      ctx.strokeRect(u - radius, v - radius, 2 * radius, 2 * radius);
-      ctx.setLineDash([]);
-      ctx.beginPath(); ctx.moveTo(u, v); ctx.lineTo(hu, hv); ctx.stroke();
-    } else {
-      virtual.moveTo(u + radius, v); virtual.arc(u, v, radius, 0, 2 * Math.PI);
-      virtual.moveTo(u, v); virtual.lineTo(hu, hv);
+    const d = bodyOnCanvas(body, r, P.project, scale);
+    if (d.outline) ++outlines;
+    if (d.wheels) {
+      ++wheeled;
+      for (const w of d.wheels) addPolygon(wheels, w);
     }
-    if (driving.robot === r.id) { ctx.strokeStyle = '#e0a800'; ctx.beginPath(); ctx.arc(u, v, radius + 5, 0, 2 * Math.PI); ctx.stroke(); }
+    if (!r.real) {
+      addBody(virtual, d);
+      virtual.moveTo(u, v); virtual.lineTo(d.heading[0], d.heading[1]);
+    }
+    shown.push([r, d]);
     if (overlays.labels) {
-      labels.push([`${r.id} ${r.behaviour}${r.real && r.health && r.health !== 'ok' ? ' [' + r.health + ']' : ''}`, u + radius + 3, v - radius - 2]);
+      labels.push([`${r.id} ${r.behaviour}${r.real && r.health && r.health !== 'ok' ? ' [' + r.health + ']' : ''}`, u + d.radius_px + 3, v - d.radius_px - 2]);
     }
   }
+  ctx.fillStyle = WHEEL_CSS; ctx.fill(wheels);
+  ctx.lineWidth = 2;
+  for (const [r, d] of shown) {
+    if (r.real) {
+      // A real robot is where the camera says: blue, faint and dashed when unseen.
+      ctx.strokeStyle = r.seen ? '#2456c7' : 'rgba(36,86,199,0.4)';
+      ctx.setLineDash(r.seen ? [] : [4, 3]);
+      const p = new Path2D();
+      addBody(p, d);
+      ctx.stroke(p);
+      ctx.setLineDash([]);
+      ctx.beginPath(); ctx.moveTo(d.centre[0], d.centre[1]); ctx.lineTo(d.heading[0], d.heading[1]); ctx.stroke();
+    }
+    if (driving.robot === r.id) { ctx.strokeStyle = '#e0a800'; ctx.beginPath(); ctx.arc(d.centre[0], d.centre[1], d.radius_px + 5, 0, 2 * Math.PI); ctx.stroke(); }
+  }
   ctx.strokeStyle = '#d22828'; ctx.stroke(virtual);
+  window.rilbed.stats.outlines = outlines; window.rilbed.stats.wheels = wheeled;
   // Many robots on the canvas: their labels only when the zoom spaces them enough to be
   // read (a label's room, LABEL_SPACING_PX, per robot on the canvas), else none.
   if (labels.length > MANY_LABELS && Math.sqrt((P.width * P.height) / labels.length) < LABEL_SPACING_PX) return;
   ctx.fillStyle = '#111'; ctx.font = '12px system-ui';
   for (const [text, x, y] of labels) ctx.fillText(text, x, y);
+}
+
+// A robot's body (body.js's bodyOnCanvas) onto `path`: its outline, or its disc.
+function addBody(path, d) {
+  if (d.outline) { addPolygon(path, d.outline); return; }
+  const [u, v] = d.centre;
+  path.moveTo(u + d.radius_px, v); path.arc(u, v, d.radius_px, 0, 2 * Math.PI);
+}
+function addPolygon(path, points) {
+  points.forEach(([u, v], i) => { if (i) path.lineTo(u, v); else path.moveTo(u, v); });
+  path.closePath();
 }
 
 // The shapes the sensor models drew (each robot's marks from its latest sensors message, so
@@ -948,6 +996,14 @@ function drawDetections(P) {
   }
 }
 
+// Where each IR ray leaves a body (its reach along the ray), worked out once a body.
+const irRims = new WeakMap();
+function irRim(body) {
+  let rim = irRims.get(body);
+  if (!rim) irRims.set(body, (rim = IR_ANGLES_RAD.map((a) => reachAlong(body, a))));
+  return rim;
+}
+
 function drawSensors(P) {
   const layouts = new Map((run.world?.robots || []).map((r) => [r.id, r.sensors]));
   const idleIr = new Path2D(); // the IR rays that see nothing: one stroke for them all, last
@@ -964,11 +1020,13 @@ function drawSensors(P) {
     const at = (fx, fy) => [r.x_m + c * fx - sn * fy, r.y_m + sn * fx + c * fy]; // robot frame to field
     if (overlays.ir && s.proximity?.length === 8) {
       const reach = layout.ir_range_m || IR_RANGE_M;
-      const r0 = ROBOT_DIAMETER_M / 2, r1 = r0 + reach, A = P.affine;
+      const rim = irRim(bodyOf(r.id)), A = P.affine;
       for (let i = 0; i < 8; ++i) {
         const value = s.proximity[i];
-        // The ray from the rim outwards, in the field: the robot frame's (cos a, sin a) turned by theta.
+        // The ray from the rim (where it leaves the body) outwards, in the field: the robot
+        // frame's (cos a, sin a) turned by theta.
         const dx = c * IR_COS[i] - sn * IR_SIN[i], dy = sn * IR_COS[i] + c * IR_SIN[i];
+        const r0 = rim[i], r1 = r0 + reach;
         const x0 = r.x_m + r0 * dx, y0 = r.y_m + r0 * dy, x1 = r.x_m + r1 * dx, y1 = r.y_m + r1 * dy;
         if (value > 0) {
           ctx.strokeStyle = `rgba(230,120,0,${0.3 + 0.7 * Math.min(1, value / 1023)})`; ctx.lineWidth = 2;

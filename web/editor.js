@@ -14,15 +14,21 @@
 // "Start from this run" builds a scenario from what the live page holds (app.js's
 // window.rilbed.run: /rilbed/world and /rilbed/poses); "Poses from run" puts the run's
 // current poses into the scenario being edited.
+//
+// A robot entry's `model:`, `body:` and `wheels:` are kept as loaded. One with a `body:`
+// override is drawn as that body (its disc, or its outline turned to its heading), and hit
+// and checked by it; one with a `model:` alone is drawn as a Khepera (the page does not
+// read model files), its label naming the model.
 import { prepareCanvas } from './canvas.js';
 import { degToRad, headingDeg, radToDeg } from './angles.js';
+import { KHEPERA_BODY, bodyOnCanvas, robotBody } from './body.js';
 import { centroid, distToSegment, pointInPolygon } from './geometry.js';
 import { formatIds, parseIds } from './ids.js';
 import { editorLayout, toField, toPx } from './projection.js';
 import { controllerLabel, controllerTitle, loadRegistry, numberText, paramDescription } from './controller_registry.js';
 import {
-  DEFAULT_CONTROLLER, DEFAULT_FIELD, ROBOT_RADIUS_M, controllerRef, controllerValue, entryIds, isNum, isPoint, isPose,
-  listOf, obstaclePoints, robotHasSensor, robotItems as robotItemsOf, scenarioField, trackPoints,
+  DEFAULT_CONTROLLER, DEFAULT_FIELD, ROBOT_RADIUS_M, controllerRef, controllerValue, entryBody, entryIds, entryRadius, isNum,
+  isPoint, isPose, listOf, modelName, obstaclePoints, robotHasSensor, robotItems as robotItemsOf, scenarioField, trackPoints,
 } from './scenario.js';
 import { findProblems as scenarioProblems } from './scenario_checks.js';
 import { readScenarioText, scenarioText as yamlText } from './scenario_yaml.js';
@@ -374,31 +380,50 @@ function startFromRun() {
   }
   if (W.beacons?.length) doc.beacons = W.beacons.map((b, i) => ({ id: i + 1, position: [round3(b.x_m), round3(b.y_m)] }));
   const poses = new Map((run.poses?.robots || []).map((r) => [r.id, r]));
+  let bodies = 0;
   doc.robots = (W.robots || []).map((r) => {
     const e = { id: r.id };
     if (r.real) { e.kind = 'real'; e.link = { emulate: true }; }
     const p = poses.get(r.id);
     e.pose = p ? [round3(p.x_m), round3(p.y_m), headingDeg(radToDeg(p.theta_rad))] : 'random';
     e.controller = DEFAULT_CONTROLLER;
+    if (bodyOverride(e, r.body)) ++bodies;
     return e;
   });
   if (doc.robots.some((r) => r.kind === 'real')) doc.camera = { emulate: true };
-  const placed = doc.robots.filter((r) => isPose(r.pose)).map((r) => r.pose);
-  const nudged = nudgeApart(placed, doc.field.walls, W.width_m, W.height_m, (doc.obstacles || []).map((o) => o.polygon));
+  const placed = doc.robots.filter((r) => isPose(r.pose));
+  const nudged = nudgeApart(placed.map((r) => r.pose), placed.map(entryRadius), doc.field.walls, W.width_m, W.height_m,
+    (doc.obstacles || []).map((o) => o.polygon));
   setDoc(doc, '', `Started from the run of ${W.scenario}: ${doc.robots.length} robots at their poses of t = ` +
     `${(run.poses?.t_s ?? 0).toFixed(1)} s${nudged ? ` (${nudged} moved apart by a millimetre or two: they touched)` : ''}. The run does not say its robots' controllers and sensors, its beacons' ` +
     'IDs, apertures and ranges, nor real robots\' links: they are defaults here (convoy; 360°, 2 m; emulated). ' +
+    `${bodies ? `Nor their model files: the ${bodies} robots that are not Kheperas have their bodies and wheels as body: and wheels:. ` : ''}` +
     'To keep a file\'s, load it and use "Poses from run".');
+}
+// Entry e's `body:` and `wheels:` for a run's robot of body `b` (/rilbed/world's), unless it
+// is a Khepera's (what an entry without them is). Returns whether it added them.
+const round6 = (v) => Math.round(v * 1e6) / 1e6;
+function bodyOverride(e, b) {
+  if (!b) return false;
+  const body = robotBody(b), K = KHEPERA_BODY;
+  const same = (x, y) => Math.abs(x - y) < 1e-9;
+  if (!body.outline.length && same(body.radius_m, K.radius_m) && same(body.wheel_base_m, K.wheel_base_m) &&
+    same(body.wheel_radius_m, K.wheel_radius_m)) return false;
+  e.body = body.outline.length ? { outline_m: body.outline.map((p) => p.map(round6)) } : { radius_m: round6(body.radius_m) };
+  e.wheels = { base_m: round6(body.wheel_base_m), radius_m: round6(body.wheel_radius_m) };
+  return true;
 }
 // The run's poses as start poses: robots that touch (a wall, an obstacle, each other) in
 // the run would overlap by a rounding's fraction of a millimetre, which rilbed run refuses:
-// such robots are moved apart by a millimetre or two. Returns how many moved.
-function nudgeApart(poses, walls, W, H, obstacles) {
-  const R = ROBOT_RADIUS_M, gap = 0.001;
+// such robots are moved apart by a millimetre or two. `radii`: each robot's bounding
+// disc's. Returns how many moved.
+function nudgeApart(poses, radii, walls, W, H, obstacles) {
+  const gap = 0.001;
   const start = poses.map((p) => [p[0], p[1]]);
   for (let pass = 0; pass < 30; ++pass) {
     let moved = false;
-    for (const p of poses) {
+    for (const [i, p] of poses.entries()) {
+      const R = radii[i];
       if (walls) {
         const x = Math.min(Math.max(p[0], R + gap), W - R - gap), y = Math.min(Math.max(p[1], R + gap), H - R - gap);
         if (x !== p[0] || y !== p[1]) { p[0] = x; p[1] = y; moved = true; }
@@ -418,10 +443,10 @@ function nudgeApart(poses, walls, W, H, obstacles) {
     }
     for (let i = 0; i < poses.length; ++i) {
       for (let j = i + 1; j < poses.length; ++j) {
-        const a = poses[i], b = poses[j];
+        const a = poses[i], b = poses[j], R2 = radii[i] + radii[j];
         const d = Math.hypot(b[0] - a[0], b[1] - a[1]);
-        if (d >= 2 * R + gap / 2) continue;
-        const ux = d > 1e-9 ? (b[0] - a[0]) / d : 1, uy = d > 1e-9 ? (b[1] - a[1]) / d : 0, push = (2 * R + gap - d) / 2;
+        if (d >= R2 + gap / 2) continue;
+        const ux = d > 1e-9 ? (b[0] - a[0]) / d : 1, uy = d > 1e-9 ? (b[1] - a[1]) / d : 0, push = (R2 + gap - d) / 2;
         a[0] -= ux * push; a[1] -= uy * push; b[0] += ux * push; b[1] += uy * push;
         moved = true;
       }
@@ -441,8 +466,9 @@ function posesFromRun() {
   const taken = run.poses.robots.filter((p) => ids.has(p.id));
   const poses = taken.map((p) => [round3(p.x_m), round3(p.y_m), headingDeg(radToDeg(p.theta_rad))]);
   // (Robots of the scenario the run does not have keep their places, and are kept clear of.)
-  const others = robotItems().filter((r) => r.placed && !taken.some((p) => p.id === r.id)).map((r) => [r.x, r.y, r.th]);
-  const nudged = nudgeApart([...poses, ...others], F.walls, F.w, F.h, list('obstacles').map(obstaclePoints));
+  const others = robotItems().filter((r) => r.placed && !taken.some((p) => p.id === r.id));
+  const radii = [...taken.map((p) => entryRadius(robotItems().find((x) => x.id === p.id).e)), ...others.map((r) => entryRadius(r.e))];
+  const nudged = nudgeApart([...poses, ...others.map((r) => [r.x, r.y, r.th])], radii, F.walls, F.w, F.h, list('obstacles').map(obstaclePoints));
   taken.forEach((p, k) => {
     const r = robotItems().find((x) => x.id === p.id);
     placeRobot(r.index, r.id, ...poses[k]);
@@ -510,7 +536,7 @@ function rotateHandle(L, s = ed.sel) {
     const e = ed.doc.robots[s.index];
     if (!e || !isPose(e.pose) || entryIds(e).length !== 1) return null;
     const [u, v] = toPx(L, e.pose[0], e.pose[1]);
-    const d = Math.max(6, ROBOT_RADIUS_M * L.s) + 16, a = degToRad(e.pose[2]);
+    const d = Math.max(6, entryRadius(e) * L.s) + 16, a = degToRad(e.pose[2]);
     return [u + d * Math.cos(a), v - d * Math.sin(a)];
   }
   if (s.type === 'beacon') {
@@ -551,7 +577,7 @@ function hitTest(u, v) {
   let best = null;
   for (const r of robotItems().filter((x) => x.placed)) {
     const [ru, rv] = toPx(L, r.x, r.y), d = Math.hypot(ru - u, rv - v);
-    if (d <= Math.max(8, ROBOT_RADIUS_M * L.s) && (!best || d < best.d)) best = { d, r };
+    if (d <= Math.max(8, entryRadius(r.e) * L.s) && (!best || d < best.d)) best = { d, r };
   }
   if (best) return { type: 'robot', index: best.r.index, id: best.r.id };
   const beacons = list('beacons');
@@ -661,7 +687,7 @@ function draw() {
     ctx.fillStyle = '#000'; ctx.font = '11px system-ui'; ctx.fillText(`B${b.id}`, u + 8, v - 8);
   });
   // Robots on the field.
-  for (const r of robotItems().filter((x) => x.placed)) drawRobot(r, ...P(r.x, r.y), Math.max(5, ROBOT_RADIUS_M * L.s), selected('robot', r.index));
+  for (const r of robotItems().filter((x) => x.placed)) drawRobot(r, robotShape(L, r.e, r.x, r.y, r.th), selected('robot', r.index));
   // The tray: robots with random poses.
   ctx.fillStyle = '#f1f3f6'; ctx.fillRect(0, L.trayTop, w, TRAY_HEIGHT_PX);
   ctx.fillStyle = '#6b7684'; ctx.font = '11px system-ui';
@@ -669,7 +695,7 @@ function draw() {
   const tray = trayRobots();
   tray.forEach((r, k) => {
     const [u, v] = trayPosition(L, k);
-    drawRobot({ ...r, th: 90 }, u, v, 10, ed.sel?.type === 'robot' && ed.sel.index === r.index && ed.sel.id === r.id, true);
+    drawRobot(r, { u, v, radius: 10, outline: null, heading: null }, ed.sel?.type === 'robot' && ed.sel.index === r.index && ed.sel.id === r.id, true);
   });
   if (!tray.length) ctx.fillText('(none: every robot has a pose; drag one here to make its pose random)', MARGIN_PX + 100, L.trayTop + TRAY_HEIGHT_PX / 2 + 4);
   // The selection's handles.
@@ -706,28 +732,49 @@ function draw() {
   // A tray robot being dragged onto the field.
   if (ed.drag?.mode === 'place' && ed.mouse) {
     ctx.globalAlpha = 0.6;
-    drawRobot({ ...ed.drag.robot, th: 90 }, ...ed.mouse, Math.max(5, ROBOT_RADIUS_M * L.s), true);
+    drawRobot(ed.drag.robot, robotShape(L, ed.drag.robot.e, ...toField(L, ...ed.mouse), 90), true);
     ctx.globalAlpha = 1;
   }
 }
-function drawRobot(r, u, v, radius, isSelected, inTray = false) {
+// How a robot of entry e at (x, y) metres, heading th degrees, is drawn on layout L:
+// {u, v, radius (px, its bounding disc), outline (canvas points, or null: a disc or a
+// square), heading (the mark's end)}. Its body override's shape (body.js), else a Khepera's disc.
+function robotShape(L, e, x, y, th) {
+  const [u, v] = toPx(L, x, y), a = degToRad(th);
+  const body = entryBody(e);
+  const d = body && bodyOnCanvas(body, { x_m: x, y_m: y, theta_rad: a }, (fx, fy) => toPx(L, fx, fy), L.s, { minRadiusPx: 5 });
+  const radius = d ? d.radius_px : Math.max(5, ROBOT_RADIUS_M * L.s);
+  const outline = d?.outline ?? null;
+  return { u, v, radius, outline, heading: outline ? d.heading : [u + radius * 1.2 * Math.cos(a), v - radius * 1.2 * Math.sin(a)] };
+}
+// A robot drawn as `shape` (robotShape's; in the tray a 10 px one without a heading): its
+// outline, else a disc (virtual) or a square (real), its heading mark, its label.
+function drawRobot(r, shape, isSelected, inTray = false) {
   const real = r.e?.kind === 'real';
+  const { u, v, radius, outline, heading } = shape;
   ctx.lineWidth = 2;
   ctx.strokeStyle = isSelected ? '#2456c7' : real ? '#1d6fb8' : '#d22828';
   ctx.fillStyle = isSelected ? 'rgba(36,86,199,0.15)' : 'rgba(255,255,255,0.8)';
-  if (real) {
+  if (outline) {
+    ctx.beginPath();
+    outline.forEach(([x, y], i) => { if (i) ctx.lineTo(x, y); else ctx.moveTo(x, y); });
+    ctx.closePath(); ctx.fill(); ctx.stroke();
+  } else if (real) {
     ctx.fillRect(u - radius, v - radius, 2 * radius, 2 * radius);
     ctx.strokeRect(u - radius, v - radius, 2 * radius, 2 * radius);
   } else {
     ctx.beginPath(); ctx.arc(u, v, radius, 0, 2 * Math.PI); ctx.fill(); ctx.stroke();
   }
-  if (!inTray) {
-    const a = degToRad(r.th);
-    ctx.beginPath(); ctx.moveTo(u, v); ctx.lineTo(u + radius * 1.2 * Math.cos(a), v - radius * 1.2 * Math.sin(a)); ctx.stroke();
-  }
+  if (heading) { ctx.beginPath(); ctx.moveTo(u, v); ctx.lineTo(heading[0], heading[1]); ctx.stroke(); }
   ctx.fillStyle = '#111'; ctx.font = '11px system-ui';
   if (inTray) { ctx.textAlign = 'center'; ctx.fillText(String(r.id), u, v + 4); ctx.textAlign = 'start'; }
-  else ctx.fillText(`${r.id}${controllerTag(r.e)}`, u + radius + 3, v - radius - 1);
+  else ctx.fillText(`${r.id}${controllerTag(r.e)}${modelTag(r.e)}`, u + radius + 3, v - radius - 1);
+}
+// What a robot's label says of its model: the model file's name, in brackets; nothing
+// without one.
+function modelTag(e) {
+  const m = modelName(e);
+  return m ? ` [${m}]` : '';
 }
 // What a robot's label says after its ID: its controller's name, unless it runs the default.
 function controllerTag(e) {

@@ -2,6 +2,7 @@
 // reads it: its field, its robot entries and their IDs, obstacles, tracks, sensors. The
 // editor edits the object itself; these only look at it.
 import { parseIds } from './ids.js';
+import { robotBody } from './body.js';
 
 export const ROBOT_RADIUS_M = 0.0275; // a Khepera
 export const DEFAULT_FIELD = { width_m: 1.5, height_m: 1.2 };
@@ -78,4 +79,29 @@ export function robotHasSensor(sensors, name) {
   if (name === 'proximity' || name === 'odometer') return given !== false;
   if (Array.isArray(given)) return given.length > 0;
   return given !== undefined && given !== null && given !== false;
+}
+
+// A robot entry's own body, from its `body:` override (a disc {radius_m: R}, or a convex
+// outline {outline_m: [[x, y], ...]} in the robot's frame) and its `wheels:` ({base_m,
+// radius_m}; what it leaves out is the Khepera's), as body.js draws it; null when it has
+// none (or none that can be drawn): it is its model's (`model:`, a file the page does not
+// read) or a Khepera's.
+export function entryBody(e) {
+  const b = e?.body;
+  if (!b || typeof b !== 'object' || Array.isArray(b)) return null;
+  const outline = Array.isArray(b.outline_m) ? b.outline_m.filter(isPoint) : [];
+  if (outline.length < 3 && !(isNum(b.radius_m) && b.radius_m > 0)) return null;
+  const w = e.wheels && typeof e.wheels === 'object' ? e.wheels : {};
+  return robotBody({ radius_m: b.radius_m, outline_m: outline, wheel_base_m: w.base_m, wheel_radius_m: w.radius_m });
+}
+
+// The radius of a robot entry's bounding disc: its body override's, else a Khepera's.
+export const entryRadius = (e) => entryBody(e)?.radius_m ?? ROBOT_RADIUS_M;
+
+// The robot model a robot entry names (`model: robots/epuck.yaml`, or `epuck`), as a
+// label shows it: the file's name without its folder and .yaml; null without one.
+export function modelName(e) {
+  const m = e?.model;
+  if (typeof m !== 'string' || !m.trim()) return null;
+  return m.trim().split('/').pop().replace(/\.ya?ml$/, '') || m.trim();
 }

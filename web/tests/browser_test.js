@@ -23,6 +23,12 @@
 //   6. closing the tab while driving stops the robot (seen from a second page);
 //   7. Exit (confirmed) ends the run: the banner says so, rilbed exits 0 and says
 //      "robot 4 (emulated): last speed 0 0";
+//   8. robot bodies: a run of its own (a scenario written to the temp folder: a square
+//      robot, `model: square`; an e-puck, `model: robots/epuck.yaml`; a Khepera; a wedge,
+//      an e-puck with a `body:` override) whose /rilbed/world gives each its body, which
+//      the live view draws: red on each body's edge (the square's corners, the e-puck's
+//      35 mm rim), none 5 px inside or outside it; "Start from this run" keeps them as
+//      `body:` and `wheels:`, and rilbed run accepts that scenario;
 // and that no page logged a console error or threw, all the test long. Screenshots of
 // the important moments go to $RILBED_ARTIFACTS, else ARTEFACT_DIR (CTest passes
 // BUILD/web-artifacts), else a temp folder; their paths are printed. Every wait polls
@@ -31,6 +37,7 @@
 // web_browser (label e2e); `./run test` installs its npm packages and Chromium.
 'use strict';
 
+const { spawnSync } = require('node:child_process');
 const fs = require('node:fs');
 const path = require('node:path');
 const {
@@ -267,6 +274,178 @@ function trajectories(runDir) {
     byId.get(id).push({ t, x, y });
   }
   return byId;
+}
+
+// ---------------------------------------------------------------- robot bodies
+// Robots of parts (robots/*.yaml named by `model:`, a body override): a square (robots/
+// square.yaml), an e-puck (a 35 mm disc), a Khepera (no model: 27.5 mm) and a wedge (an
+// e-puck with a body override, three points), all standing (controller none) well apart,
+// in a field without a camera.
+const SQUARE_OUTLINE = [[0.035, 0.035], [-0.035, 0.035], [-0.035, -0.035], [0.035, -0.035]]; // robots/square.yaml's
+const WEDGE_OUTLINE = [[0.065, 0], [-0.025, 0.035], [-0.025, -0.035]];
+// Each: its entry's keys (`yaml`), and the body and wheels the run must give it.
+const BODY_ROBOTS = [
+  { id: 1, yaml: ['model: square'], pose: [0.2, 0.3, 30], outline: SQUARE_OUTLINE, wheels: { base_m: 0.06, radius_m: 0.016 } },
+  { id: 2, yaml: ['model: robots/epuck.yaml'], pose: [0.45, 0.3, 0], radius: 0.035, wheels: { base_m: 0.053, radius_m: 0.0205 } },
+  { id: 3, yaml: [], pose: [0.65, 0.3, 0], radius: 0.0275, wheels: null },
+  { id: 4, yaml: ['model: epuck', 'body: {outline_m: [[0.065, 0], [-0.025, 0.035], [-0.025, -0.035]]}', 'wheels: {base_m: 0.05, radius_m: 0.012}'],
+    pose: [0.85, 0.3, 90], outline: WEDGE_OUTLINE, wheels: { base_m: 0.05, radius_m: 0.012 } },
+];
+function bodiesScenario() {
+  const robots = BODY_ROBOTS.map((r) => [`  - id: ${r.id}`, ...r.yaml.map((l) => `    ${l}`), `    pose: [${r.pose.join(', ')}]`,
+    '    controller: none'].join('\n'));
+  return `# browser_test.js: robots of parts, drawn with their own bodies.
+name: bodies
+description: A square robot, an e-puck, a Khepera and a wedge (an e-puck with a body override), standing.
+field: {width_m: 1.0, height_m: 0.6, walls: true}
+duration_s: 300
+robots:
+${robots.join('\n')}
+`;
+}
+
+// The live view around each robot of BODY_ROBOTS, in one animation frame: red pixels
+// (VIRTUAL_RGB) near points on its body's edge (each must have some), and near points
+// OFF_PX inside and outside its edge (none may): a body drawn as a Khepera's disc, or
+// as any other shape, fails both. Directions within 35 degrees of the heading (the
+// heading mark runs there) are left out. Points are robot-frame [x, y] metres, turned and
+// moved to the robot's pose (trajectories.csv's start, which controller none keeps).
+function sampleBodies(page) {
+  return page.evaluate(({ robots, VIRTUAL_RGB, COLOUR_TOLERANCE }) => {
+    const R = window.rilbed;
+    const canvas = document.getElementById('view');
+    const dpr = window.devicePixelRatio || 1;
+    const image = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height);
+    const red = (i) => VIRTUAL_RGB.every((c, k) => Math.abs(image.data[i + k] - c) <= COLOUR_TOLERANCE) && image.data[i + 3] > 200;
+    const HALF_PX = 1.5, OFF_PX = 5; // the window's half size and the off-edge distance, CSS pixels
+    const redNear = ([x, y]) => {
+      const [u, v] = R.project(x, y);
+      let n = 0;
+      for (let py = Math.floor((v - HALF_PX) * dpr); py <= Math.ceil((v + HALF_PX) * dpr); ++py) {
+        for (let px = Math.floor((u - HALF_PX) * dpr); px <= Math.ceil((u + HALF_PX) * dpr); ++px) {
+          if (px >= 0 && py >= 0 && px < image.width && py < image.height && red(4 * (py * image.width + px))) ++n;
+        }
+      }
+      return n;
+    };
+    const [u0, v0] = R.project(0, 0), [u1, v1] = R.project(0.01, 0);
+    const pxPerM = Math.hypot(u1 - u0, v1 - v0) / 0.01, off = OFF_PX / pxPerM;
+    return robots.map((r) => {
+      const [x0, y0, th] = r.pose, a = (th * Math.PI) / 180, c = Math.cos(a), s = Math.sin(a);
+      const field = ([fx, fy]) => [x0 + c * fx - s * fy, y0 + s * fx + c * fy];
+      const awayFromMark = ([fx, fy]) => Math.abs(Math.atan2(fy, fx)) > (35 * Math.PI) / 180;
+      // On the edge: the outline's corners and the middles of its sides, or 8 points round the disc.
+      let edge, sides;
+      if (r.outline) {
+        sides = r.outline.map((p, k) => { const q = r.outline[(k + 1) % r.outline.length]; return [(p[0] + q[0]) / 2, (p[1] + q[1]) / 2]; });
+        edge = [...r.outline, ...sides];
+      } else {
+        sides = Array.from({ length: 8 }, (_, k) => [r.radius * Math.cos((k * Math.PI) / 4), r.radius * Math.sin((k * Math.PI) / 4)]);
+        edge = sides;
+      }
+      edge = edge.filter(awayFromMark);
+      sides = sides.filter(awayFromMark);
+      // Off the edge: from each side's middle (or the disc's points), OFF_PX along the normal,
+      // which for these (a disc, outlines around the centre) is along the ray from the centre
+      // for a disc and the side's own normal for an outline.
+      const offPoints = (sign) => sides.map((p, k) => {
+        let nx, ny;
+        if (r.outline) {
+          const q = r.outline[k], w = r.outline[(k + 1) % r.outline.length];
+          const len = Math.hypot(w[0] - q[0], w[1] - q[1]);
+          nx = (w[1] - q[1]) / len; ny = -(w[0] - q[0]) / len; // outwards: the outline is counter-clockwise
+        } else {
+          const len = Math.hypot(p[0], p[1]);
+          nx = p[0] / len; ny = p[1] / len;
+        }
+        return [p[0] + sign * off * nx, p[1] + sign * off * ny];
+      });
+      const count = (pts) => pts.map((p) => redNear(field(p)));
+      return { id: r.id, pxPerM, edge: count(edge), inside: count(offPoints(-1)), outside: count(offPoints(1)) };
+    });
+  }, { robots: BODY_ROBOTS, VIRTUAL_RGB, COLOUR_TOLERANCE });
+}
+
+async function checkBodies(state, binary) {
+  const scenario = path.join(state.tmp, 'bodies.yaml');
+  fs.writeFileSync(scenario, bodiesScenario());
+  console.log(`# ${scenario}: ${BODY_ROBOTS.map((r) => `robot ${r.id} {${r.yaml.join(', ')}}`).join(', ')}`);
+  const bodies = await startRilbed(state, binary, scenario, { label: 'bodies' });
+  const context = await newContext(state, { viewport: { width: 1280, height: 900 }, deviceScaleFactor: 2 });
+  const page = await openPage(state, context, 'bodies page', bodies.url);
+  // What /rilbed/world says of each robot's body.
+  const world = await page.evaluate(() => window.rilbed.run.world.robots.map((r) => ({ id: r.id, body: r.body || null })));
+  const near = (a, b) => Math.abs(a - b) < 1e-6;
+  const samePoints = (pts, want) => pts.length === want.length && pts.every((p, k) => near(p.x_m, want[k][0]) && near(p.y_m, want[k][1]));
+  for (const r of BODY_ROBOTS) {
+    const b = world.find((w) => w.id === r.id)?.body;
+    const described = JSON.stringify(b);
+    if (!b && !r.wheels) continue; // a Khepera may go without
+    if (r.outline) {
+      check(b && samePoints(b.outline, r.outline) && near(b.radius_m, Math.max(...r.outline.map(([x, y]) => Math.hypot(x, y)))),
+        `/rilbed/world gives robot ${r.id} the body ${described}, not the outline ${JSON.stringify(r.outline)}`);
+    } else {
+      check(b && b.outline.length === 0 && near(b.radius_m, r.radius), `/rilbed/world gives robot ${r.id} the body ${described}, not a disc of ${r.radius} m`);
+    }
+    if (r.wheels) {
+      check(near(b.wheel_base_m, r.wheels.base_m) && near(b.wheel_radius_m, r.wheels.radius_m),
+        `/rilbed/world gives robot ${r.id} the wheels of ${described}, not ${JSON.stringify(r.wheels)}`);
+    }
+  }
+  ok(`/rilbed/world gives each robot its body: ${world.map((w) => `${w.id} ${w.body ? `${w.body.name} ` +
+    (w.body.outline.length ? `${w.body.outline.length}-point outline` : `disc ${w.body.radius_m} m`) : 'none (a Khepera)'}`).join(', ')}`);
+
+  // The live view draws them: each robot's edge red where its body's edge is, nothing red
+  // just inside or outside it.
+  await poll('the bodies page to draw the four robots with their outlines and wheels (stats.outlines 2, stats.wheels 4)',
+    () => page.evaluate(() => window.rilbed.stats.outlines === 2 && window.rilbed.stats.wheels === 4),
+    { describe: () => page.evaluate(() => JSON.stringify(window.rilbed.stats)) });
+  const shapes = await poll('every robot drawn with its own body: red on its edge, none just inside or outside it', async () => {
+    await page.evaluate(() => new Promise((resolve) => requestAnimationFrame(() => requestAnimationFrame(resolve))));
+    const s = await sampleBodies(page);
+    state.lastBodies = s;
+    return s.every((r) => r.edge.every((n) => n > 0) && r.inside.every((n) => n === 0) && r.outside.every((n) => n === 0)) && s;
+  }, { everyMs: 300, ms: 15000, describe: () => JSON.stringify(state.lastBodies) });
+  await screenshot(state, page, '07-bodies');
+  const view = path.join(state.artifacts, `${state.shotPrefix}-07-bodies-view.png`);
+  await page.locator('#view').screenshot({ path: view });
+  state.screenshots.push(view);
+  console.log(`# screenshot ${view}`);
+  ok(`the live view draws each robot's own body (${shapes[0].pxPerM.toFixed(0)} px/m): ` +
+     shapes.map((s) => `${s.id} red at ${s.edge.length} points of its edge, none at ${s.inside.length + s.outside.length} points just off it`).join('; '));
+
+  // The editor started from this run keeps the bodies as body: and wheels: overrides
+  // (the Khepera without), and rilbed run accepts the scenario.
+  await page.click('#editor-panel > summary');
+  await page.locator('#editor-from-run').scrollIntoViewIfNeeded();
+  await page.click('#editor-from-run');
+  const doc = await poll('the editor to hold the run\'s 4 robots', () => page.evaluate(() => {
+    const d = window.rilbedEditor.doc;
+    return d.robots?.length === 4 && JSON.parse(JSON.stringify(d));
+  }));
+  const problems = await page.evaluate(() => window.rilbedEditor.problems());
+  for (const r of BODY_ROBOTS) {
+    const e = doc.robots.find((q) => q.id === r.id);
+    const want = r.outline ? { outline_m: r.outline } : r.wheels ? { radius_m: r.radius } : undefined;
+    check(JSON.stringify(e.body) === JSON.stringify(want) && JSON.stringify(e.wheels) === JSON.stringify(r.wheels ?? undefined),
+      `"Start from this run" made robot ${r.id} ${JSON.stringify(e)}, not one with body ${JSON.stringify(want)} and wheels ${JSON.stringify(r.wheels)}`);
+  }
+  check(problems.length === 0, `the editor finds problems in the scenario started from the bodies run: ${problems.join(' ')}`);
+  await page.locator('#editor-canvas').scrollIntoViewIfNeeded();
+  const editorShot = path.join(state.artifacts, `${state.shotPrefix}-08-bodies-editor.png`);
+  await page.locator('#editor-canvas').screenshot({ path: editorShot });
+  state.screenshots.push(editorShot);
+  console.log(`# screenshot ${editorShot}`);
+  const saved = path.join(state.tmp, 'bodies-from-run.yaml');
+  fs.writeFileSync(saved, await page.evaluate(() => window.rilbedEditor.yaml));
+  const accepted = spawnSync(binary, ['run', saved, '--fast', '--duration', '1', '--quiet', '--out', path.join(state.tmp, 'bodies-from-run')],
+    { encoding: 'utf8', timeout: 60000 });
+  check(accepted.status === 0, `rilbed run refuses the scenario the editor started from the bodies run (${accepted.error?.message || accepted.signal || `exit code ${accepted.status}`}):\n` +
+    `${accepted.stderr}\n--- the file ---\n${fs.readFileSync(saved, 'utf8')}`);
+  ok(`"Start from this run" keeps the bodies (${doc.robots.map((e) => `${e.id} ${e.body ? JSON.stringify(e.body) : 'a Khepera'}`).join(', ')}); ` +
+     'no problem found, and rilbed run accepts it');
+  await context.close();
+  await bodies.child.kill();
 }
 
 // ---------------------------------------------------------------- the test
@@ -526,6 +705,9 @@ async function main(state) {
   check(/The run has ended/.test(finalBanner.text), `once the server closed, the banner says "${finalBanner.text}"`);
   await screenshot(state, page, '06-ended');
   ok(`Exit (confirm "End the run?" accepted): banner "${finalBanner.text}", rilbed exited 0 saying "${lastSpeed}", events.csv "${endedLine}"`);
+
+  // ------------------------------------------------ 8. robot bodies
+  await checkBodies(state, binary);
 
   // ------------------------------------------------ no errors on any page, all along
   check(state.pageErrors.length === 0, `the pages logged ${state.pageErrors.length} errors:\n  ${state.pageErrors.join('\n  ')}`);

@@ -19,6 +19,9 @@
 //   4. each scenarios/*.yaml loaded through the file input and saved unchanged parses
 //      (js-yaml) to an object deep-equal to the original's, and `RILBED run` accepts it
 //      (--fast --duration 1, plus --all-virtual when it has real robots);
+//   4b. a scenario of robots of parts (model:, body: as a disc and as an outline,
+//      wheels:) loaded and saved unchanged, without problems, accepted by rilbed run; the
+//      bodies drawn as themselves and hit by their size;
 //   5. a group split by dragging one of its robots out of the tray; 6. "Poses from run";
 //   7. the controllers are the server's registry: controllers.json is what `RILBED
 //      controllers --json` prints, the new robot's and a robot's controller choices are
@@ -28,9 +31,9 @@
 //      required params; with controllers.json failing (503) the editor says so and offers
 //      no controller;
 // and that the page logged no console error and threw nothing. Screenshots of the
-// editor (editor.png, editor-params.png, editor-no-registry.png) go to $RILBED_ARTIFACTS,
-// else ARTEFACT_DIR (CTest passes BUILD/web-artifacts), else a temp folder; their paths
-// are printed. Every wait polls with a deadline; on any
+// editor (editor.png, editor-bodies.png, editor-params.png, editor-no-registry.png) go
+// to $RILBED_ARTIFACTS, else ARTEFACT_DIR (CTest passes BUILD/web-artifacts), else a temp
+// folder; their paths are printed. Every wait polls with a deadline; on any
 // failure it says what it was waiting for, shows the end of rilbed's output, kills
 // rilbed and the browser and exits 1. CTest runs it as web_editor (label e2e); `./run
 // test` installs its npm packages (web/tests and web/: the page's js-yaml) and Chromium.
@@ -334,6 +337,9 @@ async function main(state) {
     ok(`${f}: loaded, saved unchanged (js-yaml: deep-equal), rilbed run accepts it${real ? ' (--all-virtual)' : ''}`);
   }
 
+  // 4b. Robots of parts: model, body and wheels kept, drawn and hit by their bodies.
+  await checkBodies(state, page, until, binary, save, yaml);
+
   // 5. A group split by dragging one of its robots from the tray: convoy_mixed's real
   // robots 4-5, robot 4 put at (0.3, 0.3) (an entry of its own, before 5's: ID order); robot
   // 8 of group 6-8 deleted with the button.
@@ -441,6 +447,104 @@ async function checkControllerLists(page, until, registry) {
   check(JSON.stringify(form) === JSON.stringify(names), `robot 1's controller choices are ${form}, not the registry's ${names}`);
   check(await page.inputValue('#editor-form select[name=controller]') === 'wander', 'robot 1 of wander.yaml does not show controller wander');
   ok(`controllers.json is rilbed controllers --json; the editor offers exactly its controllers (${names.join(', ')}) for a new robot and in a robot's form`);
+}
+
+// A scenario whose robots name models (robots/*.yaml) and override their bodies and
+// wheels; robot 4's outline in block style (saved in flow style, the same scenario).
+const BODIES_YAML = `# editor_test.js: robots of parts.
+name: bodies
+field: {width_m: 1.2, height_m: 0.8}
+duration_s: 30
+robots:
+  - ids: 1-2
+    model: epuck
+    pose: random
+    controller: wander
+  - id: 3
+    model: robots/square.yaml
+    pose: [0.3, 0.4, 30]
+    controller: wander
+    wheels: {base_m: 0.058}
+  - id: 4
+    model: epuck
+    body:
+      outline_m:
+        - [0.065, 0]
+        - [-0.025, 0.035]
+        - [-0.025, -0.035]
+    wheels: {base_m: 0.05, radius_m: 0.012}
+    pose: [0.6, 0.4, 90]
+    controller: wander
+  - id: 5
+    body: {radius_m: 0.05}
+    pose: [0.9, 0.4, 0]
+    controller: wander
+`;
+
+// 4b. BODIES_YAML loaded and saved: the same scenario (model, body and wheels kept), no
+// problem found, rilbed run accepts it; robot 5's 50 mm disc and robot 4's wedge drawn
+// (red on their edges: on the disc's, none on a Khepera's within it; on the wedge's back
+// corners, 15 mm beyond a Khepera's edge), robot 5 selected by a click 45 mm
+// from its centre (outside a Khepera's 27.5 mm); robot 3 (a model alone) labelled with it.
+async function checkBodies(state, page, until, binary, save, yaml) {
+  const file = path.join(state.tmp, 'bodies.yaml');
+  fs.writeFileSync(file, BODIES_YAML);
+  const loadsBefore = await page.evaluate(() => window.rilbedEditor.loads);
+  await page.setInputFiles('#editor-file', file);
+  await until('the editor to load bodies.yaml', ([n, name]) => window.rilbedEditor.loads > n && window.rilbedEditor.loadedName === name, [loadsBefore, 'bodies.yaml']);
+  const out = await save('bodies');
+  try {
+    assert.deepStrictEqual(yaml.load(out.text), yaml.load(BODIES_YAML));
+  } catch (e) {
+    fail(`bodies.yaml loaded and saved is not the same scenario:\n${e.message.slice(0, 3000)}`);
+  }
+  check(/^ {4}body: \{outline_m: \[\[0\.065, 0\], \[-0\.025, 0\.035\], \[-0\.025, -0\.035\]\]\}$/m.test(out.text),
+    `the saved bodies.yaml does not hold robot 4's outline in flow style:\n${out.text}`);
+  const problems = await page.evaluate(() => window.rilbedEditor.problems());
+  check(problems.length === 0, `the editor finds problems in bodies.yaml: ${problems.join(' ')}`);
+  runAccepts(binary, out.file, ['--fast', '--duration', '1'], path.join(state.tmp, 'run-bodies'));
+  ok('bodies.yaml (model:, body: as a disc and as an outline, wheels:): loaded, saved unchanged, no problem, rilbed run accepts it');
+
+  const canvas = page.locator('#editor-canvas');
+  await canvas.evaluate((el) => el.scrollIntoView({ block: 'center' }));
+  await page.evaluate(() => new Promise((resolve) => requestAnimationFrame(() => requestAnimationFrame(resolve))));
+  // Red (#d22828) within 1.5 px of robot-frame points of robot (x, y, heading th degrees).
+  const red = await page.evaluate(() => {
+    const E = window.rilbedEditor, c = document.getElementById('editor-canvas');
+    const dpr = window.devicePixelRatio || 1, img = c.getContext('2d').getImageData(0, 0, c.width, c.height);
+    const near = ([x, y]) => {
+      const [u, v] = E.project(x, y);
+      let n = 0;
+      for (let py = Math.floor((v - 1.5) * dpr); py <= Math.ceil((v + 1.5) * dpr); ++py) {
+        for (let px = Math.floor((u - 1.5) * dpr); px <= Math.ceil((u + 1.5) * dpr); ++px) {
+          const i = 4 * (py * img.width + px);
+          if (Math.abs(img.data[i] - 0xd2) < 40 && Math.abs(img.data[i + 1] - 0x28) < 40 && Math.abs(img.data[i + 2] - 0x28) < 40 && img.data[i + 3] > 200) ++n;
+        }
+      }
+      return n;
+    };
+    const at = (x, y, th) => ([fx, fy]) => {
+      const a = (th * Math.PI) / 180;
+      return [x + Math.cos(a) * fx - Math.sin(a) * fy, y + Math.sin(a) * fx + Math.cos(a) * fy];
+    };
+    const disc = (r) => [90, 180, 270].map((d) => [r * Math.cos((d * Math.PI) / 180), r * Math.sin((d * Math.PI) / 180)]);
+    return {
+      r5: disc(0.05).map(at(0.9, 0.4, 0)).map(near), r5khepera: disc(0.0275).map(at(0.9, 0.4, 0)).map(near),
+      // Its back corners, 43 mm from its centre (15 mm beyond a Khepera's edge), and its back's middle.
+      r4: [[-0.025, 0.035], [-0.025, 0], [-0.025, -0.035]].map(at(0.6, 0.4, 90)).map(near),
+    };
+  });
+  check(red.r5.every((n) => n > 0) && red.r5khepera.every((n) => n === 0),
+    `robot 5 (body: {radius_m: 0.05}) is not drawn as a 50 mm disc: red at its edge ${red.r5}, at a Khepera's ${red.r5khepera}`);
+  check(red.r4.every((n) => n > 0), `robot 4 (its outline) is not drawn as its wedge: red at its back corners and middle ${red.r4}`);
+  const box = await canvas.boundingBox();
+  const [u, v] = await page.evaluate(() => window.rilbedEditor.project(0.9, 0.445));
+  await page.mouse.click(box.x + u, box.y + v);
+  await until('robot 5 to be selected by a click 45 mm from its centre', () => window.rilbedEditor.selection?.type === 'robot' && window.rilbedEditor.selection.id === 5);
+  const shot = path.join(state.artifacts, 'editor-bodies.png');
+  await page.locator('#editor').screenshot({ path: shot });
+  ok(`the editor draws robot 5's 50 mm disc (red on its edge, none on a Khepera's) and robot 4's wedge (red at its back corners), and a click 45 mm ` +
+     `from robot 5's centre selects it (screenshot ${shot})`);
 }
 
 async function loadScenario(page, until, name) {

@@ -32,8 +32,10 @@ rilbed_web_test(web_protocol e2e 300 "Node and the npm packages"
 # The web panel in a browser (browser_test.js: playwright-core driving Debian's
 # /usr/bin/chromium) against `rilbed run --gui` with emulated real robots: the page, the
 # live view's robots, Pause/Start, the real-time factor (on convoy_sim), manual driving,
-# a closed tab stopping its robot, Exit. Screenshots go to ${CMAKE_BINARY_DIR}/web-artifacts
-# (or $RILBED_ARTIFACTS).
+# a closed tab stopping its robot, Exit; then robot bodies (a scenario of its own with
+# `model: square` and `model: epuck` robots: each drawn as its own outline or disc, kept by
+# "Start from this run"). Screenshots go to ${CMAKE_BINARY_DIR}/web-artifacts (or
+# $RILBED_ARTIFACTS).
 rilbed_web_test(web_browser e2e 300 "Node, the npm packages and Chromium"
   ${_web_tests}/browser_test.js $<TARGET_FILE:rilbed> ${_scenarios}/convoy_mixed.yaml ${_scenarios}/convoy_sim.yaml
   ${CMAKE_BINARY_DIR}/web-artifacts)
@@ -49,14 +51,15 @@ rilbed_web_test(web_vision e2e 300 "Node, the npm packages and Chromium"
 # The page's scenario editor (editor_test.js, in Chromium) against `rilbed run --gui` on
 # convoy_sim: a scenario started from the run, edited with the mouse and saved, which
 # `rilbed run` accepts; the controller lists and forms from the server's registry; every
-# scenarios/*.yaml loaded and saved unchanged. It needs web/node_modules too (js-yaml).
+# scenarios/*.yaml loaded and saved unchanged, and one of robots with model:, body: and
+# wheels:, drawn by their bodies. It needs web/node_modules too (js-yaml).
 rilbed_web_test(web_editor e2e 300 "Node, the npm packages and Chromium"
   ${_web_tests}/editor_test.js $<TARGET_FILE:rilbed> ${CMAKE_BINARY_DIR}/web-artifacts)
 
 # The page's pure helpers in Node (unit/*.test.mjs, node's test runner): the projection, ID
-# lists, angles, geometry, the scenario checks against a controller registry fixture, the
-# scenario's YAML read and written (with web/node_modules' js-yaml, as the page does), the
-# Foxglove client against a stand-in WebSocket. No build, no browser. node --test runs in
+# lists, angles, geometry, robot bodies, the scenario checks against a controller registry
+# fixture, the scenario's YAML read and written (with web/node_modules' js-yaml, as the
+# page does), the Foxglove client against a stand-in WebSocket. No build, no browser. node --test runs in
 # that folder and finds its *.test.mjs there itself, since a folder given as an argument is
 # searched by Node 20 but taken for a test file by Node 22.
 rilbed_web_test(web_unit web 120 "Node and the npm packages" WORKING_DIRECTORY ${_web_tests}/unit --test)

@@ -1,7 +1,9 @@
 // Reading a scenario object (web/scenario.js) as rilbed run reads it.
 import test from 'node:test';
 import assert from 'node:assert/strict';
-import { controllerRef, controllerValue, entryIds, robotHasSensor, robotItems, scenarioField } from '../../scenario.js';
+import {
+  ROBOT_RADIUS_M, controllerRef, controllerValue, entryBody, entryIds, entryRadius, modelName, robotHasSensor, robotItems, scenarioField,
+} from '../../scenario.js';
 
 test('the field: its size, the defaults for what is missing or not above 0, its walls', () => {
   assert.deepEqual(scenarioField({ field: { width_m: 2, height_m: 1, walls: false } }), { w: 2, h: 1, walls: false });
@@ -67,4 +69,28 @@ test('robotHasSensor as robot_has_sensor: defaults on, lists need an element, th
   assert.equal(robotHasSensor({ range_finders: [{}] }, 'range_finders'), true);
   assert.equal(robotHasSensor({}, 'beacon_finder'), false);
   assert.equal(robotHasSensor({ beacon_finder: { field_of_view_deg: 360 } }, 'beacon_finder'), true);
+});
+
+test('entryBody: a body override as drawn (its wheels, else the Khepera\'s); none without one, or one that cannot be drawn', () => {
+  assert.equal(entryBody({ id: 1 }), null);
+  assert.equal(entryBody({ id: 1, model: 'epuck' }), null); // the model file's: the page does not read it
+  assert.equal(entryBody({ id: 1, wheels: { base_m: 0.06 } }), null);
+  assert.equal(entryBody({ id: 1, body: { outline_m: [[0.03, 0], [-0.03, 0]] } }), null);
+  assert.equal(entryBody({ id: 1, body: [0.05] }), null);
+  assert.deepEqual(entryBody({ body: { radius_m: 0.05 }, wheels: { base_m: 0.07 } }),
+    { name: 'khepera2', radius_m: 0.05, outline: [], wheel_base_m: 0.07, wheel_radius_m: 0.00764 });
+  const square = entryBody({ model: 'square', body: { outline_m: [[0.035, 0.035], [-0.035, 0.035], [-0.035, -0.035], [0.035, -0.035]] } });
+  assert.deepEqual(square.outline, [[0.035, 0.035], [-0.035, 0.035], [-0.035, -0.035], [0.035, -0.035]]);
+  assert.ok(Math.abs(square.radius_m - Math.hypot(0.035, 0.035)) < 1e-15);
+  assert.equal(entryRadius({ body: { radius_m: 0.05 } }), 0.05);
+  assert.equal(entryRadius({ model: 'epuck' }), ROBOT_RADIUS_M);
+});
+
+test('modelName: the model file\'s name without its folder and .yaml', () => {
+  assert.equal(modelName({ model: 'epuck' }), 'epuck');
+  assert.equal(modelName({ model: 'robots/epuck.yaml' }), 'epuck');
+  assert.equal(modelName({ model: '../lab/wedge_bot.yml' }), 'wedge_bot');
+  assert.equal(modelName({ model: '' }), null);
+  assert.equal(modelName({ id: 1 }), null);
+  assert.equal(modelName({ model: 3 }), null);
 });

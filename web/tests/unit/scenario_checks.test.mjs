@@ -3,7 +3,7 @@
 import test from 'node:test';
 import assert from 'node:assert/strict';
 import { parseRegistry } from '../../controller_registry.js';
-import { controllerProblems, findProblems, paramsProblems } from '../../scenario_checks.js';
+import { bodyProblems, controllerProblems, findProblems, paramsProblems } from '../../scenario_checks.js';
 import { C_LIBRARY, CPP_LIBRARY, LIBRARY_REGISTRY_JSON, REGISTRY_JSON } from './registry_fixture.mjs';
 
 const registry = parseRegistry(JSON.parse(JSON.stringify(REGISTRY_JSON)));
@@ -96,6 +96,86 @@ test('placed robots against the walls, the obstacles and each other', () => {
   ]);
   const open = scenario([{ id: 1, pose: [0.01, 0.5, 0] }], { field: { width_m: 1.5, height_m: 1.2, walls: false } });
   assert.deepEqual(findProblems(open, registry), []);
+});
+
+// ---------------------------------------------------------------- bodies
+const SQUARE = [[0.035, 0.035], [-0.035, 0.035], [-0.035, -0.035], [0.035, -0.035]]; // robots/square.yaml's
+const WEDGE = [[0.065, 0], [-0.025, 0.035], [-0.025, -0.035]]; // examples/robots/wedge_bot's
+
+test('model, body and wheels are a robot entry\'s keys: no problem when they are right', () => {
+  const doc = scenario([
+    { ids: '1-2', model: 'epuck', pose: 'random' },
+    { id: 3, model: 'robots/square.yaml', pose: [0.3, 0.3, 30], wheels: { base_m: 0.058 } },
+    { id: 4, model: 'epuck', body: { outline_m: WEDGE }, wheels: { base_m: 0.05, radius_m: 0.012 }, pose: [0.6, 0.3, 0] },
+    { id: 5, body: { radius_m: 0.05 }, pose: [0.9, 0.3, 0] },
+    { id: 6, body: { outline_m: [...SQUARE].reverse() }, pose: [1.2, 0.3, 90] }, // clockwise: the run turns it round
+  ]);
+  assert.deepEqual(findProblems(doc, registry), []);
+  assert.deepEqual(bodyProblems({ model: 'khepera2', body: { outline_m: SQUARE }, wheels: { base_m: 0.06, radius_m: 0.016 } }), []);
+});
+
+test('an outline needs at least 3 points, each [x, y]; at most 32', () => {
+  assert.deepEqual(bodyProblems({ body: { outline_m: [[0.03, 0], [-0.03, 0]] } }), ['body.outline_m needs at least 3 points, not 2']);
+  assert.deepEqual(bodyProblems({ body: { outline_m: [] } }), ['body.outline_m needs at least 3 points, not 0']);
+  assert.deepEqual(bodyProblems({ body: { outline_m: [[0.03, 0], [0, 0.03, 1], [-0.03, 0]] } }), ['body.outline_m: point 2 is not [x, y] (metres)']);
+  assert.deepEqual(bodyProblems({ body: { outline_m: 'square' } }), ['body.outline_m must be a list of [x, y] points (robot frame: x forward, y left, metres)']);
+  const many = Array.from({ length: 33 }, (_, k) => [0.03 * Math.cos((2 * Math.PI * k) / 33), 0.03 * Math.sin((2 * Math.PI * k) / 33)]);
+  assert.deepEqual(bodyProblems({ body: { outline_m: many } }), ['body.outline_m has 33 points: at most 32']);
+  assert.deepEqual(bodyProblems({ body: { outline_m: many.slice(0, 32) } }), []);
+  const doc = scenario([{ id: 1, pose: [0.5, 0.5, 0], body: { outline_m: [[0.03, 0], [-0.03, 0.02]] } }]);
+  assert.deepEqual(findProblems(doc, registry), ['robots[0]: body.outline_m needs at least 3 points, not 2.']);
+});
+
+test('an outline as the run checks it: convex, not crossing itself, with an area, around the centre', () => {
+  const notch = [[0.04, 0.04], [-0.04, 0.04], [-0.01, 0], [-0.04, -0.04], [0.04, -0.04]];
+  assert.deepEqual(bodyProblems({ body: { outline_m: notch } }), ['body.outline_m is not convex']);
+  const star = [0, 2, 4, 1, 3].map((k) => [0.04 * Math.cos((2 * Math.PI * k) / 5), 0.04 * Math.sin((2 * Math.PI * k) / 5)]);
+  assert.deepEqual(bodyProblems({ body: { outline_m: star } }), ['body.outline_m crosses itself']);
+  assert.deepEqual(bodyProblems({ body: { outline_m: [[0.03, 0], [0, 0], [-0.03, 0]] } }), ['body.outline_m has (almost) no area']);
+  assert.deepEqual(bodyProblems({ body: { outline_m: [[0.01, -0.02], [0.05, -0.02], [0.05, 0.02], [0.01, 0.02]] } }),
+    ["body.outline_m must hold the robot's centre (0, 0) strictly inside"]);
+  assert.deepEqual(bodyProblems({ body: { outline_m: [[2, 0], [-0.1, 0.1], [-0.1, -0.1]] } }),
+    ["body.outline_m reaches more than 1 m from the centre (a robot on a lab's table)"]);
+});
+
+test('body and wheels: their keys, one shape, numbers above 0; model a name', () => {
+  assert.deepEqual(bodyProblems({ body: { radius_m: 0.03, outline_m: SQUARE } }), ['body: give either radius_m (a disc) or outline_m']);
+  assert.deepEqual(bodyProblems({ body: { radius_m: 0, height_m: 0.02 } }),
+    ['body.height_m: unknown key (allowed here: radius_m, outline_m)', 'body.radius_m must be a number above 0, not 0']);
+  assert.deepEqual(bodyProblems({ body: { radius_m: 1.5 } }), ["body.radius_m is at most 1 m (a robot on a lab's table)"]);
+  assert.deepEqual(bodyProblems({ body: 0.03 }), ['body must be {radius_m: R} (a disc) or {outline_m: [[x, y], ...]} (a convex outline, robot frame)']);
+  assert.deepEqual(bodyProblems({ wheels: { base_m: -1, radius_m: 'big', width_m: 0.01 } }), [
+    'wheels.width_m: unknown key (allowed here: base_m, radius_m)', 'wheels.base_m must be a number above 0, not -1',
+    'wheels.radius_m must be a number above 0, not "big"',
+  ]);
+  assert.deepEqual(bodyProblems({ wheels: { base_m: 3, radius_m: 0.6 } }), ['wheels.base_m is at most 2 m', 'wheels.radius_m is at most 0.5 m']);
+  assert.deepEqual(bodyProblems({ wheels: [0.05, 0.01] }), ['wheels must be {base_m: B, radius_m: R}']);
+  assert.deepEqual(bodyProblems({ model: '' }), ["model must name a robot model file (robots/epuck.yaml) or a shipped model's name (epuck)"]);
+  assert.deepEqual(bodyProblems({ model: 3 }), ["model must name a robot model file (robots/epuck.yaml) or a shipped model's name (epuck)"]);
+});
+
+test('placed robots overlap by their body overrides: discs by their radius, outlines by their shape', () => {
+  // 40 mm from the left wall: a disc of 50 mm overlaps it, a Khepera (27.5 mm) does not.
+  assert.deepEqual(findProblems(scenario([{ id: 1, pose: [0.04, 0.5, 0], body: { radius_m: 0.05 } }]), registry), ['robot 1 overlaps a wall.']);
+  assert.deepEqual(findProblems(scenario([{ id: 1, pose: [0.04, 0.5, 0] }]), registry), []);
+  // A square 40 mm from the wall: it fits facing +x (its side 35 mm out), not turned 45 degrees (its corner 49.5 mm out).
+  assert.deepEqual(findProblems(scenario([{ id: 1, pose: [0.04, 0.5, 0], body: { outline_m: SQUARE } }]), registry), []);
+  assert.deepEqual(findProblems(scenario([{ id: 1, pose: [0.04, 0.5, 45], body: { outline_m: SQUARE } }]), registry), ['robot 1 overlaps a wall.']);
+  // Two squares side by side 72 mm apart fit; turned 45 degrees their corners meet.
+  const two = (th) => scenario([{ id: 1, pose: [0.5, 0.5, th], body: { outline_m: SQUARE } }, { id: 2, pose: [0.572, 0.5, th], body: { outline_m: SQUARE } }]);
+  assert.deepEqual(findProblems(two(0), registry), []);
+  assert.deepEqual(findProblems(two(45), registry), ['robots 1 and 2 overlap.']);
+  // A square and a Khepera: 65 mm apart they are clear along the square's side, not towards its corner.
+  const squareAndDisc = (th) => scenario([{ id: 1, pose: [0.5, 0.5, th], body: { outline_m: SQUARE } }, { id: 2, pose: [0.565, 0.5, 0] }]);
+  assert.deepEqual(findProblems(squareAndDisc(0), registry), []);
+  assert.deepEqual(findProblems(squareAndDisc(45), registry), ['robots 1 and 2 overlap.']);
+  // Against an obstacle: the wedge's nose reaches it facing it, not facing away.
+  const obstacles = [{ name: 'box', polygon: [[0.55, 0.4], [0.7, 0.4], [0.7, 0.6], [0.55, 0.6]] }];
+  const wedge = (th) => scenario([{ id: 1, pose: [0.5, 0.5, th], body: { outline_m: WEDGE } }], { obstacles });
+  assert.deepEqual(findProblems(wedge(0), registry), ['robot 1 overlaps obstacle 1 (box).']);
+  assert.deepEqual(findProblems(wedge(180), registry), []);
+  // A model alone is the model file's body, which the page does not read: checked as a Khepera.
+  assert.deepEqual(findProblems(scenario([{ id: 1, pose: [0.04, 0.5, 0], model: 'epuck' }]), registry), []);
 });
 
 test('obstacles, tracks and beacons', () => {

@@ -62,6 +62,55 @@ test('writing: a library path the flow style cannot hold plainly is quoted, and 
   assert.deepEqual(readScenarioText(scenarioText(doc)).doc, doc);
 });
 
+// Robots of parts (robots/*.yaml named by model:, with body and wheels overrides), in the
+// editor's style: saved as read, every key of every entry kept.
+const BODIES = `# Robot models and overrides.
+name: bodies
+field: {width_m: 1.2, height_m: 1}
+duration_s: 30
+robots:
+  - ids: 1-2
+    model: epuck
+    controller: wander
+  - id: 3
+    model: robots/square.yaml
+    pose: [0.3, 0.3, 30]
+    controller: wander
+    wheels: {base_m: 0.058}
+  - id: 4
+    model: epuck
+    body: {outline_m: [[0.065, 0], [-0.025, 0.035], [-0.025, -0.035]]}
+    wheels: {base_m: 0.064, radius_m: 0.018}
+    pose: [0.6, 0.5, 90]
+    controller: wander
+  - id: 5
+    body: {radius_m: 0.05}
+    pose: [0.9, 0.5, 0]
+    controller: wander
+`;
+
+test('round trip: model, body and wheels of robot entries are saved as they were read', () => {
+  const { doc, header } = readScenarioText(BODIES);
+  assert.equal(doc.robots[1].model, 'robots/square.yaml');
+  assert.deepEqual(doc.robots[2].body, { outline_m: [[0.065, 0], [-0.025, 0.035], [-0.025, -0.035]] });
+  assert.deepEqual(doc.robots[2].wheels, { base_m: 0.064, radius_m: 0.018 });
+  assert.deepEqual(doc.robots[3].body, { radius_m: 0.05 });
+  assert.equal(scenarioText(doc, header), BODIES);
+  assert.deepEqual(findProblems(doc, registry), []);
+});
+
+test('round trip: an outline written in block style reads back the same, written in flow style', () => {
+  const block = BODIES.replace('    body: {outline_m: [[0.065, 0], [-0.025, 0.035], [-0.025, -0.035]]}\n',
+    '    body:\n      outline_m:\n        - [0.065, 0]\n        - [-0.025, 0.035]\n        - [-0.025, -0.035]\n');
+  assert.notEqual(block, BODIES);
+  const { doc, header } = readScenarioText(block);
+  assert.equal(scenarioText(doc, header), BODIES);
+  // A long outline (16 points) still reads back the same.
+  const round6 = (v) => Math.round(v * 1e6) / 1e6 + 0; // (+ 0: never -0, which JSON makes 0)
+  doc.robots[2].body.outline_m = Array.from({ length: 16 }, (_, k) => [0.041234 * Math.cos((k * Math.PI) / 8), 0.041234 * Math.sin((k * Math.PI) / 8)].map(round6));
+  assert.deepEqual(readScenarioText(scenarioText(doc)).doc, JSON.parse(JSON.stringify(doc)));
+});
+
 test('readScenarioText refuses what is not YAML or not a mapping, saying so', () => {
   assert.throws(() => readScenarioText('robots: [1, 2'), /^Error: not valid YAML: /);
   assert.throws(() => readScenarioText('- 1\n- 2\n'), /not a scenario \(a mapping of keys is expected\)/);
