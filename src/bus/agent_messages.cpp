@@ -18,15 +18,27 @@ rilbed::agent_input_t to_lcm(const agents::ControlInput& input) {
   m.y_m = input.pose ? input.pose->position_m.y : 0.0;
   m.theta_rad = input.pose ? input.pose->heading_rad : 0.0;
   fill(m.sensors, input.robot_id, input.sensors);
+  m.models.id = input.robot_id;
+  for (const environment::ModelReading& model : input.sensors.models) {
+    rilbed::model_reading_t reading;
+    reading.name = std::string(model.name);
+    reading.values = model.values;
+    reading.num_values = static_cast<std::int16_t>(reading.values.size());
+    m.models.readings.push_back(std::move(reading));
+  }
+  m.models.num_readings = static_cast<std::int16_t>(m.models.readings.size());
+  m.models.num_marks = 0;  // marks are for displays, not controllers
   return m;
 }
 
-agents::ControlInput from_lcm(const rilbed::agent_input_t& m, TimeUs t_us) {
+agents::ControlInput from_lcm(const rilbed::agent_input_t& m, TimeUs t_us, std::set<std::string, std::less<>>& names) {
   agents::ControlInput input;
   input.t_us = t_us;
   input.robot_id = m.id;
   if (m.has_pose) input.pose = Pose2{{m.x_m, m.y_m}, m.theta_rad};
   input.sensors = from_lcm(m.sensors, t_us);
+  // (Checked by plausible(); past the names' bound a robot's models are left out.)
+  merge_models(m.models, input.sensors, names);
   return input;
 }
 
@@ -80,6 +92,7 @@ bool plausible(const rilbed::quantum_t& q) {
     if (!std::all_of(s.range_m.begin(), s.range_m.end(), finite)) return false;
     if (!std::all_of(s.beacon_bearing_rad.begin(), s.beacon_bearing_rad.end(), finite)) return false;
     if (std::any_of(s.track.begin(), s.track.end(), [](std::int32_t v) { return v < 0; })) return false;
+    if (models_problem(in.models)) return false;
   }
   for (const rilbed::team_member_t& m : q.team) {
     if (!(finite(m.x_m) && finite(m.y_m) && finite(m.theta_rad))) return false;

@@ -3,7 +3,9 @@
 // controller stepped in another process decides exactly as it would in the run's.
 #pragma once
 
+#include <set>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -17,10 +19,13 @@
 
 namespace rilbed::bus {
 
-/// `input`'s robot, pose and sensors (not its team: see to_lcm(TeamMessage)).
+/// `input`'s robot, pose, sensors and sensor models' readings (not their marks, nor its
+/// team: see to_lcm(TeamMessage)).
 rilbed::agent_input_t to_lcm(const agents::ControlInput& input);
-/// Back to a ControlInput at `t_us` (its team left empty).
-agents::ControlInput from_lcm(const rilbed::agent_input_t& message, TimeUs t_us);
+/// Back to a ControlInput at `t_us` (its team left empty), its sensor models' names interned
+/// in `model_names` (which must outlive the input).
+agents::ControlInput from_lcm(const rilbed::agent_input_t& message, TimeUs t_us,
+                              std::set<std::string, std::less<>>& model_names);
 
 rilbed::team_member_t to_lcm(const agents::TeamMessage& member);
 /// Its behaviour interned (agents::intern_behaviour).

@@ -107,7 +107,7 @@ void AgentServer::on_quantum(const void* data, std::size_t size) {
   for (const rilbed::agent_input_t& in : q.inputs) {
     const auto it = controllers_.find(in.id);
     if (it == controllers_.end() || !it->second) continue;  // not one of ours
-    agents::ControlInput input = from_lcm(in, q.utime);
+    agents::ControlInput input = from_lcm(in, q.utime, model_names_);
     if (q.has_team && it->second->wants_team()) input.team = team;
     run::RemoteOutput out;
     out.robot_id = in.id;

@@ -9,6 +9,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -85,7 +86,8 @@ class AgentServer {
   std::string run_;  // the run being served, empty between runs
   bool run_ended_ = false;
   std::int64_t last_quantum_ = -1;
-  rilbed::quantum_reply_t last_reply_;  // sent again for a repeat
+  rilbed::quantum_reply_t last_reply_;              // sent again for a repeat
+  std::set<std::string, std::less<>> model_names_;  // what its controllers' sensor-model readings name
   std::map<int, std::unique_ptr<agents::Controller>> controllers_;
   std::chrono::steady_clock::time_point last_quantum_at_{};
   AgentServerCounters counters_;

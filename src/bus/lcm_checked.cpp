@@ -244,20 +244,21 @@ void fields(Walk& w, const rilbed::robot_bodies_t*) {
   w.skip(static_cast<std::size_t>(robots) * 2 * 4);
 }
 
+void robot_models(Walk& w) {
+  w.i32();
+  const std::int32_t readings = w.count(w.i16(), 4 + 1 + 2);  // an empty name, no values
+  for (std::int32_t k = 0; k < readings && w.ok(); ++k) {
+    w.string();
+    const std::int32_t values = w.count(w.i16(), 8);
+    w.skip(static_cast<std::size_t>(values) * 8);
+  }
+  const std::int32_t marks = w.count(w.i16(), 1 + 5 * 8 + 4);
+  w.skip(static_cast<std::size_t>(marks) * (1 + 5 * 8 + 4));
+}
 void fields(Walk& w, const rilbed::sensor_models_t*) {
   w.i64();
   const std::int32_t robots = w.count(w.i32(), 4 + 2 + 2);  // a robot with neither readings nor marks
-  for (std::int32_t r = 0; r < robots && w.ok(); ++r) {
-    w.i32();
-    const std::int32_t readings = w.count(w.i16(), 4 + 1 + 2);  // an empty name, no values
-    for (std::int32_t k = 0; k < readings && w.ok(); ++k) {
-      w.string();
-      const std::int32_t values = w.count(w.i16(), 8);
-      w.skip(static_cast<std::size_t>(values) * 8);
-    }
-    const std::int32_t marks = w.count(w.i16(), 1 + 5 * 8 + 4);
-    w.skip(static_cast<std::size_t>(marks) * (1 + 5 * 8 + 4));
-  }
+  for (std::int32_t r = 0; r < robots && w.ok(); ++r) robot_models(w);
 }
 
 // The agent exchange (processes of their own, here or on other machines).
@@ -276,6 +277,7 @@ void agent_input(Walk& w) {
   w.f64();
   w.f64();
   robot_sensors(w);
+  robot_models(w);
 }
 void team_member(Walk& w) {
   w.i32();

@@ -162,10 +162,8 @@ bool fill(rilbed::sensor_models_t& m, TimeUs t_us, std::span<const run::SensorRe
   return !m.robots.empty();
 }
 
-std::optional<std::string> merge_models(const rilbed::robot_models_t& m, environment::SensorReadings& readings,
-                                        std::set<std::string, std::less<>>& names) {
-  constexpr std::size_t kMostValues = 64, kLongestName = 64, kMostNames = 1024;
-  std::vector<environment::ModelReading> models;
+std::optional<std::string> models_problem(const rilbed::robot_models_t& m) {
+  constexpr std::size_t kMostValues = 64, kLongestName = 64;
   for (const rilbed::model_reading_t& r : m.readings) {
     const bool printable = std::all_of(r.name.begin(), r.name.end(), [](char c) { return c >= 0x20 && c < 0x7f; });
     if (r.name.empty() || r.name.size() > kLongestName || !printable)
@@ -174,6 +172,22 @@ std::optional<std::string> merge_models(const rilbed::robot_models_t& m, environ
       return "model '" + r.name + "' has " + std::to_string(r.values.size()) + " values";
     if (!std::all_of(r.values.begin(), r.values.end(), [](double v) { return std::isfinite(v); }))
       return "model '" + r.name + "' has a value that is not finite";
+  }
+  for (const rilbed::sensor_mark_t& x : m.marks) {
+    if (x.shape != 0 && x.shape != 1) return "a mark of shape " + std::to_string(x.shape);
+    for (const double v : {x.x_m, x.y_m, x.radius_m, x.x2_m, x.y2_m})
+      if (!std::isfinite(v)) return "a mark that is not finite";
+    if (x.radius_m < 0.0) return "a circle of negative radius";
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> merge_models(const rilbed::robot_models_t& m, environment::SensorReadings& readings,
+                                        std::set<std::string, std::less<>>& names) {
+  if (auto problem = models_problem(m)) return problem;
+  constexpr std::size_t kMostNames = 1024;
+  std::vector<environment::ModelReading> models;
+  for (const rilbed::model_reading_t& r : m.readings) {
     auto name = names.find(r.name);
     if (name == names.end()) {
       // A hostile stream of new names must not grow the decoder without bound.
@@ -184,10 +198,6 @@ std::optional<std::string> merge_models(const rilbed::robot_models_t& m, environ
   }
   std::vector<environment::SensorMark> marks;
   for (const rilbed::sensor_mark_t& x : m.marks) {
-    if (x.shape != 0 && x.shape != 1) return "a mark of shape " + std::to_string(x.shape);
-    for (const double v : {x.x_m, x.y_m, x.radius_m, x.x2_m, x.y2_m})
-      if (!std::isfinite(v)) return "a mark that is not finite";
-    if (x.radius_m < 0.0) return "a circle of negative radius";
     marks.push_back({x.shape == 0 ? environment::SensorMark::Shape::kCircle : environment::SensorMark::Shape::kLine,
                      {x.x_m, x.y_m},
                      {x.x2_m, x.y2_m},

@@ -49,6 +49,8 @@ void fill(rilbed::sensors_t& message, TimeUs t_us, std::span<const run::SensorRe
 /// The robots' sensor-model readings and marks (robots with neither left out); false when
 /// no robot has any (nothing to publish).
 bool fill(rilbed::sensor_models_t& message, TimeUs t_us, std::span<const run::SensorReport> sensors);
+/// Why one robot's model readings and marks are unusable (see merge_models), or nullopt.
+std::optional<std::string> models_problem(const rilbed::robot_models_t& message);
 /// One robot's model readings and marks into `readings` (its models and marks replaced),
 /// their names interned in `names` (which must outlive `readings`), or the reason the
 /// message is unusable: a name that is empty, longer than 64 bytes or not printable ASCII,

@@ -66,7 +66,10 @@ void read_body_parts(const Reader& r, RobotBody& body) {
       if (body.radius_m > 1.0) b.fail_key("radius_m", "is at most 1 m (a robot on a lab's table)");
       body.outline_m.clear();
     }
-    if (b.has("outline_m")) read_outline(b, body);
+    if (b.has("outline_m")) {
+      read_outline(b, body);
+      body.radius_m = environment::outline_bounding_radius_m(body.outline_m);
+    }
     if (!body.outline_m.empty() && environment::outline_bounding_radius_m(body.outline_m) > 1.0)
       b.fail_key("outline_m", "reaches more than 1 m from the centre (a robot on a lab's table)");
   }

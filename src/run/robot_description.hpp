@@ -35,7 +35,7 @@ inline constexpr double kKheperaWheelRadius_m = 0.00764;
 struct RobotBody {
   std::string name = "khepera2";                    ///< the model's name (for displays)
   std::string file;                                 ///< the model file, absolute; empty: built in
-  double radius_m = environment::kKheperaRadius_m;  ///< a disc (when outline_m is empty)
+  double radius_m = environment::kKheperaRadius_m;  ///< the disc; with an outline, its bounding radius
   std::vector<Vec2> outline_m;  ///< convex outline, robot frame (x forward, y left); empty: the disc
   double wheel_base_m = environment::kKheperaWheelBase_m;  ///< between the wheels' contact points
   double wheel_radius_m = kKheperaWheelRadius_m;           ///< drawn by the displays

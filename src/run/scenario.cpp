@@ -402,6 +402,11 @@ LinkSpec read_link(const Reader& l, const YAML::Node& at) {
   link.port = l.text("port", "");
   link.baud = l.integer("baud", link.baud);
   link.model = l.text("model", link.model);
+  // Checked here, not when the robot is connected; the firmware's other spellings too.
+  if (link.model == "khepera") link.model = "khepera2";
+  if (link.model == "e-puck") link.model = "epuck";
+  if (link.model != "khepera2" && link.model != "epuck")
+    l.fail_key("model", "is khepera2 or epuck, not '" + link.model + "'");
   link.emulate = l.boolean("emulate", false);
   link.reply_timeout_ms = l.integer("reply_timeout_ms", link.reply_timeout_ms);
   if (link.reply_timeout_ms <= 0) l.fail_key("reply_timeout_ms", "must be greater than 0");
@@ -477,8 +482,11 @@ std::vector<RobotSpec> read_robots(const Reader& top, ScenarioControllers& contr
       if (base.kind != environment::RobotKind::kReal) r.fail_key("link", "only a robot of kind real has a link");
       base.link = read_link(r.child("link"), r.get("link"));
       if (!r.child("link").has("model") && model.link.model) base.link->model = *model.link.model;
-      base.link->speed_unit_mps = model.link.speed_unit_mps;
-      base.link->counter_pulse_m = model.link.counter_pulse_m;
+      // The model's units are its protocol's: a link that speaks another keeps that one's own.
+      if (!model.link.model || *model.link.model == base.link->model) {
+        base.link->speed_unit_mps = model.link.speed_unit_mps;
+        base.link->counter_pulse_m = model.link.counter_pulse_m;
+      }
     } else if (base.kind == environment::RobotKind::kReal) {
       r.fail(list[i], "a robot of kind real needs a `link` ({port: /dev/ttyUSB0, baud: 38400} or {emulate: true})");
     }

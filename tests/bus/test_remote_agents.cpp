@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <random>
+#include <set>
 #include <thread>
 
 #include "agents/behaviour_names.hpp"
@@ -58,7 +59,11 @@ TEST(AgentMessages, AnInputAndAnOutputCrossTheWireExactly) {
   in.sensors.beacons = {{3, any(rng)}};
   in.sensors.track = {0, 17, 255};
   in.sensors.odometry = environment::OdometryReading{-123456789012LL, 42};
-  const agents::ControlInput back = from_lcm(to_lcm(in), in.t_us);
+  in.sensors.models.push_back({"to_goal", {any(rng), -3.0}});
+  in.sensors.models.push_back({"light", {}});
+  in.sensors.marks.push_back({environment::SensorMark::Shape::kCircle, {0.02, 0.0}, {}, 0.004, 0xffu});
+  std::set<std::string, std::less<>> names;
+  const agents::ControlInput back = from_lcm(to_lcm(in), in.t_us, names);
   EXPECT_EQ(back.robot_id, 7);
   EXPECT_EQ(back.t_us, in.t_us);
   ASSERT_TRUE(back.pose);
@@ -75,10 +80,23 @@ TEST(AgentMessages, AnInputAndAnOutputCrossTheWireExactly) {
   EXPECT_EQ(back.sensors.track, in.sensors.track);
   ASSERT_TRUE(back.sensors.odometry);
   EXPECT_EQ(back.sensors.odometry->left_pulses, -123456789012LL);
+  // Sensor models' values, as a controller reads them in the run's process; not the marks.
+  ASSERT_EQ(back.sensors.models.size(), 2u);
+  EXPECT_EQ(back.sensors.models[0].name, "to_goal");
+  EXPECT_TRUE(same_bits(back.sensors.models[0].values[0], in.sensors.models[0].values[0]));
+  EXPECT_TRUE(back.sensors.models[1].values.empty());
+  EXPECT_TRUE(back.sensors.marks.empty());
+  // A quantum whose input holds a model value that is not finite is not plausible.
+  rilbed::quantum_t q;
+  q.inputs.push_back(to_lcm(in));
+  q.num_inputs = 1;
+  EXPECT_TRUE(plausible(q));
+  q.inputs[0].models.readings[0].values[1] = std::nan("");
+  EXPECT_FALSE(plausible(q));
 
   agents::ControlInput unseen;
   unseen.robot_id = 2;
-  EXPECT_FALSE(from_lcm(to_lcm(unseen), 0).pose);
+  EXPECT_FALSE(from_lcm(to_lcm(unseen), 0, names).pose);
 
   const run::RemoteOutput out{4, agents::ControlOutput{{-127, 300}, "follow"}, true};
   const run::RemoteOutput got = from_lcm(to_lcm(out));

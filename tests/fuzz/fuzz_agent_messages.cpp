@@ -62,6 +62,11 @@ class TouchingController final : public agents::Controller {
     }
     for (const auto& b : in.sensors.beacons) FUZZ_CHECK(std::isfinite(b.bearing_rad));
     for (const int v : in.sensors.track) FUZZ_CHECK(v >= 0);
+    for (const auto& m : in.sensors.models) {
+      FUZZ_CHECK(!m.name.empty() && m.name.size() <= 64 && m.values.size() <= 64);
+      for (const double v : m.values) FUZZ_CHECK(std::isfinite(v));
+      sum += static_cast<double>(m.name.size());
+    }
     for (const auto& m : in.team) {
       FUZZ_CHECK(std::isfinite(m.pose.position_m.x));
       sum += static_cast<double>(m.behaviour.size());

@@ -59,9 +59,9 @@ std::string g_channel;  // the channel of the input being checked, for the repor
 const std::vector<std::string>& channel_names() {
   static const std::vector<std::string> names = [] {
     const bus::Channels c = bus::Channels::with_prefix("");
-    return std::vector<std::string>{c.poses,         c.events,  c.status,       c.world,         c.summary,
-                                    c.wheels,        c.sensors, c.detections,   c.frames,        c.camera,
-                                    c.sensor_layout, c.vision,  c.robot_bodies, c.sensor_models, "RILBED_UNKNOWN"};
+    return std::vector<std::string>{c.poses,         c.events,  c.status,         c.world,        c.summary,
+                                    c.wheels,        c.sensors, c.detections,     c.frames,       c.camera,
+                                    c.sensor_layout, c.vision,  "RILBED_UNKNOWN", c.robot_bodies, c.sensor_models};
   }();
   return names;
 }
@@ -78,9 +78,9 @@ enum Pick {
   kCamera,
   kSensorLayout,
   kVision,
+  kUnknown,  // (before the later channels: the seeds' first bytes keep their channels)
   kRobotBodies,
   kSensorModels,
-  kUnknown,
   kPicks
 };
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <unistd.h>
+#include <cmath>
 #include <fstream>
 #include <string>
 
@@ -53,6 +54,7 @@ TEST_F(RobotFiles, TheShippedModelsAreFoundByNameOrPath) {
   EXPECT_TRUE(epuck.outline_m.empty());
   const RobotBody& square = s.robots[1].body;
   ASSERT_EQ(square.outline_m.size(), 4u);
+  EXPECT_DOUBLE_EQ(square.radius_m, 0.035 * std::sqrt(2.0));  // its bounding disc
   EXPECT_DOUBLE_EQ(square.wheel_base_m, 0.06);
   EXPECT_EQ(std::filesystem::path(square.file).filename(), "square.yaml");
   // Khepera II's file is what a robot without a model is.
@@ -84,6 +86,10 @@ TEST_F(RobotFiles, AModelFilesLinkIsTheDefaultOfARealRobotsLink) {
   EXPECT_EQ(s.robots[0].link->model, "epuck");
   EXPECT_NEAR(*s.robots[0].link->speed_unit_mps, 0.000128805, 1e-12);
   EXPECT_EQ(s.robots[1].link->model, "khepera2");
+  EXPECT_FALSE(s.robots[1].link->speed_unit_mps);  // the e-puck's units are not a Khepera's
+  EXPECT_NE(error_of("  - {id: 1, kind: real, controller: none, link: {emulate: true, model: nxt}}\n")
+                .find("robots[0].link.model: is khepera2 or epuck, not 'nxt'"),
+            std::string::npos);
 }
 
 TEST_F(RobotFiles, EveryErrorNamesTheFileTheLineAndTheKey) {
