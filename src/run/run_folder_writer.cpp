@@ -28,10 +28,17 @@ void RunFolderWriter::on_world(TimeUs, const WorldReport& world) {
     if (detections_.is_open()) detections_.close();
     finished_ = false;
   }
+  FieldDrawing field = world.field;
+  for (const auto& [id, index] : world.body_of) {
+    if (index < 0 || static_cast<std::size_t>(index) >= world.bodies.size()) continue;
+    const BodyDrawing& body = world.bodies[static_cast<std::size_t>(index)];
+    field.body_radius_m[id] = body.radius_m;
+    if (!body.outline_m.empty()) field.body_outline_m[id] = body.outline_m;
+  }
   if (recorder_) {
-    recorder_->set_field(world.field);
+    recorder_->set_field(field);
   } else {
-    recorder(&world.field);
+    recorder(&field);
   }
 }
 

@@ -146,7 +146,6 @@ void RunRecorder::write_svg() const {
     const Screen s = screen(b);
     svg << "<circle r=\"6\" fill=\"#fc0\" stroke=\"#a80\" cx=\"" << s.x << "\" cy=\"" << s.y << "\"/>\n";
   }
-  const double body_r = 0.0275 * scale;  // a Khepera is 55 mm across
   int index = 0;
   for (const auto& [id, path] : paths_) {
     const char* c = colour(index++);
@@ -163,11 +162,23 @@ void RunRecorder::write_svg() const {
     const auto it = last_pose_.find(id);
     if (it != last_pose_.end()) {
       const Pose2& p = it->second;
+      const auto radius = field_.body_radius_m.find(id);
+      const double radius_m = radius != field_.body_radius_m.end() ? radius->second : 0.0275;  // a Khepera's
+      const double body_r = radius_m * scale;
       const Screen centre = screen(p.position_m);
-      const Screen nose = screen(p.position_m + Vec2{std::cos(p.heading_rad), std::sin(p.heading_rad)} * 0.0275);
+      const Screen nose = screen(p.position_m + Vec2{std::cos(p.heading_rad), std::sin(p.heading_rad)} * radius_m);
       const std::string& cx = centre.x;
       const std::string& cy = centre.y;
-      if (real) {
+      if (const auto outline = field_.body_outline_m.find(id); outline != field_.body_outline_m.end()) {
+        // Its outline, turned with it; dashed when real.
+        const double ch = std::cos(p.heading_rad), sh = std::sin(p.heading_rad);
+        svg << "<polygon class=\"" << (real ? "real" : "virtual") << "\" fill=\"" << c
+            << "\" fill-opacity=\"0.35\" stroke=\"" << (real ? "#000" : c) << "\""
+            << (real ? " stroke-width=\"2\"" : "") << " points=\"";
+        for (const Vec2& v : outline->second)
+          svg << px(p.position_m + Vec2{ch * v.x - sh * v.y, sh * v.x + ch * v.y}) << ' ';
+        svg << "\"/>\n";
+      } else if (real) {
         svg << "<rect class=\"real\" width=\"" << format("%.1f", 2 * body_r) << "\" height=\""
             << format("%.1f", 2 * body_r) << "\" x=\"" << format("%.1f", std::stod(cx) - body_r) << "\" y=\""
             << format("%.1f", std::stod(cy) - body_r) << "\" fill=\"" << c

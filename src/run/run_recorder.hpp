@@ -49,6 +49,10 @@ struct FieldDrawing {
   std::vector<Vec2> beacons;
   /// Robots that are real (drawn apart from virtual ones, with a legend).
   std::set<int> real_robot_ids;
+  /// Robots' bodies where the run described them: a disc's radius, or a convex outline in
+  /// the robot's frame; a robot in neither is drawn as a Khepera (27.5 mm).
+  std::map<int, double> body_radius_m;
+  std::map<int, std::vector<Vec2>> body_outline_m;
 };
 
 /// Writes one run's folder. Not thread-safe. The picture shows each robot's path (solid

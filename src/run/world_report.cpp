@@ -9,7 +9,7 @@ namespace rilbed::run {
 namespace {}  // namespace
 
 FieldDrawing field_drawing(const Scenario& scenario, const std::vector<int>& real_ids) {
-  FieldDrawing drawing{scenario.map.field.width_m, scenario.map.field.height_m, {}, {}, {}, {}};
+  FieldDrawing drawing{scenario.map.field.width_m, scenario.map.field.height_m, {}, {}, {}, {}, {}, {}};
   for (const auto& o : scenario.map.obstacles) drawing.obstacles.push_back(o.vertices_m);
   for (const auto& t : scenario.map.tracks) {
     auto points = t.points_m;
@@ -18,6 +18,10 @@ FieldDrawing field_drawing(const Scenario& scenario, const std::vector<int>& rea
   }
   for (const auto& b : scenario.map.beacons) drawing.beacons.push_back(b.position_m);
   drawing.real_robot_ids = {real_ids.begin(), real_ids.end()};
+  for (const RobotSpec& r : scenario.robots) {
+    drawing.body_radius_m[r.id] = r.body.radius_m;
+    if (!r.body.outline_m.empty()) drawing.body_outline_m[r.id] = r.body.outline_m;
+  }
   return drawing;
 }
 

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 
+#include "lcm_namespace.hpp"
 #include "run_command.hpp"
 
 namespace rilbed::e2e {
@@ -52,6 +53,15 @@ TEST(RobotModelsCli, TheWedgeBotExampleRunsBesideTheShippedModels) {
   // The same seed, the same run.
   ASSERT_EQ(run_rilbed("run " + quoted(scenario) + " --fast --seed 2 --out " + quoted(scratch / "again")).exit_code, 0);
   EXPECT_EQ(read_file(scratch / "run" / "trajectories.csv"), read_file(scratch / "again" / "trajectories.csv"));
+
+  // In agent processes (on a bus inside a network namespace of the test's own), which read
+  // the scenario's model files as the run does: the same run.
+  std::ofstream(scenario, std::ios::app) << "agents: {processes: 2}\n";
+  const fs::path agents_out = scratch / "agents";
+  const int status = in_namespace(scratch / "wedge_bot", "\"$R\" run mixed_team.yaml --fast --seed 2 --out '" +
+                                                             agents_out.string() + "' --lcm \"$URL\" > run.txt 2>&1\n");
+  ASSERT_EQ(status, 0) << read_file(scratch / "wedge_bot" / "run.txt");
+  EXPECT_EQ(read_file(scratch / "run" / "trajectories.csv"), read_file(agents_out / "trajectories.csv"));
 
   // A lab's edit that breaks its model: refused, naming the scenario's line, the model
   // file, its line and its key.

@@ -147,7 +147,16 @@ TEST_F(RobotFiles, SquareRobotsRunWithTheirOutlinesAndNeverOverlap) {
   RunOptions o;
   o.seed = 5;
   o.keep_in_memory = true;
+  o.out_dir = dir_ / "run";
   const RunResult r = run_scenario(s, o);
+  // The picture draws each square's outline and each e-puck's disc at its last pose.
+  std::ifstream svg_in(dir_ / "run" / "trajectories.svg");
+  const std::string svg((std::istreambuf_iterator<char>(svg_in)), std::istreambuf_iterator<char>());
+  std::size_t outlines = 0;
+  for (auto at = svg.find("<polygon class=\"virtual\""); at != std::string::npos;
+       at = svg.find("<polygon class=\"virtual\"", at + 1))
+    ++outlines;
+  EXPECT_EQ(outlines, 6u);
   EXPECT_LT(r.max_overlap_m, 1e-6);
   EXPECT_DOUBLE_EQ(r.simulated_s, 30.0) << r.ended_by;
   EXPECT_GT(r.collisions, 0);  // wanderers in a small field meet walls and each other
