@@ -58,7 +58,19 @@ environment::SensorReadings RealBody::sense(TimeUs t_us) {
       (*r.proximity)[i] = std::max((*r.proximity)[i], value);
     }
   }
-  if (const auto counters = link_->latest_counters()) r.odometry = counters->value;
+  if (const auto counters = link_->latest_counters()) {
+    // In the controllers' pulses of 0.08 mm, whatever the firmware counts (an e-puck's
+    // motor steps are 0.129 mm; a Khepera's pass unchanged).
+    const double pulse_m = link_->config().model.counter_pulse_m;
+    auto in_pulses = [pulse_m](std::int64_t counts) {
+      return pulse_m == environment::kKheperaPulse_m
+                 ? counts
+                 : static_cast<std::int64_t>(
+                       std::llround(static_cast<double>(counts) * pulse_m / environment::kKheperaPulse_m));
+    };
+    r.odometry =
+        environment::OdometryReading{in_pulses(counters->value.left_pulses), in_pulses(counters->value.right_pulses)};
+  }
   link_->request_proximity();  // fresh for the next step (ignored if one is queued)
   return r;
 }

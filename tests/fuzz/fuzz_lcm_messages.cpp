@@ -339,9 +339,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     FUZZ_CHECK(seen.calls.total() == 0);
     FUZZ_CHECK(problem->rfind(g_channel + ": ", 0) == 0);
   } else {
-    // A camera is kept for the next world (which carries it): no call of its own.
-    FUZZ_CHECK(seen.calls.total() ==
-               (pick == kUnknown || pick == kCamera || pick == kSensorLayout || pick == kVision ? 0 : 1));
+    // A camera is kept for the next world (which carries it), sensor models for the next
+    // sensors: no call of their own.
+    const bool kept =
+        pick == kCamera || pick == kSensorLayout || pick == kVision || pick == kRobotBodies || pick == kSensorModels;
+    FUZZ_CHECK(seen.calls.total() == (pick == kUnknown || kept ? 0 : 1));
   }
   FUZZ_CHECK(decoder.summary_seen() == (seen.calls.summary == 1));
   FUZZ_CHECK(decoder.last_status().has_value() == (seen.calls.status == 1));
@@ -416,7 +418,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       }
       FUZZ_CHECK(readable && plausible);
       check_round_trip(m, message, length);
-      rilbed::world_t world;
+      rilbed::world_t world{};
       std::vector<std::uint8_t> bytes(static_cast<std::size_t>(world.getEncodedSize()));
       FUZZ_CHECK(world.encode(bytes.data(), 0, static_cast<int>(bytes.size())) > 0);
       FUZZ_CHECK(!decoder.decode(bus::Channels::with_prefix("").world, bytes.data(), bytes.size()));
@@ -475,7 +477,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       }
       FUZZ_CHECK(consistent);
       check_round_trip(m, message, length);
-      rilbed::world_t world;
+      rilbed::world_t world{};
       std::vector<std::uint8_t> bytes(static_cast<std::size_t>(world.getEncodedSize()));
       FUZZ_CHECK(world.encode(bytes.data(), 0, static_cast<int>(bytes.size())) > 0);
       FUZZ_CHECK(!decoder.decode(bus::Channels::with_prefix("").world, bytes.data(), bytes.size()));
@@ -505,7 +507,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       FUZZ_CHECK(usable == !problem);
       if (problem) break;
       check_round_trip(m, message, length);
-      rilbed::world_t world;
+      rilbed::world_t world{};
       std::vector<std::uint8_t> bytes(static_cast<std::size_t>(world.getEncodedSize()));
       FUZZ_CHECK(world.encode(bytes.data(), 0, static_cast<int>(bytes.size())) > 0);
       FUZZ_CHECK(!decoder.decode(bus::Channels::with_prefix("").world, bytes.data(), bytes.size()));
@@ -528,7 +530,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       FUZZ_CHECK(readable == !problem);
       if (problem) break;
       check_round_trip(m, message, length);
-      rilbed::sensors_t step;
+      rilbed::sensors_t step{};
       step.utime = m.utime;
       std::set<std::int32_t> ids;
       for (const rilbed::robot_models_t& r : m.robots)

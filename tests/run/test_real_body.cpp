@@ -375,6 +375,7 @@ class EpuckBodyTest : public RealBodyTest {
 TEST_F(EpuckBodyTest, ConvertsSpeedsAndProximityToTheModelsUnits) {
   serial::LinkConfig config = link_config();
   config.model = serial::epuck_model();
+  config.counters_period_ms = 20;  // so that sense() also reports the robot's counters
   make_body(config);
   observe(0.75, 0.6, 0.0);
   // 10 Khepera units are 80 mm/s: 621 e-puck steps of 0.129 mm per second.
@@ -388,4 +389,17 @@ TEST_F(EpuckBodyTest, ConvertsSpeedsAndProximityToTheModelsUnits) {
   })) << log_.text();
   const auto r = body_->sense(world_.time_us());
   EXPECT_EQ((*r.proximity)[2], 512);  // 2048 of 4095, on the 0..1023 scale
+  // Its wheel counters, in motor steps of 0.129 mm, reach the controller in pulses of 0.08 mm.
+  ASSERT_TRUE(eventually([&] {
+    const auto c = body_->link().latest_counters();
+    return c && c->value.left_pulses > 20;
+  })) << log_.text();
+  // The left wheel goes forward: its count between the reads before and after the body's.
+  const auto before = body_->link().latest_counters();
+  const auto odometry = body_->sense(world_.time_us()).odometry;
+  const auto after = body_->link().latest_counters();
+  ASSERT_TRUE(odometry.has_value());
+  const double per_step = serial::epuck_model().counter_pulse_m / environment::kKheperaPulse_m;
+  EXPECT_GE(static_cast<double>(odometry->left_pulses), static_cast<double>(before->value.left_pulses) * per_step - 1);
+  EXPECT_LE(static_cast<double>(odometry->left_pulses), static_cast<double>(after->value.left_pulses) * per_step + 1);
 }
