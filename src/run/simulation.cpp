@@ -4,6 +4,8 @@
 #include <array>
 #include <random>
 #include <set>
+#include <stop_token>
+#include <thread>
 
 #include "core/id_list.hpp"
 #include "run/camera_model.hpp"
@@ -249,15 +251,41 @@ void Run::attach_control() {
   control_attached_ = true;
 }
 
+std::jthread Run::interrupt_watcher(std::atomic<bool>& fired) {
+  // A paused real-time run sleeps in its clock, where the monitor (which checks the
+  // interrupt each control step) never runs: Ctrl-C would do nothing until someone resumed.
+  // This turns an interrupt while paused into a stop; end() then stops every robot.
+  if (!options_.realtime || !options_.interrupt) return {};
+  return std::jthread([this, &fired](const std::stop_token& stop) {
+    constexpr auto kPoll = std::chrono::milliseconds(50);
+    while (!stop.stop_requested()) {
+      if (options_.interrupt->load() && real_clock_->paused()) {
+        fired.store(true);
+        coordinator_->stop();
+        return;
+      }
+      std::this_thread::sleep_for(kPoll);
+    }
+  });
+}
+
 void Run::loop() {
   const environment::WorldStepTimes world_times_before = world_.step_times();
   const auto run_start = std::chrono::steady_clock::now();
   const double cpu_start = thread_cpu_seconds();
-  try {
-    coordinator_->run_until(end_us_);
-  } catch (const std::exception& e) {
-    failure_ = std::current_exception();
-    result_.ended_by = std::string("error: ") + e.what();
+  std::atomic<bool> interrupted_paused{false};
+  {
+    const std::jthread watcher = interrupt_watcher(interrupted_paused);
+    try {
+      coordinator_->run_until(end_us_);
+    } catch (const std::exception& e) {
+      failure_ = std::current_exception();
+      result_.ended_by = std::string("error: ") + e.what();
+    }
+  }  // (the watcher is asked to stop and joined here)
+  if (interrupted_paused.load() && result_.ended_by.empty()) {
+    result_.ended_by = "interrupt";
+    monitor_->record_event({coordinator_->now_us(), "console", 0, 0, "interrupted while paused"});
   }
   if (control_attached_) options_.control->detach();
   control_attached_ = false;

@@ -15,6 +15,7 @@
 #include <exception>
 #include <memory>
 #include <optional>
+#include <thread>
 #include <vector>
 
 #include "agents/body.hpp"
@@ -63,6 +64,9 @@ class Run {
   RunResult end();
 
  private:
+  // A thread that stops the run when an interrupt comes while it is paused (none for a
+  // fast run, or without an interrupt flag); `fired` tells loop() it did.
+  std::jthread interrupt_watcher(std::atomic<bool>& fired);
   void check_convoy();
   void make_bodies(const RealBodyFactory& real_bodies);
   void add_agents();

@@ -4,10 +4,14 @@
 // a reset, and the refusals.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <filesystem>
+#include <future>
 #include <map>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "run/run_control.hpp"
@@ -168,6 +172,43 @@ TEST(RunControl, ResetEndsTheRunToStartItOver) {
   EXPECT_LT(r.simulated_s, 2.0);
   EXPECT_TRUE(script.has_event("reset by test: the run starts over"));
   EXPECT_EQ(script.statuses.back().ended_by, "reset");
+}
+
+}  // namespace
+}  // namespace rilbed::run
+
+namespace rilbed::run {
+namespace {
+
+// Ctrl-C ends a paused run: a paused real-time run sleeps in its clock, where the monitor
+// never looks at the interrupt; the run must end (its robots stopped) without a resume.
+TEST(RunControl, AnInterruptEndsAPausedRun) {
+  RunControl control;
+  Script script;
+  script.actions = {{300'000, action(ControlAction::Kind::kPause)}};
+  std::atomic<bool> interrupt{false};
+  script.control = &control;
+  RunOptions o;
+  o.seed = 2;
+  o.duration_s = 60.0;
+  o.realtime = true;
+  o.observer = &script;
+  o.control = &control;
+  o.interrupt = &interrupt;
+  auto run = std::async(std::launch::async, [&] { return run_scenario(shipped("convoy_sim"), o); });
+  // Wait for what is expected: the run paused, then ended by the interrupt.
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (!control.paused() && std::chrono::steady_clock::now() < give_up)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_TRUE(control.paused());
+  interrupt.store(true);
+  const bool ended = run.wait_until(give_up) == std::future_status::ready;
+  if (!ended) control.act(action(ControlAction::Kind::kResume));  // let it end, to fail cleanly
+  EXPECT_TRUE(ended) << "a paused run ignored the interrupt";
+  const RunResult r = run.get();
+  EXPECT_EQ(r.ended_by, "interrupt");
+  EXPECT_LT(r.simulated_s, 1.0);
+  EXPECT_TRUE(script.has_event("interrupted while paused"));
 }
 
 }  // namespace
