@@ -8,6 +8,7 @@
 #include <system_error>
 
 #include "agents/c_controller.hpp"
+#include "core/beside_executable.hpp"
 #include "rilbed/plugin.h"
 
 namespace rilbed::agents {
@@ -79,12 +80,6 @@ void* PluginLibrary::symbol(const char* name) const {
   return dlsym(handle_, name);
 }
 
-std::filesystem::path builtin_plugin_directory() {
-  if (const char* dir = std::getenv("RILBED_PLUGIN_DIR"); dir && *dir) return dir;
-  std::error_code ec;
-  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (ec) return "plugins";
-  return exe.parent_path() / "plugins";
-}
+std::filesystem::path builtin_plugin_directory() { return core::beside_executable("plugins", "RILBED_PLUGIN_DIR"); }
 
 }  // namespace rilbed::agents

@@ -18,16 +18,7 @@ rilbed::agent_input_t to_lcm(const agents::ControlInput& input) {
   m.y_m = input.pose ? input.pose->position_m.y : 0.0;
   m.theta_rad = input.pose ? input.pose->heading_rad : 0.0;
   fill(m.sensors, input.robot_id, input.sensors);
-  m.models.id = input.robot_id;
-  for (const environment::ModelReading& model : input.sensors.models) {
-    rilbed::model_reading_t reading;
-    reading.name = std::string(model.name);
-    reading.values = model.values;
-    reading.num_values = static_cast<std::int16_t>(reading.values.size());
-    m.models.readings.push_back(std::move(reading));
-  }
-  m.models.num_readings = static_cast<std::int16_t>(m.models.readings.size());
-  m.models.num_marks = 0;  // marks are for displays, not controllers
+  m.models = models_to_lcm(input.robot_id, input.sensors, /*with_marks=*/false);  // marks are for displays
   return m;
 }
 

@@ -128,22 +128,18 @@ void fill(rilbed::sensors_t& m, TimeUs t_us, std::span<const run::SensorReport> 
   for (std::size_t i = 0; i < sensors.size(); ++i) fill(m.robots[i], sensors[i].id, *sensors[i].readings);
 }
 
-bool fill(rilbed::sensor_models_t& m, TimeUs t_us, std::span<const run::SensorReport> sensors) {
-  m.utime = t_us;
-  m.robots.clear();
-  for (const run::SensorReport& s : sensors) {
-    const environment::SensorReadings& r = *s.readings;
-    if (r.models.empty() && r.marks.empty()) continue;
-    rilbed::robot_models_t out;
-    out.id = s.id;
-    for (const environment::ModelReading& model : r.models) {
-      rilbed::model_reading_t reading;
-      reading.name = std::string(model.name);
-      reading.values = model.values;
-      reading.num_values = static_cast<std::int16_t>(reading.values.size());
-      out.readings.push_back(std::move(reading));
-    }
-    out.num_readings = static_cast<std::int16_t>(out.readings.size());
+rilbed::robot_models_t models_to_lcm(int id, const environment::SensorReadings& r, bool with_marks) {
+  rilbed::robot_models_t out;
+  out.id = id;
+  for (const environment::ModelReading& model : r.models) {
+    rilbed::model_reading_t reading;
+    reading.name = std::string(model.name);
+    reading.values = model.values;
+    reading.num_values = static_cast<std::int16_t>(reading.values.size());
+    out.readings.push_back(std::move(reading));
+  }
+  out.num_readings = static_cast<std::int16_t>(out.readings.size());
+  if (with_marks) {
     for (const environment::SensorMark& mark : r.marks) {
       rilbed::sensor_mark_t x;
       x.shape = mark.shape == environment::SensorMark::Shape::kCircle ? 0 : 1;
@@ -155,8 +151,17 @@ bool fill(rilbed::sensor_models_t& m, TimeUs t_us, std::span<const run::SensorRe
       x.rgba = static_cast<std::int32_t>(mark.rgba);
       out.marks.push_back(x);
     }
-    out.num_marks = static_cast<std::int16_t>(out.marks.size());
-    m.robots.push_back(std::move(out));
+  }
+  out.num_marks = static_cast<std::int16_t>(out.marks.size());
+  return out;
+}
+
+bool fill(rilbed::sensor_models_t& m, TimeUs t_us, std::span<const run::SensorReport> sensors) {
+  m.utime = t_us;
+  m.robots.clear();
+  for (const run::SensorReport& s : sensors) {
+    const environment::SensorReadings& r = *s.readings;
+    if (!r.models.empty() || !r.marks.empty()) m.robots.push_back(models_to_lcm(s.id, r, true));
   }
   m.num_robots = static_cast<std::int32_t>(m.robots.size());
   return !m.robots.empty();

@@ -46,6 +46,9 @@ rilbed::world_t to_lcm(TimeUs t_us, const run::WorldReport& world);
 rilbed::summary_t to_lcm(TimeUs t_us, const nlohmann::json& summary);
 void fill(rilbed::wheels_t& message, TimeUs t_us, std::span<const run::WheelReport> wheels);
 void fill(rilbed::sensors_t& message, TimeUs t_us, std::span<const run::SensorReport> sensors);
+/// One robot's sensor-model readings, and its marks when `with_marks` (a controller has no
+/// use for them; a display does).
+rilbed::robot_models_t models_to_lcm(int id, const environment::SensorReadings& readings, bool with_marks);
 /// The robots' sensor-model readings and marks (robots with neither left out); false when
 /// no robot has any (nothing to publish).
 bool fill(rilbed::sensor_models_t& message, TimeUs t_us, std::span<const run::SensorReport> sensors);

@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "core/beside_executable.hpp"
 #include "environment/body_shape.hpp"
 #include "run/yaml_reader.hpp"
 
@@ -10,13 +11,7 @@ namespace rilbed::run {
 
 using yaml_detail::Reader;
 
-std::filesystem::path robot_model_directory() {
-  if (const char* dir = std::getenv("RILBED_ROBOT_DIR"); dir && *dir) return dir;
-  std::error_code ec;
-  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (ec) return "robots";
-  return exe.parent_path() / "robots";
-}
+std::filesystem::path robot_model_directory() { return core::beside_executable("robots", "RILBED_ROBOT_DIR"); }
 
 core::Result<std::filesystem::path> find_robot_model(const std::string& name,
                                                      const std::filesystem::path& scenario_dir) {
