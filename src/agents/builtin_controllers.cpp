@@ -27,6 +27,7 @@ ControllerEntry convoy_entry() {
       "coordinator instead";
   e.sensors = {"proximity", "pose"};
   e.wants_team = true;
+  e.forms_convoy = true;
   e.make = [](const ControllerContext& c) { return std::make_unique<ConvoyController>(c.robot_id, c.convoy); };
   return e;
 }

@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string_view>
 #include <vector>
 
@@ -73,6 +74,17 @@ struct ControlOutput {
   std::string_view behaviour = "idle";
 };
 
+/// A controller failed at a step: its own code raised an error, or it answered what rilbed
+/// cannot use. The message names the controller, where it comes from and the robot, and
+/// holds the cause (a Python traceback, for one). The run then stops the robot (or every
+/// robot, and ends; RunOptions::on_controller_error).
+class ControllerError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class ControllerGroup;
+
 /// A robot controller: called once per control period with the latest input.
 /// Implementations keep their own state between calls; one instance per robot.
 class Controller {
@@ -92,6 +104,11 @@ class Controller {
   /// run on `--threads N`): it shares no mutable state with them. Asked once. Default
   /// true; a controller that keeps state shared between robots must say false.
   virtual bool concurrent() const { return true; }
+  /// The group it decides with, when its robot is stepped together with others in one
+  /// call (a vectorised Python class); null for a controller that decides alone. A run
+  /// steps a group's members through the group (gather, then step_gathered) rather than
+  /// one by one; step() still works alone, as a group of one. Owned by the run's groups.
+  virtual ControllerGroup* group() { return nullptr; }
 };
 
 }  // namespace rilbed::agents

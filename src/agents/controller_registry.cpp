@@ -115,6 +115,10 @@ const ParamSpec* ControllerEntry::param(std::string_view wanted) const {
 std::optional<ParamProblem> check_params(const ControllerEntry& entry, const std::map<std::string, double>& given) {
   for (const auto& [key, value] : given) {
     const ParamSpec* p = entry.param(key);
+    if (!p && entry.open_params) {
+      if (!std::isfinite(value)) return ParamProblem{key, "must be a finite number"};
+      continue;
+    }
     if (!p) {
       std::vector<std::string> names;
       for (const ParamSpec& q : entry.params) names.push_back(q.name);

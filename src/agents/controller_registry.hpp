@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "agents/controller.hpp"
+#include "agents/controller_group.hpp"
 #include "agents/convoy.hpp"
 #include "environment/sensor_suite.hpp"
 
@@ -59,6 +60,9 @@ class ControllerParams {
   /// The value given, else the default. Throws std::out_of_range for a name that was
   /// neither given nor has a default (ask given() first for such a parameter).
   double get(std::string_view name) const;
+  /// Every parameter the scenario gave, by name (for an entry with open_params, whose
+  /// controller reads names rilbed does not know).
+  const std::map<std::string, double, std::less<>>& given_values() const { return given_; }
 
  private:
   const std::vector<ParamSpec>* specs_;
@@ -71,6 +75,9 @@ struct ControllerContext {
   const ControllerParams& params;                 ///< checked against the entry
   const environment::SensorSuiteConfig& sensors;  ///< the robot's sensors as configured
   const ConvoyConfig& convoy;                     ///< the scenario's `convoy:` block
+  /// The run's groups of controllers that step together (ControllerGroup); null: each
+  /// controller that would join a group gets one of its own. Owned by the run.
+  ControllerGroups* groups = nullptr;
 };
 
 /// Makes one robot's controller, or nullptr for a robot that stands still. Throws
@@ -91,6 +98,14 @@ struct ControllerEntry {
   /// The plug-in library's absolute path, for a controller a scenario names with
   /// `controller: {library: ..., name: ...}`; empty for one named by its name alone.
   std::string library;
+  /// It takes any parameter names, and checks them itself when it is made (a Python
+  /// class: its `__init__` gets `params` as a dict); `params` then lists none.
+  bool open_params = false;
+  /// Its robots form the convoy of paper 001 (robot k follows robot k - 1, IDs 1..N): the
+  /// run watches them for formation (summary: formed, formation_time_s), and in central
+  /// mode rilbed's coordinator drives them. rilbed's `convoy`; a Python class that sets
+  /// `forms_convoy = True`.
+  bool forms_convoy = false;
   ControllerFactory make;  ///< makes one; must be set
 
   /// The entry's parameter `name`, or nullptr.

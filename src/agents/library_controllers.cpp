@@ -126,8 +126,8 @@ class ClassController final : public Controller {
     char error[512] = {0};
     if (class_.step(instance_, &raw_, &out, error, sizeof error) != 0) {
       error[sizeof error - 1] = '\0';
-      throw std::runtime_error(who_ + ": its step at t = " + std::to_string(input.t_us / 1000) +
-                               " ms failed: " + (error[0] ? error : "(no message)"));
+      throw ControllerError(who_ + ": its step at t = " + std::to_string(input.t_us / 1000) +
+                            " ms failed: " + (error[0] ? error : "(no message)"));
     }
     return output_from_class(out);
   }

@@ -148,10 +148,10 @@ int agent_command(const AgentArgs& args) {
   config.scenario_name = scenario.name;
   config.robot_ids = ids;
   config.once = args.once;
-  bus::AgentServer server(*lcm, *answers, config, [&scenario](int id) {
+  bus::AgentServer server(*lcm, *answers, config, [&scenario](int id, agents::ControllerGroups& groups) {
     const auto spec =
         std::find_if(scenario.robots.begin(), scenario.robots.end(), [&](const auto& r) { return r.id == id; });
-    return run::make_controller(scenario, *spec);
+    return run::make_controller(scenario, *spec, &groups);
   });
   const InterruptFlag interrupt;
   if (lifeline) watch_lifeline();

@@ -35,6 +35,7 @@ struct RunArgs {
   session::SessionOptions session;
   std::string scenario;
   std::string mode;  // overrides the scenario's
+  std::string on_controller_error = "end-run";
 };
 
 int run_command(RunArgs& args) {
@@ -43,6 +44,7 @@ int run_command(RunArgs& args) {
   o.scenario = args.scenario;
   if (args.mode == "central") o.mode = run::ConvoyMode::kCentral;
   if (args.mode == "distributed") o.mode = run::ConvoyMode::kDistributed;
+  if (args.on_controller_error == "stop-robot") o.on_controller_error = run::ControllerErrorAction::kStopRobot;
   o.interrupt = &interrupt.flag();
   session::SessionOutput output;
   output.ask_operator = ask_operator_on_stdin;
@@ -91,6 +93,12 @@ void add_run_command(CLI::App& app) {
       ->default_val(1);
   cmd->add_option("--mode", args->mode, "Override the scenario's convoy mode")
       ->check(CLI::IsMember({"central", "distributed"}));
+  cmd->add_option("--on-controller-error", args->on_controller_error,
+                  "What a controller's error (a Python exception, an answer rilbed cannot use) does: end-run stops "
+                  "every robot and ends the run with exit 1; stop-robot stops that robot only (behaviour `error`, "
+                  "an event) and the run goes on")
+      ->check(CLI::IsMember({"end-run", "stop-robot"}))
+      ->default_val("end-run");
   cmd->add_flag(
       "--all-virtual", args->session.all_virtual,
       "Make every real robot virtual (same poses and controllers): the simulation half of a sim-to-real comparison");

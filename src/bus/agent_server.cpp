@@ -26,7 +26,7 @@ std::string host_name() {
 
 }  // namespace
 
-AgentServer::AgentServer(lcm::LCM& quanta, lcm::LCM& answers, AgentServerConfig config, ControllerFactory make)
+AgentServer::AgentServer(lcm::LCM& quanta, lcm::LCM& answers, AgentServerConfig config, GroupedControllerFactory make)
     : quanta_(quanta), answers_(answers), config_(std::move(config)), make_(std::move(make)) {
   std::random_device rd;
   std::ostringstream s;
@@ -56,7 +56,8 @@ void AgentServer::start_run(const std::string& run) {
   run_ended_ = false;
   last_quantum_ = -1;
   last_reply_ = {};
-  for (const int id : config_.robot_ids) controllers_[id] = make_(id);
+  groups_ = std::make_unique<agents::ControllerGroups>();
+  for (const int id : config_.robot_ids) controllers_[id] = make_(id, *groups_);
   ++counters_.runs;
 }
 
@@ -65,6 +66,7 @@ void AgentServer::finish_run() {
     if (controller) controller->finish();
   }
   controllers_.clear();
+  groups_.reset();
 }
 
 void AgentServer::on_quantum(const void* data, std::size_t size) {
@@ -95,26 +97,11 @@ void AgentServer::on_quantum(const void* data, std::size_t size) {
   }
   if (q.quantum < last_quantum_) return;  // stale
   if (last_quantum_ >= 0 && q.quantum > last_quantum_ + 1) counters_.skipped += q.quantum - last_quantum_ - 1;
-  std::vector<agents::TeamMessage> team;
-  if (q.has_team) {
-    team.reserve(q.team.size());
-    for (const rilbed::team_member_t& m : q.team) team.push_back(from_lcm(m));
-  }
   rilbed::quantum_reply_t reply;
   reply.run = q.run;
   reply.session = session_;
   reply.quantum = q.quantum;
-  for (const rilbed::agent_input_t& in : q.inputs) {
-    const auto it = controllers_.find(in.id);
-    if (it == controllers_.end() || !it->second) continue;  // not one of ours
-    agents::ControlInput input = from_lcm(in, q.utime, model_names_);
-    if (q.has_team && it->second->wants_team()) input.team = team;
-    run::RemoteOutput out;
-    out.robot_id = in.id;
-    out.output = it->second->step(input);
-    out.done = it->second->done();
-    reply.outputs.push_back(to_lcm(out));
-  }
+  step_quantum(q, reply);
   reply.num_outputs = static_cast<std::int32_t>(reply.outputs.size());
   last_quantum_ = q.quantum;
   last_reply_ = reply;
@@ -122,6 +109,36 @@ void AgentServer::on_quantum(const void* data, std::size_t size) {
     publish_encoded(answers_, config_.channels.quantum_reply, reply);
   }
   ++counters_.steps;
+}
+
+void AgentServer::step_quantum(const rilbed::quantum_t& q, rilbed::quantum_reply_t& reply) {
+  std::vector<agents::TeamMessage> team;
+  if (q.has_team) {
+    team.reserve(q.team.size());
+    for (const rilbed::team_member_t& m : q.team) team.push_back(from_lcm(m));
+  }
+  std::vector<agents::ControllerGroup*> groups;  // those with members in this quantum, in order met
+  for (const rilbed::agent_input_t& in : q.inputs) {
+    const auto it = controllers_.find(in.id);
+    if (it == controllers_.end() || !it->second) continue;  // not one of ours
+    agents::ControlInput input = from_lcm(in, q.utime, model_names_);
+    if (q.has_team && it->second->wants_team()) input.team = team;
+    if (agents::ControllerGroup* group = it->second->group()) {
+      group->gather(input);
+      if (std::find(groups.begin(), groups.end(), group) == groups.end()) groups.push_back(group);
+      continue;
+    }
+    run::RemoteOutput out;
+    out.robot_id = in.id;
+    out.output = it->second->step(input);
+    out.done = it->second->done();
+    reply.outputs.push_back(to_lcm(out));
+  }
+  for (agents::ControllerGroup* group : groups) {
+    for (const agents::GroupAnswer& a : group->step_gathered()) {
+      reply.outputs.push_back(to_lcm(run::RemoteOutput{a.robot_id, a.output, a.done}));
+    }
+  }
 }
 
 void AgentServer::serve(const std::atomic<bool>& stop) {

@@ -16,8 +16,10 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "agents/controller.hpp"
+#include "agents/controller_group.hpp"
 #include "bus/lcm_bus.hpp"
 #include "rilbed/quantum_reply_t.hpp"
+#include "rilbed/quantum_t.hpp"
 
 namespace rilbed::bus {
 
@@ -49,11 +51,20 @@ struct AgentServerCounters {
 
 class AgentServer {
  public:
-  /// Builds a fresh controller for a robot, for each run.
+  /// Builds a fresh controller for a robot, for each run; a controller that decides with a
+  /// group (a vectorised Python class) joins `groups`, the run's, and the server then steps
+  /// each group once per quantum.
+  using GroupedControllerFactory =
+      std::function<std::unique_ptr<agents::Controller>(int robot_id, agents::ControllerGroups& groups)>;
+  /// The same for controllers that never form groups.
   using ControllerFactory = std::function<std::unique_ptr<agents::Controller>(int robot_id)>;
   /// `quanta` (handled here) and `answers` (published on only: answers and announcements)
   /// must outlive the server and be handled by no other thread; they may be one instance.
-  AgentServer(lcm::LCM& quanta, lcm::LCM& answers, AgentServerConfig config, ControllerFactory make);
+  AgentServer(lcm::LCM& quanta, lcm::LCM& answers, AgentServerConfig config, GroupedControllerFactory make);
+  AgentServer(lcm::LCM& quanta, lcm::LCM& answers, AgentServerConfig config, ControllerFactory make)
+      : AgentServer(quanta, answers, std::move(config),
+                    GroupedControllerFactory(
+                        [make = std::move(make)](int id, agents::ControllerGroups&) { return make(id); })) {}
   ~AgentServer();
 
   /// Serves until `stop` becomes true (checked at least every 100 ms) or, with `once`,
@@ -74,6 +85,8 @@ class AgentServer {
 
  private:
   void on_quantum(const void* data, std::size_t size);
+  // Steps one quantum's inputs: each lone controller in turn, then each group once.
+  void step_quantum(const rilbed::quantum_t& q, rilbed::quantum_reply_t& reply);
   void hello();
   void start_run(const std::string& run);
   void finish_run();
@@ -81,13 +94,15 @@ class AgentServer {
   lcm::LCM& quanta_;
   lcm::LCM& answers_;
   AgentServerConfig config_;
-  ControllerFactory make_;
+  GroupedControllerFactory make_;
   std::string session_;
   std::string run_;  // the run being served, empty between runs
   bool run_ended_ = false;
   std::int64_t last_quantum_ = -1;
   rilbed::quantum_reply_t last_reply_;              // sent again for a repeat
   std::set<std::string, std::less<>> model_names_;  // what its controllers' sensor-model readings name
+  // The run's groups before its controllers: members point into them.
+  std::unique_ptr<agents::ControllerGroups> groups_;
   std::map<int, std::unique_ptr<agents::Controller>> controllers_;
   std::chrono::steady_clock::time_point last_quantum_at_{};
   AgentServerCounters counters_;

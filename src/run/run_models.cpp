@@ -55,10 +55,10 @@ void AgentModel::internal_transition() {
     body_->drive(state_.manual->wheels);
     state_.last.wheels = state_.manual->wheels;
     state_.last.behaviour = "console";
-  } else if (controller_ && !state_.commanded) {
+  } else if (controller_ && !state_.commanded && !failed_) {
     step();
   }
-  const bool stepping = controller_ && !state_.commanded;
+  const bool stepping = controller_ && !state_.commanded && !failed_;
   if (stepping) {
     state_.sigma_us = period_us_;
   } else if (state_.manual) {
@@ -82,13 +82,37 @@ void AgentModel::step() {
     // Its answer comes back through complete(), later in this instant.
     remote_->submit(input);
   } else {
-    state_.last = controller_->step(input);
+    state_.last = decide(input);
     body_->drive(state_.last.wheels);
   }
   if (keep_sensors_) sensors_ = std::move(input.sensors);  // for the run's observer
   if (profiled_) {
     times_.sensing_s += std::chrono::duration<double>(sensed - start).count();
     times_.behaviours_s += std::chrono::duration<double>(Clock::now() - sensed).count();
+  }
+}
+
+agents::ControlOutput AgentModel::decide(const agents::ControlInput& input) {
+  using Clock = std::chrono::steady_clock;
+  if (!watch_) return controller_->step(input);
+  const Clock::time_point start = watch_->step_budget_s > 0 ? Clock::now() : Clock::time_point{};
+  try {
+    agents::ControlOutput out = controller_->step(input);
+    if (watch_->step_budget_s > 0) {
+      const double took_s = std::chrono::duration<double>(Clock::now() - start).count();
+      if (took_s > watch_->step_budget_s && overruns_++ == 0 && watch_->report) {
+        watch_->report(input.t_us, body_->id(),
+                       "overran: a step took " + std::to_string(int(took_s * 1000 + 0.5)) + " ms of its " +
+                           std::to_string(int(watch_->step_budget_s * 1000 + 0.5)) +
+                           " ms period (the summary counts every overrun)");
+      }
+    }
+    return out;
+  } catch (const agents::ControllerError& e) {
+    if (!watch_->stop_robot_on_error) throw;
+    failed_ = true;
+    if (watch_->report) watch_->report(input.t_us, body_->id(), std::string("error, robot stopped: ") + e.what());
+    return {{}, "error"};
   }
 }
 

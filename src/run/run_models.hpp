@@ -62,6 +62,17 @@ struct AgentState {
   std::optional<ManualDrive> manual;  ///< driven by hand (its controller and commands set aside) until then
 };
 
+/// What the agents of a run do when a controller fails or is slow (one per run, shared).
+struct ControllerWatch {
+  /// A step that throws agents::ControllerError stops that robot only (behaviour
+  /// "error", an event, never stepped again) instead of ending the run.
+  bool stop_robot_on_error = false;
+  /// > 0 (real-time runs): a step that takes longer than this, wall seconds, is an overrun.
+  double step_budget_s = 0.0;
+  /// Records an event (kind "controller") for robot `robot_id` at `t_us`; thread-safe.
+  std::function<void(TimeUs t_us, int robot_id, const std::string& detail)> report;
+};
+
 /// One robot's agent: every control period it senses through its body, runs its
 /// controller and drives its body. Without a controller, or while commanded (central
 /// mode), it applies the commands that arrive on its `command` port instead. A console
@@ -91,7 +102,9 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   bool wants_team() const { return controller_ && controller_->wants_team(); }
   /// Whether it has no goal left: no controller (it stands still or is commanded), or
   /// its controller is done.
-  bool done() const { return !controller_ || state_.commanded || (remote_ ? remote_done_ : controller_->done()); }
+  bool done() const {
+    return !controller_ || state_.commanded || failed_ || (remote_ ? remote_done_ : controller_->done());
+  }
   /// Whether its controller runs elsewhere (see the constructor).
   bool is_remote() const { return remote_ != nullptr; }
   /// A remote controller's answer: drives the body with it, as step() would have (ignored
@@ -108,6 +121,13 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   void set_keep_sensors(bool on) { keep_sensors_ = on; }
   /// Tells the controller the run ended (Controller::finish) and stops the body.
   void finish();
+  /// How it treats its controller's errors and slowness; null (the default): an error
+  /// ends the run, slowness is not timed. Must outlive the model.
+  void set_watch(const ControllerWatch* watch) { watch_ = watch; }
+  /// Steps that took longer than the watch's budget so far.
+  int overruns() const { return overruns_; }
+  /// Whether its controller failed and the robot was stopped (ControllerWatch).
+  bool failed() const { return failed_; }
   /// Times its sensing and its controller's steps (times()), or not.
   void set_profile(bool on) { profiled_ = on; }
   /// Its sensing and behaviours times so far (set_profile); the rest of `RunProfile` is 0.
@@ -139,6 +159,8 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   void apply(const ConsoleOrder& order);
   // Its own step: sense, decide (controller or hand), drive.
   void step();
+  // Its controller's step, watched (ControllerWatch): the output, or a stop once it failed.
+  agents::ControlOutput decide(const agents::ControlInput& input);
 
   // What every step touches first, together after the state (a swarm's agents are cold
   // at each step: the fewer lines, the fewer waits on memory); what it rarely touches
@@ -150,6 +172,9 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   bool profiled_ = false;
   bool remote_done_ = false;  // the remote controller's done() at its last answer
   bool keep_sensors_ = true;
+  bool failed_ = false;  // its controller failed; the robot stands (ControllerWatch)
+  int overruns_ = 0;
+  const ControllerWatch* watch_ = nullptr;
   sim::Port<TeamBroadcast>& team_in_;
   sim::Port<AgentCommand>& command_in_;
   sim::Port<ConsoleOrder>& console_in_;

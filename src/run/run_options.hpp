@@ -26,6 +26,12 @@
 
 namespace rilbed::run {
 
+/// What a run does when a controller fails (raises an error, answers what rilbed cannot use).
+enum class ControllerErrorAction {
+  kEndRun,     ///< stop every robot, keep what was recorded, end the run with the error
+  kStopRobot,  ///< stop that robot only (behaviour "error", an event); the run goes on
+};
+
 /// How to run.
 struct RunOptions {
   std::uint64_t seed = 1;            ///< initial poses, wheel slip and sensor noise derive from it
@@ -56,6 +62,8 @@ struct RunOptions {
   /// robot it serves is stepped through it, one quantum per control instant. May be null
   /// (every controller in this process). Must outlive the call.
   AgentExchange* remote_agents = nullptr;
+  /// What a controller's failure does (`--on-controller-error`).
+  ControllerErrorAction on_controller_error = ControllerErrorAction::kEndRun;
   /// Time the run's parts (RunResult::profile): a few clock reads per robot and step.
   bool profile = false;
   /// Threads that step the world and the agents (>= 1). The run folder and every result
@@ -90,6 +98,11 @@ struct RunResult {
   std::uint64_t trajectory_digest = 0;
   /// With RunOptions::profile: where run_wall_s went (the rest is the DEVS kernel's).
   std::optional<RunProfile> profile;
+  /// Real-time runs: control steps of this process's controllers that took longer than
+  /// the control period in wall time (each robot's first one is also an event).
+  int controller_overruns = 0;
+  /// Robots whose controller failed and was stopped (ControllerErrorAction::kStopRobot).
+  std::vector<int> controller_failed;
   std::string ended_by;                      ///< "duration", "formed", "done" or "interrupt"
   std::vector<int> not_done;                 ///< with stop_when_done: the robots whose agent was not done at the end
   std::vector<TrajectorySample> trajectory;  ///< with keep_in_memory only

@@ -19,6 +19,8 @@ nlohmann::json RunResult::summary() const {
   j["wall_s"] = wall_s;
   j["run_wall_s"] = run_wall_s;
   j["ended_by"] = ended_by;
+  j["controller_overruns"] = controller_overruns;
+  j["controller_failed"] = controller_failed;
   if (!loop_latency_ms.empty()) {
     const std::vector<double> ms(loop_latency_ms.begin(), loop_latency_ms.end());
     j["loop_latency_ms"] = {{"p50", percentile(ms, 0.5)},

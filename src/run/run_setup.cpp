@@ -6,7 +6,8 @@
 
 namespace rilbed::run {
 
-std::unique_ptr<agents::Controller> make_controller(const Scenario& scenario, const RobotSpec& spec) {
+std::unique_ptr<agents::Controller> make_controller(const Scenario& scenario, const RobotSpec& spec,
+                                                    agents::ControllerGroups* groups) {
   const std::string where =
       scenario.source.string() + ":" + std::to_string(spec.line) + ": robot " + std::to_string(spec.id);
   const std::shared_ptr<const agents::ControllerRegistry> registry =
@@ -26,7 +27,7 @@ std::unique_ptr<agents::Controller> make_controller(const Scenario& scenario, co
   }
   const agents::ControllerParams params(entry->params, spec.controller.params);
   try {
-    return entry->make(agents::ControllerContext{spec.id, params, spec.sensors, scenario.convoy});
+    return entry->make(agents::ControllerContext{spec.id, params, spec.sensors, scenario.convoy, groups});
   } catch (const std::invalid_argument& e) {
     throw ScenarioError(where + ": controller " + entry->name + ": " + e.what());
   }

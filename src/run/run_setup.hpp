@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "agents/controller.hpp"
+#include "agents/controller_group.hpp"
 #include "core/geometry.hpp"
 #include "run/scenario.hpp"
 
@@ -16,7 +17,10 @@ namespace rilbed::run {
 /// a convoy agent gets its own controller in central mode too, idle until the console
 /// switches the run to distributed). Throws ScenarioError naming the robot for an unknown
 /// name, a parameter its entry does not allow, or a sensor the controller needs.
-std::unique_ptr<agents::Controller> make_controller(const Scenario& scenario, const RobotSpec& spec);
+/// `groups` (may be null; must outlive the controller): the run's groups of controllers
+/// that step together, which a vectorised controller joins (agents::ControllerGroups).
+std::unique_ptr<agents::Controller> make_controller(const Scenario& scenario, const RobotSpec& spec,
+                                                    agents::ControllerGroups* groups = nullptr);
 
 /// The robots' start poses of a run with `seed` (in scenario.robots' order): fixed poses
 /// as given, the others drawn from the seed (draw_initial_poses), exactly as

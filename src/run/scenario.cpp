@@ -18,6 +18,7 @@
 #include "core/id_list.hpp"
 #include "environment/body_shape.hpp"
 #include "environment/shapes.hpp"
+#include "python/python_controllers.hpp"
 #include "run/robot_description.hpp"
 #include "run/sensor_parameters.hpp"
 #include "run/yaml_reader.hpp"
@@ -297,6 +298,26 @@ class ScenarioControllers {
     return *entry;
   }
 
+  // The entry of class `class_name` of the Python file at `path` (absolute), imported the
+  // first time; a problem is reported against `r`'s `controller` key.
+  const agents::ControllerEntry& from_python(const Reader& r, const std::filesystem::path& path,
+                                             const std::string& class_name) {
+    const std::string key = path.string() + "\n" + class_name;
+    if (const auto it = python_.find(key); it != python_.end()) return *registry().find(it->second);
+    core::Result<agents::ControllerEntry> entry = python::load_python_controller(path, class_name);
+    if (!entry) r.fail_key("controller", entry.error());
+    if (!extended_) extended_ = *base_;
+    const std::string name = entry->name;
+    if (const agents::ControllerEntry* taken = extended_->find(name)) {
+      r.fail_key("controller", "the Python class " + name + " of " + path.string() +
+                                   " has the name of the controller from " + taken->origin +
+                                   "; rename the file or the class");
+    }
+    extended_->add(std::move(*entry));
+    python_.emplace(key, name);
+    return *registry().find(name);
+  }
+
  private:
   void add_library(const Reader& r, const std::filesystem::path& path) {
     core::Result<std::vector<agents::ControllerEntry>> entries = agents::load_library_controllers(path);
@@ -314,12 +335,33 @@ class ScenarioControllers {
   std::shared_ptr<const agents::ControllerRegistry> base_;
   std::optional<agents::ControllerRegistry> extended_;
   std::set<std::string> loaded_;
+  std::map<std::string, std::string> python_;  // file and class -> the entry's name
 };
 
 // The entry a robot's `controller` names: a name of the registry, or a plug-in library's
 // controller, `{library: PATH, name: NAME}` with PATH relative to the scenario file.
 const agents::ControllerEntry& read_controller_name(const Reader& r, ScenarioControllers& controllers,
                                                     ControllerSpec& spec) {
+  const bool python = r.has("controller") && [&] {
+    const YAML::Node c = r.get("controller");
+    return c.IsMap() && c["python"];
+  }();
+  if (python) {
+    const Reader c = r.child("controller");
+    c.allow({"python", "class"});
+    const std::string file = c.text("python", "");
+    const std::string class_name = c.text("class", "");
+    if (file.empty()) c.fail_key("python", "give the Python file's path, relative to the scenario file");
+    if (class_name.empty())
+      c.fail_key("class", "give the name of a class of the file that subclasses rilbed.Controller");
+    const std::filesystem::path base = std::filesystem::path(r.source()).parent_path();
+    std::error_code ec;
+    const std::filesystem::path path = std::filesystem::absolute(base / file, ec).lexically_normal();
+    const agents::ControllerEntry& entry = controllers.from_python(r, path, class_name);
+    spec.name = entry.name;
+    spec.library = path.string();
+    return entry;
+  }
   if (r.has("controller") && r.get("controller").IsMap()) {
     const Reader c = r.child("controller");
     c.allow({"library", "name"});
@@ -338,7 +380,12 @@ const agents::ControllerEntry& read_controller_name(const Reader& r, ScenarioCon
   if (!controller) {
     r.fail_key("controller",
                "unknown controller '" + spec.name + "' (known: " + controllers.registry().names_text() +
-                   "; `rilbed controllers` lists them; a plug-in library's: {library: PATH, name: NAME})");
+                   "; `rilbed controllers` lists them; a plug-in library's: {library: PATH, name: NAME}; a Python "
+                   "class: {python: FILE, class: NAME})");
+  }
+  if (!controller->library.empty() && controller->open_params) {
+    r.fail_key("controller", "'" + spec.name + "' is a Python class of " + controller->library +
+                                 ": name it as {python: FILE, class: NAME}");
   }
   if (!controller->library.empty()) {
     r.fail_key("controller", "'" + spec.name + "' comes from the plug-in library " + controller->library +

@@ -82,7 +82,9 @@ struct ControllerSpec {
   /// "convoy", "wander", ..., "none" (stands still).
   std::string name = "convoy";
   /// The plug-in library it comes from, an absolute path (`controller: {library: PATH,
-  /// name: NAME}`, PATH relative to the scenario file); empty for a name of the registry.
+  /// name: NAME}`, PATH relative to the scenario file), or the Python file of a Python class
+  /// (`controller: {python: FILE, class: NAME}`; `name` is then `<file's stem>.<class>`);
+  /// empty for a name of the registry.
   std::string library;
   std::map<std::string, double> params;  ///< the entry's parameters, checked against it
 };

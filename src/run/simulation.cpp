@@ -7,9 +7,11 @@
 #include <stop_token>
 #include <thread>
 
+#include "agents/builtin_controllers.hpp"
 #include "core/id_list.hpp"
 #include "run/camera_model.hpp"
 #include "run/control_model.hpp"
+#include "run/group_exchange.hpp"
 #include "run/monitor_model.hpp"
 #include "run/run_models.hpp"
 #include "run/virtual_body.hpp"
@@ -33,8 +35,10 @@ environment::World make_world(const Scenario& scenario, std::uint64_t seed) {
 
 std::vector<int> convoy_ids_of(const Scenario& scenario) {
   std::vector<int> ids;
+  const auto registry = scenario.controllers ? scenario.controllers : agents::default_controllers();
   for (const RobotSpec& r : scenario.robots) {
-    if (r.controller.name == "convoy") ids.push_back(r.id);
+    const agents::ControllerEntry* entry = registry->find(r.controller.name);
+    if (entry && entry->forms_convoy) ids.push_back(r.id);
   }
   return ids;
 }
@@ -149,13 +153,42 @@ void Run::make_bodies(const RealBodyFactory& real_bodies) {
   }
 }
 
+void Run::make_watch() {
+  watch_ = std::make_unique<ControllerWatch>();
+  watch_->stop_robot_on_error = options_.on_controller_error == ControllerErrorAction::kStopRobot;
+  // A step longer than the period in wall time makes a real-time run fall behind the clock.
+  if (options_.realtime) watch_->step_budget_s = us_to_seconds(scenario_.control_period_us) / options_.rt_factor;
+  watch_->report = [this](TimeUs t_us, int robot_id, const std::string& detail) {
+    const std::lock_guard lock(watch_mutex_);
+    monitor_->record_event(RunEvent{t_us, "controller", robot_id, 0, detail});
+  };
+}
+
+GroupExchange& Run::group_exchange(agents::ControllerGroup& group) {
+  for (const auto& g : group_exchanges_) {
+    if (&g->group() == &group) return *g;
+  }
+  group_exchanges_.push_back(std::make_unique<GroupExchange>(group, *watch_));
+  return *group_exchanges_.back();
+}
+
 void Run::add_agents() {
+  make_watch();
   const bool central = scenario_.mode == ConvoyMode::kCentral;
   for (std::size_t i = 0; i < scenario_.robots.size(); ++i) {
-    auto controller = make_controller(scenario_, scenario_.robots[i]);
+    const int id = scenario_.robots[i].id;
+    auto controller = make_controller(scenario_, scenario_.robots[i], &groups_);
     const bool commanded = central && i < convoy_ids_.size();
+    // A robot another process serves runs there; a group's member steps with its group.
+    AgentExchange* exchange = options_.remote_agents;
+    if ((!exchange || !exchange->serves(id)) && controller && controller->group()) {
+      GroupExchange& g = group_exchange(*controller->group());
+      g.add_member(id);
+      exchange = &g;
+    }
     agents_.push_back(&root_->emplace<AgentModel>(*bodies_[i], std::move(controller), scenario_.control_period_us, 0,
-                                                  commanded, options_.remote_agents));
+                                                  commanded, exchange));
+    agents_.back()->set_watch(watch_.get());
   }
   // The readings each step are kept for an observer only (the GUI and the bus report them),
   // and so are what sensor models draw.
@@ -174,6 +207,9 @@ void Run::add_team_models() {
   if (options_.remote_agents &&
       std::any_of(agents_.begin(), agents_.end(), [](const AgentModel* a) { return a->is_remote(); })) {
     quantum_ = &root_->emplace<QuantumModel>(*options_.remote_agents, agents_, scenario_.control_period_us, 0);
+  }
+  for (const auto& g : group_exchanges_) {
+    group_quanta_.push_back(&root_->emplace<QuantumModel>(*g, agents_, scenario_.control_period_us, 0));
   }
   // Both ways of running a convoy are built; the mode says which one drives (the console
   // may switch it while the run runs).
@@ -218,8 +254,10 @@ void Run::add_monitor() {
   setup.camera = camera_.get();
   if (options_.profile) setup.profile = &profile_;
   monitor_ = &root_->emplace<MonitorModel>(setup);
-  if (quantum_) {
-    quantum_->on_notice([monitor = monitor_](TimeUs t, const ExchangeNotice& n) {
+  std::vector<QuantumModel*> quanta = group_quanta_;
+  if (quantum_) quanta.push_back(quantum_);
+  for (QuantumModel* q : quanta) {
+    q->on_notice([monitor = monitor_](TimeUs t, const ExchangeNotice& n) {
       monitor->record_event(RunEvent{t, n.kind, n.robot_id, 0, n.detail});
     });
   }
@@ -280,7 +318,9 @@ void Run::loop() {
       coordinator_->run_until(end_us_);
     } catch (const std::exception& e) {
       failure_ = std::current_exception();
-      result_.ended_by = std::string("error: ") + e.what();
+      // The first line (a Python controller's traceback follows it; the error says it all).
+      const std::string what = e.what();
+      result_.ended_by = "error: " + what.substr(0, what.find('\n'));
     }
   }  // (the watcher is asked to stop and joined here)
   if (interrupted_paused.load() && result_.ended_by.empty()) {
@@ -312,6 +352,16 @@ RunResult Run::end() {
   // Every body is stopped whatever happened (a real robot must not drive on).
   for (AgentModel* a : agents_) a->finish();
   if (quantum_) options_.remote_agents->end();
+  for (const auto& g : group_exchanges_) g->end();
+  for (const AgentModel* a : agents_) {
+    result_.controller_overruns += a->overruns();
+    if (a->failed()) result_.controller_failed.push_back(a->body().id());
+  }
+  for (const auto& g : group_exchanges_) {
+    result_.controller_overruns += g->overruns();
+    for (const int id : g->failed_members()) result_.controller_failed.push_back(id);
+  }
+  std::sort(result_.controller_failed.begin(), result_.controller_failed.end());
   if (result_.ended_by.empty()) result_.ended_by = "duration";
   result_.simulated_s = us_to_seconds(std::min(coordinator_->now_us(), end_us_));
   result_.formed = monitor_->formed();

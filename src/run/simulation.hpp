@@ -14,11 +14,13 @@
 #include <chrono>
 #include <exception>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <thread>
 #include <vector>
 
 #include "agents/body.hpp"
+#include "agents/controller_group.hpp"
 #include "core/worker_pool.hpp"
 #include "environment/world.hpp"
 #include "run/run_options.hpp"
@@ -37,6 +39,8 @@ class AgentModel;
 class QuantumModel;
 class CentralConvoyModel;
 class MonitorModel;
+class GroupExchange;
+struct ControllerWatch;
 
 /// A run, in three steps: the constructor builds it, loop() runs it, end() stops every body
 /// and reports what it came to. Borrows the scenario, the options and what they point to
@@ -70,6 +74,9 @@ class Run {
   void check_convoy();
   void make_bodies(const RealBodyFactory& real_bodies);
   void add_agents();
+  // The exchange of `group` (made the first time), for its members' agents.
+  GroupExchange& group_exchange(agents::ControllerGroup& group);
+  void make_watch();
   void add_team_models();
   void add_monitor();
   void add_control();
@@ -88,11 +95,18 @@ class Run {
   std::optional<core::WorkerPool> workers_;
   std::shared_ptr<VisionModel> camera_;
   std::vector<std::unique_ptr<agents::Body>> bodies_;  // in scenario.robots' order
+  // Before the models: the agents' controllers point into the groups, the groups' quanta
+  // to their exchanges, and every agent to the watch.
+  agents::ControllerGroups groups_;
+  std::vector<std::unique_ptr<GroupExchange>> group_exchanges_;
+  std::unique_ptr<ControllerWatch> watch_;
+  std::mutex watch_mutex_;  // the watch's reports may come from several threads
   std::shared_ptr<sim::Coupled> root_;
   WorldModel* world_model_ = nullptr;
   SensingModel* sensing_ = nullptr;
   std::vector<AgentModel*> agents_;  // in scenario.robots' (ID) order
   QuantumModel* quantum_ = nullptr;
+  std::vector<QuantumModel*> group_quanta_;  // one per group of controllers
   CentralConvoyModel* central_model_ = nullptr;
   MonitorModel* monitor_ = nullptr;
   RunProfile profile_;

@@ -3,6 +3,8 @@
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <stdexcept>
@@ -134,9 +136,24 @@ class SessionSetup {
   }
 
  private:
+  // The scenario file, or the text given, with the overrides applied. Throws ScenarioError.
+  run::Scenario scenario_from_options() const {
+    if (o_.scenario_text.empty() && o_.overrides.empty()) return run::load_scenario(o_.scenario, o_.controllers);
+    std::string text = o_.scenario_text;
+    if (text.empty()) {
+      std::ifstream in(o_.scenario);
+      if (!in) throw run::ScenarioError(o_.scenario.string() + ": cannot read the file");
+      text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    if (!o_.overrides.empty()) text = run::apply_overrides(text, o_.overrides, o_.scenario.string());
+    run::Scenario scenario = run::parse_scenario(text, o_.scenario.string(), o_.controllers);
+    scenario.source = o_.scenario;
+    return scenario;
+  }
+
   std::optional<SessionResult> read_scenario() {
     try {
-      p_.scenario = run::load_scenario(o_.scenario, o_.controllers);
+      p_.scenario = scenario_from_options();
     } catch (const run::ScenarioError& e) {
       return problem(Status::kFailed, e.what());
     }
@@ -158,6 +175,7 @@ class SessionSetup {
     b.virtual_stand_ins = stand_ins;
     b.rt_factor = o_.rt_factor;
     b.duration_s = o_.duration_s;
+    b.on_controller_error = o_.on_controller_error;
     b.stop_when_formed = o_.stop_when_formed;
     b.seed = o_.seed;
     b.threads = o_.threads;

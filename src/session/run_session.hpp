@@ -18,13 +18,21 @@
 #include "run/batch_summary.hpp"
 #include "run/run_options.hpp"
 #include "run/scenario.hpp"
+#include "run/scenario_overrides.hpp"
 #include "session/panel.hpp"
 
 namespace rilbed::session {
 
 /// What a session is asked to do (the options of `rilbed run`, without the command line).
 struct SessionOptions {
-  std::filesystem::path scenario;       ///< the scenario file (YAML)
+  std::filesystem::path scenario;  ///< the scenario file (YAML)
+  /// The scenario's text instead of reading `scenario` (a scenario Python built as a dict);
+  /// `scenario` then only names it, and its folder is where relative paths start.
+  std::string scenario_text;
+  /// Changes to the scenario before it is read (run::apply_overrides), in order.
+  std::vector<run::ScenarioOverride> overrides;
+  /// What a controller's failure does (`--on-controller-error`).
+  run::ControllerErrorAction on_controller_error = run::ControllerErrorAction::kEndRun;
   bool fast = false;                    ///< as fast as possible (refused with real robots)
   bool realtime = false;                ///< paced to the wall clock (the default with real robots)
   double rt_factor = 1.0;               ///< simulated seconds per wall second, when realtime

@@ -1,0 +1,516 @@
+#include "python/python_controllers.hpp"
+
+#include <cmath>
+#include <map>
+#include <memory>
+#include <mutex>
+
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+#include <spdlog/spdlog.h>
+
+#include "agents/behaviour_names.hpp"
+#include "agents/controller_group.hpp"
+#include "python/controller_api.hpp"
+#include "python/python_runtime.hpp"
+
+namespace py = pybind11;
+
+namespace rilbed::python {
+
+namespace {
+
+// A Python object that C++ owns: released with the GIL held, whichever thread lets it go;
+// left alone once the interpreter is gone (a program's exit).
+class PyRef {
+ public:
+  PyRef() = default;
+  explicit PyRef(py::object o) : object_(new py::object(std::move(o)), release) {}
+  const py::object& operator*() const { return *object_; }
+  const py::object* operator->() const { return object_.get(); }
+
+ private:
+  static void release(py::object* o) {
+    if (Py_IsInitialized()) {
+      PythonLock lock;
+      delete o;
+    } else {
+      o->release();  // the interpreter is gone: nothing to give back
+      delete o;
+    }
+  }
+  std::shared_ptr<py::object> object_;
+};
+
+// The class a scenario named, with what rilbed learned about it when it was loaded.
+struct PythonClass {
+  std::string file;        // absolute path
+  std::string class_name;  // as in the file
+  PyRef cls;
+  bool vectorised = false;    // step_all, not step
+  bool wants_team = false;    // the class's wants_team
+  bool forms_convoy = false;  // the class's forms_convoy
+  bool has_done = false;      // it overrides done()
+  bool has_finish = false;    // it overrides finish()
+
+  std::string stem() const { return std::filesystem::path(file).filename().string(); }
+  // "convoy.py: Convoy", for messages.
+  std::string who() const { return stem() + ": " + class_name; }
+};
+
+std::string robot_list_text(const std::vector<int>& ids) {
+  if (ids.size() == 1) return "robot " + std::to_string(ids[0]);
+  std::string out = "robots ";
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (i == 8) return out + ", ... (" + std::to_string(ids.size()) + " robots)";
+    out += (i ? ", " : "") + std::to_string(ids[i]);
+  }
+  return out;
+}
+
+int wheel_units(double v, const std::string& what) {
+  if (!std::isfinite(v)) throw agents::ControllerError(what + " is not a finite number");
+  const double clamped = std::clamp(std::round(v), double(-agents::kMaxWheelUnits), double(agents::kMaxWheelUnits));
+  return static_cast<int>(clamped);
+}
+
+std::string repr_text(py::handle h) {
+  std::string text = py::repr(h).cast<std::string>();
+  if (text.size() > 200) text = text.substr(0, 200) + "...";
+  return text;
+}
+
+const char* const kReturnHint =
+    "; return (left, right) wheel speeds in Khepera units (8 mm/s, ±127) or rilbed.Output(left, right, "
+    "behaviour=...)";
+
+// A step's answer as rilbed's: a tuple or list of two numbers, or rilbed.Output.
+agents::ControlOutput output_from_python(py::handle result, const std::string& who) {
+  if (py::isinstance<StepOutput>(result)) {
+    const StepOutput& o = result.cast<const StepOutput&>();
+    return {{wheel_units(o.left, who + "'s left wheel"), wheel_units(o.right, who + "'s right wheel")},
+            agents::intern_behaviour(o.behaviour)};
+  }
+  if (!py::isinstance<py::str>(result) && !py::isinstance<py::bytes>(result) && PySequence_Check(result.ptr()) &&
+      PySequence_Size(result.ptr()) == 2) {
+    py::sequence s = py::reinterpret_borrow<py::sequence>(result);
+    double wheel[2];
+    for (int k = 0; k < 2; ++k) {
+      py::object item = s[k];
+      if (py::isinstance<py::bool_>(item) || !PyNumber_Check(item.ptr())) {
+        throw agents::ControllerError(who + " returned " + repr_text(result) + kReturnHint);
+      }
+      wheel[k] = py::float_(item).cast<double>();
+    }
+    return {{wheel_units(wheel[0], who + "'s left wheel"), wheel_units(wheel[1], who + "'s right wheel")}, "python"};
+  }
+  if (PyErr_Occurred()) PyErr_Clear();
+  throw agents::ControllerError(who + " returned " + repr_text(result) + kReturnHint);
+}
+
+py::dict params_dict(const agents::ControllerParams& params) {
+  py::dict d;
+  for (const auto& [name, value] : params.given_values()) d[py::str(name)] = value;
+  return d;
+}
+
+// Makes an instance of the class with the robot's params; a refusal is the scenario's problem.
+py::object make_instance(const PythonClass& c, const agents::ControllerParams& params, const std::string& robots) {
+  try {
+    return (*c.cls)(params_dict(params));
+  } catch (py::error_already_set& e) {
+    throw std::invalid_argument(c.who() + " refused its params for " + robots + ":\n" + traceback_text(e));
+  }
+}
+
+// One robot's Python controller (a class with step).
+class PythonController final : public agents::Controller {
+ public:
+  PythonController(std::shared_ptr<const PythonClass> c, int robot_id, py::object instance)
+      : class_(std::move(c)),
+        robot_id_(robot_id),
+        who_("robot " + std::to_string(robot_id) + "'s controller " + class_->who()),
+        instance_(instance),
+        step_(instance.attr("step")) {}
+
+  agents::ControlOutput step(const agents::ControlInput& input) override {
+    PythonLock lock;
+    try {
+      py::object result = (*step_)(py::cast(StepInput::copy_of(input)));
+      agents::ControlOutput out = output_from_python(result, who_);
+      if (class_->has_done) done_ = py::bool_((*instance_).attr("done")()).cast<bool>();
+      return out;
+    } catch (py::error_already_set& e) {
+      throw agents::ControllerError(who_ + " raised an error:\n" + traceback_text(e));
+    }
+  }
+  void finish() override {
+    if (!class_->has_finish) return;
+    PythonLock lock;
+    try {
+      (*instance_).attr("finish")();
+    } catch (py::error_already_set& e) {
+      spdlog::error("{}: finish() raised an error:\n{}", who_, traceback_text(e));
+    }
+  }
+  bool wants_team() const override { return class_->wants_team; }
+  bool done() const override { return done_; }
+  bool concurrent() const override { return false; }  // the GIL: one Python step at a time
+
+ private:
+  std::shared_ptr<const PythonClass> class_;
+  int robot_id_;
+  std::string who_;
+  PyRef instance_;
+  PyRef step_;  // the bound method, looked up once
+  bool done_ = false;
+};
+
+// Copies the gathered inputs into the arrays of a rilbed.SwarmInput.
+class SwarmArrays {
+ public:
+  explicit SwarmArrays(const std::vector<StepInput>& in) : in_(in), n_(static_cast<py::ssize_t>(in.size())) {}
+
+  SwarmInput make() const {
+    SwarmInput s;
+    s.t_us = in_.empty() ? 0 : in_.front().input.t_us;
+    py::array_t<long long> ids(n_);
+    auto id = ids.mutable_unchecked<1>();
+    for (py::ssize_t i = 0; i < n_; ++i) id(i) = in_[i].input.robot_id;
+    s.robot_id = ids;
+    s.proximity = rows(environment::kProximityCount, [](const StepInput& r, double* out) {
+      if (!r.input.sensors.proximity) return false;
+      for (int k = 0; k < environment::kProximityCount; ++k) out[k] = (*r.input.sensors.proximity)[k];
+      return true;
+    });
+    s.pose = rows(3, [](const StepInput& r, double* out) {
+      if (!r.input.pose) return false;
+      out[0] = r.input.pose->position_m.x, out[1] = r.input.pose->position_m.y, out[2] = r.input.pose->heading_rad;
+      return true;
+    });
+    s.odometer = rows(2, [](const StepInput& r, double* out) {
+      if (!r.input.sensors.odometry) return false;
+      out[0] = double(r.input.sensors.odometry->left_pulses), out[1] = double(r.input.sensors.odometry->right_pulses);
+      return true;
+    });
+    s.range_m = ragged([](const StepInput& r) { return r.input.sensors.ranges.size(); },
+                       [](const StepInput& r, std::size_t k) {
+                         const auto& g = r.input.sensors.ranges[k];
+                         return g.hit ? g.distance_m : std::numeric_limits<double>::infinity();
+                       });
+    s.track = ragged([](const StepInput& r) { return r.input.sensors.track.size(); },
+                     [](const StepInput& r, std::size_t k) { return double(r.input.sensors.track[k]); });
+    py::list beacons;
+    for (const StepInput& r : in_) beacons.append(py::cast(r.input.sensors.beacons));
+    s.beacons = beacons;
+    s.models = models();
+    py::list team;
+    if (!in_.empty()) {
+      for (const agents::TeamMessage& m : in_.front().team) team.append(py::cast(m));
+    }
+    s.team = team;
+    return s;
+  }
+
+ private:
+  // An (n, width) array: fill(row, out) writes a row and says whether the robot has it (else NaN).
+  template <typename Fill>
+  py::array_t<double> rows(py::ssize_t width, Fill fill) const {
+    py::array_t<double> a({n_, width});
+    double* data = a.mutable_data();
+    for (py::ssize_t i = 0; i < n_; ++i) {
+      double* row = data + i * width;
+      if (!fill(in_[i], row)) std::fill(row, row + width, std::numeric_limits<double>::quiet_NaN());
+    }
+    return a;
+  }
+  // An (n, k) array of readings a robot may have fewer of (k: the most any robot has).
+  template <typename Count, typename Value>
+  py::array_t<double> ragged(Count count, Value value) const {
+    std::size_t width = 0;
+    for (const StepInput& r : in_) width = std::max(width, count(r));
+    return rows(static_cast<py::ssize_t>(width), [&](const StepInput& r, double* out) {
+      const std::size_t c = count(r);
+      for (std::size_t k = 0; k < width; ++k) out[k] = k < c ? value(r, k) : std::numeric_limits<double>::quiet_NaN();
+      return true;
+    });
+  }
+  py::dict models() const {
+    std::map<std::string, std::size_t> widths;
+    for (const StepInput& r : in_) {
+      for (const auto& m : r.input.sensors.models) {
+        auto& w = widths[std::string(m.name)];
+        w = std::max(w, m.values.size());
+      }
+    }
+    py::dict out;
+    for (const auto& [name, width] : widths) {
+      out[py::str(name)] = rows(static_cast<py::ssize_t>(width), [&](const StepInput& r, double* row) {
+        for (const auto& m : r.input.sensors.models) {
+          if (m.name != name) continue;
+          for (std::size_t k = 0; k < width; ++k) {
+            row[k] = k < m.values.size() ? m.values[k] : std::numeric_limits<double>::quiet_NaN();
+          }
+          return true;
+        }
+        return false;
+      });
+    }
+    return out;
+  }
+
+  const std::vector<StepInput>& in_;
+  py::ssize_t n_;
+};
+
+// The robots one instance of a vectorised class (step_all) controls.
+class PythonSwarm final : public agents::ControllerGroup {
+ public:
+  PythonSwarm(std::shared_ptr<const PythonClass> c, py::object instance)
+      : class_(std::move(c)), instance_(instance), step_all_(instance.attr("step_all")) {}
+
+  void add_member(int robot_id) override { members_.push_back(robot_id); }
+  void gather(const agents::ControlInput& input) override { gathered_.push_back(StepInput::copy_of(input)); }
+  std::vector<agents::GroupAnswer> step_gathered() override {
+    if (gathered_.empty()) return {};
+    std::vector<StepInput> in;
+    in.swap(gathered_);
+    PythonLock lock;
+    try {
+      py::object result = (*step_all_)(py::cast(SwarmArrays(in).make()));
+      std::vector<agents::GroupAnswer> answers = answers_from(result, in);
+      if (class_->has_done) {
+        const bool done = py::bool_((*instance_).attr("done")()).cast<bool>();
+        for (agents::GroupAnswer& a : answers) a.done = done;
+      }
+      return answers;
+    } catch (py::error_already_set& e) {
+      throw agents::ControllerError(describe() + " raised an error:\n" + traceback_text(e));
+    }
+  }
+  void finish() override {
+    if (finished_ || !class_->has_finish) return;
+    finished_ = true;
+    PythonLock lock;
+    try {
+      (*instance_).attr("finish")();
+    } catch (py::error_already_set& e) {
+      spdlog::error("{}: finish() raised an error:\n{}", describe(), traceback_text(e));
+    }
+  }
+  bool wants_team() const override { return class_->wants_team; }
+  std::string describe() const override {
+    return "the controller " + class_->who() + " of " + robot_list_text(members_);
+  }
+
+ private:
+  // step_all's answer: an (n, 2) array-like, or (that, behaviour) with behaviour one
+  // string or n strings.
+  std::vector<agents::GroupAnswer> answers_from(py::handle result, const std::vector<StepInput>& in) const {
+    const std::size_t n = in.size();
+    py::object wheels = py::reinterpret_borrow<py::object>(result);
+    std::vector<std::string_view> behaviours(n, "python");
+    if (py::isinstance<py::tuple>(result) && py::len(result) == 2) {
+      py::tuple t = py::reinterpret_borrow<py::tuple>(result);
+      if (py::isinstance<py::str>(t[1]) || is_text_list(t[1])) {
+        wheels = t[0];
+        read_behaviours(t[1], behaviours);
+      }
+    }
+    py::array_t<double, py::array::c_style | py::array::forcecast> a;
+    try {
+      a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(wheels);
+    } catch (py::error_already_set&) {}
+    if (!a || a.ndim() != 2 || a.shape(0) != py::ssize_t(n) || a.shape(1) != 2) {
+      if (PyErr_Occurred()) PyErr_Clear();
+      throw agents::ControllerError(describe() + ": step_all returned " + shape_text(wheels) +
+                                    "; return an array of shape (" + std::to_string(n) +
+                                    ", 2), a (left, right) row per robot in inp.robot_id's order, or (that array, "
+                                    "behaviour)");
+    }
+    auto w = a.unchecked<2>();
+    std::vector<agents::GroupAnswer> answers(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const int id = in[i].input.robot_id;
+      const std::string row =
+          describe() + ": step_all's row " + std::to_string(i) + " (robot " + std::to_string(id) + ")";
+      answers[i] = {id, {{wheel_units(w(i, 0), row), wheel_units(w(i, 1), row)}, behaviours[i]}, false};
+    }
+    return answers;
+  }
+  static bool is_text_list(py::handle h) {
+    if (!py::isinstance<py::list>(h) && !py::isinstance<py::tuple>(h)) return false;
+    py::sequence s = py::reinterpret_borrow<py::sequence>(h);
+    return py::len(s) > 0 && py::isinstance<py::str>(s[0]);
+  }
+  void read_behaviours(py::handle h, std::vector<std::string_view>& out) const {
+    if (py::isinstance<py::str>(h)) {
+      std::fill(out.begin(), out.end(), agents::intern_behaviour(h.cast<std::string>()));
+      return;
+    }
+    py::sequence s = py::reinterpret_borrow<py::sequence>(h);
+    if (py::len(s) != out.size()) {
+      throw agents::ControllerError(describe() + ": step_all returned " + std::to_string(py::len(s)) +
+                                    " behaviours for " + std::to_string(out.size()) + " robots");
+    }
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      if (!py::isinstance<py::str>(s[i])) {
+        throw agents::ControllerError(describe() + ": step_all's behaviour " + std::to_string(i) + " is " +
+                                      repr_text(s[i]) + ", not a str");
+      }
+      out[i] = agents::intern_behaviour(s[i].cast<std::string>());
+    }
+  }
+  static std::string shape_text(py::handle h) {
+    if (py::hasattr(h, "shape")) return "an array of shape " + py::str(h.attr("shape")).cast<std::string>();
+    return repr_text(h);
+  }
+
+  std::shared_ptr<const PythonClass> class_;
+  PyRef instance_;
+  PyRef step_all_;
+  std::vector<int> members_;
+  std::vector<StepInput> gathered_;
+  bool finished_ = false;
+};
+
+// The entry's factory: an instance per robot, or one per group of robots with equal params.
+agents::ControllerFactory factory_for(std::shared_ptr<const PythonClass> c) {
+  return [c](const agents::ControllerContext& context) -> std::unique_ptr<agents::Controller> {
+    const std::string robot = "robot " + std::to_string(context.robot_id);
+    if (!c->vectorised) {
+      PythonLock lock;
+      py::object instance = make_instance(*c, context.params, robot);
+      return std::make_unique<PythonController>(c, context.robot_id, instance);
+    }
+    std::string key = c->file + "\n" + c->class_name;
+    for (const auto& [name, value] : context.params.given_values()) key += "\n" + name + "=" + std::to_string(value);
+    return agents::join_group(context.groups, key, context.robot_id, [&]() -> std::unique_ptr<agents::ControllerGroup> {
+      PythonLock lock;
+      py::object instance = make_instance(*c, context.params, robot + " (and the robots with its params)");
+      return std::make_unique<PythonSwarm>(c, instance);
+    });
+  };
+}
+
+// The module a file was imported as, per absolute path: a file is imported once per
+// process, whichever of its classes the scenarios name.
+py::object import_file(const std::string& file) {
+  static std::map<std::string, PyRef> modules;
+  if (const auto it = modules.find(file); it != modules.end()) return *it->second;
+  py::module_ sys = py::module_::import("sys");
+  const std::string folder = std::filesystem::path(file).parent_path().string();
+  if (!py::cast<bool>(sys.attr("path").attr("__contains__")(folder))) sys.attr("path").attr("insert")(1, folder);
+  py::module_ util = py::module_::import("importlib.util");
+  const std::string name =
+      "rilbed_controllers_" + std::to_string(modules.size()) + "_" + std::filesystem::path(file).stem().string();
+  py::object spec = util.attr("spec_from_file_location")(name, file);
+  if (spec.is_none()) throw std::runtime_error("Python cannot import it");
+  py::object module = util.attr("module_from_spec")(spec);
+  sys.attr("modules")[py::str(name)] = module;
+  try {
+    spec.attr("loader").attr("exec_module")(module);
+  } catch (...) {
+    sys.attr("modules").attr("pop")(name, py::none());
+    throw;
+  }
+  modules.emplace(file, PyRef(module));
+  return module;
+}
+
+bool overrides(py::handle cls, py::handle base, const char* method) {
+  if (!py::hasattr(cls, method)) return false;
+  return !py::hasattr(base, method) || !cls.attr(method).is(base.attr(method));
+}
+
+core::Result<std::shared_ptr<PythonClass>> read_class(const std::string& file, const std::string& class_name) {
+  auto c = std::make_shared<PythonClass>();
+  c->file = file;
+  c->class_name = class_name;
+  const std::string where = "Python controller " + file + ": ";
+  py::object module;
+  try {
+    module = import_file(file);
+  } catch (py::error_already_set& e) {
+    return core::Failure{where + "it does not import:\n" + traceback_text(e)};
+  } catch (const std::exception& e) {
+    return core::Failure{where + e.what()};
+  }
+  if (!py::hasattr(module, class_name.c_str())) {
+    std::string classes;
+    py::object base = py::module_::import("rilbed").attr("Controller");
+    for (auto item : module.attr("__dict__").cast<py::dict>()) {
+      if (PyType_Check(item.second.ptr()) && !item.second.is(base) &&
+          PyObject_IsSubclass(item.second.ptr(), base.ptr()) == 1) {
+        classes += (classes.empty() ? "" : ", ") + item.first.cast<std::string>();
+      }
+    }
+    return core::Failure{where + "it has no class '" + class_name + "' (its rilbed.Controller classes: " +
+                         (classes.empty() ? std::string("none") : classes) + ")"};
+  }
+  py::object cls = module.attr(class_name.c_str());
+  py::object base = py::module_::import("rilbed").attr("Controller");
+  if (!PyType_Check(cls.ptr()) || PyObject_IsSubclass(cls.ptr(), base.ptr()) != 1) {
+    if (PyErr_Occurred()) PyErr_Clear();
+    return core::Failure{where + "'" + class_name + "' is not a class that subclasses rilbed.Controller"};
+  }
+  const bool step = overrides(cls, base, "step"), step_all = overrides(cls, base, "step_all");
+  if (step == step_all) {
+    return core::Failure{where + class_name +
+                         (step ? " defines both step and step_all: give step (one robot per call) or step_all (every "
+                                 "robot at once)"
+                               : " defines neither step(self, inp) nor step_all(self, inp)")};
+  }
+  c->cls = PyRef(cls);
+  c->vectorised = step_all;
+  c->wants_team = py::bool_(cls.attr("wants_team")).cast<bool>();
+  c->forms_convoy = py::bool_(cls.attr("forms_convoy")).cast<bool>();
+  c->has_done = overrides(cls, base, "done");
+  c->has_finish = overrides(cls, base, "finish");
+  return c;
+}
+
+std::string summary_of(py::handle cls, const std::string& fallback) {
+  py::object doc = cls.attr("__doc__");
+  if (doc.is_none()) return fallback;
+  std::string text = doc.cast<std::string>();
+  const auto start = text.find_first_not_of(" \n\t");
+  if (start == std::string::npos) return fallback;
+  text = text.substr(start);
+  return text.substr(0, text.find('\n'));
+}
+
+}  // namespace
+
+core::Result<agents::ControllerEntry> load_python_controller(const std::filesystem::path& file,
+                                                             const std::string& class_name) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) {
+    return core::Failure{"Python controller " + file.string() + ": no such file"};
+  }
+  try {
+    ensure_interpreter();
+  } catch (const std::exception& e) {
+    return core::Failure{"Python controller " + file.string() + ": " + e.what()};
+  }
+  PythonLock lock;
+  try {
+    core::Result<std::shared_ptr<PythonClass>> c = read_class(file.string(), class_name);
+    if (!c) return core::Failure{c.error()};
+    agents::ControllerEntry e;
+    e.name = file.stem().string() + "." + class_name;
+    e.summary = summary_of(*(*c)->cls, "Python class " + class_name + (((*c)->vectorised) ? " (step_all)" : ""));
+    e.wants_team = (*c)->wants_team;
+    e.forms_convoy = (*c)->forms_convoy;
+    e.concurrent = false;
+    e.origin = file.string();
+    e.library = file.string();
+    e.open_params = true;
+    e.make = factory_for(*c);
+    return e;
+  } catch (py::error_already_set& e) {
+    return core::Failure{"Python controller " + file.string() + ": " + class_name + ":\n" + traceback_text(e)};
+  }
+}
+
+}  // namespace rilbed::python

@@ -1,0 +1,120 @@
+// Python controllers through the real binary: the shipped Python convoy runs and forms;
+// an exception stops the real robot, keeps the run folder and exits 1 with the traceback;
+// --on-controller-error stop-robot lets the run go on; the same classes, per robot and
+// vectorised, run in `rilbed agent` processes and give the in-process run's trajectories.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "lcm_namespace.hpp"
+#include "run_command.hpp"
+
+namespace rilbed::e2e {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kPython = fs::path(RILBED_SOURCE_DIR) / "examples" / "python";
+const fs::path kFaulty = fs::path(RILBED_SOURCE_DIR) / "tests" / "python" / "controllers" / "faulty.py";
+
+std::string quoted(const fs::path& p) {
+  std::string q = "'";  // piece by piece: GCC 12's false -Wrestrict (PR 105329)
+  q += p.string();
+  q += "'";
+  return q;
+}
+
+TEST(PythonCli, TheShippedPythonConvoyRunsAndForms) {
+  const fs::path out = scratch_dir("python_convoy");
+  const CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_py") +
+                                     " --fast --stop-when-formed --seed 2 --out " + quoted(out / "run"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string summary = read_file(out / "run" / "summary.json");
+  EXPECT_NE(summary.find("\"convoy_size\": 8"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"formed\": true"), std::string::npos) << summary;
+  EXPECT_NE(read_file(out / "run" / "trajectories.csv").find(",follow"), std::string::npos);
+  // The port does what the C++ convoy does, operation for operation: the same run.
+  const CommandResult cpp = run_rilbed("run " + shipped_scenario_arg("convoy_sim") +
+                                       " --fast --stop-when-formed --seed 2 --out " + quoted(out / "cpp"));
+  ASSERT_EQ(cpp.exit_code, 0) << cpp.err;
+  EXPECT_EQ(read_file(out / "run" / "trajectories.csv"), read_file(out / "cpp" / "trajectories.csv"));
+  fs::remove_all(out);
+}
+
+// A real (emulated) Khepera under a Python controller that raises at t = 2 s.
+void write_failing_scenario(const fs::path& file, const std::string& extra = "") {
+  std::ofstream(file) << "field: {width_m: 1.0, height_m: 1.0}\n"
+                         "camera: {emulate: true}\n"
+                         "robots:\n"
+                         "  - id: 1\n"
+                         "    kind: real\n"
+                         "    pose: [0.5, 0.5, 0]\n"
+                         "    link: {emulate: true}\n"
+                         "    controller: {python: "
+                      << kFaulty.string()
+                      << ", class: RaisesAtTwoSeconds}\n"
+                         "    params: {robot: 1}\n"
+                      << extra;
+}
+
+TEST(PythonCli, AnExceptionStopsTheRealRobotAndEndsTheRunWithItsTraceback) {
+  const fs::path scratch = scratch_dir("python_failure");
+  write_failing_scenario(scratch / "failing.yaml");
+  const CommandResult r = run_rilbed("run " + quoted(scratch / "failing.yaml") + " --duration 5 --no-place --out " +
+                                     quoted(scratch / "run"));
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_NE(r.err.find("robot 1's controller faulty.py: RaisesAtTwoSeconds raised an error:"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("faulty.py\", line 19, in broken_sensor_model"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("ZeroDivisionError: division by zero"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("robot 1 (emulated): last speed 0 0"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(scratch / "run" / "trajectories.csv"));
+  EXPECT_NE(
+      read_file(scratch / "run" / "summary.json").find("robot 1's controller faulty.py: RaisesAtTwoSeconds raised"),
+      std::string::npos)
+      << read_file(scratch / "run" / "summary.json");
+
+  // Stop-robot: the robot stands with behaviour `error`, the run goes to its end.
+  const CommandResult s =
+      run_rilbed("run " + quoted(scratch / "failing.yaml") +
+                 " --duration 4 --no-place --on-controller-error stop-robot --out " + quoted(scratch / "run2"));
+  EXPECT_EQ(s.exit_code, 0) << s.out << s.err;
+  const std::string events = read_file(scratch / "run2" / "events.csv");
+  EXPECT_NE(events.find(",controller,1,0,\"error, robot stopped: robot 1's controller faulty.py"), std::string::npos)
+      << events;
+  EXPECT_NE(read_file(scratch / "run2" / "trajectories.csv").find(",error"), std::string::npos);
+  EXPECT_NE(read_file(scratch / "run2" / "summary.json").find("\"controller_failed\": [\n    1\n  ]"),
+            std::string::npos)
+      << read_file(scratch / "run2" / "summary.json");
+  fs::remove_all(scratch);
+}
+
+TEST(PythonCli, PythonClassesRunInAgentProcessesAsInTheRunsOwn) {
+  const fs::path scratch = scratch_dir("python_agents");
+  for (const std::string cls : {"Wander", "SwarmWander"}) {
+    const fs::path dir = scratch / cls;  // a namespace script's folder each
+    fs::create_directories(dir);
+    const std::string body =
+        "name: wander_agents\nduration_s: 6\nfield: {width_m: 1.5, height_m: 1.2, walls: true}\n"
+        "robots:\n  - ids: 1-6\n    pose: random\n    controller: {python: " +
+        (kPython / "wander.py").string() + ", class: " + cls +
+        "}\n    sensors:\n      proximity: {range_m: 0.05, noise_sd: 3}\n";
+    std::ofstream(dir / "local.yaml") << body;
+    std::ofstream(dir / "agents.yaml") << body << "agents: {processes: 2}\n";
+    const CommandResult local =
+        run_rilbed("run " + quoted(dir / "local.yaml") + " --fast --seed 3 --out " + quoted(dir / "local"));
+    ASSERT_EQ(local.exit_code, 0) << local.err;
+    const int status =
+        in_namespace(dir, "\"$R\" run agents.yaml --fast --seed 3 --out agents --lcm \"$URL\" > run.txt 2>&1\n");
+    ASSERT_EQ(status, 0) << read_file(dir / "run.txt");
+    const std::string trajectories = read_file(dir / "local" / "trajectories.csv");
+    EXPECT_NE(trajectories.find(",avoid"), std::string::npos) << cls;
+    EXPECT_EQ(trajectories, read_file(dir / "agents" / "trajectories.csv")) << cls;
+  }
+  fs::remove_all(scratch);
+}
+
+}  // namespace
+}  // namespace rilbed::e2e
