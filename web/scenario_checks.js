@@ -45,6 +45,15 @@ export function paramsProblems(c, params) {
 // The problems of a `controller: {library: PATH, name: NAME}` mapping's own keys, in the
 // scenario parser's words: it takes those two, and needs both.
 function controllerMappingProblems(v) {
+  if ('python' in v) {
+    // A Python class (`{python: FILE, class: NAME}`): the run imports the file and checks
+    // the class and its params when it reads the scenario; the page cannot.
+    const out = Object.keys(v).filter((k) => k !== 'python' && k !== 'class')
+      .map((k) => `controller.${k}: unknown key (allowed here: python, class)`);
+    if (typeof v.python !== 'string' || !v.python) out.push("controller.python: give the Python file's path, relative to the scenario file");
+    if (typeof v.class !== 'string' || !v.class) out.push('controller.class: give the name of a class of the file that subclasses rilbed.Controller');
+    return out;
+  }
   const out = Object.keys(v).filter((k) => k !== 'library' && k !== 'name')
     .map((k) => `controller.${k}: unknown key (allowed here: library, name)`);
   if (typeof v.library !== 'string' || !v.library) out.push("controller.library: give the plug-in library's path, relative to the scenario file");
@@ -76,7 +85,7 @@ export function controllerProblems(e, registry) {
   const v = e.controller;
   if (v && typeof v === 'object' && !Array.isArray(v)) {
     const shape = controllerMappingProblems(v);
-    if (shape.length) return shape;
+    if (shape.length || 'python' in v) return shape;
   }
   const ref = controllerRef(e);
   if (!ref) return ["controller must be a controller's name or {library: PATH, name: NAME}"];

@@ -12,7 +12,7 @@ class Controller:
     - ``step_all(self, inp)``: every robot the class controls at once. ``inp`` is a
       :class:`rilbed.SwarmInput` of NumPy arrays with a row per robot, in ``inp.robot_id``'s
       order; return an array of shape (n, 2), or ``(that array, behaviour)`` with behaviour
-      one string or n strings. One instance per group of robots with the same ``params``.
+      one string, a list of n strings or a NumPy array of n strings. One instance per group of robots with the same ``params``.
 
     ``__init__(self, params)`` gets the scenario's ``params`` as a dict of numbers; raise
     (``ValueError``, ...) to refuse them: the run does not start, and says why.

@@ -16,6 +16,7 @@ std::string_view intern_behaviour(std::string_view name) {
                                                      "avoid", "unknown", "cruise", "arrived", "home",   "placed",
                                                      "yield", "place",   "align",  "c0",      "c1",     "c2",
                                                      "c3",    "c4",      "c5",     "c6",      "c7",     "c?"};
+  if (name.empty()) return "idle";  // an empty field would read as a missing one in CSV files
   if (name.size() > kMaxLength) return "other";
   // Names go into CSV files, JSON and terminals: printable ASCII without , and ".
   for (const char c : name) {

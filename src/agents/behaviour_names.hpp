@@ -11,7 +11,7 @@ namespace rilbed::agents {
 /// for the same name. Names are kept up to 64 bytes of printable ASCII other than `,` and
 /// `"` (they go into CSV files), at most 1,024 distinct ones, the names of rilbed's own
 /// controllers among them from the start; anything else (a peer or a library sending
-/// junk) is "other". Thread-safe.
+/// junk) is "other", and an empty name is "idle". Thread-safe.
 std::string_view intern_behaviour(std::string_view name);
 
 }  // namespace rilbed::agents

@@ -3,12 +3,14 @@
 // an output with its behaviour.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <pybind11/pybind11.h>
 
 #include "agents/controller.hpp"
+#include "python/swarm_columns.hpp"
 
 namespace rilbed::python {
 
@@ -26,18 +28,19 @@ struct StepInput {
 };
 
 /// Every robot of a vectorised class at one control instant: `rilbed.SwarmInput`. Each
-/// field is a NumPy array (or a list, a dict) with a row per robot, in robot_id's order.
+/// field is a NumPy array (or a list, a dict) with a row per robot, in robot_id's order,
+/// made from `columns` the first time it is read and kept.
 struct SwarmInput {
-  long long t_us = 0;          ///< simulated time of the step, microseconds
-  pybind11::object robot_id;   ///< (n,) int64
-  pybind11::object proximity;  ///< (n, 8) float64, 0..1023; NaN rows for robots without IR sensors
-  pybind11::object pose;       ///< (n, 3) float64: x_m, y_m, theta_rad; NaN rows when unknown
-  pybind11::object range_m;    ///< (n, k) float64; inf: nothing in range; NaN: no such range finder
-  pybind11::object track;      ///< (n, k) float64; NaN: no such track sensor
-  pybind11::object odometer;   ///< (n, 2) float64 pulses; NaN rows without an odometer
-  pybind11::object beacons;    ///< list of n lists of rilbed.Beacon
-  pybind11::object models;     ///< dict: a sensor model's name -> (n, k) float64
-  pybind11::object team;       ///< list of rilbed.TeamMember (the latest broadcast)
+  std::shared_ptr<const SwarmColumns> columns;  ///< never null
+  pybind11::object robot_id;                    ///< (n,) int64
+  pybind11::object proximity;                   ///< (n, 8) float64, 0..1023; NaN rows for robots without IR sensors
+  pybind11::object pose;                        ///< (n, 3) float64: x_m, y_m, theta_rad; NaN rows when unknown
+  pybind11::object range_m;                     ///< (n, k) float64; inf: nothing in range; NaN: no such range finder
+  pybind11::object track;                       ///< (n, k) float64; NaN: no such track sensor
+  pybind11::object odometer;                    ///< (n, 2) float64 pulses; NaN rows without an odometer
+  pybind11::object beacons;                     ///< list of n lists of rilbed.Beacon
+  pybind11::object models;                      ///< dict: a sensor model's name -> (n, k) float64
+  pybind11::object team;                        ///< list of rilbed.TeamMember (the latest broadcast)
 };
 
 /// What a controller answers with when it names its behaviour: `rilbed.Output`.

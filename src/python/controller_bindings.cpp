@@ -1,9 +1,11 @@
 // The controller API as Python sees it: rilbed.Input, rilbed.SwarmInput, rilbed.Output,
 // the readings' small types and the Khepera's constants. Names and units follow the C++
 // ControlInput, so that one page of docs serves both.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
 #include "environment/sensor_readings.hpp"
@@ -100,19 +102,96 @@ void bind_step_input(py::module_& m) {
           py::arg("name"), "The readings of the sensor model mounted as `name`, or None.");
 }
 
+// An (n, width) array of a flat column.
+py::array_t<double> flat_array(const std::vector<double>& data, std::size_t n, std::size_t width) {
+  py::array_t<double> a({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(width)});
+  std::copy(data.begin(), data.end(), a.mutable_data());
+  return a;
+}
+
+// An (n, k) array of a per-row column (k: the longest row; NaN past a row's end and for
+// rows past the column's end).
+py::array_t<double> ragged_array(const std::vector<std::vector<double>>& rows, std::size_t n) {
+  std::size_t width = 0;
+  for (const auto& r : rows) width = std::max(width, r.size());
+  py::array_t<double> a({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(width)});
+  double* data = a.mutable_data();
+  std::fill(data, data + n * width, std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t i = 0; i < rows.size(); ++i) std::copy(rows[i].begin(), rows[i].end(), data + i * width);
+  return a;
+}
+
+py::dict models_arrays(const SwarmColumns& c) {
+  std::vector<std::string_view> names;
+  for (const auto& row : c.models) {
+    for (const auto& [name, values] : row) {
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+    }
+  }
+  py::dict out;
+  for (const std::string_view name : names) {
+    std::vector<std::vector<double>> rows(c.models.size());
+    for (std::size_t i = 0; i < c.models.size(); ++i) {
+      for (const auto& [n, values] : c.models[i]) {
+        if (n == name) rows[i] = values;
+      }
+    }
+    out[py::str(std::string(name))] = ragged_array(rows, c.rows());
+  }
+  return out;
+}
+
+py::list beacon_lists(const SwarmColumns& c) {
+  py::list out;
+  for (std::size_t i = 0; i < c.rows(); ++i) {
+    out.append(i < c.beacons.size() ? py::cast(c.beacons[i]) : py::list());
+  }
+  return out;
+}
+
+// A property of SwarmInput made on first access and kept.
+template <typename Make>
+auto lazily(py::object SwarmInput::*field, Make make) {
+  return [field, make](SwarmInput& s) {
+    py::object& cached = s.*field;
+    if (!cached) cached = make(*s.columns);
+    return cached;
+  };
+}
+
 void bind_swarm_input(py::module_& m) {
   py::class_<SwarmInput>(m, "SwarmInput", "What step_all gets: every robot of the class at once, a row per robot.")
-      .def_readonly("t_us", &SwarmInput::t_us)
-      .def_readonly("robot_id", &SwarmInput::robot_id)
-      .def_readonly("proximity", &SwarmInput::proximity)
-      .def_readonly("pose", &SwarmInput::pose)
-      .def_readonly("range_m", &SwarmInput::range_m)
-      .def_readonly("track", &SwarmInput::track)
-      .def_readonly("odometer", &SwarmInput::odometer)
-      .def_readonly("beacons", &SwarmInput::beacons)
-      .def_readonly("models", &SwarmInput::models)
-      .def_readonly("team", &SwarmInput::team)
-      .def("__len__", [](const SwarmInput& s) { return py::len(s.robot_id); });
+      .def_property_readonly("t_us", [](const SwarmInput& s) { return s.columns->t_us; })
+      .def_property_readonly("robot_id", lazily(&SwarmInput::robot_id,
+                                                [](const SwarmColumns& c) -> py::object {
+                                                  py::array_t<long long> a(static_cast<py::ssize_t>(c.rows()));
+                                                  std::copy(c.robot_id.begin(), c.robot_id.end(), a.mutable_data());
+                                                  return a;
+                                                }))
+      .def_property_readonly("proximity", lazily(&SwarmInput::proximity,
+                                                 [](const SwarmColumns& c) -> py::object {
+                                                   return flat_array(c.proximity, c.rows(),
+                                                                     environment::kProximityCount);
+                                                 }))
+      .def_property_readonly(
+          "pose", lazily(&SwarmInput::pose,
+                         [](const SwarmColumns& c) -> py::object { return flat_array(c.pose, c.rows(), 3); }))
+      .def_property_readonly(
+          "odometer", lazily(&SwarmInput::odometer,
+                             [](const SwarmColumns& c) -> py::object { return flat_array(c.odometer, c.rows(), 2); }))
+      .def_property_readonly(
+          "range_m", lazily(&SwarmInput::range_m,
+                            [](const SwarmColumns& c) -> py::object { return ragged_array(c.range_m, c.rows()); }))
+      .def_property_readonly(
+          "track", lazily(&SwarmInput::track,
+                          [](const SwarmColumns& c) -> py::object { return ragged_array(c.track, c.rows()); }))
+      .def_property_readonly(
+          "beacons", lazily(&SwarmInput::beacons, [](const SwarmColumns& c) -> py::object { return beacon_lists(c); }))
+      .def_property_readonly(
+          "models", lazily(&SwarmInput::models, [](const SwarmColumns& c) -> py::object { return models_arrays(c); }))
+      .def_property_readonly(
+          "team", lazily(&SwarmInput::team, [](const SwarmColumns& c) -> py::object { return team_list(c.team); }))
+      .def("__len__", [](const SwarmInput& s) { return s.columns->rows(); });
 }
 
 void bind_output(py::module_& m) {

@@ -5,6 +5,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <atomic>
+#include <csignal>
+
 #include "python/python_runtime.hpp"
 #include "session/run_session.hpp"
 
@@ -81,9 +84,21 @@ std::string run_session(const std::string& scenario, const std::string& scenario
   output.notice = [](const std::string&) {};
   session::SessionResult result;
   {
+    // Ctrl-C (a notebook's interrupt) ends the run cleanly, as `rilbed run`'s does: its
+    // robots stopped and its files written; Python's own handler is back afterwards.
+    static std::atomic<bool> interrupted;
+    interrupted = false;
+    o.interrupt = &interrupted;
+    const auto previous = std::signal(SIGINT, [](int) { interrupted = true; });
     py::gil_scoped_release release;  // the run's controllers take it when they call Python
     session::RunSession s(o, output);
     result = s.run();
+    std::signal(SIGINT, previous);
+    if (interrupted) {
+      py::gil_scoped_acquire acquire;
+      PyErr_SetString(PyExc_KeyboardInterrupt, "the run was interrupted; it ended cleanly");
+      throw py::error_already_set();
+    }
   }
   if (result.status == session::SessionResult::Status::kUsage) throw py::value_error(result.error);
   if (result.status != session::SessionResult::Status::kOk || result.runs.empty())

@@ -12,7 +12,9 @@
 #include "agents/behaviour_names.hpp"
 #include "agents/controller_group.hpp"
 #include "python/controller_api.hpp"
+#include "python/python_answers.hpp"
 #include "python/python_runtime.hpp"
+#include "python/swarm_columns.hpp"
 
 namespace py = pybind11;
 
@@ -66,46 +68,6 @@ std::string robot_list_text(const std::vector<int>& ids) {
     out += (i ? ", " : "") + std::to_string(ids[i]);
   }
   return out;
-}
-
-int wheel_units(double v, const std::string& what) {
-  if (!std::isfinite(v)) throw agents::ControllerError(what + " is not a finite number");
-  const double clamped = std::clamp(std::round(v), double(-agents::kMaxWheelUnits), double(agents::kMaxWheelUnits));
-  return static_cast<int>(clamped);
-}
-
-std::string repr_text(py::handle h) {
-  std::string text = py::repr(h).cast<std::string>();
-  if (text.size() > 200) text = text.substr(0, 200) + "...";
-  return text;
-}
-
-const char* const kReturnHint =
-    "; return (left, right) wheel speeds in Khepera units (8 mm/s, ±127) or rilbed.Output(left, right, "
-    "behaviour=...)";
-
-// A step's answer as rilbed's: a tuple or list of two numbers, or rilbed.Output.
-agents::ControlOutput output_from_python(py::handle result, const std::string& who) {
-  if (py::isinstance<StepOutput>(result)) {
-    const StepOutput& o = result.cast<const StepOutput&>();
-    return {{wheel_units(o.left, who + "'s left wheel"), wheel_units(o.right, who + "'s right wheel")},
-            agents::intern_behaviour(o.behaviour)};
-  }
-  if (!py::isinstance<py::str>(result) && !py::isinstance<py::bytes>(result) && PySequence_Check(result.ptr()) &&
-      PySequence_Size(result.ptr()) == 2) {
-    py::sequence s = py::reinterpret_borrow<py::sequence>(result);
-    double wheel[2];
-    for (int k = 0; k < 2; ++k) {
-      py::object item = s[k];
-      if (py::isinstance<py::bool_>(item) || !PyNumber_Check(item.ptr())) {
-        throw agents::ControllerError(who + " returned " + repr_text(result) + kReturnHint);
-      }
-      wheel[k] = py::float_(item).cast<double>();
-    }
-    return {{wheel_units(wheel[0], who + "'s left wheel"), wheel_units(wheel[1], who + "'s right wheel")}, "python"};
-  }
-  if (PyErr_Occurred()) PyErr_Clear();
-  throw agents::ControllerError(who + " returned " + repr_text(result) + kReturnHint);
 }
 
 py::dict params_dict(const agents::ControllerParams& params) {
@@ -166,103 +128,6 @@ class PythonController final : public agents::Controller {
   bool done_ = false;
 };
 
-// Copies the gathered inputs into the arrays of a rilbed.SwarmInput.
-class SwarmArrays {
- public:
-  explicit SwarmArrays(const std::vector<StepInput>& in) : in_(in), n_(static_cast<py::ssize_t>(in.size())) {}
-
-  SwarmInput make() const {
-    SwarmInput s;
-    s.t_us = in_.empty() ? 0 : in_.front().input.t_us;
-    py::array_t<long long> ids(n_);
-    auto id = ids.mutable_unchecked<1>();
-    for (py::ssize_t i = 0; i < n_; ++i) id(i) = in_[i].input.robot_id;
-    s.robot_id = ids;
-    s.proximity = rows(environment::kProximityCount, [](const StepInput& r, double* out) {
-      if (!r.input.sensors.proximity) return false;
-      for (int k = 0; k < environment::kProximityCount; ++k) out[k] = (*r.input.sensors.proximity)[k];
-      return true;
-    });
-    s.pose = rows(3, [](const StepInput& r, double* out) {
-      if (!r.input.pose) return false;
-      out[0] = r.input.pose->position_m.x, out[1] = r.input.pose->position_m.y, out[2] = r.input.pose->heading_rad;
-      return true;
-    });
-    s.odometer = rows(2, [](const StepInput& r, double* out) {
-      if (!r.input.sensors.odometry) return false;
-      out[0] = double(r.input.sensors.odometry->left_pulses), out[1] = double(r.input.sensors.odometry->right_pulses);
-      return true;
-    });
-    s.range_m = ragged([](const StepInput& r) { return r.input.sensors.ranges.size(); },
-                       [](const StepInput& r, std::size_t k) {
-                         const auto& g = r.input.sensors.ranges[k];
-                         return g.hit ? g.distance_m : std::numeric_limits<double>::infinity();
-                       });
-    s.track = ragged([](const StepInput& r) { return r.input.sensors.track.size(); },
-                     [](const StepInput& r, std::size_t k) { return double(r.input.sensors.track[k]); });
-    py::list beacons;
-    for (const StepInput& r : in_) beacons.append(py::cast(r.input.sensors.beacons));
-    s.beacons = beacons;
-    s.models = models();
-    py::list team;
-    if (!in_.empty()) {
-      for (const agents::TeamMessage& m : in_.front().team) team.append(py::cast(m));
-    }
-    s.team = team;
-    return s;
-  }
-
- private:
-  // An (n, width) array: fill(row, out) writes a row and says whether the robot has it (else NaN).
-  template <typename Fill>
-  py::array_t<double> rows(py::ssize_t width, Fill fill) const {
-    py::array_t<double> a({n_, width});
-    double* data = a.mutable_data();
-    for (py::ssize_t i = 0; i < n_; ++i) {
-      double* row = data + i * width;
-      if (!fill(in_[i], row)) std::fill(row, row + width, std::numeric_limits<double>::quiet_NaN());
-    }
-    return a;
-  }
-  // An (n, k) array of readings a robot may have fewer of (k: the most any robot has).
-  template <typename Count, typename Value>
-  py::array_t<double> ragged(Count count, Value value) const {
-    std::size_t width = 0;
-    for (const StepInput& r : in_) width = std::max(width, count(r));
-    return rows(static_cast<py::ssize_t>(width), [&](const StepInput& r, double* out) {
-      const std::size_t c = count(r);
-      for (std::size_t k = 0; k < width; ++k) out[k] = k < c ? value(r, k) : std::numeric_limits<double>::quiet_NaN();
-      return true;
-    });
-  }
-  py::dict models() const {
-    std::map<std::string, std::size_t> widths;
-    for (const StepInput& r : in_) {
-      for (const auto& m : r.input.sensors.models) {
-        auto& w = widths[std::string(m.name)];
-        w = std::max(w, m.values.size());
-      }
-    }
-    py::dict out;
-    for (const auto& [name, width] : widths) {
-      out[py::str(name)] = rows(static_cast<py::ssize_t>(width), [&](const StepInput& r, double* row) {
-        for (const auto& m : r.input.sensors.models) {
-          if (m.name != name) continue;
-          for (std::size_t k = 0; k < width; ++k) {
-            row[k] = k < m.values.size() ? m.values[k] : std::numeric_limits<double>::quiet_NaN();
-          }
-          return true;
-        }
-        return false;
-      });
-    }
-    return out;
-  }
-
-  const std::vector<StepInput>& in_;
-  py::ssize_t n_;
-};
-
 // The robots one instance of a vectorised class (step_all) controls.
 class PythonSwarm final : public agents::ControllerGroup {
  public:
@@ -270,15 +135,17 @@ class PythonSwarm final : public agents::ControllerGroup {
       : class_(std::move(c)), instance_(instance), step_all_(instance.attr("step_all")) {}
 
   void add_member(int robot_id) override { members_.push_back(robot_id); }
-  void gather(const agents::ControlInput& input) override { gathered_.push_back(StepInput::copy_of(input)); }
+  void gather(const agents::ControlInput& input) override { gathered_.add(input); }
   std::vector<agents::GroupAnswer> step_gathered() override {
-    if (gathered_.empty()) return {};
-    std::vector<StepInput> in;
-    in.swap(gathered_);
+    if (gathered_.rows() == 0) return {};
+    auto columns = std::make_shared<const SwarmColumns>(std::move(gathered_));
+    gathered_ = {};
+    gathered_.reserve(columns->rows());  // the next step's rows, as many as this one's
+    std::vector<int> ids(columns->robot_id.begin(), columns->robot_id.end());
     PythonLock lock;
     try {
-      py::object result = (*step_all_)(py::cast(SwarmArrays(in).make()));
-      std::vector<agents::GroupAnswer> answers = answers_from(result, in);
+      py::object result = (*step_all_)(py::cast(SwarmInput{columns}));
+      std::vector<agents::GroupAnswer> answers = swarm_answers(result, ids, describe());
       if (class_->has_done) {
         const bool done = py::bool_((*instance_).attr("done")()).cast<bool>();
         for (agents::GroupAnswer& a : answers) a.done = done;
@@ -304,73 +171,11 @@ class PythonSwarm final : public agents::ControllerGroup {
   }
 
  private:
-  // step_all's answer: an (n, 2) array-like, or (that, behaviour) with behaviour one
-  // string or n strings.
-  std::vector<agents::GroupAnswer> answers_from(py::handle result, const std::vector<StepInput>& in) const {
-    const std::size_t n = in.size();
-    py::object wheels = py::reinterpret_borrow<py::object>(result);
-    std::vector<std::string_view> behaviours(n, "python");
-    if (py::isinstance<py::tuple>(result) && py::len(result) == 2) {
-      py::tuple t = py::reinterpret_borrow<py::tuple>(result);
-      if (py::isinstance<py::str>(t[1]) || is_text_list(t[1])) {
-        wheels = t[0];
-        read_behaviours(t[1], behaviours);
-      }
-    }
-    py::array_t<double, py::array::c_style | py::array::forcecast> a;
-    try {
-      a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(wheels);
-    } catch (py::error_already_set&) {}
-    if (!a || a.ndim() != 2 || a.shape(0) != py::ssize_t(n) || a.shape(1) != 2) {
-      if (PyErr_Occurred()) PyErr_Clear();
-      throw agents::ControllerError(describe() + ": step_all returned " + shape_text(wheels) +
-                                    "; return an array of shape (" + std::to_string(n) +
-                                    ", 2), a (left, right) row per robot in inp.robot_id's order, or (that array, "
-                                    "behaviour)");
-    }
-    auto w = a.unchecked<2>();
-    std::vector<agents::GroupAnswer> answers(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const int id = in[i].input.robot_id;
-      const std::string row =
-          describe() + ": step_all's row " + std::to_string(i) + " (robot " + std::to_string(id) + ")";
-      answers[i] = {id, {{wheel_units(w(i, 0), row), wheel_units(w(i, 1), row)}, behaviours[i]}, false};
-    }
-    return answers;
-  }
-  static bool is_text_list(py::handle h) {
-    if (!py::isinstance<py::list>(h) && !py::isinstance<py::tuple>(h)) return false;
-    py::sequence s = py::reinterpret_borrow<py::sequence>(h);
-    return py::len(s) > 0 && py::isinstance<py::str>(s[0]);
-  }
-  void read_behaviours(py::handle h, std::vector<std::string_view>& out) const {
-    if (py::isinstance<py::str>(h)) {
-      std::fill(out.begin(), out.end(), agents::intern_behaviour(h.cast<std::string>()));
-      return;
-    }
-    py::sequence s = py::reinterpret_borrow<py::sequence>(h);
-    if (py::len(s) != out.size()) {
-      throw agents::ControllerError(describe() + ": step_all returned " + std::to_string(py::len(s)) +
-                                    " behaviours for " + std::to_string(out.size()) + " robots");
-    }
-    for (std::size_t i = 0; i < out.size(); ++i) {
-      if (!py::isinstance<py::str>(s[i])) {
-        throw agents::ControllerError(describe() + ": step_all's behaviour " + std::to_string(i) + " is " +
-                                      repr_text(s[i]) + ", not a str");
-      }
-      out[i] = agents::intern_behaviour(s[i].cast<std::string>());
-    }
-  }
-  static std::string shape_text(py::handle h) {
-    if (py::hasattr(h, "shape")) return "an array of shape " + py::str(h.attr("shape")).cast<std::string>();
-    return repr_text(h);
-  }
-
   std::shared_ptr<const PythonClass> class_;
   PyRef instance_;
   PyRef step_all_;
   std::vector<int> members_;
-  std::vector<StepInput> gathered_;
+  SwarmColumns gathered_;
   bool finished_ = false;
 };
 

@@ -80,9 +80,16 @@ void ensure_interpreter() {
 std::string traceback_text(py::error_already_set& e) {
   try {
     py::module_ traceback = py::module_::import("traceback");
-    py::list lines = traceback.attr("format_exception")(e.type(), e.value(), e.trace());
+    // Python's import machinery's own frames (`<frozen importlib._bootstrap>`) say nothing
+    // about the lab's file: left out.
+    py::object report = traceback.attr("TracebackException")(e.type(), e.value(), e.trace());
+    py::list kept;
+    for (py::handle frame : report.attr("stack")) {
+      if (frame.attr("filename").cast<std::string>().rfind("<frozen ", 0) != 0) kept.append(frame);
+    }
+    report.attr("stack") = traceback.attr("StackSummary").attr("from_list")(kept);
     std::string text;
-    for (py::handle line : lines) text += line.cast<std::string>();
+    for (py::handle line : report.attr("format")()) text += line.cast<std::string>();
     while (!text.empty() && text.back() == '\n') text.pop_back();
     return text;
   } catch (const std::exception&) {

@@ -182,12 +182,21 @@ QuantumModel::QuantumModel(AgentExchange& exchange, std::vector<AgentModel*> age
 
 void QuantumModel::internal_transition() {
   const TimeUs t = t_us_;
+  auto next = agents_.begin();
   for (const RemoteOutput& answer : exchange_.exchange(t)) {
     // The agents are in ID order (a search: a world of 1,000 robots made this loop a
-    // million comparisons per step).
-    const auto it = std::lower_bound(agents_.begin(), agents_.end(), answer.robot_id,
-                                     [](const AgentModel* a, int id) { return a->body().id() < id; });
-    if (it != agents_.end() && (*it)->body().id() == answer.robot_id) (*it)->complete(answer);
+    // million comparisons per step). Answers mostly come in ID order too (a group's
+    // always): the agent after the last one answered is tried first, which spares a
+    // swarm's 100,000 agents 17 cold reads each.
+    auto it = next;
+    if (it == agents_.end() || (*it)->body().id() != answer.robot_id) {
+      it = std::lower_bound(agents_.begin(), agents_.end(), answer.robot_id,
+                            [](const AgentModel* a, int id) { return a->body().id() < id; });
+    }
+    if (it != agents_.end() && (*it)->body().id() == answer.robot_id) {
+      (*it)->complete(answer);
+      next = it + 1;
+    }
   }
   if (record_) {
     for (const ExchangeNotice& n : exchange_.take_notices()) record_(t, n);

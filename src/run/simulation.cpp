@@ -209,7 +209,11 @@ void Run::add_team_models() {
     quantum_ = &root_->emplace<QuantumModel>(*options_.remote_agents, agents_, scenario_.control_period_us, 0);
   }
   for (const auto& g : group_exchanges_) {
-    group_quanta_.push_back(&root_->emplace<QuantumModel>(*g, agents_, scenario_.control_period_us, 0));
+    std::vector<AgentModel*> members;
+    for (AgentModel* a : agents_) {
+      if (g->serves(a->body().id())) members.push_back(a);
+    }
+    group_quanta_.push_back(&root_->emplace<QuantumModel>(*g, members, scenario_.control_period_us, 0));
   }
   // Both ways of running a convoy are built; the mode says which one drives (the console
   // may switch it while the run runs).

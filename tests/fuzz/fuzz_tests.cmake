@@ -12,6 +12,7 @@
 #   fuzz_agent_messages
 #   fuzz_plugin_answers
 #   fuzz_sensor_parameters
+#   fuzz_python_answers
 # All have the label `fuzz`: `ctest -L fuzz` runs only them, `ctest -LE fuzz` all but them.
 # Without clang++ or libFuzzer, configuring says so and the fuzz tests show as disabled.
 
@@ -25,7 +26,7 @@ find_program(RILBED_FUZZ_CXX NAMES clang++ clang++-14 DOC "clang++ for the fuzz 
 set(_fuzz_dir ${CMAKE_CURRENT_LIST_DIR})
 set(_fuzz_bin ${CMAKE_BINARY_DIR}/fuzz)
 set(_fuzz_targets fuzz_khepera_reply fuzz_scenario fuzz_lcm_messages fuzz_lcm_log fuzz_console_command fuzz_foxglove_messages
-    fuzz_agent_messages fuzz_plugin_answers fuzz_sensor_parameters)
+    fuzz_agent_messages fuzz_plugin_answers fuzz_sensor_parameters fuzz_python_answers)
 # Seeds per target, read but never written (the fuzzer adds to the first corpus folder
 # only, the working one in the build tree). The scenarios ship with the project.
 set(_fuzz_seeds_fuzz_khepera_reply ${_fuzz_dir}/corpus/khepera_reply)
@@ -37,6 +38,7 @@ set(_fuzz_seeds_fuzz_foxglove_messages ${_fuzz_dir}/corpus/foxglove_messages)
 set(_fuzz_seeds_fuzz_agent_messages ${_fuzz_dir}/corpus/agent_messages)
 set(_fuzz_seeds_fuzz_plugin_answers ${_fuzz_dir}/corpus/plugin_answers)
 set(_fuzz_seeds_fuzz_sensor_parameters ${_fuzz_dir}/corpus/sensor_parameters)
+set(_fuzz_seeds_fuzz_python_answers ${_fuzz_dir}/corpus/python_answers)
 set(_fuzz_dict_fuzz_khepera_reply ${_fuzz_dir}/khepera_reply.dict)
 set(_fuzz_dict_fuzz_scenario ${_fuzz_dir}/scenario.dict)
 set(_fuzz_dict_fuzz_lcm_messages ${_fuzz_dir}/lcm_messages.dict)
@@ -46,6 +48,11 @@ set(_fuzz_dict_fuzz_foxglove_messages ${_fuzz_dir}/foxglove_messages.dict)
 set(_fuzz_dict_fuzz_agent_messages ${_fuzz_dir}/agent_messages.dict)
 set(_fuzz_dict_fuzz_plugin_answers ${_fuzz_dir}/plugin_answers.dict)
 set(_fuzz_dict_fuzz_sensor_parameters ${_fuzz_dir}/sensor_parameters.dict)
+set(_fuzz_dict_fuzz_python_answers ${_fuzz_dir}/python_answers.dict)
+# The embedded interpreter lives until exit (it is never finalised): its allocations are not
+# leaks, of an input's or at exit.
+set(_fuzz_args_fuzz_python_answers -detect_leaks=0)
+set(_fuzz_env_fuzz_python_answers ASAN_OPTIONS=detect_leaks=0)
 
 # Can clang++ link a fuzzer? (On Debian libFuzzer comes apart, in libclang-rt-14-dev.)
 set(_fuzz_problem "")
@@ -87,9 +94,9 @@ else()
   foreach(_target IN LISTS _fuzz_targets)
     # Through `cmake -E env`: the target exists only once fuzz_build has run.
     add_test(NAME ${_target}
-             COMMAND ${CMAKE_COMMAND} -E env UBSAN_OPTIONS=print_stacktrace=1
+             COMMAND ${CMAKE_COMMAND} -E env UBSAN_OPTIONS=print_stacktrace=1 ${_fuzz_env_${_target}}
                      ${_fuzz_bin}/${_target} ${_fuzz_bin}/corpus/${_target} ${_fuzz_seeds_${_target}}
-                     -dict=${_fuzz_dict_${_target}}
+                     -dict=${_fuzz_dict_${_target}} ${_fuzz_args_${_target}}
                      -max_total_time=${RILBED_FUZZ_SECONDS} -rss_limit_mb=2048 -timeout=10
                      -print_final_stats=1 -artifact_prefix=${_fuzz_bin}/artifacts/${_target}-
              WORKING_DIRECTORY ${_fuzz_bin})

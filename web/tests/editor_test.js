@@ -284,13 +284,13 @@ async function main(state) {
   ok(`screenshot of the editor: ${shot}`);
 
   // 3. Save: the download, the text shown, what it holds, and rilbed run accepting it.
-  const save = async (what) => {
+  const save = async (what, dir = state.tmp) => {
     const [download] = await Promise.all([
       page.waitForEvent('download', { timeout: DEADLINE_MS }).catch((e) => fail(`no download after Save (${what}): ${e.message.split('\n')[0]}`)),
       page.click('#editor-save'),
     ]);
     check(download.suggestedFilename() === 'scenario.yaml', `the download is named ${download.suggestedFilename()}, not scenario.yaml`);
-    const file = path.join(state.tmp, `saved-${what}.yaml`);
+    const file = path.join(dir, `saved-${what}.yaml`);
     await download.saveAs(file);
     const text = fs.readFileSync(file, 'utf8');
     const shown = await page.inputValue('#editor-yaml');
@@ -316,7 +316,12 @@ async function main(state) {
   runAccepts(binary, saved.file, ['--fast', '--duration', '2'], path.join(state.tmp, 'run-edited'));
   ok('rilbed run SAVED --fast --duration 2 exits 0');
 
-  // 4. Every shipped scenario, loaded and saved unchanged.
+  // 4. Every shipped scenario, loaded and saved unchanged. Saved where a path relative to
+  // the scenario (a Python controller's `../examples/python/...`) still leads to its file:
+  // a scenarios/ folder beside a link to the project's examples/.
+  const shippedDir = path.join(state.tmp, 'scenarios');
+  fs.mkdirSync(shippedDir);
+  fs.symlinkSync(path.resolve(SCENARIOS, '../examples'), path.join(state.tmp, 'examples'));
   const files = fs.readdirSync(SCENARIOS).filter((f) => f.endsWith('.yaml')).sort();
   check(files.length > 0, `no scenarios in ${SCENARIOS}`);
   for (const f of files) {
@@ -324,7 +329,7 @@ async function main(state) {
     const loadsBefore = await page.evaluate(() => window.rilbedEditor.loads);
     await page.setInputFiles('#editor-file', original);
     await until(`the editor to load ${f}`, ([n, name]) => window.rilbedEditor.loads > n && window.rilbedEditor.loadedName === name, [loadsBefore, f]);
-    const out = await save(path.basename(f, '.yaml'));
+    const out = await save(path.basename(f, '.yaml'), shippedDir);
     const a = yaml.load(fs.readFileSync(original, 'utf8'));
     const c = yaml.load(out.text);
     try {

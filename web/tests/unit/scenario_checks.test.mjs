@@ -27,6 +27,16 @@ test('a controller the registry does not have is unknown, named with those it ha
   assert.deepEqual(findProblems(doc, registry), ["robots[0]: unknown controller 'beacon_homing' (rilbed knows convoy, wander, sweeper)."]);
 });
 
+test('a Python class is the run\'s to check; only the shape of its mapping is the page\'s', () => {
+  assert.deepEqual(controllerProblems({ controller: { python: '../examples/python/convoy.py', class: 'Convoy' }, params: { standoff_m: 0.1 } }, registry), []);
+  assert.deepEqual(controllerProblems({ controller: { python: 'convoy.py', klass: 'Convoy' } }, registry), [
+    'controller.klass: unknown key (allowed here: python, class)',
+    'controller.class: give the name of a class of the file that subclasses rilbed.Controller',
+  ]);
+  assert.deepEqual(controllerProblems({ controller: { python: '', class: 'Convoy' } }, registry),
+    ["controller.python: give the Python file's path, relative to the scenario file"]);
+});
+
 test('a parameter the controller does not take', () => {
   assert.deepEqual(paramsProblems(registry.find('wander'), { speed_mps: 0.1, lanes: 2 }),
     ["controller wander has no parameter 'lanes' (it takes speed_mps)"]);
