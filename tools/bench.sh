@@ -51,7 +51,7 @@ echo
 "$BUILD_DIR/rilbed" sim-bench --robots 100,1000,10000 --seconds 10
 # Python controllers beside the C++ one (same world, same seed), then one call's cost.
 echo
-GLIBC_TUNABLES=glibc.malloc.mmap_threshold=67108864:glibc.malloc.trim_threshold=268435456 "$BUILD_DIR/bench_python"
+GLIBC_TUNABLES=glibc.malloc.mmap_threshold=67108864:glibc.malloc.trim_threshold=268435456 "$BUILD_DIR/bench_python" --swarm-seconds 5
 echo
 echo "## Convoy batch: 100 seeds of scenarios/convoy_sim.yaml, --fast --stop-when-formed"
 echo

@@ -194,6 +194,10 @@ void QuantumModel::internal_transition() {
                             [](const AgentModel* a, int id) { return a->body().id() < id; });
     }
     if (it != agents_.end() && (*it)->body().id() == answer.robot_id) {
+      // The agents a group's answers reach next are cold: asked for ahead, as the
+      // monitor does (prefetch_view's two rounds).
+      if (agents_.end() - it > 8) (*(it + 8))->prefetch_view(0);
+      if (agents_.end() - it > 4) (*(it + 4))->prefetch_view(1);
       (*it)->complete(answer);
       next = it + 1;
     }
