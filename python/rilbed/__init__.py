@@ -10,6 +10,8 @@ built-in module ``_rilbed_embedded``; in any other ``/usr/bin/python3`` (with
 ``PYTHONPATH=build/python``) from the extension module ``rilbed._rilbed``.
 """
 
+import os as _os
+
 try:
     import _rilbed_embedded as _api  # inside a run of the rilbed binary
 
@@ -18,6 +20,13 @@ except ImportError:
     from . import _rilbed as _api
 
     _IN_RUN = False
+    # What rilbed finds beside its binary (built-in plug-ins, robot models, the binary
+    # that agent processes run), found beside this build's binary instead: this process's
+    # executable is python3. The extension lives in <build>/python/rilbed/.
+    _BUILD = _os.path.dirname(_os.path.dirname(_os.path.dirname(_os.path.abspath(_api.__file__))))
+    for _variable, _name in (("RILBED_BINARY", "rilbed"), ("RILBED_PLUGIN_DIR", "plugins"), ("RILBED_ROBOT_DIR", "robots")):
+        if _os.path.exists(_os.path.join(_BUILD, _name)):
+            _os.environ.setdefault(_variable, _os.path.join(_BUILD, _name))
 
 Input = _api.Input
 SwarmInput = _api.SwarmInput

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -20,7 +21,11 @@ namespace rilbed::session {
 
 namespace {
 
+// The rilbed binary the agents are: RILBED_BINARY when set (a Python process, whose own
+// executable is python3: the `rilbed` package sets it to the binary of its build), else
+// this process's own.
 std::optional<std::string> own_binary() {
+  if (const char* binary = std::getenv("RILBED_BINARY"); binary && *binary) return std::string(binary);
   char self[4096] = {};
   const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
   if (n <= 0) return std::nullopt;
@@ -72,8 +77,8 @@ void AgentProcesses::stop() {
   started_.clear();
 }
 
-bool AgentProcesses::spawn(const std::vector<std::string>& args, bool search_path, const std::string& input,
-                           Started& started, std::string& error) {
+bool AgentProcesses::spawn(const std::vector<std::string>& args, bool search_path, bool with_input,
+                           const std::string& input, Started& started, std::string& error) {
   std::vector<std::string> copy = args;
   std::vector<char*> argv;
   for (std::string& a : copy) argv.push_back(a.data());
@@ -81,9 +86,9 @@ bool AgentProcesses::spawn(const std::vector<std::string>& args, bool search_pat
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   int pipe_fds[2] = {-1, -1};
-  if (search_path) {
-    // The launch command reads the scenario from a pipe, whose write end this keeps: the
-    // agent at the far end takes the end of its input for the end of the run.
+  if (with_input) {
+    // The agent (or the launch command) reads the scenario from a pipe, whose write end
+    // this keeps: the agent takes the end of its input for the end of the run.
     if (pipe2(pipe_fds, O_CLOEXEC) != 0) {
       error = std::string("cannot make a pipe for an agent process: ") + std::strerror(errno);
       posix_spawn_file_actions_destroy(&actions);
@@ -118,7 +123,26 @@ bool AgentProcesses::start(const AgentLaunchConfig& config, const std::vector<Ag
     error = "cannot find rilbed's own binary to start the agents";
     return false;
   }
+  // The scenario's text for an agent's input, read once: what the run read, ended by the
+  // YAML end-of-document line (it tells the agent where the scenario ends; its input stays
+  // open after it, as its lifeline).
   std::string scenario_text;
+  const auto scenario_input = [&]() -> bool {
+    if (!scenario_text.empty()) return true;
+    if (config.scenario_text.empty()) {
+      const std::optional<std::string> text = read_text(config.scenario_file);
+      if (!text) {
+        error = "cannot read " + config.scenario_file + " to send it to the agents";
+        return false;
+      }
+      scenario_text = *text;
+    } else {
+      scenario_text = config.scenario_text;
+    }
+    if (!scenario_text.empty() && scenario_text.back() != '\n') scenario_text.push_back('\n');
+    scenario_text.append("...\n");
+    return true;
+  };
   for (const AgentPlacement& placement : placements) {
     std::vector<std::string> agent = {"agent", "--ids", id_ranges_text(placement.ids), "--lcm", config.url, "--quiet"};
     if (!config.prefix.empty()) {
@@ -130,26 +154,20 @@ bool AgentProcesses::start(const AgentLaunchConfig& config, const std::vector<Ag
     if (placement.host.empty()) {
       std::vector<std::string> args = {*self};
       args.insert(args.end(), agent.begin(), agent.end());
-      args.insert(args.end(), {"--scenario", config.scenario_file});
-      if (!spawn(args, false, {}, started, error)) return false;
-    } else {
-      if (scenario_text.empty()) {
-        const std::optional<std::string> text = read_text(config.scenario_file);
-        if (!text) {
-          error = "cannot read " + config.scenario_file + " to send it to the agents' hosts";
-          return false;
-        }
-        // The YAML end-of-document line tells the agent where the scenario ends; its input
-        // stays open after it.
-        scenario_text = *text;
-        if (!scenario_text.empty() && scenario_text.back() != '\n') scenario_text.push_back('\n');
-        scenario_text.append("...\n");
+      if (config.scenario_text.empty()) {
+        args.insert(args.end(), {"--scenario", config.scenario_file});
+        if (!spawn(args, false, false, {}, started, error)) return false;
+      } else {
+        // With '=': a file name that starts with '-' stays the option's value.
+        args.push_back("--scenario-stdin=" + config.scenario_file);
+        if (!scenario_input() || !spawn(args, false, true, scenario_text, started, error)) return false;
       }
+    } else {
+      if (!scenario_input()) return false;
       std::string command = shell_quote(config.remote_rilbed.empty() ? *self : config.remote_rilbed);
       for (const std::string& a : agent) command.append(" ").append(shell_quote(a));
-      // With '=': a file name that starts with '-' stays the option's value.
       command.append(" ").append(shell_quote("--scenario-stdin=" + config.scenario_file));
-      if (!spawn(launch_arguments(config.launch, placement.host, command), true, scenario_text, started, error)) {
+      if (!spawn(launch_arguments(config.launch, placement.host, command), true, true, scenario_text, started, error)) {
         return false;
       }
     }

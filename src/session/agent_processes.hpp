@@ -14,8 +14,12 @@ namespace rilbed::session {
 /// How the agent processes of a run are started (shared by all of them).
 struct AgentLaunchConfig {
   std::string scenario_file;  ///< the run's scenario file (agents on this machine read it)
-  std::string url;            ///< the run's LCM URL
-  std::string prefix;         ///< the run's channel prefix; empty: none
+  /// The scenario as the run read it, when that is not the file's text (a scenario from
+  /// Python, overrides): every agent then gets it on its input, as agents on other hosts
+  /// get the file's, with `scenario_file` naming it. Empty: the file as it is.
+  std::string scenario_text;
+  std::string url;     ///< the run's LCM URL
+  std::string prefix;  ///< the run's channel prefix; empty: none
   /// For agents on other hosts: the launch command, `{host}` and `{command}` in its items
   /// (agents::AgentsSpec::launch), and the rilbed binary there (empty: this binary's path).
   std::vector<std::string> launch;
@@ -51,12 +55,14 @@ class AgentProcesses {
  private:
   struct Started {
     pid_t pid = 0;
-    int input_fd = -1;  ///< the write end of a remote process's standard input; -1 for local ones
+    int input_fd = -1;  ///< the write end of the process's standard input (the scenario); -1: it reads a file
     AgentPlacement placement;
     bool ended = false;
   };
-  bool spawn(const std::vector<std::string>& args, bool search_path, const std::string& input, Started& started,
-             std::string& error);
+  // Starts `args` (searched on PATH with `search_path`); `with_input`: `input` goes to its
+  // standard input, which stays open while the process is ours.
+  bool spawn(const std::vector<std::string>& args, bool search_path, bool with_input, const std::string& input,
+             Started& started, std::string& error);
   std::vector<Started> started_;
 };
 

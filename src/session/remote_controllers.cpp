@@ -10,14 +10,15 @@ namespace rilbed::session {
 
 RemoteControllers::RemoteControllers(const run::Scenario& scenario, const std::string& scenario_file,
                                      const std::string& lcm_url, const bus::Channels& channels,
-                                     const std::string& channel_prefix, bool realtime)
+                                     const std::string& channel_prefix, bool realtime, const std::string& scenario_text)
     : scenario_file_(scenario_file) {
   const run::AgentsSpec& spec = *scenario.agents;
   std::string error;
   quanta_bus_ = bus::open_lcm(lcm_url, error);
   if (quanta_bus_) answers_bus_ = bus::open_lcm(bus::agent_reply_url(lcm_url), error);
   if (!quanta_bus_ || !answers_bus_) throw std::runtime_error(error);
-  const AgentLaunchConfig launch{scenario_file, lcm_url, channel_prefix, spec.launch, spec.remote_rilbed};
+  const AgentLaunchConfig launch{scenario_file,  scenario_text, lcm_url,
+                                 channel_prefix, spec.launch,   spec.remote_rilbed};
   if (spec.processes > 0 && !processes_.start(launch, place_agents(spec.ids, spec.processes, spec.hosts), error)) {
     throw std::runtime_error(error);
   }

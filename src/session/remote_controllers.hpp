@@ -23,7 +23,8 @@ class RemoteControllers {
   /// starts the scenario's agent processes. Throws std::runtime_error when a bus cannot be
   /// opened or a process cannot start.
   RemoteControllers(const run::Scenario& scenario, const std::string& scenario_file, const std::string& lcm_url,
-                    const bus::Channels& channels, const std::string& channel_prefix, bool realtime);
+                    const bus::Channels& channels, const std::string& channel_prefix, bool realtime,
+                    const std::string& scenario_text = {});
   RemoteControllers(const RemoteControllers&) = delete;
   RemoteControllers& operator=(const RemoteControllers&) = delete;
 

@@ -87,6 +87,7 @@ gui_web::ConsoleSink run_control_sink(run::RunControl& control) {
 // goes in: the agent processes and the real robots first, the bus last).
 struct SessionParts {
   run::Scenario scenario;
+  std::string scenario_text;  // the scenario as read, when not the file's (SessionOptions::scenario_text, overrides)
   std::vector<int> real_ids;
   run::RunOptions base;  // every run's options but its seed and folder
   bus::Channels channels;
@@ -137,7 +138,7 @@ class SessionSetup {
 
  private:
   // The scenario file, or the text given, with the overrides applied. Throws ScenarioError.
-  run::Scenario scenario_from_options() const {
+  run::Scenario scenario_from_options() {
     if (o_.scenario_text.empty() && o_.overrides.empty()) return run::load_scenario(o_.scenario, o_.controllers);
     std::string text = o_.scenario_text;
     if (text.empty()) {
@@ -146,6 +147,7 @@ class SessionSetup {
       text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     }
     if (!o_.overrides.empty()) text = run::apply_overrides(text, o_.overrides, o_.scenario.string());
+    p_.scenario_text = text;  // what agent processes must read too
     run::Scenario scenario = run::parse_scenario(text, o_.scenario.string(), o_.controllers);
     scenario.source = o_.scenario;
     return scenario;
@@ -299,7 +301,7 @@ class SessionSetup {
     }
     try {
       p_.remote = std::make_unique<RemoteControllers>(p_.scenario, o_.scenario.string(), o_.lcm_url, p_.channels,
-                                                      o_.channel_prefix, p_.base.realtime);
+                                                      o_.channel_prefix, p_.base.realtime, p_.scenario_text);
     } catch (const std::runtime_error& e) {
       return problem(Status::kFailed, e.what());
     }

@@ -116,5 +116,32 @@ TEST(PythonCli, PythonClassesRunInAgentProcessesAsInTheRunsOwn) {
   fs::remove_all(scratch);
 }
 
+// rilbed.run's overrides reach the agent processes: they get the scenario the run read,
+// not the file's, and the run gives the in-process run's trajectories.
+TEST(PythonCli, ARunFromPythonGivesItsAgentProcessesTheScenarioItRead) {
+  const fs::path dir = scratch_dir("python_run_agents");
+  std::ofstream(dir / "wander.yaml")
+      << "name: wander_agents\nduration_s: 5\nfield: {width_m: 1.5, height_m: 1.2, walls: "
+         "true}\nrobots:\n  - ids: 1-4\n    pose: random\n    controller: {python: "
+      << (kPython / "wander.py").string()
+      << ", class: Wander}\n    params: {speed_mps: 0.05}\n    sensors:\n      "
+         "proximity: {range_m: 0.05}\n";
+  std::ofstream(dir / "runs.py") << "import sys, rilbed\n"
+                                    "url = sys.argv[1]\n"
+                                    "fast = {'robots.0.params.speed_mps': 0.2}\n"
+                                    "rilbed.run('wander.yaml', seed=4, out='local', overrides=fast)\n"
+                                    "rilbed.run('wander.yaml', seed=4, out='agents', lcm_url=url,\n"
+                                    "           overrides=dict(fast, **{'agents': {'processes': 2}}))\n"
+                                    "rilbed.run('wander.yaml', seed=4, out='slow')\n";
+  const fs::path python_dir = fs::path(RILBED_BINARY).parent_path() / "python";
+  const int status =
+      in_namespace(dir, "PYTHONPATH='" + python_dir.string() + "' /usr/bin/python3 runs.py \"$URL\" > runs.txt 2>&1\n");
+  ASSERT_EQ(status, 0) << read_file(dir / "runs.txt");
+  const std::string local = read_file(dir / "local" / "trajectories.csv");
+  EXPECT_EQ(local, read_file(dir / "agents" / "trajectories.csv"));
+  EXPECT_NE(local, read_file(dir / "slow" / "trajectories.csv"));
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace rilbed::e2e

@@ -20,14 +20,22 @@
 #include <vector>
 
 #include <fuzzer/FuzzedDataProvider.h>
+#include <pybind11/embed.h>
 #include <pybind11/eval.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include "python/controller_api.hpp"
 #include "python/python_answers.hpp"
-#include "python/python_runtime.hpp"
 
 namespace py = pybind11;
+
+// Of the controller API, what an answer can be: rilbed.Output (bound as controller_bindings.cpp
+// binds it; the rest of the API, which no answer holds, stays out of this target's build).
+PYBIND11_EMBEDDED_MODULE(_rilbed_embedded, m) {
+  py::class_<rilbed::python::StepOutput>(m, "Output")
+      .def(py::init<int, int, std::string>(), py::arg("left"), py::arg("right"), py::arg("behaviour") = "idle");
+}
 
 namespace {
 
@@ -132,8 +140,13 @@ void check_output(const rilbed::agents::ControlOutput& o) {
 }  // namespace
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  rilbed::python::ensure_interpreter();
-  rilbed::python::PythonLock lock;
+  // Debian's python3, as rilbed embeds it (python_runtime.cpp): named outright, no signal
+  // handlers.
+  PyConfig config;
+  PyConfig_InitPythonConfig(&config);
+  config.install_signal_handlers = 0;
+  PyConfig_SetBytesString(&config, &config.program_name, "/usr/bin/python3");
+  py::initialize_interpreter(&config, 0, nullptr, false);
   py::module_::import("_rilbed_embedded");
   py::module_::import("numpy");
   helpers();
@@ -141,8 +154,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  FuzzedDataProvider in(data, size);
-  rilbed::python::PythonLock lock;
+  FuzzedDataProvider in(data, size);  // (this thread holds the GIL from the start)
   const bool swarm = in.ConsumeBool();
   std::vector<int> ids(static_cast<std::size_t>(in.ConsumeIntegralInRange<int>(0, 5)));
   for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<int>(i) + 1;

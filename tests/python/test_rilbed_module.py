@@ -95,6 +95,17 @@ class RunsFromPython(unittest.TestCase):
         summary = rilbed.run(self.faulty("RaisesAtTwoSeconds"), seed=1, on_controller_error="stop-robot")
         self.assertEqual(summary["controller_failed"], [2])
 
+    def test_what_rilbed_ships_beside_its_binary_is_found_from_python(self):
+        # A shipped robot model named bare, and the C controller built into plugins/:
+        # both found beside the build's binary, not beside python3.
+        d = wander_dict(duration_s=2)
+        d["robots"][0]["model"] = "epuck"
+        d["robots"][0]["controller"] = "c:braitenberg"
+        d["robots"][0].pop("sensors")
+        summary = rilbed.run(d, seed=1)
+        self.assertEqual(summary["simulated_s"], 2.0)
+        self.assertTrue(os.path.exists(os.environ["RILBED_BINARY"]))
+
     def test_a_malformed_run_folder_is_named_with_its_line(self):
         out = os.path.join(self.tmp, "bad")
         rilbed.run(CONVOY, seed=1, duration_s=1, out=out)
