@@ -285,7 +285,52 @@ std::string summary_of(py::handle cls, const std::string& fallback) {
   return text.substr(0, text.find('\n'));
 }
 
+// The names of the rilbed.Controller classes `module` defines itself, in its order.
+std::vector<std::string> controller_classes(py::handle module) {
+  py::object base = py::module_::import("rilbed").attr("Controller");
+  const py::object name = module.attr("__name__");
+  std::vector<std::string> out;
+  for (auto item : module.attr("__dict__").cast<py::dict>()) {
+    py::handle value = item.second;
+    if (!PyType_Check(value.ptr()) || value.is(base) || PyObject_IsSubclass(value.ptr(), base.ptr()) != 1) continue;
+    if (!py::object(value.attr("__module__")).equal(name)) continue;
+    out.push_back(item.first.cast<std::string>());
+  }
+  if (PyErr_Occurred()) PyErr_Clear();
+  return out;
+}
+
 }  // namespace
+
+core::Result<std::vector<agents::ControllerEntry>> load_python_controllers(const std::filesystem::path& file) {
+  std::error_code ec;
+  const std::filesystem::path path = std::filesystem::absolute(file, ec).lexically_normal();
+  if (!std::filesystem::is_regular_file(path, ec))
+    return core::Failure{"Python controller " + path.string() + ": no such file"};
+  try {
+    ensure_interpreter();
+  } catch (const std::exception& e) {
+    return core::Failure{"Python controller " + path.string() + ": " + e.what()};
+  }
+  std::vector<std::string> names;
+  {
+    PythonLock lock;
+    try {
+      names = controller_classes(import_file(path.string()));
+    } catch (py::error_already_set& e) {
+      return core::Failure{"Python controller " + path.string() + ": it does not import:\n" + traceback_text(e)};
+    }
+  }
+  if (names.empty())
+    return core::Failure{"Python controller " + path.string() + ": it defines no rilbed.Controller class"};
+  std::vector<agents::ControllerEntry> entries;
+  for (const std::string& name : names) {
+    core::Result<agents::ControllerEntry> e = load_python_controller(path, name);
+    if (!e) return core::Failure{e.error()};
+    entries.push_back(std::move(*e));
+  }
+  return entries;
+}
 
 core::Result<agents::ControllerEntry> load_python_controller(const std::filesystem::path& file,
                                                              const std::string& class_name) {

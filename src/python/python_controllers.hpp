@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "agents/controller_registry.hpp"
 #include "core/result.hpp"
@@ -23,5 +24,11 @@ namespace rilbed::python {
 /// turns into std::invalid_argument (a scenario error naming the robot).
 core::Result<agents::ControllerEntry> load_python_controller(const std::filesystem::path& file,
                                                              const std::string& class_name);
+
+/// Every class of the Python file `file` that subclasses rilbed.Controller and is defined
+/// there (not imported into it), as load_python_controller() makes each, in the file's
+/// order: what `rilbed controllers --python FILE` lists. A failure names the file (and the
+/// class) as load_python_controller()'s do; none at all is a failure too.
+core::Result<std::vector<agents::ControllerEntry>> load_python_controllers(const std::filesystem::path& file);
 
 }  // namespace rilbed::python

@@ -43,6 +43,18 @@ TEST(PythonCli, TheShippedPythonConvoyRunsAndForms) {
   fs::remove_all(out);
 }
 
+TEST(PythonCli, ControllersListsAPythonFilesClassesOrSaysWhyItCannot) {
+  const CommandResult r = run_rilbed("controllers --python " + quoted(kPython / "wander.py"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("| `wander.Wander` | A Braitenberg wanderer"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("| `wander.SwarmWander` | Wander for a whole swarm"), std::string::npos) << r.out;
+  const CommandResult broken =
+      run_rilbed("controllers --python " + quoted(kFaulty.parent_path() / "does_not_import.py"));
+  EXPECT_EQ(broken.exit_code, 1);
+  EXPECT_NE(broken.err.find("does_not_import.py: it does not import:"), std::string::npos) << broken.err;
+  EXPECT_NE(broken.err.find("SyntaxError: expected ':'"), std::string::npos) << broken.err;
+}
+
 // A real (emulated) Khepera under a Python controller that raises at t = 2 s.
 void write_failing_scenario(const fs::path& file, const std::string& extra = "") {
   std::ofstream(file) << "field: {width_m: 1.0, height_m: 1.0}\n"
