@@ -1,20 +1,13 @@
 #include "agents/controller_group.hpp"
 
-#include <stdexcept>
-
 namespace rilbed::agents {
 
 ControllerGroup& ControllerGroups::find_or_make(const std::string& key,
                                                 const std::function<std::unique_ptr<ControllerGroup>()>& make) {
   auto it = groups_.find(key);
-  if (it == groups_.end()) {
-    it = groups_.emplace(key, make()).first;
-    order_.push_back(it->second.get());
-  }
+  if (it == groups_.end()) it = groups_.emplace(key, make()).first;
   return *it->second;
 }
-
-std::vector<ControllerGroup*> ControllerGroups::all() const { return order_; }
 
 GroupMember::GroupMember(int robot_id, ControllerGroup& group, std::shared_ptr<ControllerGroup> owned)
     : robot_id_(robot_id), group_(&group), owned_(std::move(owned)) {}

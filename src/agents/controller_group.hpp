@@ -49,12 +49,9 @@ class ControllerGroups {
  public:
   /// The group for `key`, made with `make` the first time.
   ControllerGroup& find_or_make(const std::string& key, const std::function<std::unique_ptr<ControllerGroup>()>& make);
-  /// Every group, in the order made.
-  std::vector<ControllerGroup*> all() const;
 
  private:
   std::map<std::string, std::unique_ptr<ControllerGroup>> groups_;
-  std::vector<ControllerGroup*> order_;
 };
 
 /// One robot's controller inside a group: step() alone steps the group for this robot

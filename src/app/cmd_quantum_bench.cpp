@@ -92,8 +92,11 @@ std::optional<Row> bench_one(const QuantumBenchArgs& args, lcm::LCM& lcm, lcm::L
   for (int id = 1; id <= robots; ++id) ids.push_back(id);
   session::AgentProcesses agents_here;
   std::string error;
-  if (!agents_here.start({file.string(), args.url, args.prefix, {}, {}}, session::place_agents(ids, processes, {}),
-                         error)) {
+  session::AgentLaunchConfig launch;
+  launch.scenario_file = file.string();
+  launch.url = args.url;
+  launch.prefix = args.prefix;
+  if (!agents_here.start(launch, session::place_agents(ids, processes, {}), error)) {
     spdlog::error("quantum-bench: {}", error);
     return std::nullopt;
   }

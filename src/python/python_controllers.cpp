@@ -1,15 +1,11 @@
 #include "python/python_controllers.hpp"
 
-#include <cmath>
 #include <map>
 #include <memory>
-#include <mutex>
 
-#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 #include <spdlog/spdlog.h>
 
-#include "agents/behaviour_names.hpp"
 #include "agents/controller_group.hpp"
 #include "python/controller_api.hpp"
 #include "python/python_answers.hpp"
@@ -33,13 +29,13 @@ class PyRef {
 
  private:
   static void release(py::object* o) {
-    if (Py_IsInitialized()) {
-      PythonLock lock;
-      delete o;
-    } else {
+    if (!Py_IsInitialized()) {
       o->release();  // the interpreter is gone: nothing to give back
       delete o;
+      return;
     }
+    PythonLock lock;
+    delete o;
   }
   std::shared_ptr<py::object> object_;
 };
@@ -90,7 +86,6 @@ class PythonController final : public agents::Controller {
  public:
   PythonController(std::shared_ptr<const PythonClass> c, int robot_id, py::object instance)
       : class_(std::move(c)),
-        robot_id_(robot_id),
         who_("robot " + std::to_string(robot_id) + "'s controller " + class_->who()),
         instance_(instance),
         step_(instance.attr("step")) {}
@@ -121,7 +116,6 @@ class PythonController final : public agents::Controller {
 
  private:
   std::shared_ptr<const PythonClass> class_;
-  int robot_id_;
   std::string who_;
   PyRef instance_;
   PyRef step_;  // the bound method, looked up once

@@ -36,6 +36,13 @@ TimeUs milliseconds(const Reader& r, const std::string& key, TimeUs fallback_us)
   return us;
 }
 
+// `path` relative to the file `r` reads (a scenario, or a robot model file it names),
+// absolute: what a scenario's plug-in libraries, parameter files and Python files are.
+std::filesystem::path resolved(const Reader& r, const std::string& path) {
+  std::error_code ec;
+  return std::filesystem::absolute(std::filesystem::path(r.source()).parent_path() / path, ec).lexically_normal();
+}
+
 // The sensor models a scenario's robots mount (`sensors: {models: [...]}`): their libraries
 // loaded once each, their parameter files read and checked, each mount made (its model's
 // create(), with the scenario's static map and control period) once per robot entry.
@@ -105,11 +112,6 @@ class ScenarioSensors {
   }
 
  private:
-  // Relative to the file `r` reads (a scenario, or a robot model file it names).
-  static std::filesystem::path resolved(const Reader& r, const std::string& path) {
-    std::error_code ec;
-    return std::filesystem::absolute(std::filesystem::path(r.source()).parent_path() / path, ec).lexically_normal();
-  }
   const agents::SensorModelEntry& model(const Reader& m, const std::filesystem::path& path, const std::string& name) {
     auto it = libraries_.find(path.string());
     if (it == libraries_.end()) {
@@ -354,9 +356,7 @@ const agents::ControllerEntry& read_controller_name(const Reader& r, ScenarioCon
     if (file.empty()) c.fail_key("python", "give the Python file's path, relative to the scenario file");
     if (class_name.empty())
       c.fail_key("class", "give the name of a class of the file that subclasses rilbed.Controller");
-    const std::filesystem::path base = std::filesystem::path(r.source()).parent_path();
-    std::error_code ec;
-    const std::filesystem::path path = std::filesystem::absolute(base / file, ec).lexically_normal();
+    const std::filesystem::path path = resolved(r, file);
     const agents::ControllerEntry& entry = controllers.from_python(r, path, class_name);
     spec.name = entry.name;
     spec.library = path.string();
@@ -369,9 +369,7 @@ const agents::ControllerEntry& read_controller_name(const Reader& r, ScenarioCon
     spec.name = c.text("name", "");
     if (library.empty()) c.fail_key("library", "give the plug-in library's path, relative to the scenario file");
     if (spec.name.empty()) c.fail_key("name", "give the name of one of the library's controllers");
-    const std::filesystem::path base = std::filesystem::path(r.source()).parent_path();
-    std::error_code ec;
-    const std::filesystem::path path = std::filesystem::absolute(base / library, ec).lexically_normal();
+    const std::filesystem::path path = resolved(r, library);
     spec.library = path.string();
     return controllers.from_library(r, path, spec.name);
   }
