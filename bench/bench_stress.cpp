@@ -5,8 +5,12 @@
 // of a full-frame search on textured floors beside plain ones, and AprilTag and ArUco on
 // the same frames. A report, not a test: it prints Markdown and asserts nothing.
 //
-//   bench_stress [--scenes N] [--seed S] [--frames-per-scene K] [--threads T] [--timing-frames F]
-//                [--mistakes M] [--no-peers]
+//   bench_stress [--generator stress|lab] [--scenes N] [--seed S] [--frames-per-scene K] [--threads T]
+//                [--timing-frames F] [--mistakes M] [--no-peers]
+//
+// `--generator lab` draws the scenes from the second, independent generator instead
+// (src/vision/lab_footage.hpp: light traced from lamp to JPEG, scenes plain, hard and harsh
+// in turn) and adds its tables: recall by finer sizes and by difficulty.
 //
 // Without --seed it draws one (and prints it): run it again with that seed to see the same
 // frames (`rilbed synth --preset stress --seed S` writes them). Scenes are rendered on T
@@ -39,6 +43,7 @@
 #include <thread>
 #include <vector>
 
+#include "vision/lab_footage.hpp"
 #include "vision/marker_tracker.hpp"
 #include "vision/stress_score.hpp"
 
@@ -51,6 +56,7 @@ using rilbed::bench::thread_cpu_ms;
 namespace {
 
 struct Options {
+  std::string generator = "stress";  // or "lab"
   int scenes = 500;
   std::uint64_t seed = 0;
   bool seed_given = false;
@@ -58,13 +64,51 @@ struct Options {
   int threads = 2;
   int timing_frames = 60;  // per floor class (plain, textured)
   int mistakes = 12;
+  int explain = 0;  // misses explained one by one (0: only their causes counted)
   bool peers = true;
 };
+
+// Why one whole marker was missed by a full search: the furthest its blob got, or why
+// the blob detector turned its region away, or that no region was filled there.
+std::string miss_cause(const rv::StressTruth& t, const std::vector<rv::CandidateVerdict>& verdicts,
+                       const std::vector<rv::RejectedRegion>& rejections, std::string* detail) {
+  const double reach = 0.5 * t.diameter_px;
+  const rv::CandidateVerdict* best = nullptr;
+  for (const auto& v : verdicts) {
+    if (std::hypot(v.u - t.u, v.v - t.v) > reach) continue;
+    if (best == nullptr || static_cast<int>(v.fate) > static_cast<int>(best->fate)) best = &v;
+  }
+  char b[160];
+  if (best != nullptr) {
+    // Every blob there: an enclosing one (a robot's dark top) and what was found inside it.
+    detail->clear();
+    for (const auto& v : verdicts) {
+      if (std::hypot(v.u - t.u, v.v - t.v) > reach) continue;
+      std::snprintf(b, sizeof b, "%s%s: ID %d, %.3f (next %.3f), disc %.1f px", detail->empty() ? "" : "; ",
+                    rv::fate_name(v.fate), v.id, v.score, v.runner_up, v.diameter_px);
+      *detail += b;
+    }
+    return std::string("blob: ") + rv::fate_name(best->fate);
+  }
+  std::map<std::string, int> why;
+  for (const auto& r : rejections) {
+    if (std::hypot(r.u - t.u, r.v - t.v) > reach) continue;
+    ++why[rv::rejection_name(r.why)];
+    std::snprintf(b, sizeof b, "region %.0f px at (%.1f, %.1f)", r.extent_px, r.u - t.u, r.v - t.v);
+    *detail = b;
+  }
+  if (why.empty()) {
+    *detail = "";
+    return "no region filled";
+  }
+  const auto most = std::max_element(why.begin(), why.end(), [](auto& a, auto& c) { return a.second < c.second; });
+  return "region: " + most->first;
+}
 
 // Scenes rendered on worker threads, handed to the scorer in order of their index.
 class SceneQueue {
  public:
-  SceneQueue(const Options& opt, const rv::StressOptions& stress) : opt_(opt), stress_(stress) {
+  SceneQueue(const Options& opt, std::function<rv::StressScene(int)> make) : opt_(opt), make_(std::move(make)) {
     for (int t = 0; t < std::max(1, opt.threads); ++t) workers_.emplace_back([this] { work(); });
   }
   ~SceneQueue() {
@@ -98,7 +142,7 @@ class SceneQueue {
         if (stop_ || next_in_ >= opt_.scenes) return;
         index = next_in_++;
       }
-      rv::StressScene s = rv::make_stress_scene(opt_.seed, index, stress_);
+      rv::StressScene s = make_(index);
       {
         std::lock_guard lock(mutex_);
         ready_.emplace(index, std::move(s));
@@ -107,7 +151,7 @@ class SceneQueue {
     }
   }
   const Options& opt_;
-  rv::StressOptions stress_;
+  std::function<rv::StressScene(int)> make_;
   std::mutex mutex_;
   std::condition_variable changed_;
   std::map<int, rv::StressScene> ready_;
@@ -156,6 +200,8 @@ struct TimedFrame {
 int main(int argc, char** argv) {
   Options opt;
   CLI::App app{"rilbed on the vision stress set"};
+  app.add_option("--generator", opt.generator, "stress (the tuning set) or lab (the second, independent generator)")
+      ->check(CLI::IsMember({"stress", "lab"}));
   app.add_option("--scenes", opt.scenes, "Scenes (each --frames-per-scene frames)")->check(CLI::PositiveNumber);
   app.add_option("--seed", opt.seed, "The set's seed (default: drawn, and printed)")->each([&](const std::string&) {
     opt.seed_given = true;
@@ -167,6 +213,8 @@ int main(int argc, char** argv) {
   app.add_option("--timing-frames", opt.timing_frames, "Frames timed per floor class (plain, textured)")
       ->check(CLI::Range(0, 1000));
   app.add_option("--mistakes", opt.mistakes, "Mistakes listed")->check(CLI::Range(0, 100000));
+  app.add_option("--explain", opt.explain, "Whole markers missed by full-frame search listed with their cause")
+      ->check(CLI::Range(0, 100000));
   app.add_flag("!--no-peers", opt.peers, "Leave out AprilTag and ArUco");
   CLI11_PARSE(app, argc, argv);
   if (!opt.seed_given) opt.seed = std::random_device{}() | (static_cast<std::uint64_t>(std::random_device{}()) << 32);
@@ -177,7 +225,10 @@ int main(int argc, char** argv) {
 
   rv::StressOptions stress;
   stress.frames_per_scene = opt.frames_per_scene;
-  std::printf("# rilbed on the vision stress set\n\n");
+  rv::LabFootageOptions lab;
+  lab.frames_per_scene = opt.frames_per_scene;
+  const bool is_lab = opt.generator == "lab";
+  std::printf(is_lab ? "# rilbed on the second generator's lab footage\n\n" : "# rilbed on the vision stress set\n\n");
   std::printf("- CPU: %s; `nproc`: %d; load average at start: %s\n", rilbed::bench::cpu_model().c_str(),
               rilbed::bench::usable_cpus(), rilbed::bench::first_line("/proc/loadavg").c_str());
   std::printf("- build: %s; sources: %s\n", rilbed::bench::env_or("RILBED_BENCH_BUILD_TYPE", "unknown").c_str(),
@@ -186,13 +237,25 @@ int main(int argc, char** argv) {
               static_cast<unsigned long long>(opt.seed), opt.scenes, opt.frames_per_scene,
               opt.scenes * opt.frames_per_scene, stress.image_size.width, stress.image_size.height,
               rv::stress_floor_photos(stress).size(), stress.photo_dir.c_str());
-  std::printf(
-      "- every condition drawn per scene (src/vision/stress_scene.cpp): marker 20-64 px (outer diameter at the "
-      "image centre), blur sigma 0-2 px, motion blur 0-4 px in any direction, noise 0-10, JPEG 50-95, light "
-      "ratio 1-4 and vignetting 0-0.5, tilt 0-20 deg, k1 0 to -0.3 (with the matching calibration), floors "
-      "plain light/dark, photographs, drawn wood/fabric/carpet/concrete; 4-14 clutter items (dark discs, "
-      "rings, tape, chessboards, text, AprilTag and ArUco tags, cables); 4-8 robots of IDs 1-8, about a third "
-      "touching another; a quarter of the markers partly under a cable (2-15 %% of the disc)\n");
+  if (is_lab) {
+    std::printf(
+        "- scenes plain, hard and harsh in turn (src/vision/lab_footage.cpp): rays from a pinhole with the angle "
+        "distorted, 4x4 rays per photosite at edges; paper stickers (grain, toner spread, gloss) on robots' tops "
+        "30-60 mm high; one lamp (light ratio plain 1.1-1.5, hard 2.5-3.5, harsh 3.5-4.5), shadows, cos^4 "
+        "vignetting; a defocus disc (plain 0.2-0.8 px, else 0.7-2.2 px, growing to the corners); rolling shutter "
+        "and motion blur; shot and read noise, 10-bit ADC, Bayer or mono, sRGB curve; JPEG plain 85-95, hard "
+        "60-70, harsh 50-60; markers 42-48 mm, plain 30-40 px, hard 24-32, harsh 24-36 at the centre (tilt "
+        "12-20 deg); cables over a marker in 60 %% of hard and harsh scenes; 3-10 dark discs, washers, tape, "
+        "screws and printed words on the floor\n");
+  } else {
+    std::printf(
+        "- every condition drawn per scene (src/vision/stress_scene.cpp): marker 20-64 px (outer diameter at the "
+        "image centre), blur sigma 0-2 px, motion blur 0-4 px in any direction, noise 0-10, JPEG 50-95, light "
+        "ratio 1-4 and vignetting 0-0.5, tilt 0-20 deg, k1 0 to -0.3 (with the matching calibration), floors "
+        "plain light/dark, photographs, drawn wood/fabric/carpet/concrete; 4-14 clutter items (dark discs, "
+        "rings, tape, chessboards, text, AprilTag and ArUco tags, cables); 4-8 robots of IDs 1-8, about a third "
+        "touching another; a quarter of the markers partly under a cable (2-15 %% of the disc)\n");
+  }
   std::printf(
       "- the tracker lists IDs 1-8 in every scene (absent robots' IDs too); full-frame: "
       "`MarkerTracker::detect_full_frame` on each frame; tracked: a fresh `MarkerTracker::process` over each "
@@ -207,15 +270,41 @@ int main(int argc, char** argv) {
   rv::StressTally full, tracked;
   std::vector<TimedFrame> timed;
   int plain_kept = 0, textured_kept = 0;
+  std::map<std::string, int> miss_causes;
+  std::vector<std::string> miss_rows;
+  std::vector<rv::CandidateVerdict> verdicts;
+  std::vector<rv::RejectedRegion> rejections;
   {
-    SceneQueue queue(opt, stress);
+    SceneQueue queue(opt, [&](int index) {
+      return is_lab ? rv::make_lab_scene(opt.seed, index, lab) : rv::make_stress_scene(opt.seed, index, stress);
+    });
     rv::MarkerTracker single(family, all_ids());
+    single.set_verdict_log(&verdicts, &rejections);
     while (auto scene = queue.next()) {
       rv::MarkerTracker clip(family, all_ids());
       for (int f = 0; f < static_cast<int>(scene->frames.size()); ++f) {
         const cv::Mat& frame = scene->frames[static_cast<std::size_t>(f)];
+        verdicts.clear();
+        rejections.clear();
+        const std::size_t before = full.outcomes().size();
         const auto found_full = single.detect_full_frame(frame);
         full.add(*scene, f, found_full, single.last_stats().declined);
+        for (std::size_t i = before; i < full.outcomes().size(); ++i) {
+          const rv::StressOutcome& o = full.outcomes()[i];
+          if (o.found || o.occluded > 0 || o.touching) continue;
+          for (const auto& t : scene->truth[static_cast<std::size_t>(f)]) {
+            if (t.id != o.id) continue;
+            std::string detail;
+            const std::string cause = miss_cause(t, verdicts, rejections, &detail);
+            ++miss_causes[cause];
+            if (static_cast<int>(miss_rows.size()) < opt.explain) {
+              char b[400];
+              std::snprintf(b, sizeof b, "| %d | %d | %d | %.1f | %.1f | %.1f | %s | %s |", o.scene, o.frame, o.id,
+                            t.diameter_px, t.u, t.v, cause.c_str(), detail.c_str());
+              miss_rows.emplace_back(b);
+            }
+          }
+        }
         const auto found_tracked = clip.process(frame);
         tracked.add(*scene, f, found_tracked, clip.last_stats().declined);
       }
@@ -246,6 +335,22 @@ int main(int argc, char** argv) {
                 t->count(rv::StressMistake::Kind::kDuplicate), t->declined());
   }
   std::printf("\n");
+
+  // ------------------------------------------------------------ why whole markers were missed
+  {
+    int total = 0;
+    for (const auto& [cause, n] : miss_causes) total += n;
+    std::printf("## Why full-frame search missed whole markers (%d misses)\n\n| cause | misses |\n| --- | ---: |\n",
+                total);
+    for (const auto& [cause, n] : miss_causes) std::printf("| %s | %d |\n", cause.c_str(), n);
+    if (!miss_rows.empty()) {
+      std::printf(
+          "\n| scene | frame | ID | diameter px | u | v | cause | detail |\n| ---: | ---: | ---: | ---: | ---: | ---: "
+          "| --- | --- |\n");
+      for (const auto& r : miss_rows) std::printf("%s\n", r.c_str());
+    }
+    std::printf("\n");
+  }
 
   // ------------------------------------------------------------ by size
   const auto unoccluded = [](const rv::StressOutcome& o) { return o.occluded == 0; };
@@ -304,6 +409,91 @@ int main(int argc, char** argv) {
   std::printf("\n## By floor (markers >= 24 px, unoccluded)\n\n%s", head);
   print_bucket_rows("full-frame", full.outcomes(), floors);
   print_bucket_rows("tracked", tracked.outcomes(), floors);
+
+  if (is_lab) {
+    // The second generator's own tables: the sizes the targets name, and each difficulty
+    // (scene k is plain, hard, harsh for k % 3 = 0, 1, 2).
+    const auto whole = [](const rv::StressOutcome& o) { return o.occluded == 0 && !o.touching; };
+    const std::vector<Bucket> fine = {
+        {"< 24 px", [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px < 24; }},
+        {"24-28 px", [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px >= 24 && o.diameter_px < 28; }},
+        {"28-32 px", [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px >= 28 && o.diameter_px < 32; }},
+        {"32-40 px", [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px >= 32 && o.diameter_px < 40; }},
+        {">= 40 px", [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px >= 40; }},
+        {"under a cable", [](const rv::StressOutcome& o) { return o.occluded > 0; }},
+    };
+    std::printf("\n## Lab footage by size (whole markers unless said)\n\n%s", head);
+    print_bucket_rows("full-frame", full.outcomes(), fine);
+    print_bucket_rows("tracked", tracked.outcomes(), fine);
+    std::vector<Bucket> kinds;
+    for (int k = 0; k < 3; ++k) {
+      static const char* names[] = {"plain, whole", "hard, whole", "harsh, whole"};
+      kinds.push_back({names[k], [&, k](const rv::StressOutcome& o) { return whole(o) && o.scene % 3 == k; }});
+    }
+    std::printf("\n## Lab footage by difficulty\n\n%s", head);
+    print_bucket_rows("full-frame", full.outcomes(), kinds);
+    print_bucket_rows("tracked", tracked.outcomes(), kinds);
+    // The heading's mean error by ID: a bias by code is what a lab cannot calibrate away.
+    std::printf("\n## Lab footage: mean heading error by ID (whole markers >= 24 px)\n\n| mode |");
+    for (int id = 1; id <= 8; ++id) std::printf(" ID %d |", id);
+    std::printf(" all |\n| --- |%s\n", " ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    for (const rv::StressTally* t : {&full, &tracked}) {
+      std::printf("| %s |", t == &full ? "full-frame" : "tracked");
+      double all_sum = 0;
+      int all_n = 0;
+      for (int id = 1; id <= 8; ++id) {
+        double sum = 0;
+        int n = 0;
+        for (const auto& o : t->outcomes()) {
+          if (o.id != id || !o.found || !whole(o) || o.diameter_px < 24) continue;
+          sum += o.heading_error_deg;
+          ++n;
+        }
+        all_sum += sum;
+        all_n += n;
+        std::printf(" %+.3f |", n ? sum / n : 0.0);
+      }
+      std::printf(" %+.3f |\n", all_n ? all_sum / all_n : 0.0);
+    }
+    std::printf("\n## The lab footage's targets\n\n| target | full-frame | tracked |\n| --- | ---: | ---: |\n");
+    auto row = [&](const char* name, const std::function<std::string(const rv::StressTally&)>& value) {
+      std::printf("| %s | %s | %s |\n", name, value(full).c_str(), value(tracked).c_str());
+    };
+    row("0 wrong IDs (cables included)",
+        [](const rv::StressTally& t) { return std::to_string(t.count(rv::StressMistake::Kind::kWrongId)); });
+    row("0 false detections",
+        [](const rv::StressTally& t) { return std::to_string(t.count(rv::StressMistake::Kind::kFalseDetection)); });
+    row("recall >= 0.99, whole, >= 28 px", [&](const rv::StressTally& t) {
+      return pct(rv::summarise(t.outcomes(), [&](const rv::StressOutcome& o) {
+                   return whole(o) && o.diameter_px >= 28;
+                 }).recall());
+    });
+    row("recall >= 0.97, whole, 24-28 px", [&](const rv::StressTally& t) {
+      return pct(rv::summarise(t.outcomes(), [&](const rv::StressOutcome& o) {
+                   return whole(o) && o.diameter_px >= 24 && o.diameter_px < 28;
+                 }).recall());
+    });
+    auto hard = [&](const rv::StressOutcome& o) { return whole(o) && o.scene % 3 == 1 && o.diameter_px >= 24; };
+    row("heading <= 1.0 deg RMS, hard", [&](const rv::StressTally& t) {
+      char b[32];
+      std::snprintf(b, sizeof b, "%.3f", rv::summarise(t.outcomes(), hard).heading_rms_deg);
+      return std::string(b);
+    });
+    row("no ID's mean heading error beyond 0.3 deg, whole, >= 24 px", [&](const rv::StressTally& t) {
+      const auto st =
+          rv::summarise(t.outcomes(), [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px >= 24; });
+      char b[48];
+      std::snprintf(b, sizeof b, "ID %d: %+.3f", st.worst_bias_id, st.worst_bias_deg);
+      return std::string(b);
+    });
+    row("centre <= 0.15 px RMS, whole, >= 24 px", [&](const rv::StressTally& t) {
+      char b[32];
+      std::snprintf(b, sizeof b, "%.3f", rv::summarise(t.outcomes(), [&](const rv::StressOutcome& o) {
+                                           return whole(o) && o.diameter_px >= 24;
+                                         }).centre_rms_px);
+      return std::string(b);
+    });
+  }
 
   // ------------------------------------------------------------ targets
   std::printf("\n## The stress set's targets\n\n| target | full-frame | tracked |\n| --- | ---: | ---: |\n");

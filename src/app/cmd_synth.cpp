@@ -10,6 +10,7 @@
 
 #include "app/commands.hpp"
 #include "vision/field_mapping.hpp"
+#include "vision/lab_footage.hpp"
 #include "vision/stress_scene.hpp"
 #include "vision/synthetic_scene.hpp"
 
@@ -30,10 +31,12 @@ struct SynthOptions {
   int frames_per_scene = 4;  // stress: each scene's clip
 };
 
-// `--preset stress`: scenes of the vision stress set, each its own camera, floor, light and
-// clutter (src/vision/stress_scene.hpp), as PNG frames (each already through JPEG at its
+// `--preset stress` and `--preset lab`: scenes of the vision stress set (each its own camera,
+// floor, light and clutter, src/vision/stress_scene.hpp) or of the second generator's lab
+// footage (src/vision/lab_footage.hpp), as PNG frames (each already through JPEG at its
 // scene's quality), with per-scene conditions and calibration.
 int run_stress_synth(const SynthOptions& opt, const std::filesystem::path& dir) {
+  const bool lab = opt.preset == "lab";
   std::error_code ec;
   std::filesystem::create_directories(dir / "frames", ec);
   std::filesystem::create_directories(dir / "calibration", ec);
@@ -44,6 +47,10 @@ int run_stress_synth(const SynthOptions& opt, const std::filesystem::path& dir) 
   vision::StressOptions stress;
   stress.frames_per_scene = opt.frames_per_scene;
   stress.image_size = {opt.width, opt.height};
+  vision::LabFootageOptions lab_options;
+  lab_options.frames_per_scene = opt.frames_per_scene;
+  lab_options.image_size = {opt.width, opt.height};
+  lab_options.fps = opt.fps;
   std::ofstream truth(dir / "ground_truth.csv");
   truth << "frame,id,u,v,heading_deg,scene,diameter_px,occluded,touching\n";
   std::ofstream scenes(dir / "scenes.csv");
@@ -53,7 +60,8 @@ int run_stress_synth(const SynthOptions& opt, const std::filesystem::path& dir) 
   char line[512];
   int frame = 0;
   for (int k = opt.first_scene; frame < opt.frames; ++k) {
-    const vision::StressScene scene = vision::make_stress_scene(opt.seed, k, stress);
+    const vision::StressScene scene =
+        lab ? vision::make_lab_scene(opt.seed, k, lab_options) : vision::make_stress_scene(opt.seed, k, stress);
     const vision::StressConditions& c = scene.conditions;
     std::snprintf(line, sizeof line, "%d,%d,%zu,%.2f,%.3f,%.3f,%.1f,%.2f,%d,%.3f,%.3f,%.2f,%.4f,%s,%s,%.1f,%d,%d\n", k,
                   frame, scene.frames.size(), c.marker_diameter_px, c.blur_sigma_px, c.motion_blur_px,
@@ -81,9 +89,9 @@ int run_stress_synth(const SynthOptions& opt, const std::filesystem::path& dir) 
     }
   }
   std::ofstream about(dir / "scene.txt");
-  about << "rendered by: rilbed synth --preset stress --frames " << opt.frames << " --seed " << opt.seed << " --scene "
-        << opt.first_scene << " --frames-per-scene " << opt.frames_per_scene << " --width " << opt.width << " --height "
-        << opt.height
+  about << "rendered by: rilbed synth --preset " << opt.preset << " --frames " << opt.frames << " --seed " << opt.seed
+        << " --scene " << opt.first_scene << " --frames-per-scene " << opt.frames_per_scene << " --width " << opt.width
+        << " --height " << opt.height
         << "\nfamily 6ucp, IDs 1..8; each scene's conditions in scenes.csv, its calibration in "
            "calibration/scene_NNNN.yaml\n";
   std::printf("wrote %d frames (frames/*.png), ground_truth.csv, scenes.csv, calibration/ and scene.txt to %s\n",
@@ -92,7 +100,7 @@ int run_stress_synth(const SynthOptions& opt, const std::filesystem::path& dir) 
 }
 
 int run_synth(const SynthOptions& opt) {
-  if (opt.preset == "stress") return run_stress_synth(opt, opt.out);
+  if (opt.preset == "stress" || opt.preset == "lab") return run_stress_synth(opt, opt.out);
   vision::ScenePreset preset;
   try {
     preset = vision::scene_preset(opt.preset, {opt.width, opt.height});
@@ -179,13 +187,14 @@ void add_synth_command(CLI::App& app) {
   auto opt = std::make_shared<SynthOptions>();
   CLI::App* cmd = app.add_subcommand("synth", "Render footage with ground truth from the synthetic overhead camera");
   cmd->add_option("--preset", opt->preset,
-                  "nominal, hard, or stress (every scene's conditions drawn at random from wide ranges; PNG frames, "
-                  "per-scene conditions and calibration)")
+                  "nominal, hard, stress (every scene's conditions drawn at random from wide ranges; PNG frames, "
+                  "per-scene conditions and calibration) or lab (the second generator: light traced from lamp to "
+                  "JPEG, scenes plain, hard and harsh in turn; frames as stress's)")
       ->capture_default_str();
-  cmd->add_option("--scene", opt->first_scene, "stress: the first scene written (scene K of the seed's set)")
+  cmd->add_option("--scene", opt->first_scene, "stress, lab: the first scene written (scene K of the seed's set)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--frames-per-scene", opt->frames_per_scene, "stress: frames of each scene's clip")
+  cmd->add_option("--frames-per-scene", opt->frames_per_scene, "stress, lab: frames of each scene's clip")
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
   cmd->add_option("--out", opt->out, "Output directory")->capture_default_str();
@@ -202,7 +211,8 @@ void add_synth_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::IsMember({"avi", "jpg", "png"}));
   cmd->callback([opt, height] {
-    if (opt->preset == "stress" && height->count() == 0) opt->height = 960;  // the stress set's frames are 1280x960
+    // The stress set's and the lab footage's frames are 1280x960.
+    if ((opt->preset == "stress" || opt->preset == "lab") && height->count() == 0) opt->height = 960;
     exit_code() = run_synth(*opt);
   });
 }

@@ -82,6 +82,20 @@ void store_half_results(const v_uint8x16& v, std::uint8_t* out) {
 }
 }  // namespace
 
+const char* rejection_name(RegionRejection why) {
+  switch (why) {
+    case RegionRejection::kCut: return "cut";
+    case RegionRejection::kTooSmall: return "too small";
+    case RegionRejection::kNotCompact: return "not compact";
+    case RegionRejection::kDimOutline: return "dim outline";
+    case RegionRejection::kDegenerate: return "degenerate";
+    case RegionRejection::kElongated: return "elongated";
+    case RegionRejection::kAreaMismatch: return "area mismatch";
+    case RegionRejection::kRaggedOutline: return "ragged outline";
+  }
+  return "?";
+}
+
 double Blob::disc_diameter_px() const { return 2.0 * std::sqrt(filled_area_px / kPi); }
 
 // Bookkeeping of one region (swept or filled).
@@ -812,8 +826,13 @@ bool BlobDetector::measure(const cv::Mat& grey, const Fill& fill, Blob& blob) co
     cols.add(a, b, x);
     col_chords.push_back({a, b, static_cast<double>(x)});
   }
-  if (rows.area <= 0.0 || cols.area <= 0.0) return false;
-  if (bright_edges < config_.min_bright_outline * edges) return false;
+  auto reject = [&](RegionRejection why) {
+    last_rejection_ = why;
+    return false;
+  };
+  if (rows.area <= 0.0 || cols.area <= 0.0) return reject(RegionRejection::kDegenerate);
+  const double least_bright = exact_fills_ ? inside_bright_outline_ : config_.min_bright_outline;
+  if (bright_edges < least_bright * edges) return reject(RegionRejection::kDimOutline);
 
   rows.finish();
   cols.finish();
@@ -824,26 +843,28 @@ bool BlobDetector::measure(const cv::Mat& grey, const Fill& fill, Blob& blob) co
   const double sxy = 0.5 * (rows.cross_along / rows.area - cx * rows.cross / rows.area + cols.cross_along / cols.area -
                             cy * cols.cross / cols.area);
   const double det = sxx * syy - sxy * sxy;
-  if (sxx <= 0.0 || syy <= 0.0 || det <= 0.0) return false;
+  if (sxx <= 0.0 || syy <= 0.0 || det <= 0.0) return reject(RegionRejection::kDegenerate);
 
   // Axis ratio from the eigenvalues of the covariance.
   const double mean = 0.5 * (sxx + syy);
   const double diff = std::sqrt(0.25 * (sxx - syy) * (sxx - syy) + sxy * sxy);
   const double l_major = mean + diff, l_minor = mean - diff;
-  if (l_minor <= 0.0 || std::sqrt(l_major / l_minor) > config_.max_axis_ratio) return false;
+  if (l_minor <= 0.0 || std::sqrt(l_major / l_minor) > config_.max_axis_ratio)
+    return reject(RegionRejection::kElongated);
 
   // A uniform ellipse with covariance S has outline q^T (4S)^-1 q = 1 and area 4*pi*sqrt(det S).
   const double ellipse_area = 4.0 * kPi * std::sqrt(det);
   const double area = 0.5 * (rows.area + cols.area);
-  if (std::abs(area - ellipse_area) > config_.max_area_error * ellipse_area) return false;
+  if (std::abs(area - ellipse_area) > config_.max_area_error * ellipse_area)
+    return reject(RegionRejection::kAreaMismatch);
 
   const double inv = 1.0 / (4.0 * det);
   const double qxx = syy * inv, qyy = sxx * inv, qxy = -sxy * inv;
   const double chord_limit = std::max(config_.max_chord_error, config_.max_doubtful_chord_error);
   const double row_err = chord_error(row_chords, qxx, qxy, qyy, cx, cy);
-  if (row_err > chord_limit) return false;
+  if (row_err > chord_limit) return reject(RegionRejection::kRaggedOutline);
   const double col_err = chord_error(col_chords, qyy, qxy, qxx, cy, cx);
-  if (col_err > chord_limit) return false;
+  if (col_err > chord_limit) return reject(RegionRejection::kRaggedOutline);
   blob.doubtful = std::max(row_err, col_err) > config_.max_chord_error;
 
   // Symmetric square root of 4S maps the unit circle onto the outline.
@@ -884,7 +905,7 @@ bool BlobDetector::try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blo
   // alone is half its disc): a region that is not, such as the floor around a marker
   // on a dark mat or a circular floor track around robots, may enclose dark shapes
   // that are not connected to it, and only the true fill tells them apart.
-  if (sweep_fill(roi, x, y, fill)) {
+  if (!exact_fills_ && sweep_fill(roi, x, y, fill)) {
     // A swept region holds every dark region it touches, whole: when all of it is too
     // small for a disc, so is everything in it, and the exact fill is not needed. Most
     // of a textured floor's dark specks end here, at the cost of one sweep.
@@ -905,6 +926,15 @@ bool BlobDetector::try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blo
   }
   const bool whole = flood_fill(roi, x, y, fill);
   const bool ok = whole && measure_region(grey, fill, blob);
+  if (!ok && rejections_ != nullptr) {
+    if (whole) {
+      rejections_->push_back({0.5 * (fill.x0 + fill.x1), 0.5 * (fill.y0 + fill.y1),
+                              static_cast<double>(std::max(fill.x1 - fill.x0, fill.y1 - fill.y0) + 1),
+                              last_rejection_});
+    } else {
+      rejections_->push_back({static_cast<double>(x), static_cast<double>(y), 0.0, RegionRejection::kCut});
+    }
+  }
   reset_region(fill);
   return ok;
 }
@@ -942,7 +972,14 @@ bool BlobDetector::centre_is_dark(const Blob& blob) const {
 }
 
 bool BlobDetector::measure_region(const cv::Mat& grey, const Fill& fill, Blob& blob) {
-  if (fill.area < min_disc_area() || !could_be_ellipse(fill)) return false;
+  if (fill.area < min_disc_area()) {
+    last_rejection_ = RegionRejection::kTooSmall;
+    return false;
+  }
+  if (!could_be_ellipse(fill)) {
+    last_rejection_ = RegionRejection::kNotCompact;
+    return false;
+  }
   // Column extents of the region, from its row extents: only candidates pay for them
   // (a long strip of tape is filled, but never measured). A column's bottom is the last
   // row (going down) that covers it and its top the last going up: two plain fills per
@@ -1001,6 +1038,14 @@ std::vector<Blob> BlobDetector::scan(const cv::Mat& grey, cv::Rect roi) {
 std::vector<Blob> BlobDetector::detect(const cv::Mat& grey, cv::Rect roi) {
   if (!begin_search(grey, roi)) return {};
   return scan(grey, roi);
+}
+
+std::vector<Blob> BlobDetector::detect_inside(const cv::Mat& grey, cv::Rect roi, double min_bright_outline) {
+  exact_fills_ = true;
+  inside_bright_outline_ = min_bright_outline;
+  std::vector<Blob> blobs = detect(grey, roi);
+  exact_fills_ = false;
+  return blobs;
 }
 
 bool BlobDetector::seed_near(const cv::Mat& grey, cv::Rect roi, cv::Point2d expected_px, Blob& blob) {

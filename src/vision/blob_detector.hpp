@@ -90,6 +90,28 @@ struct Blob {
   bool doubtful = false;
 };
 
+/// Why a dark region was not kept as a blob (BlobDetector::set_rejection_log).
+enum class RegionRejection {
+  kCut,            ///< the region touches the search window's border, or is larger than any marker
+  kTooSmall,       ///< smaller than the least marker's disc
+  kNotCompact,     ///< fills too little of its bounding box, or the box is too long, for an ellipse
+  kDimOutline,     ///< too few of its outside neighbours are bright (min_bright_outline)
+  kDegenerate,     ///< no area, or a covariance without two axes
+  kElongated,      ///< axis ratio beyond max_axis_ratio
+  kAreaMismatch,   ///< its area is not that of its moments' ellipse (max_area_error)
+  kRaggedOutline,  ///< its chords stray from the ellipse beyond max_doubtful_chord_error
+};
+
+/// The name of a rejection ("cut", "too small", ...).
+const char* rejection_name(RegionRejection why);
+
+/// One region a full search filled and turned away, for finding out why a marker was missed.
+struct RejectedRegion {
+  double u = 0, v = 0;   ///< the centre of its bounding box (kCut: the seed), pixels
+  double extent_px = 0;  ///< the longer side of its bounding box (kCut: 0)
+  RegionRejection why = RegionRejection::kCut;
+};
+
 /// Detects marker blobs in 8-bit grey frames of one size. Keeps its scratch buffers
 /// between calls (not thread-safe; one per camera).
 class BlobDetector {
@@ -114,11 +136,24 @@ class BlobDetector {
   /// The whole image.
   std::vector<Blob> detect(const cv::Mat& grey) { return detect(grey, cv::Rect(0, 0, grey.cols, grey.rows)); }
 
+  /// Like detect(grey, roi), but every region is filled exactly, so that what a dark
+  /// region encloses is searched as well: a marker's disc within the dark top of the robot
+  /// that carries it (the top, itself a dark disc, is among the blobs returned). The
+  /// quick sweep that detect() tries first takes in an enclosing region's inside whole
+  /// and clears it; this costs an exact fill per region instead. A disc there is held to
+  /// `min_bright_outline` in place of the config's: a marker's thin white ring between
+  /// its black ring and a dark top, blurred, dips below the local threshold in places.
+  std::vector<Blob> detect_inside(const cv::Mat& grey, cv::Rect roi, double min_bright_outline);
+
   const BlobDetectorConfig& config() const { return config_; }
   /// New knobs from the next frame on (a person tuning the search while it runs).
   void set_config(BlobDetectorConfig config);
   /// Flood fills started since the last call of this function (work done, for stats).
   int take_fill_count() { return std::exchange(fill_count_, 0); }
+  /// Every region a search fills exactly and turns away is appended to `log` (not owned;
+  /// nullptr, the default, logs nothing). A diagnosis, not for every frame: it costs a
+  /// push per rejected region (a textured floor makes hundreds).
+  void set_rejection_log(std::vector<RejectedRegion>* log) { rejections_ = log; }
 
  private:
   struct Fill;
@@ -167,6 +202,10 @@ class BlobDetector {
   std::vector<int> contrast_tile_count_;                                // per tile row: how many are listed
   mutable std::vector<std::array<double, 3>> row_chords_, col_chords_;  // measure()'s scratch
   int fill_count_ = 0;
+  std::vector<RejectedRegion>* rejections_ = nullptr;
+  bool exact_fills_ = false;                                        // detect_inside(): no sweeps
+  double inside_bright_outline_ = 0.9;                              // detect_inside()'s min_bright_outline
+  mutable RegionRejection last_rejection_ = RegionRejection::kCut;  // why measure_region() last said no
   int floor_range_ = 0;  // the floor's local contrast found by the last large search, grey levels
   // Per pixel, nonzero while it is dark (below its threshold) and not yet filled in the
   // current search (bit 1; bit 2 when it is dark enough to seed a fill): the fill and the

@@ -74,6 +74,34 @@ void drop_confirmed(std::vector<Blob>& blobs, const std::vector<MarkerDetection>
 
 }  // namespace
 
+const char* fate_name(CandidateFate fate) {
+  switch (fate) {
+    case CandidateFate::kRefitFailed: return "refit failed";
+    case CandidateFate::kLowScore: return "low score";
+    case CandidateFate::kAmbiguous: return "ambiguous";
+    case CandidateFate::kLevels: return "levels";
+    case CandidateFate::kTemplate: return "template";
+    case CandidateFate::kNotChosen: return "not chosen";
+    case CandidateFate::kNamed: return "named";
+  }
+  return "?";
+}
+
+void MarkerTracker::log_verdict(const Blob& blob, CandidateFate fate, const CodeMatch* match, double runner_up) {
+  if (verdicts_ == nullptr) return;
+  CandidateVerdict v;
+  v.u = blob.u;
+  v.v = blob.v;
+  v.diameter_px = blob.disc_diameter_px();
+  v.fate = fate;
+  if (match != nullptr) {
+    v.id = match->id;
+    v.score = match->score;
+  }
+  v.runner_up = runner_up;
+  verdicts_->push_back(v);
+}
+
 MarkerTracker::MarkerTracker(MarkerFamily family, std::vector<int> ids, TrackerConfig config)
     : family_(std::move(family)),
       ids_(checked_ids(family_, std::move(ids))),
@@ -130,6 +158,7 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
   similarity_.assign(blobs.size() * columns, -1.0);
   if (matches_.size() < blobs.size()) matches_.resize(blobs.size());
   thresholds_.clear();
+  passed_.assign(blobs.size(), false);
   stats_.blobs += static_cast<int>(blobs.size());
   for (std::size_t b = 0; b < blobs.size(); ++b) {
     const Blob& blob = blobs[b];
@@ -146,13 +175,28 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
     double runner_up = matches[own].rival_score;
     for (std::size_t m = 0; m < matches.size(); ++m)
       if (m != own) runner_up = std::max(runner_up, matches[m].score);
-    if (matches[own].score < config_.min_assign_score) continue;
-    if (matches[own].score - runner_up < config_.ambiguity_margin) {
-      ++stats_.declined;
+    if (matches[own].score < config_.min_assign_score) {
+      log_verdict(blob, CandidateFate::kLowScore, &matches[own], runner_up);
+      unread_.push_back(blob);
       continue;
     }
-    if (!decoder_.levels_agree(grey, blob, signal_, matches[own])) continue;  // not a printed marker's levels
-    if (!templates_.matches(grey, blob, matches[own].id, matches[own].key_angle_rad)) continue;  // not all of one
+    if (matches[own].score - runner_up < config_.ambiguity_margin) {
+      ++stats_.declined;
+      log_verdict(blob, CandidateFate::kAmbiguous, &matches[own], runner_up);
+      unread_.push_back(blob);
+      continue;
+    }
+    if (!decoder_.levels_agree(grey, blob, signal_, matches[own])) {  // not a printed marker's levels
+      log_verdict(blob, CandidateFate::kLevels, &matches[own], runner_up);
+      unread_.push_back(blob);
+      continue;
+    }
+    if (!templates_.matches(grey, blob, matches[own].id, matches[own].key_angle_rad)) {  // not all of one
+      log_verdict(blob, CandidateFate::kTemplate, &matches[own], runner_up);
+      unread_.push_back(blob);
+      continue;
+    }
+    passed_[b] = true;
     double* row = &similarity_[b * columns];
     for (std::size_t c = 0; c < columns; ++c) {
       if (static_cast<std::size_t>(decoder_index_[c]) != own) continue;  // only the ID its code reads
@@ -172,6 +216,12 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
                                                         static_cast<int>(columns), config_.min_assign_score);
   std::vector<MarkerDetection> out;
   for (std::size_t r = 0; r < blobs.size(); ++r) {
+    if (verdicts_ != nullptr && passed_[r]) {
+      const auto& m = matches_[r];
+      const auto own =
+          std::max_element(m.begin(), m.end(), [](const auto& x, const auto& y) { return x.score < y.score; });
+      log_verdict(blobs[r], chosen[r] >= 0 ? CandidateFate::kNamed : CandidateFate::kNotChosen, &*own);
+    }
     if (chosen[r] < 0) continue;
     out.push_back(make_detection(blobs[r], matches_[r][decoder_index_[chosen[r]]], false, thresholds_[r]));
   }
@@ -194,17 +244,26 @@ void MarkerTracker::settle_doubtful(const cv::Mat& grey, std::vector<Blob>& blob
     auto fit = fit_disc_edges(grey, blob, blob.threshold, config_.edge_fit);
     if (!fit) fit = fit_disc_edges(grey, blob, blob.threshold, config_.doubtful_edge_fit);
     if (!fit) {
-      if (!config_.use_ring_search) return true;
+      if (!config_.use_ring_search) {
+        log_verdict(blob, CandidateFate::kRefitFailed);
+        return true;
+      }
       if (fragments != nullptr) {
         fragments->push_back(blob);
         return true;
       }
       const auto disc = rescue_fragment(grey, blob);
-      if (!disc) return true;
+      if (!disc) {
+        log_verdict(blob, CandidateFate::kRefitFailed);
+        return true;
+      }
       blob = *disc;
       return false;
     }
-    if (fit->white_fraction < decoder_.config().min_white_ring_fraction) return true;
+    if (fit->white_fraction < decoder_.config().min_white_ring_fraction) {
+      log_verdict(blob, CandidateFate::kRefitFailed);
+      return true;
+    }
     ++stats_.refits_kept;
     blob = fit->blob;
     blob.doubtful = false;
@@ -230,7 +289,11 @@ void MarkerTracker::assign_rescued(const cv::Mat& grey, const std::vector<Blob>&
   if (fragments.empty() || found.size() >= ids_.size()) return;
   std::vector<Blob> discs;
   for (const Blob& fragment : fragments) {
-    if (auto disc = rescue_fragment(grey, fragment)) append_unique(discs, {*disc});
+    if (auto disc = rescue_fragment(grey, fragment)) {
+      append_unique(discs, {*disc});
+    } else {
+      log_verdict(fragment, CandidateFate::kRefitFailed);
+    }
   }
   drop_confirmed(discs, found);
   if (discs.empty()) return;
@@ -240,13 +303,46 @@ void MarkerTracker::assign_rescued(const cv::Mat& grey, const std::vector<Blob>&
   std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
 }
 
+void MarkerTracker::assign_nested(const cv::Mat& grey, bool use_tracks, std::vector<MarkerDetection>& found) {
+  if (!config_.search_inside_unread || unread_.empty() || found.size() >= ids_.size()) return;
+  const std::vector<Blob> outer = std::move(unread_);
+  unread_.clear();
+  std::vector<Blob> inner;
+  for (const Blob& b : outer) {
+    // The smallest disc a marker has is min_diameter_px scaled to its dark disc; a blob
+    // that cannot hold one inside its own outline holds no marker.
+    const double least_disc = config_.blobs.min_diameter_px * MarkerFamily::black_ring_outer_radius;
+    if (b.disc_diameter_px() < config_.nested_disc_ratio * least_disc) continue;
+    // Its outline's box, searched with exact fills (detect_inside): the enclosing blob is
+    // found again (and dropped below) and what it encloses with it.
+    const double half_u = std::hypot(b.shape(0, 0), b.shape(0, 1)) + 2;
+    const double half_v = std::hypot(b.shape(1, 0), b.shape(1, 1)) + 2;
+    const cv::Rect box(static_cast<int>(std::floor(b.u - half_u)), static_cast<int>(std::floor(b.v - half_v)),
+                       static_cast<int>(std::ceil(2 * half_u)) + 1, static_cast<int>(std::ceil(2 * half_v)) + 1);
+    ++stats_.nested_searches;
+    std::vector<Blob> here = detector_.detect_inside(grey, box, config_.nested_min_bright_outline);
+    std::erase_if(here, [&](const Blob& h) { return h.disc_diameter_px() > 0.9 * b.disc_diameter_px(); });
+    settle_doubtful(grey, here);
+    append_unique(inner, here);
+  }
+  drop_confirmed(inner, found);
+  if (inner.empty()) return;
+  std::vector<int> taken;
+  for (const MarkerDetection& d : found) taken.push_back(d.id);
+  for (MarkerDetection& d : assign(grey, inner, use_tracks, taken)) found.push_back(std::move(d));
+  unread_.clear();  // what failed inside is not searched again
+  std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
+}
+
 std::vector<MarkerDetection> MarkerTracker::detect_full_frame(const cv::Mat& frame) {
   const cv::Mat grey = to_grey(frame);
   stats_ = FrameStats{};
   stats_.full_search = true;
   fragments_.clear();
+  unread_.clear();
   auto found = assign(grey, find_blobs(grey, &fragments_), false);
   assign_rescued(grey, fragments_, false, found);
+  assign_nested(grey, false, found);
   stats_.fills = detector_.take_fill_count();
   return found;
 }
@@ -339,6 +435,7 @@ std::optional<MarkerDetection> MarkerTracker::confirm_by_edges(const cv::Mat& gr
 std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
   const cv::Mat grey = to_grey(frame);
   stats_ = FrameStats{};
+  unread_.clear();
   std::vector<Blob> blobs;  // found but not confirmed: decoded against the family
   // The markers confirmed near their tracks go straight into the result (its first
   // `confirmed` entries); those decoded from blobs follow.
@@ -406,12 +503,14 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
   if (tracks_.empty() || (!all_found && frames_since_full_ >= config_.full_search_interval_frames)) {
     frames_since_full_ = 0;
     fragments_.clear();
+    unread_.clear();
     std::vector<Blob> more = find_blobs(grey, &fragments_);
     found.resize(confirmed);  // the blobs are assigned again, with the new ones
     drop_confirmed(more, found);
     append_unique(blobs, more);
     for (MarkerDetection& d : assign(grey, blobs, true, confirmed_ids)) found.push_back(std::move(d));
     assign_rescued(grey, fragments_, true, found);
+    assign_nested(grey, true, found);
     stats_.full_search = true;
   }
   auto by_id = [](const auto& a, const auto& b) { return a.id < b.id; };

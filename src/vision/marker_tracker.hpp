@@ -104,6 +104,21 @@ struct TrackerConfig {
   /// a textured floor makes about 20); off with `use_ring_search`.
   RingSearchConfig ring_search;
   bool use_ring_search = true;
+  /// A marker on a robot whose top is dark and wider than the marker lies inside a
+  /// larger dark disc (the top around its white ring) that the search takes for a
+  /// blob, and whose inside it then no longer searches. So, while some listed ID is
+  /// still missing after a full search, the inside of every blob that was decoded but
+  /// named nothing is searched again on its own (FrameStats::nested_searches). Only
+  /// blobs at least `nested_disc_ratio` times the least marker's disc are: smaller ones
+  /// cannot hold a marker. Costs a small search (a few microseconds) per such blob, and
+  /// only in frames that miss a marker; off with `search_inside_unread`.
+  bool search_inside_unread = true;
+  double nested_disc_ratio = 1.1;
+  /// The least bright share of a disc's outline in that search (BlobDetectorConfig::
+  /// min_bright_outline elsewhere): between the black ring and a dark top the white ring is
+  /// thin, and blur takes it below the local threshold in places. What passes still faces
+  /// every test of the decoder (its white ring unbroken) and the template.
+  double nested_min_bright_outline = 0.7;
   /// See quick_edge_fit; a fraction of the radius (DiscEdgeFit::residual). A clean disc
   /// whose shape is as kept fits within about 0.01; lower refits the shape more often.
   double shape_refit_residual = 0.02;
@@ -154,6 +169,30 @@ struct TrackerConfig {
   double confirm_drop = 0.08;
 };
 
+/// What became of one candidate blob in a search (MarkerTracker::set_verdict_log).
+enum class CandidateFate {
+  kRefitFailed,  ///< a doubtful blob whose outline fitted no clean ellipse (nor its rings, when searched)
+  kLowScore,     ///< its best reading scored below min_assign_score
+  kAmbiguous,    ///< another reading came within ambiguity_margin (FrameStats::declined)
+  kLevels,       ///< its black and white levels are not a printed marker's (Decoder::levels_agree)
+  kTemplate,     ///< the whole marker its reading names does not match (MarkerTemplates)
+  kNotChosen,    ///< its reading was a listed ID another blob took, or is not listed
+  kNamed,        ///< it took an ID
+};
+
+/// The name of a fate ("refit failed", "low score", ...).
+const char* fate_name(CandidateFate fate);
+
+/// One candidate blob and what became of it.
+struct CandidateVerdict {
+  double u = 0, v = 0;     ///< its centre, pixels
+  double diameter_px = 0;  ///< its dark disc's equivalent diameter
+  CandidateFate fate = CandidateFate::kNamed;
+  int id = 0;            ///< the ID its code reads best (0 before decoding)
+  double score = 0;      ///< that reading's score
+  double runner_up = 0;  ///< the next explanation's score
+};
+
 /// Per-frame work counters, for summaries and benchmarks.
 struct FrameStats {
   bool full_search = false;  ///< a full-frame search ran
@@ -165,6 +204,7 @@ struct FrameStats {
   int refits_kept = 0;       ///< ...and that fitted a clean ellipse, so went on to decoding
   int ring_searches = 0;     ///< refits that failed and searched for the disc's rings (TrackerConfig::ring_search)
   int declined = 0;  ///< decoded blobs left unnamed: two explanations too close (TrackerConfig::ambiguity_margin)
+  int nested_searches = 0;  ///< unread blobs searched inside (TrackerConfig::search_inside_unread)
 };
 
 /// Runs the pipeline over a stream of frames of one size. Not thread-safe; one per
@@ -188,6 +228,14 @@ class MarkerTracker {
 
   /// Counters of the last processed frame.
   const FrameStats& last_stats() const { return stats_; }
+  /// Every candidate blob of the following searches and its fate is appended to
+  /// `verdicts`, every dark region the blob detector turned away to `rejections` (neither
+  /// owned; nullptr, the default, logs nothing). For finding out why a marker is missed
+  /// (bench_stress --explain); a push per candidate, not for every frame of a run.
+  void set_verdict_log(std::vector<CandidateVerdict>* verdicts, std::vector<RejectedRegion>* rejections = nullptr) {
+    verdicts_ = verdicts;
+    detector_.set_rejection_log(rejections);
+  }
   /// The IDs this tracker assigns.
   const std::vector<int>& ids() const { return ids_; }
   const TrackerConfig& config() const { return config_; }
@@ -247,6 +295,9 @@ class MarkerTracker {
   void assign_rescued(const cv::Mat& grey, const std::vector<Blob>& fragments, bool use_tracks,
                       std::vector<MarkerDetection>& found);
   cv::Mat to_grey(const cv::Mat& frame);
+  // While some listed ID is missing from `found`: the blobs inside the decoded blobs that
+  // named nothing (unread_), assigned to the IDs still free, added to `found`.
+  void assign_nested(const cv::Mat& grey, bool use_tracks, std::vector<MarkerDetection>& found);
   // decoder_index_ for decoder_.
   void index_decoder();
 
@@ -258,6 +309,7 @@ class MarkerTracker {
   std::vector<double> similarity_;
   std::vector<std::vector<CodeMatch>> matches_;
   std::vector<double> thresholds_;
+  std::vector<bool> passed_;    // per blob: it passed every test before the assignment
   std::uint8_t load_sink_ = 0;  // keeps load_disc_area()'s loads (its value is never used)
   TrackerConfig config_;
   BlobDetector detector_;
@@ -268,10 +320,13 @@ class MarkerTracker {
   std::vector<int> track_of_id_;    // per ID, its index in tracks_ or -1 (rebuilt per frame)
   std::vector<int> confirmed_ids_;  // process()'s, kept between frames (no allocation per frame)
   std::vector<Blob> fragments_;     // a full search's doubtful blobs whose outline did not fit (settle_doubtful)
+  std::vector<Blob> unread_;        // a search's blobs decoded but named nothing (assign_nested)
   FrameStats stats_;
   int frames_since_full_ = 0;
   cv::Mat grey_buffer_;
-  SampledSignal signal_;  // reused for every blob: no allocation per blob
+  SampledSignal signal_;                               // reused for every blob: no allocation per blob
+  std::vector<CandidateVerdict>* verdicts_ = nullptr;  // set_verdict_log's
+  void log_verdict(const Blob& blob, CandidateFate fate, const CodeMatch* match = nullptr, double runner_up = 0);
 };
 
 /// Convenience: one full-frame detection of `ids` in one image with default knobs.

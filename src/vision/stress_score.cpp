@@ -1,6 +1,7 @@
 #include "vision/stress_score.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <map>
 
 #include "core/geometry.hpp"
@@ -139,6 +140,17 @@ const char* mistake_name(StressMistake::Kind kind) {
     case StressMistake::Kind::kDuplicate: return "duplicate";
   }
   return "?";
+}
+
+std::string list_mistakes(const StressTally& tally) {
+  std::string out;
+  for (const auto& m : tally.mistakes()) {
+    char line[160];
+    std::snprintf(line, sizeof line, "scene %d frame %d: %s, ID %d reported at (%.1f, %.1f) on marker %d\n", m.scene,
+                  m.frame, mistake_name(m.kind), m.id, m.u, m.v, m.true_id);
+    out += line;
+  }
+  return out;
 }
 
 }  // namespace rilbed::vision

@@ -85,6 +85,9 @@ struct StressStats {
 StressStats summarise(const std::vector<StressOutcome>& outcomes,
                       const std::function<bool(const StressOutcome&)>& keep);
 
+/// Every mistake of a tally, one line each (scene, frame, kind, where), for a failing test's message.
+std::string list_mistakes(const StressTally& tally);
+
 /// The kind's name ("wrong ID", "false detection", ...).
 const char* mistake_name(StressMistake::Kind kind);
 

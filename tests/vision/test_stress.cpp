@@ -75,17 +75,6 @@ const Tallies& tallies() {
   return result;
 }
 
-std::string describe(const StressTally& t) {
-  std::string out;
-  for (const auto& m : t.mistakes()) {
-    char line[160];
-    std::snprintf(line, sizeof line, "scene %d frame %d: %s, ID %d reported at (%.1f, %.1f) on marker %d\n", m.scene,
-                  m.frame, mistake_name(m.kind), m.id, m.u, m.v, m.true_id);
-    out += line;
-  }
-  return out;
-}
-
 // One test for both modes: the scenes are rendered once (CTest runs each test in a process
 // of its own).
 TEST(StressSet, FullFrameAndTrackedHoldTheirTargetsOrTheLevelReached) {
@@ -97,10 +86,10 @@ TEST(StressSet, FullFrameAndTrackedHoldTheirTargetsOrTheLevelReached) {
                 t.frames(), t.outcomes().size(), t.declined());
     // A miss beats a wrong ID; clutter (other tag families among it) never gets one; no
     // heading is far off.
-    EXPECT_EQ(t.count(StressMistake::Kind::kWrongId), 0) << describe(t);
-    EXPECT_EQ(t.count(StressMistake::Kind::kFalseDetection), 0) << describe(t);
-    EXPECT_EQ(t.count(StressMistake::Kind::kWrongHeading), 0) << describe(t);
-    EXPECT_EQ(t.count(StressMistake::Kind::kDuplicate), 0) << describe(t);
+    EXPECT_EQ(t.count(StressMistake::Kind::kWrongId), 0) << list_mistakes(t);
+    EXPECT_EQ(t.count(StressMistake::Kind::kFalseDetection), 0) << list_mistakes(t);
+    EXPECT_EQ(t.count(StressMistake::Kind::kWrongHeading), 0) << list_mistakes(t);
+    EXPECT_EQ(t.count(StressMistake::Kind::kDuplicate), 0) << list_mistakes(t);
     if (kSanitized) continue;
 
     const auto large =
