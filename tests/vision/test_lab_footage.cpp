@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <future>
 
+#include "sanitized.hpp"
 #include "vision/lab_footage.hpp"
 #include "vision/marker_tracker.hpp"
 #include "vision/stress_score.hpp"
@@ -19,17 +20,6 @@ namespace {
 
 constexpr std::uint64_t kSeed = 341066799223761092ull;  // never tuned on
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-#else
-constexpr bool kSanitized = false;
-#endif
 // Under the sanitizers (some thirty times slower) a few scenes, held to the mistakes only.
 constexpr int kScenes = kSanitized ? 3 : 18;
 constexpr int kFrames = 4;

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <future>
 
+#include "sanitized.hpp"
 #include "vision/marker_tracker.hpp"
 #include "vision/stress_score.hpp"
 
@@ -21,17 +22,6 @@ constexpr std::uint64_t kSeed = 3354018184;  // drawn after the last threshold c
 // slower: there the test renders 12 scenes and holds them to the mistakes only (a wrong ID,
 // a false detection, a heading far off need no statistics; recall and RMS over 12 scenes
 // would be noise). The scenes are the same, the results bit for bit those of Release.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-#else
-constexpr bool kSanitized = false;
-#endif
 constexpr int kScenes = kSanitized ? 12 : 60;
 
 // Two of the stress set's targets are held here at a level below the target, for want of frames
