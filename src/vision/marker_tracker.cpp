@@ -64,6 +64,13 @@ MarkerDetection make_detection(const Blob& blob, const CodeMatch& match, bool tr
 }
 
 // Blobs at a confirmed marker's place are that marker: drop them.
+// Whether `blob`'s dark disc belongs to a marker `marker_diameter_px` across (a track's),
+// within a third either way: a robot's dark top around a marker is 1.5-2 times as wide.
+bool similar_size(const Blob& blob, double marker_diameter_px) {
+  const double ratio = blob.disc_diameter_px() / (MarkerFamily::black_ring_outer_radius * marker_diameter_px);
+  return ratio > 0.75 && ratio < 1.33;
+}
+
 void drop_confirmed(std::vector<Blob>& blobs, const std::vector<MarkerDetection>& confirmed) {
   std::erase_if(blobs, [&](const Blob& b) {
     return std::any_of(confirmed.begin(), confirmed.end(), [&](const MarkerDetection& d) {
@@ -347,6 +354,14 @@ std::vector<MarkerDetection> MarkerTracker::detect_full_frame(const cv::Mat& fra
   return found;
 }
 
+std::vector<Blob> MarkerTracker::search_window_inside(const cv::Mat& grey, const Track& track, cv::Rect window) {
+  ++stats_.nested_searches;
+  std::vector<Blob> inside = detector_.detect_inside(grey, window, config_.nested_min_bright_outline);
+  std::erase_if(inside, [&](const Blob& b) { return !similar_size(b, track.diameter_px); });
+  settle_doubtful(grey, inside);
+  return inside;
+}
+
 std::optional<MarkerDetection> MarkerTracker::confirm(const cv::Mat& grey, const Track& track, const Blob& blob) {
   decoder_.sample(grey, blob, signal_);
   if (!signal_.usable) return std::nullopt;
@@ -479,6 +494,10 @@ std::vector<MarkerDetection> MarkerTracker::process(const cv::Mat& frame) {
                        static_cast<int>(std::ceil(2 * half)) + 1, static_cast<int>(std::ceil(2 * half)) + 1);
     std::vector<Blob> near = detector_.detect_near(grey, roi, p, t.threshold_grey);
     settle_doubtful(grey, near);
+    if (config_.search_inside_unread && t.missed == 0 && !(near.size() == 1 && similar_size(near[0], t.diameter_px))) {
+      std::vector<Blob> inside = search_window_inside(grey, t, roi);
+      if (!inside.empty()) near = std::move(inside);
+    }
     if (near.size() == 1 && t.missed == 0) {
       ++stats_.blobs;
       if (auto d = confirm(grey, t, near[0])) {

@@ -112,6 +112,9 @@ struct TrackerConfig {
   /// blobs at least `nested_disc_ratio` times the least marker's disc are: smaller ones
   /// cannot hold a marker. Costs a small search (a few microseconds) per such blob, and
   /// only in frames that miss a marker; off with `search_inside_unread`.
+  /// A tracked marker on such a top is searched for the same way within its window when
+  /// the fill from its predicted centre finds no disc of its size there (it took in the
+  /// top): one small search, where the track would otherwise be lost to a full search.
   bool search_inside_unread = true;
   double nested_disc_ratio = 1.1;
   /// The least bright share of a disc's outline in that search (BlobDetectorConfig::
@@ -280,6 +283,10 @@ class MarkerTracker {
   std::optional<MarkerDetection> confirm(const cv::Mat& grey, const Track& track, const Blob& blob);
   // The tracked marker re-found by the edge fit around its prediction, confirmed.
   std::optional<MarkerDetection> confirm_by_edges(const cv::Mat& grey, const Track& track);
+  // The blobs of a track's window when the fill from its prediction found none of the
+  // track's size (a marker on a dark top): the window searched with exact fills, and of
+  // what it holds the discs within a third of the track's size.
+  std::vector<Blob> search_window_inside(const cv::Mat& grey, const Track& track, cv::Rect window);
   // The blob detector's full search, with its doubtful blobs settled (settle_doubtful;
   // those that fail go to `fragments`).
   std::vector<Blob> find_blobs(const cv::Mat& grey, std::vector<Blob>* fragments);
