@@ -98,6 +98,51 @@ const char* rejection_name(RegionRejection why) {
 
 double Blob::disc_diameter_px() const { return 2.0 * std::sqrt(filled_area_px / kPi); }
 
+int rays_crossing_bright(const cv::Mat& grey, const Blob& blob, int rays, double from, double to) {
+  CV_Assert(grey.type() == CV_8UC1);
+  // Each ray's direction in pixels: the shape maps the unit circle to the outline.
+  std::vector<cv::Point2d> directions(static_cast<std::size_t>(rays));
+  for (int k = 0; k < rays; ++k) {
+    const double a = 2.0 * kPi * k / rays;
+    directions[static_cast<std::size_t>(k)] = {blob.shape(0, 0) * std::cos(a) + blob.shape(0, 1) * std::sin(a),
+                                               blob.shape(1, 0) * std::cos(a) + blob.shape(1, 1) * std::sin(a)};
+  }
+  auto grey_at = [&](const cv::Point2d& d, double r, int& out) {
+    const int x = static_cast<int>(std::lround(blob.u + r * d.x));
+    const int y = static_cast<int>(std::lround(blob.v + r * d.y));
+    if (x < 0 || y < 0 || x >= grey.cols || y >= grey.rows) return false;
+    out = grey.at<std::uint8_t>(y, x);
+    return true;
+  };
+  // The blob's own contrast: halfway between its rim (0.9 of its radius) and what lies
+  // just outside it (1.25). The local threshold at its centre does not serve: a dark
+  // region wider than the tiles' neighbourhood has no contrast at its centre.
+  double rim = 0, outside = 0;
+  int rim_n = 0, outside_n = 0;
+  for (const cv::Point2d& d : directions) {
+    int g = 0;
+    if (grey_at(d, 0.9, g)) rim += g, ++rim_n;
+    if (grey_at(d, 1.25, g)) outside += g, ++outside_n;
+  }
+  if (rim_n == 0 || outside_n == 0) return 0;
+  const double threshold = 0.5 * (rim / rim_n + outside / outside_n);
+  int crossing = 0;
+  for (const cv::Point2d& d : directions) {
+    const double length_px = std::hypot(d.x, d.y);
+    if (length_px <= 0) continue;
+    const double step = 0.5 / length_px;  // half a pixel, as a fraction of the radius
+    for (double r = from; r <= to; r += step) {
+      int g = 0;
+      if (!grey_at(d, r, g)) break;
+      if (g > threshold) {
+        ++crossing;
+        break;
+      }
+    }
+  }
+  return crossing;
+}
+
 // Bookkeeping of one region (swept or filled).
 struct BlobDetector::Fill {
   int area = 0;                        // dark pixels in the region

@@ -90,6 +90,15 @@ struct Blob {
   bool doubtful = false;
 };
 
+/// How many of `rays` rays from `blob`'s centre, spread evenly round its ellipse, cross a
+/// pixel of `grey` (8-bit) brighter than halfway between the blob's rim (0.9 of its
+/// radius) and what lies just outside it (1.25), between `from` and `to` times its radius
+/// (fractions of the ellipse; nearest pixels, half a pixel apart). A
+/// dark region that encloses a marker, such as a robot's dark top, has the marker's white
+/// ring all round inside it; a marker's own disc has two black slices from its hole to its
+/// rim, and dark floor specks little bright inside. Costs about rays x radius pixel reads.
+int rays_crossing_bright(const cv::Mat& grey, const Blob& blob, int rays, double from, double to);
+
 /// Why a dark region was not kept as a blob (BlobDetector::set_rejection_log).
 enum class RegionRejection {
   kCut,            ///< the region touches the search window's border, or is larger than any marker

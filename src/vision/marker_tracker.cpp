@@ -63,7 +63,11 @@ MarkerDetection make_detection(const Blob& blob, const CodeMatch& match, bool tr
   return d;
 }
 
-// Blobs at a confirmed marker's place are that marker: drop them.
+// The rays of TrackerConfig::nested_min_bright_rays: 16, from 0.3 of the blob's radius
+// (clear of a hole at its centre) to 0.95 (short of its rim).
+constexpr int kNestedRays = 16;
+constexpr double kNestedRaysFrom = 0.3, kNestedRaysTo = 0.95;
+
 // Whether `blob`'s dark disc belongs to a marker `marker_diameter_px` across (a track's),
 // within a third either way: a robot's dark top around a marker is 1.5-2 times as wide.
 bool similar_size(const Blob& blob, double marker_diameter_px) {
@@ -71,6 +75,7 @@ bool similar_size(const Blob& blob, double marker_diameter_px) {
   return ratio > 0.75 && ratio < 1.33;
 }
 
+// Blobs at a confirmed marker's place are that marker: drop them.
 void drop_confirmed(std::vector<Blob>& blobs, const std::vector<MarkerDetection>& confirmed) {
   std::erase_if(blobs, [&](const Blob& b) {
     return std::any_of(confirmed.begin(), confirmed.end(), [&](const MarkerDetection& d) {
@@ -320,6 +325,10 @@ void MarkerTracker::assign_nested(const cv::Mat& grey, bool use_tracks, std::vec
     // that cannot hold one inside its own outline holds no marker.
     const double least_disc = config_.blobs.min_diameter_px * MarkerFamily::black_ring_outer_radius;
     if (b.disc_diameter_px() < config_.nested_disc_ratio * least_disc) continue;
+    if (config_.nested_min_bright_rays > 0 &&
+        rays_crossing_bright(grey, b, kNestedRays, kNestedRaysFrom, kNestedRaysTo) < config_.nested_min_bright_rays) {
+      continue;
+    }
     // Its outline's box, searched with exact fills (detect_inside): the enclosing blob is
     // found again (and dropped below) and what it encloses with it.
     const double half_u = std::hypot(b.shape(0, 0), b.shape(0, 1)) + 2;

@@ -177,3 +177,51 @@ TEST(BlobDetector, MarkerFoundTheSameFromEverySeedRow) {
     }
   }
 }
+
+// rays_crossing_bright tells a dark robot top holding a marker (the marker's white ring
+// all round inside it) from a marker's own disc (two black slices from hole to rim) and a
+// solid dark disc (nothing bright inside), at every heading and at two sizes and blurs.
+TEST(BlobDetector, RaysCrossingBrightTellATopHoldingAMarker) {
+  const auto f = MarkerFamily::six_ucp();
+  for (const int size_px : {28, 40}) {
+    for (const double blur_px : {0.0, 1.2}) {
+      for (int id = 1; id <= 8; ++id) {
+        for (double heading = 0; heading < 360; heading += 37) {
+          // A marker on the floor: its own disc.
+          cv::Mat floor(160, 160, CV_8UC1, cv::Scalar(185));
+          render_marker_topdown(f, id, size_px, heading, 185.0).copyTo(floor(cv::Rect(60, 60, size_px, size_px)));
+          // The same marker on a dark top 1.6 times its width.
+          cv::Mat top(160, 160, CV_8UC1, cv::Scalar(185));
+          const double centre = 60 + size_px / 2.0 - 0.5;
+          cv::circle(top, cv::Point(static_cast<int>(centre * 16), static_cast<int>(centre * 16)),
+                     static_cast<int>(0.8 * size_px * 16), cv::Scalar(45), cv::FILLED, cv::LINE_AA, 4);
+          render_marker_topdown(f, id, size_px, heading, 45.0).copyTo(top(cv::Rect(60, 60, size_px, size_px)));
+          if (blur_px > 0) {
+            cv::GaussianBlur(floor, floor, cv::Size(), blur_px);
+            cv::GaussianBlur(top, top, cv::Size(), blur_px);
+          }
+          BlobDetector detector;
+          const auto own = detector.detect(floor);
+          ASSERT_EQ(own.size(), 1u) << "id " << id << " heading " << heading;
+          const auto on_top = detector.detect(top);
+          const auto top_blob = std::max_element(on_top.begin(), on_top.end(), [](const Blob& a, const Blob& b) {
+            return a.filled_area_px < b.filled_area_px;
+          });
+          ASSERT_NE(top_blob, on_top.end()) << "id " << id << " heading " << heading;
+          ASSERT_GT(top_blob->disc_diameter_px(), 1.3 * own[0].disc_diameter_px());
+          const std::string where = "size " + std::to_string(size_px) + " blur " + std::to_string(blur_px) + " id " +
+                                    std::to_string(id) + " heading " + std::to_string(heading);
+          EXPECT_EQ(rays_crossing_bright(top, *top_blob, 16, 0.3, 0.95), 16) << where;
+          EXPECT_LE(rays_crossing_bright(floor, own[0], 16, 0.3, 0.95), 14) << where;
+        }
+      }
+    }
+  }
+  // A solid dark disc: nothing bright inside.
+  cv::Mat solid(120, 120, CV_8UC1, cv::Scalar(185));
+  cv::circle(solid, {60, 60}, 18, cv::Scalar(40), cv::FILLED, cv::LINE_AA);
+  BlobDetector detector;
+  const auto blobs = detector.detect(solid);
+  ASSERT_EQ(blobs.size(), 1u);
+  EXPECT_EQ(rays_crossing_bright(solid, blobs[0], 16, 0.3, 0.95), 0);
+}
