@@ -43,6 +43,11 @@ std::uint64_t hash3(std::uint64_t a, std::uint64_t b, std::uint64_t c) {
   return splitmix(splitmix(splitmix(a) ^ b) ^ c);
 }
 
+// A scene's draws. Never two in one call's arguments (or one constructor's): their order is
+// unspecified, and GCC evaluates them right to left on x86-64 but left to right on arm64,
+// which gives another scene. Such draws are made one per statement, in the order x86 has
+// always made them. This file is compiled with -ffp-contract=off (CMakeLists.txt): a * b + c
+// fused into one rounding on arm64 (and not on x86-64) would move values by an ulp.
 class Draw {
  public:
   explicit Draw(std::uint64_t seed) : state_(seed) {}
@@ -596,7 +601,11 @@ Floor draw_floor(Draw& draw, LabDifficulty difficulty) {
   f.kind = static_cast<FloorKind>(kind);
   const bool dark = difficulty != LabDifficulty::kPlain && draw.chance(0.3);
   const double level = dark ? draw.uniform(0.06, 0.16) : draw.uniform(0.35, 0.7);
-  const Rgb hue(draw.uniform(0.85, 1.1), draw.uniform(0.9, 1.05), draw.uniform(0.75, 1.05));
+  // Blue, green, then red: one draw per statement (see Draw).
+  const double blue = draw.uniform(0.75, 1.05);
+  const double green = draw.uniform(0.9, 1.05);
+  const double red = draw.uniform(0.85, 1.1);
+  const Rgb hue(red, green, blue);
   f.base = hue * level;
   if (f.kind == FloorKind::kMat) f.base = Rgb(1, 1, 1) * draw.uniform(0.05, 0.14);
   if (f.kind == FloorKind::kWood) f.base = Rgb(0.62, 0.45, 0.3) * draw.uniform(0.8, 1.3);
@@ -641,15 +650,17 @@ cv::Point2d seen_at(const Lens& lens, double u, double v, double z) {
 void place_robots(LabSetup& s, Draw& draw, double marker_m, int frames, double fps) {
   const double speed_max = s.difficulty == LabDifficulty::kPlain ? 0.15 : 0.35;
   const double height = draw.uniform(0.03, 0.06);
-  const double body = std::max(marker_m / 2 + draw.uniform(0.002, 0.008), draw.uniform(0.0275, 0.035));
+  const double least_body = draw.uniform(0.0275, 0.035);  // before the margin: see Draw
+  const double body = std::max(marker_m / 2 + draw.uniform(0.002, 0.008), least_body);
   const std::array<Rgb, 5> tops = {Rgb(0.07, 0.07, 0.07), Rgb(0.08, 0.2, 0.1), Rgb(0.3, 0.3, 0.32),
                                    Rgb(0.55, 0.55, 0.55), Rgb(0.12, 0.14, 0.3)};
   const Rgb top = tops[static_cast<std::size_t>(draw.integer(0, 4))];
   const double margin = 70;
   for (int id = 1; id <= 8; ++id) {
     for (int attempt = 0; attempt < 200; ++attempt) {
-      const cv::Point2d p = seen_at(s.lens, draw.uniform(margin, s.size.width - 1 - margin),
-                                    draw.uniform(margin, s.size.height - 1 - margin), height);
+      const double v = draw.uniform(margin, s.size.height - 1 - margin);  // v, then u: see Draw
+      const double u = draw.uniform(margin, s.size.width - 1 - margin);
+      const cv::Point2d p = seen_at(s.lens, u, v, height);
       const bool clear = std::all_of(s.robots.begin(), s.robots.end(), [&](const Robot& o) {
         return std::hypot(o.x_m - p.x, o.y_m - p.y) > 2 * body + 0.03 + speed_max * frames / fps;
       });
@@ -705,7 +716,9 @@ void add_decals(LabSetup& s, Draw& draw, double marker_m) {
   for (int k = 0; k < count; ++k) {
     Decal d;
     d.kind = static_cast<Decal::Kind>(draw.integer(0, 4));
-    d.centre_m = seen_at(s.lens, draw.uniform(20, s.size.width - 21), draw.uniform(20, s.size.height - 21), 0);
+    const double v = draw.uniform(20, s.size.height - 21);  // v, then u: see Draw
+    const double u = draw.uniform(20, s.size.width - 21);
+    d.centre_m = seen_at(s.lens, u, v, 0);
     d.angle_rad = draw.uniform(0, 2 * kPi);
     d.cos_a = std::cos(d.angle_rad);
     d.sin_a = std::sin(d.angle_rad);
@@ -757,7 +770,9 @@ LabSetup draw_setup(std::uint64_t seed, int index, const LabFootageOptions& o) {
   if (o.min_marker_px > 0) px_lo = o.min_marker_px;
   if (o.max_marker_px > 0) px_hi = o.max_marker_px;
   const double tilt = s.difficulty == LabDifficulty::kHarsh ? draw.uniform(12, tilt_hi) : draw.uniform(0, tilt_hi);
-  s.lens = draw_lens(s, draw, draw.uniform(px_lo, px_hi), marker_m, draw.uniform(1.6, 2.8), tilt, {2.0, 1.5});
+  const double height_m = draw.uniform(1.6, 2.8);  // the height, then the size: see Draw
+  const double marker_px = draw.uniform(px_lo, px_hi);
+  s.lens = draw_lens(s, draw, marker_px, marker_m, height_m, tilt, {2.0, 1.5});
   s.lens.k1 = draw.uniform(k1_lo, 0);
   s.lens.k2 = -0.1 * s.lens.k1 * draw.uniform(0, 1);
   s.floor = draw_floor(draw, s.difficulty);

@@ -44,7 +44,12 @@ constexpr std::array kFloorPhotos = {
 
 // Draws from one scene's own random stream: scene (seed, index) is the same on every machine
 // (std::mt19937_64's sequence is fixed by the standard; the distributions are written here
-// rather than taken from <random>, whose results differ between standard libraries).
+// rather than taken from <random>, whose results differ between standard libraries). Never
+// two draws in one call's arguments (or one constructor's): their order is unspecified, and
+// GCC evaluates them right to left on x86-64 but left to right on arm64, which gives another
+// scene. Such draws are made one per statement, in the order x86 has always made them.
+// This file is compiled with -ffp-contract=off (CMakeLists.txt): a * b + c fused into one
+// rounding on arm64 (and not on x86-64) would move the draws by an ulp.
 class SceneRandom {
  public:
   SceneRandom(std::uint64_t seed, int index)
@@ -122,9 +127,13 @@ cv::Mat drawn_floor(StressFloor kind, SceneRandom& rnd) {
       t = cv::Mat::zeros(n, n, CV_32F);
       for (int cells = 4, k = 0; k < 5; ++k, cells *= 2) t += smooth_noise(rnd, n, cells, cells) * (1.0 / (1 + k));
       const int pores = rnd.integer(50, 400);
-      for (int i = 0; i < pores; ++i)
-        cv::circle(t, cv::Point(rnd.integer(0, n - 1), rnd.integer(0, n - 1)), rnd.integer(1, 4), cv::Scalar(-3.0), -1,
-                   cv::LINE_AA);
+      for (int i = 0; i < pores; ++i) {
+        // Radius, then y, then x: one draw per statement (see SceneRandom).
+        const int radius = rnd.integer(1, 4);
+        const int y = rnd.integer(0, n - 1);
+        const int x = rnd.integer(0, n - 1);
+        cv::circle(t, cv::Point(x, y), radius, cv::Scalar(-3.0), -1, cv::LINE_AA);
+      }
       break;
     }
     case StressFloor::kPlain:
@@ -452,8 +461,10 @@ StressScene make_stress_scene(std::uint64_t seed, int index, const StressOptions
   // Places inside the image, through the camera's own calibration.
   const double margin_px = 1.5 * c.marker_diameter_px + 8;
   auto random_floor_point = [&] {
-    const Vec2 p = pixel_to_field(scene.calibration, rnd.uniform(margin_px, c.image_size.width - 1 - margin_px),
-                                  rnd.uniform(margin_px, c.image_size.height - 1 - margin_px));
+    // v, then u: one draw per statement (see SceneRandom).
+    const double v = rnd.uniform(margin_px, c.image_size.height - 1 - margin_px);
+    const double u = rnd.uniform(margin_px, c.image_size.width - 1 - margin_px);
+    const Vec2 p = pixel_to_field(scene.calibration, u, v);
     return cv::Point2d(p.x, p.y);
   };
   // Whether a marker at `pose` lies wholly inside the image, `margin` pixels from its edges.
