@@ -66,7 +66,40 @@ struct Options {
   int mistakes = 12;
   int explain = 0;  // misses explained one by one (0: only their causes counted)
   bool peers = true;
+  std::vector<std::string> without;  // checks turned off (tracker_config), to measure what each costs and saves
 };
+
+// The checks --without can turn off, each to what lets everything through.
+const char* const kChecks = "occluder, template, levels, white-ring, radial, ambiguity, nested";
+
+// The tracker's configuration with the checks named in `without` off; throws for a name
+// that is none of kChecks.
+rv::TrackerConfig tracker_config(const std::vector<std::string>& without) {
+  rv::TrackerConfig c;
+  for (const std::string& check : without) {
+    if (check == "occluder") {
+      c.occluder.enabled = false;
+    } else if (check == "template") {
+      c.templates.min_correlation = -1.0;
+      c.templates.max_black_ring_misfit = 1e9;
+    } else if (check == "levels") {
+      c.decoder.max_key_shortfall = 1e9;
+      c.decoder.max_black_excess = 1e9;
+      c.decoder.max_hole_excess = 1e9;
+    } else if (check == "white-ring") {
+      c.decoder.max_dark_white_ring_reads = 64;
+    } else if (check == "radial") {
+      c.decoder.min_radial_agreement = -1.0;
+    } else if (check == "ambiguity") {
+      c.ambiguity_margin = 0.0;
+    } else if (check == "nested") {
+      c.search_inside_unread = false;
+    } else {
+      throw CLI::ValidationError("--without", check + " is none of " + kChecks);
+    }
+  }
+  return c;
+}
 
 // Why one whole marker was missed by a full search: the furthest its blob got, or why
 // the blob detector turned its region away, or that no region was filled there.
@@ -224,7 +257,16 @@ int main(int argc, char** argv) {
   app.add_option("--explain", opt.explain, "Whole markers missed by full-frame search listed with their cause")
       ->check(CLI::Range(0, 100000));
   app.add_flag("!--no-peers", opt.peers, "Leave out AprilTag and ArUco");
+  app.add_option("--without", opt.without,
+                 std::string("Turn a check off, to measure what it costs in recall and saves in mistakes (repeatable): ") +
+                     kChecks);
   CLI11_PARSE(app, argc, argv);
+  rv::TrackerConfig config;
+  try {
+    config = tracker_config(opt.without);
+  } catch (const CLI::Error& e) {
+    return app.exit(e);
+  }
   if (!opt.seed_given) opt.seed = std::random_device{}() | (static_cast<std::uint64_t>(std::random_device{}()) << 32);
   cv::setNumThreads(0);
   cv::ocl::setUseOpenCL(false);
@@ -237,6 +279,11 @@ int main(int argc, char** argv) {
   lab.frames_per_scene = opt.frames_per_scene;
   const bool is_lab = opt.generator == "lab";
   std::printf(is_lab ? "# rilbed on the second generator's lab footage\n\n" : "# rilbed on the vision stress set\n\n");
+  if (!opt.without.empty()) {
+    std::string off;
+    for (const std::string& c : opt.without) off += (off.empty() ? "" : ", ") + c;
+    std::printf("- **checks turned off: %s** (to measure what they cost and save; not rilbed as it ships)\n", off.c_str());
+  }
   std::printf("- CPU: %s; `nproc`: %d; load average at start: %s\n", rilbed::bench::cpu_model().c_str(),
               rilbed::bench::usable_cpus(), rilbed::bench::first_line("/proc/loadavg").c_str());
   std::printf("- build: %s; sources: %s\n", rilbed::bench::env_or("RILBED_BENCH_BUILD_TYPE", "unknown").c_str(),
@@ -286,10 +333,10 @@ int main(int argc, char** argv) {
     SceneQueue queue(opt, [&](int index) {
       return is_lab ? rv::make_lab_scene(opt.seed, index, lab) : rv::make_stress_scene(opt.seed, index, stress);
     });
-    rv::MarkerTracker single(family, all_ids());
+    rv::MarkerTracker single(family, all_ids(), config);
     single.set_verdict_log(&verdicts, &rejections);
     while (auto scene = queue.next()) {
-      rv::MarkerTracker clip(family, all_ids());
+      rv::MarkerTracker clip(family, all_ids(), config);
       for (int f = 0; f < static_cast<int>(scene->frames.size()); ++f) {
         const cv::Mat& frame = scene->frames[static_cast<std::size_t>(f)];
         verdicts.clear();
@@ -584,7 +631,7 @@ int main(int argc, char** argv) {
   td->nthreads = 1;
   const auto dict = cv::aruco::getPredefinedDictionary(cv::aruco::DICT_4X4_50);
   const auto aruco_params = cv::aruco::DetectorParameters::create();
-  rv::MarkerTracker timing_tracker(family, all_ids());
+  rv::MarkerTracker timing_tracker(family, all_ids(), config);
   std::map<std::string, SpeedSamples> cpu;  // detector -> samples
   std::size_t sink = 0;
   const int rounds = 3;
@@ -623,7 +670,7 @@ int main(int argc, char** argv) {
       }
       // The tracker over the clip, once met warm and once cold.
       for (const bool warm : {false, true}) {
-        rv::MarkerTracker clip_tracker(family, clip.ids);
+        rv::MarkerTracker clip_tracker(family, clip.ids, config);
         sink += clip_tracker.process(first).size();
         for (std::size_t k = 1; k < clip.grey.size(); ++k) {
           time_one("rilbed tracked", clip.grey[k], clip.textured, warm,

@@ -93,6 +93,7 @@ const char* fate_name(CandidateFate fate) {
     case CandidateFate::kAmbiguous: return "ambiguous";
     case CandidateFate::kLevels: return "levels";
     case CandidateFate::kTemplate: return "template";
+    case CandidateFate::kOccluded: return "occluded";
     case CandidateFate::kNotChosen: return "not chosen";
     case CandidateFate::kNamed: return "named";
   }
@@ -207,6 +208,11 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
       log_verdict(blob, CandidateFate::kTemplate, &matches[own], runner_up);
       unread_.push_back(blob);
       continue;
+    }
+    if (find_band_across(grey, blob, signal_.black_level, signal_.white_level, config_.occluder).bands >= std::max(1, config_.occluder.min_bands)) {
+      ++stats_.occluded;
+      log_verdict(blob, CandidateFate::kOccluded, &matches[own], runner_up);
+      continue;  // not unread: it was read, and what lies across it is no robot's top
     }
     passed_[b] = true;
     double* row = &similarity_[b * columns];

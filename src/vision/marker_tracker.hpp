@@ -15,6 +15,7 @@
 #include "vision/disc_edge_fit.hpp"
 #include "vision/marker_family.hpp"
 #include "vision/marker_template.hpp"
+#include "vision/occluder.hpp"
 #include "vision/ring_search.hpp"
 
 namespace rilbed::vision {
@@ -59,6 +60,10 @@ struct TrackerConfig {
   /// one from a fill (MarkerTemplates): after the decoder's tests, the last guard
   /// against letters and digits printed on the floor.
   MarkerTemplateConfig templates;
+  /// A read marker with something lying across it (a band over its white ring that goes
+  /// on across the floor beyond) is declined: what the band covers of the code may read
+  /// as another code, and a miss beats a wrong ID. Costs 192 reads per named marker.
+  OccluderConfig occluder;
   /// How a tracked marker is re-found from its outline before any fill. In the frames
   /// that only spot-check its code (see full_confirm_interval_frames) `quick_edge_fit`
   /// comes first: the centre and size only (2 rows and 2 columns, the shape kept from the
@@ -189,6 +194,7 @@ enum class CandidateFate {
   kAmbiguous,    ///< another reading came within ambiguity_margin (FrameStats::declined)
   kLevels,       ///< its black and white levels are not a printed marker's (Decoder::levels_agree)
   kTemplate,     ///< the whole marker its reading names does not match (MarkerTemplates)
+  kOccluded,     ///< something lies across it (a band over its white ring and the floor beyond: find_band_across)
   kNotChosen,    ///< its reading was a listed ID another blob took, or is not listed
   kNamed,        ///< it took an ID
 };
@@ -218,6 +224,7 @@ struct FrameStats {
   int ring_searches = 0;     ///< refits that failed and searched for the disc's rings (TrackerConfig::ring_search)
   int declined = 0;  ///< decoded blobs left unnamed: two explanations too close (TrackerConfig::ambiguity_margin)
   int nested_searches = 0;  ///< unread blobs searched inside (TrackerConfig::search_inside_unread)
+  int occluded = 0;         ///< read markers declined for a band lying across them (TrackerConfig::occluder)
 };
 
 /// Runs the pipeline over a stream of frames of one size. Not thread-safe; one per

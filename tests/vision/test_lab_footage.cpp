@@ -18,7 +18,7 @@
 namespace rilbed::vision {
 namespace {
 
-constexpr std::uint64_t kSeed = 341066799223761092ull;  // never tuned on
+constexpr std::uint64_t kSeed = 12187823033979875300ull;  // drawn after the last threshold changed; never tuned on
 
 // Under the sanitizers (some thirty times slower) a few scenes, held to the mistakes only.
 constexpr int kScenes = kSanitized ? 3 : 18;
