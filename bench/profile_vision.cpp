@@ -48,8 +48,9 @@ struct Options {
 };
 
 [[noreturn]] void usage(int code) {
-  std::fprintf(code == 0 ? stdout : stderr,
-               "usage: profile_vision DIR [--mode full|tracked] [--ids K] [--passes N] [--runs N] [--warm] [--per-frame]\n");
+  std::fprintf(
+      code == 0 ? stdout : stderr,
+      "usage: profile_vision DIR [--mode full|tracked] [--ids K] [--passes N] [--runs N] [--warm] [--per-frame]\n");
   std::exit(code);
 }
 

@@ -70,7 +70,8 @@ BandAcross find_band_across(const cv::Mat& grey, const Blob& blob, double black_
     int first = k, last = k;
     while (last - first + 1 < kReads && floor_off[static_cast<std::size_t>((last + 1) % kReads)]) ++last;
     while (last - first + 1 < kReads && floor_off[static_cast<std::size_t>((first - 1 + kReads) % kReads)]) --first;
-    for (int j = first; j <= last; ++j) floor_run[static_cast<std::size_t>((j % kReads + kReads) % kReads)] = last - first + 1;
+    for (int j = first; j <= last; ++j)
+      floor_run[static_cast<std::size_t>((j % kReads + kReads) % kReads)] = last - first + 1;
   }
   // Runs of dim ring reads round the circle, from a read that is not dim (if any).
   int start = 0;
