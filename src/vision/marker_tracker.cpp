@@ -209,8 +209,7 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
       unread_.push_back(blob);
       continue;
     }
-    if (find_band_across(grey, blob, signal_.black_level, signal_.white_level, config_.occluder).bands >=
-        std::max(1, config_.occluder.min_bands)) {
+    if (find_band_across(grey, blob, signal_.black_level, signal_.white_level, config_.occluder).across) {
       ++stats_.occluded;
       log_verdict(blob, CandidateFate::kOccluded, &matches[own], runner_up);
       continue;  // not unread: it was read, and what lies across it is no robot's top

@@ -92,12 +92,9 @@ BandAcross find_band_across(const cv::Mat& grey, const Blob& blob, double black_
       beyond = floor_off[q] && floor_run[q] <= config.max_floor_run_reads;
     }
     if (!beyond) continue;
-    if (out.bands == 0) {
-      out.first_angle_rad = 2.0 * CV_PI * (k + 0.5 * (length - 1)) / kReads;
-    }
     ++out.bands;
-    out.covered_reads += length;
   }
+  out.across = out.bands >= std::max(1, config.min_bands);
   return out;
 }
 

@@ -55,9 +55,8 @@ struct OccluderConfig {
 
 /// What find_band_across found.
 struct BandAcross {
-  int bands = 0;               ///< runs of covered white-ring reads with the floor beyond them covered too
-  int covered_reads = 0;       ///< white-ring reads (of 64) in those runs
-  double first_angle_rad = 0;  ///< the middle of the first such run, in the shape's unit-circle frame
+  int bands = 0;        ///< runs of covered white-ring reads with the floor beyond them covered too
+  bool across = false;  ///< at least OccluderConfig::min_bands of them: something lies across the marker
 };
 
 /// Looks for a band lying across the marker whose dark disc is `blob` (centre, shape),
