@@ -163,6 +163,9 @@ class BlobDetector {
   /// nullptr, the default, logs nothing). A diagnosis, not for every frame: it costs a
   /// push per rejected region (a textured floor makes hundreds).
   void set_rejection_log(std::vector<RejectedRegion>* log) { rejections_ = log; }
+  /// The local threshold the last search used at pixel (x, y) of its ROI (grey level; 0
+  /// where its tile had too little contrast to hold a marker). For diagnosis and tests.
+  std::uint8_t local_threshold(int x, int y) const { return threshold_at(x, y); }
 
  private:
   struct Fill;

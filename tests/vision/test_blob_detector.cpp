@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include "vision/blob_detector.hpp"
 #include "vision/synthetic_camera.hpp"
@@ -224,4 +225,58 @@ TEST(BlobDetector, RaysCrossingBrightTellATopHoldingAMarker) {
   const auto blobs = detector.detect(solid);
   ASSERT_EQ(blobs.size(), 1u);
   EXPECT_EQ(rays_crossing_bright(solid, blobs[0], 16, 0.3, 0.95), 0);
+}
+
+// The tile statistics (vector kernels: sixteen tiles at a time, then two, then one) give
+// the threshold the rule states, on every tile of frames whose width is no multiple of
+// the kernels' steps: each 8x8 tile's darkest and brightest pixel over every other row,
+// taken over its 3x3 neighbourhood (clamped at the frame's edge), and their rounded-up
+// midpoint where the darkest is dark enough against the brightest to be black.
+TEST(BlobDetector, LocalThresholdsFollowTheirRuleOnEveryTile) {
+  BlobDetectorConfig config;
+  config.min_local_contrast = 0;  // no contrast cut: the rule below alone decides
+  config.max_noise_contrast = 0;
+  config.max_black_to_white = 0.7;
+  const int ratio_256 = static_cast<int>(0.7 * 255.0);
+  std::mt19937 rng(20261207);
+  for (const cv::Size size : {cv::Size(1283, 961), cv::Size(200, 100), cv::Size(131, 37)}) {
+    cv::Mat grey(size, CV_8UC1);
+    // Blocks of random levels with noise: every tile sees another darkest and brightest.
+    std::uniform_int_distribution<int> level(0, 255), noise(-20, 20);
+    for (int y = 0; y < size.height; ++y) {
+      for (int x = 0; x < size.width; ++x) {
+        const int block = ((y / 5) * 7919 + (x / 6) * 104729) % 251;
+        grey.at<std::uint8_t>(y, x) = cv::saturate_cast<std::uint8_t>(block + noise(rng) + (level(rng) < 3 ? -90 : 0));
+      }
+    }
+    BlobDetector detector(config);
+    detector.detect(grey);
+    const int tiles_x = (size.width + 7) / 8, tiles_y = (size.height + 7) / 8;
+    std::vector<int> tile_min(tiles_x * tiles_y, 255), tile_max(tiles_x * tiles_y, 0);
+    for (int y = 0; y < size.height; y += 2) {
+      for (int x = 0; x < size.width; ++x) {
+        const int i = (y / 8) * tiles_x + x / 8;
+        tile_min[i] = std::min<int>(tile_min[i], grey.at<std::uint8_t>(y, x));
+        tile_max[i] = std::max<int>(tile_max[i], grey.at<std::uint8_t>(y, x));
+      }
+    }
+    int wrong = 0;
+    for (int ty = 0; ty < tiles_y; ++ty) {
+      for (int tx = 0; tx < tiles_x; ++tx) {
+        int mn = 255, mx = 0;
+        for (int ny = std::max(0, ty - 1); ny <= std::min(tiles_y - 1, ty + 1); ++ny) {
+          for (int nx = std::max(0, tx - 1); nx <= std::min(tiles_x - 1, tx + 1); ++nx) {
+            mn = std::min(mn, tile_min[ny * tiles_x + nx]);
+            mx = std::max(mx, tile_max[ny * tiles_x + nx]);
+          }
+        }
+        const int expected = mn > ((mx * ratio_256) >> 8) ? 0 : (mn + mx + 1) / 2;
+        const int got = detector.local_threshold(std::min(size.width - 1, tx * 8), std::min(size.height - 1, ty * 8));
+        if (got != expected) {
+          if (++wrong <= 5) ADD_FAILURE() << size << " tile " << tx << "," << ty << ": " << got << " != " << expected;
+        }
+      }
+    }
+    EXPECT_EQ(wrong, 0) << size;
+  }
 }
