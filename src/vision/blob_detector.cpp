@@ -237,7 +237,8 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
       auto max_op = [](const auto& a, const auto& b) { return cv::v_max(a, b); };
       std::array<const std::uint8_t*, 8 / kStatStep> rows{};
       int sampled = 0;
-      for (int y = ty * t; y < y_end; y += kStatStep) rows[static_cast<std::size_t>(sampled++)] = grey.ptr<std::uint8_t>(y);
+      for (int y = ty * t; y < y_end; y += kStatStep)
+        rows[static_cast<std::size_t>(sampled++)] = grey.ptr<std::uint8_t>(y);
       // Minima first, then maxima from the same 512 bytes, now in L1: eight vectors of
       // each at once would not fit SSE2's sixteen registers.
       auto fold_columns = [&](int x0, auto op) {
