@@ -47,6 +47,18 @@ int count_at_or_below(const std::uint8_t* levels, int padded, int level) {
   return count + count_span_at_or_below(levels, padded, l);
 }
 
+// The largest of v[0..count) (count >= 1), in four independent running maxima: one
+// chain of compares waited on each compare before it, a fifth of a decode.
+double max_of(const double* v, int count) {
+  std::array<double, 4> m = {v[0], v[0], v[0], v[0]};
+  int i = 0;
+  for (; i + 4 <= count; i += 4) {
+    for (std::size_t k = 0; k < 4; ++k) m[k] = std::max(m[k], v[i + static_cast<int>(k)]);
+  }
+  for (; i < count; ++i) m[0] = std::max(m[0], v[i]);
+  return std::max(std::max(m[0], m[1]), std::max(m[2], m[3]));
+}
+
 // The smallest grey level L with more than `rank` of the levels at or below it, by
 // bisection over L with a count per step (sixteen levels per compare): no histogram to
 // clear and scan, and few branches. `levels` holds `count` levels rounded down, padded
@@ -569,12 +581,18 @@ void Decoder::match_all(const SampledSignal& signal, const Blob& blob, std::vect
   double family_best = -1e300;
   for (const Ideal& ideal : ideals_) {
     correlate_all_lags(p, ideal, scratch);
-    const int best = static_cast<int>(std::max_element(scratch.begin(), scratch.end()) - scratch.begin());
+    // The peak (its first lag, as std::max_element gives), and the best lag more than
+    // rival_guard_samples_ from it round the circle: the lags best + guard + 1 ...
+    // best - guard - 1 (mod n), at most two runs.
+    const double peak = max_of(scratch.data(), n);
+    const int best = static_cast<int>(std::find(scratch.begin(), scratch.end(), peak) - scratch.begin());
     double rival = -1e300;
-    for (int lag = 0; lag < n; ++lag) {
-      const int apart = std::abs(lag - best);
-      if (std::min(apart, n - apart) > rival_guard_samples_)
-        rival = std::max(rival, scratch[static_cast<std::size_t>(lag)]);
+    const int first = best + rival_guard_samples_ + 1, last = best + n - rival_guard_samples_ - 1;  // inclusive
+    if (first <= last) {
+      const int end_first_run = std::min(last, n - 1);
+      if (first <= end_first_run) rival = max_of(&scratch[static_cast<std::size_t>(first)], end_first_run - first + 1);
+      const int a = std::max(first, n) - n, b = last - n;  // the part past n, wrapped
+      if (a <= b) rival = std::max(rival, max_of(&scratch[static_cast<std::size_t>(a)], b - a + 1));
     }
     peaks.push_back({static_cast<double>(best), scratch[static_cast<std::size_t>(best)], rival});
     family_best = std::max(family_best, scratch[static_cast<std::size_t>(best)]);

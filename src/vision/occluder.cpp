@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <span>
 #include <vector>
 
 #include "vision/circle_sampler.hpp"
@@ -22,9 +23,9 @@ const CircleDirections& directions() {
   return d;
 }
 
-// The value at `fraction` of the way up the sorted copy of `reads`.
-double level_at(std::vector<float> reads, double fraction) {
-  const auto k = static_cast<std::size_t>(fraction * (reads.size() - 1) + 0.5);
+// The value at `fraction` of the way up `reads` sorted (which it reorders).
+double level_at(std::span<float> reads, double fraction) {
+  const auto k = static_cast<std::size_t>(fraction * static_cast<double>(reads.size() - 1) + 0.5);
   std::nth_element(reads.begin(), reads.begin() + static_cast<std::ptrdiff_t>(k), reads.end());
   return reads[k];
 }
@@ -42,19 +43,20 @@ BandAcross find_band_across(const cv::Mat& grey, const Blob& blob, double black_
     return out;
   }
   const CircleDirections& d = directions();
-  std::vector<float> ring(d.cos.size()), floor_reads(d.cos.size()), scratch(d.cos.size());
+  // Per-thread scratch, as the decoder's: a frame checks every named marker, and four
+  // vectors allocated per marker cost more than the reads themselves.
+  thread_local std::vector<float> ring, floor_reads, scratch, sorted;
+  for (auto* v : {&ring, &floor_reads, &scratch}) v->resize(d.cos.size());
   sample_ellipse(grey, blob.u, blob.v, blob.shape, kRingRadius * to_marker, d, ring.data());
   // The floor: of the two circles, the read further from the floor's level at each angle
   // (a cable is a band across both; a thin one may fall between reads of one circle).
   sample_ellipse(grey, blob.u, blob.v, blob.shape, kFloorRadii[0] * to_marker, d, floor_reads.data());
   sample_ellipse(grey, blob.u, blob.v, blob.shape, kFloorRadii[1] * to_marker, d, scratch.data());
-  ring.resize(kReads);
-  floor_reads.resize(kReads);
-  scratch.resize(kReads);
-  std::vector<float> both(floor_reads);
-  both.insert(both.end(), scratch.begin(), scratch.end());
-  const double floor_level = level_at(both, 0.5);
-  const double ring_level = level_at(ring, 0.75);
+  sorted.assign(floor_reads.begin(), floor_reads.begin() + kReads);
+  sorted.insert(sorted.end(), scratch.begin(), scratch.begin() + kReads);
+  const double floor_level = level_at(sorted, 0.5);
+  sorted.assign(ring.begin(), ring.begin() + kReads);
+  const double ring_level = level_at(sorted, 0.75);
   std::array<bool, kReads> floor_off{}, ring_dim{};
   for (int k = 0; k < kReads; ++k) {
     const auto i = static_cast<std::size_t>(k);
