@@ -1098,21 +1098,24 @@ void BlobDetector::reset_region(const Fill& fill) {
   }
 }
 
-std::vector<Blob> BlobDetector::scan(const cv::Mat& grey, cv::Rect roi) {
+std::vector<Blob> BlobDetector::scan(const cv::Mat& grey, cv::Rect roi, cv::Rect seeds) {
   std::vector<Blob> blobs;
   const double min_disc_d = config_.min_diameter_px * kDiscFraction;
   const int step = config_.seed_row_step > 0 ? config_.seed_row_step : std::max(1, static_cast<int>(min_disc_d / 4.0));
+  seeds &= roi;
   for (int y = roi.y + step / 2; y < roi.y + roi.height; y += step) {
+    if (y < seeds.y || y >= seeds.y + seeds.height) continue;
     const std::uint8_t* dark = dark_.ptr<std::uint8_t>(y);
     const std::size_t tile_row = static_cast<std::size_t>(tile_row_[y]) * tiles_x_;
-    const int x_end = roi.x + roi.width;
+    const int x_end = seeds.x + seeds.width;
     // Only the tiles with contrast (listed when their thresholds were set): a tile
     // without contrast holds no dark pixel, and most of a plain floor is such tiles.
     const std::int16_t* list = &contrast_tiles_[tile_row];
     const int listed = contrast_tile_count_[tile_row_[y]];
     for (int i = 0; i < listed; ++i) {
       const int tx = list[i];
-      const int xa = std::max(roi.x, tx * config_.tile_px), xb = std::min(x_end, (tx + 1) * config_.tile_px);
+      const int xa = std::max(seeds.x, tx * config_.tile_px), xb = std::min(x_end, (tx + 1) * config_.tile_px);
+      if (xa >= xb) continue;
       // Most contrast tiles hold no pixel dark enough to seed a fill on a given seed row
       // (the bright side of an edge): one load of eight mask bytes skips them.
       if (xb - xa == 8) {
@@ -1133,13 +1136,15 @@ std::vector<Blob> BlobDetector::scan(const cv::Mat& grey, cv::Rect roi) {
 
 std::vector<Blob> BlobDetector::detect(const cv::Mat& grey, cv::Rect roi) {
   if (!begin_search(grey, roi)) return {};
-  return scan(grey, roi);
+  return scan(grey, roi, roi);
 }
 
-std::vector<Blob> BlobDetector::detect_inside(const cv::Mat& grey, cv::Rect roi, double min_bright_outline) {
+std::vector<Blob> BlobDetector::detect_inside(const cv::Mat& grey, cv::Rect roi, double min_bright_outline,
+                                              std::optional<cv::Rect> seeds) {
   exact_fills_ = true;
   inside_bright_outline_ = min_bright_outline;
-  std::vector<Blob> blobs = detect(grey, roi);
+  std::vector<Blob> blobs;
+  if (begin_search(grey, roi)) blobs = scan(grey, roi, seeds.value_or(roi));
   exact_fills_ = false;
   return blobs;
 }
@@ -1171,7 +1176,7 @@ std::vector<Blob> BlobDetector::detect_near(const cv::Mat& grey, cv::Rect roi, c
   }
   if (!begin_search(grey, roi)) return {};
   if (seed_near(grey, roi, expected_px, blob)) return {blob};
-  return scan(grey, roi);
+  return scan(grey, roi, roi);
 }
 
 }  // namespace rilbed::vision

@@ -152,7 +152,11 @@ class BlobDetector {
   /// and clears it; this costs an exact fill per region instead. A disc there is held to
   /// `min_bright_outline` in place of the config's: a marker's thin white ring between
   /// its black ring and a dark top, blurred, dips below the local threshold in places.
-  std::vector<Blob> detect_inside(const cv::Mat& grey, cv::Rect roi, double min_bright_outline);
+  /// With `seeds`, fills start only from dark pixels within it (each may still extend
+  /// over all of roi): the middle of a robot's top, where its marker lies, so that the
+  /// top's own dark rim around the marker is not filled for nothing.
+  std::vector<Blob> detect_inside(const cv::Mat& grey, cv::Rect roi, double min_bright_outline,
+                                  std::optional<cv::Rect> seeds = std::nullopt);
 
   const BlobDetectorConfig& config() const { return config_; }
   /// New knobs from the next frame on (a person tuning the search while it runs).
@@ -172,7 +176,9 @@ class BlobDetector {
   void prepare(const cv::Mat& grey);
   bool begin_search(const cv::Mat& grey, cv::Rect& roi, std::optional<double> fixed_threshold = std::nullopt);
   bool seed_near(const cv::Mat& grey, cv::Rect roi, cv::Point2d expected_px, Blob& blob);
-  std::vector<Blob> scan(const cv::Mat& grey, cv::Rect roi);
+  // Fills from the dark pixels of `seeds` (within roi) on the seed rows; each region may
+  // extend over all of roi.
+  std::vector<Blob> scan(const cv::Mat& grey, cv::Rect roi, cv::Rect seeds);
   bool try_seed(const cv::Mat& grey, cv::Rect roi, int x, int y, Blob& blob);
   void compute_thresholds(const cv::Mat& grey, cv::Rect roi);
   // The dark region through the seed, as row extents in row_min_x_/row_max_x_.

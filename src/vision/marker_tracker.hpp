@@ -132,6 +132,13 @@ struct TrackerConfig {
   /// lower searches more blobs for nothing, higher risks a marker whose white ring a
   /// cable or blur breaks. 0 searches inside every unread blob.
   int nested_min_bright_rays = 6;
+  /// The inside search seeds fills only within this fraction of the enclosing blob's half
+  /// extents around its centre. A marker's dark disc on a top 1.5-1.9 times as wide has
+  /// its edge at 0.53-0.67 of the top's radius and the top's rim begins beyond its white
+  /// ring: 0.4 seeds the marker's hole and black slices, not the rim, for a marker up to a
+  /// quarter of the top's radius off its centre (one further off is still found, with the
+  /// rim filled as well, when its disc reaches into the seed box). 1 seeds everywhere.
+  double nested_seed_fraction = 0.4;
   /// The least bright share of a disc's outline in that search (BlobDetectorConfig::
   /// min_bright_outline elsewhere): between the black ring and a dark top the white ring is
   /// thin, and blur takes it below the local threshold in places. What passes still faces

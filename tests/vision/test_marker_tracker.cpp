@@ -369,3 +369,46 @@ TEST(MarkerTracker, TheShapeFollowsAStretchingMarker) {
     EXPECT_NEAR(wrap_deg_180(found[0].heading_deg - expected), 0.0, 1.5) << "frame " << i;
   }
 }
+
+// A marker on a robot's dark top 1.6 times as wide as the marker (twice its dark disc's
+// width), as the lab footage's robots carry theirs: the sweep takes the
+// top whole, and the search inside it (seeded only in its middle) finds the marker, with
+// its ID, at every ID, centred on the top and off its centre by a quarter of the top's
+// radius (where the seed box still holds the marker's hole), in a full search and when
+// tracked.
+TEST(MarkerTracker, MarkersOnDarkTopsAreFoundInside) {
+  const auto f = MarkerFamily::six_ucp();
+  constexpr int kSize = 34;
+  for (const double off_centre : {0.0, 0.25}) {
+    for (int id = 1; id <= 8; ++id) {
+      cv::Mat grey(240, 320, CV_8UC1, cv::Scalar(185));
+      const double top_radius = 0.8 * kSize;
+      const cv::Point2d top_centre(150.3, 110.6);
+      const double angle = 0.7 * id;
+      const cv::Point2d marker_centre =
+          top_centre + off_centre * top_radius * cv::Point2d(std::cos(angle), std::sin(angle));
+      cv::circle(grey, cv::Point(static_cast<int>(top_centre.x * 16), static_cast<int>(top_centre.y * 16)),
+                 static_cast<int>(top_radius * 16), cv::Scalar(40), cv::FILLED, cv::LINE_AA, 4);
+      const int x0 = static_cast<int>(std::lround(marker_centre.x - kSize / 2.0));
+      const int y0 = static_cast<int>(std::lround(marker_centre.y - kSize / 2.0));
+      const cv::Rect where(x0, y0, kSize, kSize);
+      // The marker's corners outside its white ring take the top's grey.
+      render_marker_topdown(f, id, kSize, 30.0 * id, 40.0).copyTo(grey(where));
+      cv::GaussianBlur(grey, grey, cv::Size(), 0.8);
+      const double u = x0 + kSize / 2.0 - 0.5, v = y0 + kSize / 2.0 - 0.5;
+      const std::string what = "id " + std::to_string(id) + " off centre " + std::to_string(off_centre);
+      MarkerTracker tracker(f, {1, 2, 3, 4, 5, 6, 7, 8});
+      const auto full = tracker.detect_full_frame(grey);
+      ASSERT_EQ(full.size(), 1u) << what;
+      EXPECT_EQ(full[0].id, id) << what;
+      EXPECT_NEAR(full[0].u, u, 0.3) << what;
+      EXPECT_NEAR(full[0].v, v, 0.3) << what;
+      EXPECT_GT(tracker.last_stats().nested_searches, 0) << what << ": the sweep no longer takes the top whole";
+      for (int frame = 0; frame < 3; ++frame) {
+        const auto tracked = tracker.process(grey);
+        ASSERT_EQ(tracked.size(), 1u) << what << " frame " << frame;
+        EXPECT_EQ(tracked[0].id, id) << what << " frame " << frame;
+      }
+    }
+  }
+}
