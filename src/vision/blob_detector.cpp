@@ -896,7 +896,7 @@ double chord_error(const std::vector<std::array<double, 3>>& chords, double q_al
 
 }  // namespace
 
-bool BlobDetector::measure(const cv::Mat& grey, const Fill& fill, Blob& blob) const {
+bool BlobDetector::measure(const cv::Mat& grey, const Fill& fill, Blob& blob) {
   // Sub-pixel chords along rows (for x moments) and along columns (for y moments).
   ChordMoments rows, cols;
   std::vector<std::array<double, 3>>& row_chords = row_chords_;  // {a, b, position}
@@ -926,6 +926,16 @@ bool BlobDetector::measure(const cv::Mat& grey, const Fill& fill, Blob& blob) co
     rows.add(a, b, y);
     row_chords.push_back({a, b, static_cast<double>(y)});
   }
+  const double least_bright = exact_fills_ ? inside_bright_outline_ : config_.min_bright_outline;
+  // Too few bright row ends for the outline to pass even if every column end is bright:
+  // turned away before the columns are read (most of a textured floor's regions).
+  if (bright_edges + 2 * (fill.x1 - fill.x0 + 1) < least_bright * (edges + 2 * (fill.x1 - fill.x0 + 1))) {
+    last_rejection_ = RegionRejection::kDimOutline;
+    return false;
+  }
+  // Column extents only for the regions that get this far (a long strip of tape is
+  // filled, but never measured; most specks of a textured floor end just above).
+  find_column_extents(fill);
   for (int x = fill.x0; x <= fill.x1; ++x) {
     const int yt = col_min_y_[x], yb = col_max_y_[x];
     if (yb < yt) continue;
@@ -945,7 +955,6 @@ bool BlobDetector::measure(const cv::Mat& grey, const Fill& fill, Blob& blob) co
     return false;
   };
   if (rows.area <= 0.0 || cols.area <= 0.0) return reject(RegionRejection::kDegenerate);
-  const double least_bright = exact_fills_ ? inside_bright_outline_ : config_.min_bright_outline;
   if (bright_edges < least_bright * edges) return reject(RegionRejection::kDimOutline);
 
   rows.finish();
@@ -1094,17 +1103,19 @@ bool BlobDetector::measure_region(const cv::Mat& grey, const Fill& fill, Blob& b
     last_rejection_ = RegionRejection::kNotCompact;
     return false;
   }
-  // Column extents of the region, from its row extents: only candidates pay for them
-  // (a long strip of tape is filled, but never measured). A column's bottom is the last
-  // row (going down) that covers it and its top the last going up: two plain fills per
-  // row, which vectorise, where one pass needed a compare per column.
+  return measure(grey, fill, blob);
+}
+
+void BlobDetector::find_column_extents(const Fill& fill) {
+  // A column's bottom is the last row (going down) that covers it and its top the last
+  // going up: two plain fills per row, which vectorise, where one pass needed a compare
+  // per column.
   for (int r = fill.y0; r <= fill.y1; ++r) {
     if (row_max_x_[r] >= row_min_x_[r]) std::fill(&col_max_y_[row_min_x_[r]], &col_max_y_[row_max_x_[r]] + 1, r);
   }
   for (int r = fill.y1; r >= fill.y0; --r) {
     if (row_max_x_[r] >= row_min_x_[r]) std::fill(&col_min_y_[row_min_x_[r]], &col_min_y_[row_max_x_[r]] + 1, r);
   }
-  return measure(grey, fill, blob);
 }
 
 void BlobDetector::reset_region(const Fill& fill) {

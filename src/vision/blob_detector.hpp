@@ -193,9 +193,12 @@ class BlobDetector {
   // black lies on the ring's very centre hides that marker from a full-frame search.
   bool sweep_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill);
   bool flood_fill(cv::Rect roi, int seed_x, int seed_y, Fill& fill);
-  bool measure(const cv::Mat& grey, const Fill& fill, Blob& blob) const;
-  // Column extents from the row extents, then measure(); false for a region too small.
+  // The region's ellipse from its sub-pixel chords, row by row and then column by column
+  // (the columns' extents found only once its rows' ends leave the outline a chance).
+  bool measure(const cv::Mat& grey, const Fill& fill, Blob& blob);
+  // The cheap looks (area, compactness), then measure(); false for a region turned away.
   bool measure_region(const cv::Mat& grey, const Fill& fill, Blob& blob);
+  void find_column_extents(const Fill& fill);   // col_min_y_/col_max_y_ from the row extents
   bool centre_is_dark(const Blob& blob) const;  // the mask at the blob's centre pixel
   void clear_swept_region(const Fill& fill);    // the mask within a sweep's row extents
   // Least area of a region that may be a marker's disc (config's smallest diameter,
