@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <span>
+#include <type_traits>
 
 #include <opencv2/core/hal/intrin.hpp>
 
@@ -88,7 +89,7 @@ void store_half_results(const v_uint8x16& v, std::uint8_t* out) {
 // then packed with unsigned saturation, which leaves them exact (one instruction on SSE2
 // and on NEON).
 template <class Op>
-v_uint8x16 fold_pairs(const v_uint8x16& a, const v_uint8x16& b, Op op) {
+CV_ALWAYS_INLINE v_uint8x16 fold_pairs(const v_uint8x16& a, const v_uint8x16& b, Op op) {
   const cv::v_int16x8 low = cv::v_setall_s16(0x00FF);
   auto fold = [&](const v_uint8x16& v) {
     const v_uint8x16 high_down = cv::v_reinterpret_as_u8(cv::v_shr<8>(cv::v_reinterpret_as_u16(v)));
@@ -102,7 +103,7 @@ v_uint8x16 fold_pairs(const v_uint8x16& a, const v_uint8x16& b, Op op) {
 // and doubling the bytes each result byte covers. About three operations a group, where
 // folding each vector's halves on its own took seven and two byte extracts.
 template <class Op>
-v_uint8x16 fold_groups_of_eight(const std::array<v_uint8x16, 8>& v, Op op) {
+CV_ALWAYS_INLINE v_uint8x16 fold_groups_of_eight(const std::array<v_uint8x16, 8>& v, Op op) {
   const v_uint8x16 q0 = fold_pairs(v[0], v[1], op), q1 = fold_pairs(v[2], v[3], op);
   const v_uint8x16 q2 = fold_pairs(v[4], v[5], op), q3 = fold_pairs(v[6], v[7], op);
   return fold_pairs(fold_pairs(q0, q1, op), fold_pairs(q2, q3, op), op);
@@ -258,20 +259,30 @@ void BlobDetector::compute_thresholds(const cv::Mat& grey, cv::Rect roi) {
       for (int y = ty * t; y < y_end; y += kStatStep)
         rows[static_cast<std::size_t>(sampled++)] = grey.ptr<std::uint8_t>(y);
       // Minima first, then maxima from the same 512 bytes, now in L1: eight vectors of
-      // each at once would not fit SSE2's sixteen registers.
-      auto fold_columns = [&](int x0, auto op) {
+      // each at once would not fit SSE2's sixteen registers. A whole tile row samples four
+      // rows, fixed at compile time so that the eight vectors stay in registers.
+      auto fold_columns = [&]<int kRows>(std::integral_constant<int, kRows>, int x0, auto op) {
         std::array<v_uint8x16, 8> v;
         for (std::size_t k = 0; k < 8; ++k) {
           const int x = x0 + static_cast<int>(k) * 16;
           v[k] = load16(rows[0] + x);
-          for (int r = 1; r < sampled; ++r) v[k] = op(v[k], load16(rows[static_cast<std::size_t>(r)] + x));
+          for (std::size_t r = 1; r < static_cast<std::size_t>(kRows); ++r) v[k] = op(v[k], load16(rows[r] + x));
         }
         return fold_groups_of_eight(v, op);
       };
-      for (; tx + 15 <= tx1 && (tx + 16) * 8 <= size_.width; tx += 16) {
-        const std::size_t i = static_cast<std::size_t>(ty) * tiles_x_ + tx;
-        cv::v_store(&tile_min_[i], fold_columns(tx * 8, min_op));
-        cv::v_store(&tile_max_[i], fold_columns(tx * 8, max_op));
+      auto fold_sixteen_tiles = [&](auto rows_sampled) {
+        for (; tx + 15 <= tx1 && (tx + 16) * 8 <= size_.width; tx += 16) {
+          const std::size_t i = static_cast<std::size_t>(ty) * tiles_x_ + tx;
+          cv::v_store(&tile_min_[i], fold_columns(rows_sampled, tx * 8, min_op));
+          cv::v_store(&tile_max_[i], fold_columns(rows_sampled, tx * 8, max_op));
+        }
+      };
+      static_assert(8 / kStatStep == 4, "a whole tile row samples four rows");
+      switch (sampled) {
+        case 4: fold_sixteen_tiles(std::integral_constant<int, 4>{}); break;
+        case 3: fold_sixteen_tiles(std::integral_constant<int, 3>{}); break;
+        case 2: fold_sixteen_tiles(std::integral_constant<int, 2>{}); break;
+        default: fold_sixteen_tiles(std::integral_constant<int, 1>{}); break;
       }
       for (; tx + 1 <= tx1 && (tx + 2) * 8 <= size_.width; tx += 2) {
         v_uint8x16 mn = cv::v_setall_u8(0xFF), mx = cv::v_setzero_u8();
