@@ -242,6 +242,195 @@ struct SpeedSamples {
   std::map<bool, std::vector<double>> cold, warm;
 };
 
+// AprilTag 3 (tag36h11, decimate 2, one thread) and OpenCV ArUco (DICT_4X4_50, default
+// parameters), as the speed table runs them; owns AprilTag's detector and family.
+class Peers {
+ public:
+  Peers() : family_(tag36h11_create()), detector_(apriltag_detector_create()) {
+    apriltag_detector_add_family(detector_, family_);
+    detector_->quad_decimate = 2.0f;
+    detector_->nthreads = 1;
+  }
+  ~Peers() {
+    apriltag_detector_destroy(detector_);
+    tag36h11_destroy(family_);
+  }
+  Peers(const Peers&) = delete;
+  Peers& operator=(const Peers&) = delete;
+
+  /// Tags AprilTag finds in `grey` (8-bit).
+  std::size_t apriltag(const cv::Mat& grey) {
+    image_u8_t im{grey.cols, grey.rows, static_cast<int32_t>(grey.step), grey.data};
+    zarray_t* found = apriltag_detector_detect(detector_, &im);
+    const auto n = static_cast<std::size_t>(zarray_size(found));
+    apriltag_detections_destroy(found);
+    return n;
+  }
+  /// Markers ArUco finds in `grey`.
+  std::size_t aruco(const cv::Mat& grey) {
+    std::vector<std::vector<cv::Point2f>> corners, rejected;
+    std::vector<int> ids;
+    cv::aruco::detectMarkers(grey, dictionary_, corners, ids, parameters_, rejected);
+    return ids.size();
+  }
+
+ private:
+  apriltag_family_t* family_;
+  apriltag_detector_t* detector_;
+  cv::Ptr<cv::aruco::Dictionary> dictionary_ = cv::aruco::getPredefinedDictionary(cv::aruco::DICT_4X4_50);
+  cv::Ptr<cv::aruco::DetectorParameters> parameters_ = cv::aruco::DetectorParameters::create();
+};
+
+// The speed section: rilbed's full search and tracked frames, and the peers, timed in
+// turns on the kept clips (CPU time of the thread, the timer's own cost subtracted), then
+// printed as a table and against the targets.
+class SpeedRun {
+ public:
+  SpeedRun(const rv::MarkerFamily& family, const rv::TrackerConfig& config, bool peers, double timer_cpu_ms)
+      : family_(family),
+        config_(config),
+        with_peers_(peers),
+        timer_cpu_ms_(timer_cpu_ms),
+        full_tracker_(family, all_ids(), config) {}
+
+  void print_method(int plain_clips, int textured_clips, int frames_per_clip) const {
+    std::printf("\n## Speed: one thread, CPU time per frame\n\n");
+    std::printf(
+        "Full-frame search: each scene's first frame (%d plain floors, %d textured), 8-bit grey, met **cold** "
+        "(flushed from every cache level before each call, as a frame from a camera arrives) and **warm** (read "
+        "once just before the call, as a frame a program has just decoded); the detectors take turns frame by "
+        "frame. Tracked: a `MarkerTracker::process` over each of those scenes' clips (%d frames), timed on every "
+        "frame after the first (the first is its full search), warm and cold likewise, listing the scene's robots "
+        "as a run's scenario does (a listed marker that is not found, such as one under a cable or at the frame's "
+        "edge, makes the tracker search the whole frame again). The timer's own cost "
+        "(%.4f ms CPU) subtracted. AprilTag 3: tag36h11, quad_decimate 2, nthreads 1; OpenCV ArUco: DICT_4X4_50, "
+        "default parameters. The peers search the same frames (6UCP markers and clutter, among it their own kind "
+        "of tags): their cost on them, not their recall. GLIBC_TUNABLES: %s (tools/bench.sh fixes glibc's malloc "
+        "thresholds, so that no detector pays page faults for buffers mapped afresh each frame).\n\n",
+        plain_clips, textured_clips, frames_per_clip, timer_cpu_ms_,
+        std::getenv("GLIBC_TUNABLES") ? std::getenv("GLIBC_TUNABLES") : "unset");
+  }
+
+  // Three rounds over the clips, the detectors taking turns on each frame; then rilbed
+  // alone, as `rilbed detect --no-track` meets a clip: every frame of each clip in turn,
+  // read just before the call, with no other detector between its calls (its own buffers
+  // stay in the caches).
+  void time(const std::vector<TimedClip>& clips) {
+    constexpr int kRounds = 3;
+    for (int r = 0; r < kRounds; ++r) {
+      for (const TimedClip& clip : clips) time_clip(clip);
+    }
+    for (int r = 0; r < kRounds; ++r) {
+      for (const TimedClip& clip : clips) {
+        for (const cv::Mat& frame : clip.grey) {
+          time_one(kFullAlone, frame, clip.textured, true,
+                   [&] { return full_tracker_.detect_full_frame(frame).size(); });
+        }
+      }
+    }
+  }
+
+  void print_table() {
+    std::printf(
+        "| detector | plain floor, cold: median ms | textured, cold: median ms | p90 ms | textured, warm: median ms | "
+        "p90 ms | AprilTag's textured warm median over this |\n"
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+    const double apriltag_warm = cpu_.count(kAprilTag) ? quantile(cpu_[kAprilTag].warm[true], 0.5) : 0.0;
+    for (const char* name : {kFull, kFullAlone, kTracked, kTrackedAll, kAprilTag, kArUco}) {
+      if (!cpu_.count(name)) continue;
+      SpeedSamples& d = cpu_[name];
+      const double warm_median = quantile(d.warm[true], 0.5);
+      auto cell = [](const std::vector<double>& v, double q) {
+        return v.empty() ? std::string("-") : cv::format("%.3f", quantile(v, q));
+      };
+      std::printf("| %s | %s | %s | %s | %s | %s | %s |\n", name, cell(d.cold[false], 0.5).c_str(),
+                  cell(d.cold[true], 0.5).c_str(), cell(d.cold[true], 0.9).c_str(), cell(d.warm[true], 0.5).c_str(),
+                  cell(d.warm[true], 0.9).c_str(),
+                  apriltag_warm > 0 ? cv::format("%.0fx", apriltag_warm / std::max(1e-9, warm_median)).c_str() : "-");
+    }
+  }
+
+  void print_targets(bool lab_frames) {
+    const double full_warm = quantile(cpu_[kFull].warm[true], 0.5);
+    const double full_alone = quantile(cpu_[kFullAlone].warm[true], 0.5);
+    const double full_cold = quantile(cpu_[kFull].cold[true], 0.5);
+    const double tracked_warm = quantile(cpu_[kTracked].warm[true], 0.5);
+    const double tracked_all = quantile(cpu_[kTrackedAll].warm[true], 0.5);
+    auto verdict = [](double ms, double target) { return ms <= target ? "met" : "not met"; };
+    std::printf(
+        "\nTargets, textured floors: a warm full-frame search within 0.3 ms (taking turns with the peers %.3f ms, "
+        "alone %.3f ms: %s); a warm tracked frame within 0.05 ms (all %.3f ms: %s; those without a full search "
+        "%.3f ms: %s; a listed marker not found, such as one under a cable, makes the tracker search the whole "
+        "frame again every frame); the stress set's textured frames, cold, within 1.91 ms (1.5x faster than "
+        "2.87 ms; here %.3f ms%s).\n",
+        full_warm, full_alone, verdict(std::min(full_warm, full_alone), 0.3), tracked_warm, verdict(tracked_warm, 0.05),
+        tracked_all, verdict(tracked_all, 0.05), full_cold,
+        lab_frames ? ", but these are lab frames: read it off --generator stress"
+                   : (full_cold <= 1.91 ? ": met" : ": not met"));
+  }
+
+  /// Full searches timed on plain and textured floors, cold (what the sink line reports).
+  std::size_t full_frame_calls() { return cpu_[kFull].cold[true].size() + cpu_[kFull].cold[false].size(); }
+  /// The detectors' results summed, so that no call is optimised away.
+  std::size_t sink() const { return sink_; }
+
+ private:
+  static constexpr const char* kFull = "rilbed full-frame";
+  static constexpr const char* kTracked = "rilbed tracked";
+  static constexpr const char* kAprilTag = "AprilTag 3, decimate 2";
+  static constexpr const char* kArUco = "OpenCV ArUco";
+
+  // One call, with the frame flushed (cold) or read just before (warm), its CPU time
+  // kept under `name` by floor and cache state.
+  void time_one(const std::string& name, const cv::Mat& grey, bool textured, bool warm,
+                const std::function<std::size_t()>& call) {
+    if (warm) {
+      rilbed::bench::touch(grey);
+    } else {
+      rilbed::bench::evict(grey);
+    }
+    const double c0 = thread_cpu_ms();
+    sink_ += call();
+    auto& samples = warm ? cpu_[name].warm : cpu_[name].cold;
+    samples[textured].push_back(net_ms(thread_cpu_ms() - c0, timer_cpu_ms_));
+  }
+
+  // The clip's first frame to every detector in turn, cold then warm; then a tracker
+  // over the whole clip, once met cold and once warm (its frames without a full search
+  // also kept apart).
+  void time_clip(const TimedClip& clip) {
+    const cv::Mat& first = clip.grey.front();
+    for (const bool warm : {false, true}) {
+      time_one(kFull, first, clip.textured, warm, [&] { return full_tracker_.detect_full_frame(first).size(); });
+      if (!with_peers_) continue;
+      time_one(kAprilTag, first, clip.textured, warm, [&] { return peers_.apriltag(first); });
+      time_one(kArUco, first, clip.textured, warm, [&] { return peers_.aruco(first); });
+    }
+    for (const bool warm : {false, true}) {
+      rv::MarkerTracker clip_tracker(family_, clip.ids, config_);
+      sink_ += clip_tracker.process(first).size();
+      for (std::size_t k = 1; k < clip.grey.size(); ++k) {
+        time_one(kTracked, clip.grey[k], clip.textured, warm,
+                 [&] { return clip_tracker.process(clip.grey[k]).size(); });
+        if (!clip_tracker.last_stats().full_search) {
+          const auto& samples = warm ? cpu_[kTracked].warm : cpu_[kTracked].cold;
+          auto& kept = warm ? cpu_[kTrackedAll].warm : cpu_[kTrackedAll].cold;
+          kept[clip.textured].push_back(samples.at(clip.textured).back());
+        }
+      }
+    }
+  }
+
+  const rv::MarkerFamily& family_;
+  const rv::TrackerConfig& config_;
+  bool with_peers_;
+  double timer_cpu_ms_;
+  rv::MarkerTracker full_tracker_;  // one tracker for every full search, as `rilbed detect --no-track` keeps one
+  Peers peers_;
+  std::map<std::string, SpeedSamples> cpu_;  // detector -> samples
+  std::size_t sink_ = 0;
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -619,131 +808,12 @@ int main(int argc, char** argv) {
   }
 
   // ------------------------------------------------------------ speed
-  std::printf("\n## Speed: one thread, CPU time per frame\n\n");
-  std::printf(
-      "Full-frame search: each scene's first frame (%d plain floors, %d textured), 8-bit grey, met **cold** "
-      "(flushed from every cache level before each call, as a frame from a camera arrives) and **warm** (read "
-      "once just before the call, as a frame a program has just decoded); the detectors take turns frame by "
-      "frame. Tracked: a `MarkerTracker::process` over each of those scenes' clips (%d frames), timed on every "
-      "frame after the first (the first is its full search), warm and cold likewise, listing the scene's robots as a "
-      "run's scenario does (a listed marker that is not found, such as one under a cable or at the frame's edge, makes "
-      "the tracker search the whole frame again). The timer's own cost "
-      "(%.4f ms CPU) subtracted. AprilTag 3: tag36h11, quad_decimate 2, nthreads 1; OpenCV ArUco: DICT_4X4_50, "
-      "default parameters. The peers search the same frames (6UCP markers and clutter, among it their own kind "
-      "of tags): their cost on them, not their recall. GLIBC_TUNABLES: %s (tools/bench.sh fixes glibc's malloc "
-      "thresholds, so that no detector pays page faults for buffers mapped afresh each frame).\n\n",
-      plain_kept, textured_kept, opt.frames_per_scene, timer.cpu_ms,
-      std::getenv("GLIBC_TUNABLES") ? std::getenv("GLIBC_TUNABLES") : "unset");
-  apriltag_family_t* tag_family = tag36h11_create();
-  apriltag_detector_t* td = apriltag_detector_create();
-  apriltag_detector_add_family(td, tag_family);
-  td->quad_decimate = 2.0f;
-  td->nthreads = 1;
-  const auto dict = cv::aruco::getPredefinedDictionary(cv::aruco::DICT_4X4_50);
-  const auto aruco_params = cv::aruco::DetectorParameters::create();
-  rv::MarkerTracker timing_tracker(family, all_ids(), config);
-  std::map<std::string, SpeedSamples> cpu;  // detector -> samples
-  std::size_t sink = 0;
-  const int rounds = 3;
-  auto time_one = [&](const std::string& name, const cv::Mat& grey, bool textured, bool warm,
-                      const std::function<std::size_t()>& call) {
-    if (warm) {
-      rilbed::bench::touch(grey);
-    } else {
-      rilbed::bench::evict(grey);
-    }
-    const double c0 = thread_cpu_ms();
-    sink += call();
-    auto& samples = warm ? cpu[name].warm : cpu[name].cold;
-    samples[textured].push_back(net_ms(thread_cpu_ms() - c0, timer.cpu_ms));
-  };
-  for (int r = 0; r < rounds; ++r) {
-    for (const TimedClip& clip : timed) {
-      const cv::Mat& first = clip.grey.front();
-      for (const bool warm : {false, true}) {
-        time_one("rilbed full-frame", first, clip.textured, warm,
-                 [&] { return timing_tracker.detect_full_frame(first).size(); });
-        if (!opt.peers) continue;
-        time_one("AprilTag 3, decimate 2", first, clip.textured, warm, [&] {
-          image_u8_t im{first.cols, first.rows, static_cast<int32_t>(first.step), first.data};
-          zarray_t* found = apriltag_detector_detect(td, &im);
-          const std::size_t n = static_cast<std::size_t>(zarray_size(found));
-          apriltag_detections_destroy(found);
-          return n;
-        });
-        time_one("OpenCV ArUco", first, clip.textured, warm, [&] {
-          std::vector<std::vector<cv::Point2f>> corners, rejected;
-          std::vector<int> ids;
-          cv::aruco::detectMarkers(first, dict, corners, ids, aruco_params, rejected);
-          return ids.size();
-        });
-      }
-      // The tracker over the clip, once met warm and once cold.
-      for (const bool warm : {false, true}) {
-        rv::MarkerTracker clip_tracker(family, clip.ids, config);
-        sink += clip_tracker.process(first).size();
-        for (std::size_t k = 1; k < clip.grey.size(); ++k) {
-          time_one("rilbed tracked", clip.grey[k], clip.textured, warm,
-                   [&] { return clip_tracker.process(clip.grey[k]).size(); });
-          if (!clip_tracker.last_stats().full_search) {
-            const auto& samples = warm ? cpu["rilbed tracked"].warm : cpu["rilbed tracked"].cold;
-            auto& kept = warm ? cpu[kTrackedAll].warm : cpu[kTrackedAll].cold;
-            kept[clip.textured].push_back(samples.at(clip.textured).back());
-          }
-        }
-      }
-    }
-  }
-  // rilbed alone, as `rilbed detect --no-track` meets a clip: every frame of each timed
-  // clip in turn, read just before the call, with no other detector between its calls
-  // (its own buffers stay in the caches).
-  for (int r = 0; r < rounds; ++r) {
-    for (const TimedClip& clip : timed) {
-      for (const cv::Mat& frame : clip.grey) {
-        time_one(kFullAlone, frame, clip.textured, true,
-                 [&] { return timing_tracker.detect_full_frame(frame).size(); });
-      }
-    }
-  }
-  std::printf(
-      "| detector | plain floor, cold: median ms | textured, cold: median ms | p90 ms | textured, warm: median ms | "
-      "p90 ms | AprilTag's textured warm median over this |\n"
-      "| --- | ---: | ---: | ---: | ---: | ---: | ---: |\n");
-  const double apriltag_warm =
-      cpu.count("AprilTag 3, decimate 2") ? quantile(cpu["AprilTag 3, decimate 2"].warm[true], 0.5) : 0.0;
-  for (const char* name :
-       {"rilbed full-frame", kFullAlone, "rilbed tracked", kTrackedAll, "AprilTag 3, decimate 2", "OpenCV ArUco"}) {
-    if (!cpu.count(name)) continue;
-    SpeedSamples& d = cpu[name];
-    const double warm_median = quantile(d.warm[true], 0.5);
-    auto cell = [](const std::vector<double>& v, double q) {
-      return v.empty() ? std::string("-") : cv::format("%.3f", quantile(v, q));
-    };
-    std::printf("| %s | %s | %s | %s | %s | %s | %s |\n", name, cell(d.cold[false], 0.5).c_str(),
-                cell(d.cold[true], 0.5).c_str(), cell(d.cold[true], 0.9).c_str(), cell(d.warm[true], 0.5).c_str(),
-                cell(d.warm[true], 0.9).c_str(),
-                apriltag_warm > 0 ? cv::format("%.0fx", apriltag_warm / std::max(1e-9, warm_median)).c_str() : "-");
-  }
-  const double full_warm = quantile(cpu["rilbed full-frame"].warm[true], 0.5);
-  const double full_alone = quantile(cpu[kFullAlone].warm[true], 0.5);
-  const double full_cold = quantile(cpu["rilbed full-frame"].cold[true], 0.5);
-  const double tracked_warm = quantile(cpu["rilbed tracked"].warm[true], 0.5);
-  const double tracked_all = quantile(cpu[kTrackedAll].warm[true], 0.5);
-  auto verdict = [](double ms, double target) { return ms <= target ? "met" : "not met"; };
-  std::printf(
-      "\nTargets, textured floors: a warm full-frame search within 0.3 ms (taking turns with the peers %.3f ms, "
-      "alone %.3f ms: %s); a warm tracked frame within 0.05 ms (all %.3f ms: %s; those without a full search "
-      "%.3f ms: %s; a listed marker not found, such as one under a cable, makes the tracker search the whole "
-      "frame again every frame); the stress set's textured frames, cold, within 1.91 ms (1.5x faster than "
-      "2.87 ms; here %.3f ms%s).\n",
-      full_warm, full_alone, verdict(std::min(full_warm, full_alone), 0.3), tracked_warm, verdict(tracked_warm, 0.05),
-      tracked_all, verdict(tracked_all, 0.05), full_cold,
-      is_lab ? ", but these are lab frames: read it off --generator stress"
-             : (full_cold <= 1.91 ? ": met" : ": not met"));
-  apriltag_detector_destroy(td);
-  tag36h11_destroy(tag_family);
+  SpeedRun speed(family, config, opt.peers, timer.cpu_ms);
+  speed.print_method(plain_kept, textured_kept, opt.frames_per_scene);
+  speed.time(timed);
+  speed.print_table();
+  speed.print_targets(is_lab);
   std::printf("\nRendering and scoring took %.0f s, timing %.0f s (%zu timing calls kept out of the sink: %zu).\n",
-              render_score_s, ms_since(start) / 1000 - render_score_s,
-              cpu["rilbed full-frame"].cold[true].size() + cpu["rilbed full-frame"].cold[false].size(), sink % 2);
+              render_score_s, ms_since(start) / 1000 - render_score_s, speed.full_frame_calls(), speed.sink() % 2);
   return 0;
 }
