@@ -431,49 +431,8 @@ class SpeedRun {
   std::size_t sink_ = 0;
 };
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  Options opt;
-  CLI::App app{"rilbed on the vision stress set"};
-  app.add_option("--generator", opt.generator, "stress (the tuning set) or lab (the second, independent generator)")
-      ->check(CLI::IsMember({"stress", "lab"}));
-  app.add_option("--scenes", opt.scenes, "Scenes (each --frames-per-scene frames)")->check(CLI::PositiveNumber);
-  app.add_option("--seed", opt.seed, "The set's seed (default: drawn, and printed)")->each([&](const std::string&) {
-    opt.seed_given = true;
-  });
-  app.add_option("--frames-per-scene", opt.frames_per_scene, "Frames per scene (the tracked clip)")
-      ->check(CLI::Range(1, 64));
-  app.add_option("--threads", opt.threads, "Threads rendering scenes (detection always runs on one)")
-      ->check(CLI::Range(1, 64));
-  app.add_option("--timing-frames", opt.timing_frames, "Frames timed per floor class (plain, textured)")
-      ->check(CLI::Range(0, 1000));
-  app.add_option("--mistakes", opt.mistakes, "Mistakes listed")->check(CLI::Range(0, 100000));
-  app.add_option("--explain", opt.explain, "Whole markers missed by full-frame search listed with their cause")
-      ->check(CLI::Range(0, 100000));
-  app.add_flag("!--no-peers", opt.peers, "Leave out AprilTag and ArUco");
-  app.add_option(
-      "--without", opt.without,
-      std::string("Turn a check off, to measure what it costs in recall and saves in mistakes (repeatable): ") +
-          kChecks);
-  CLI11_PARSE(app, argc, argv);
-  rv::TrackerConfig config;
-  try {
-    config = tracker_config(opt.without);
-  } catch (const CLI::Error& e) {
-    return app.exit(e);
-  }
-  if (!opt.seed_given) opt.seed = std::random_device{}() | (static_cast<std::uint64_t>(std::random_device{}()) << 32);
-  cv::setNumThreads(0);
-  cv::ocl::setUseOpenCL(false);
-  const auto timer = rilbed::bench::measure_timer_overhead();
-  const auto start = Clock::now();
-
-  rv::StressOptions stress;
-  stress.frames_per_scene = opt.frames_per_scene;
-  rv::LabFootageOptions lab;
-  lab.frames_per_scene = opt.frames_per_scene;
-  const bool is_lab = opt.generator == "lab";
+// The report's head: what was measured, on what, and how.
+void print_header(const Options& opt, bool is_lab, const rv::StressOptions& stress) {
   std::printf(is_lab ? "# rilbed on the second generator's lab footage\n\n" : "# rilbed on the vision stress set\n\n");
   if (!opt.without.empty()) {
     std::string off;
@@ -517,13 +476,30 @@ int main(int argc, char** argv) {
       "blur buckets by sqrt(sigma^2 + smear^2 / 12)\n\n",
       rv::kStressWrongHeadingDeg);
   std::fflush(stdout);
+}
 
-  const rv::MarkerFamily family = rv::MarkerFamily::six_ucp();
+// What each scene's frames gave, full-frame and tracked, with the clips kept for timing.
+struct Scored {
   rv::StressTally full, tracked;
   std::vector<TimedClip> timed;
-  int plain_kept = 0, textured_kept = 0;
-  std::map<std::string, int> miss_causes;
-  std::vector<std::string> miss_rows;
+  int plain_kept = 0, textured_kept = 0;   // clips kept for timing, by floor
+  std::map<std::string, int> miss_causes;  // whole markers full-frame search missed, by cause
+  std::vector<std::string> miss_rows;      // the first --explain of them, as table rows
+};
+
+// Renders the scenes (on opt.threads threads) and scores each as it comes: a full search
+// on every frame (its misses explained from the tracker's verdicts) and a tracker over the
+// scene's clip; the first clips of each floor class are kept for timing.
+Scored score_scenes(const Options& opt, bool is_lab, const rv::StressOptions& stress, const rv::LabFootageOptions& lab,
+                    const rv::MarkerFamily& family, const rv::TrackerConfig& config) {
+  Scored out;
+  rv::StressTally& full = out.full;
+  rv::StressTally& tracked = out.tracked;
+  std::vector<TimedClip>& timed = out.timed;
+  int& plain_kept = out.plain_kept;
+  int& textured_kept = out.textured_kept;
+  std::map<std::string, int>& miss_causes = out.miss_causes;
+  std::vector<std::string>& miss_rows = out.miss_rows;
   std::vector<rv::CandidateVerdict> verdicts;
   std::vector<rv::RejectedRegion> rejections;
   {
@@ -573,8 +549,13 @@ int main(int argc, char** argv) {
       }
     }
   }
-  const double render_score_s = ms_since(start) / 1000;
+  return out;
+}
 
+// Wrong IDs, false detections, far-off headings, duplicates and declines, by mode.
+void print_mistakes(const Scored& scored) {
+  const rv::StressTally& full = scored.full;
+  const rv::StressTally& tracked = scored.tracked;
   // ------------------------------------------------------------ mistakes
   std::printf(
       "## Mistakes\n\n| mode | frames | markers | recall | wrong IDs | false detections | headings > %.0f deg off | "
@@ -589,23 +570,37 @@ int main(int argc, char** argv) {
                 t->count(rv::StressMistake::Kind::kDuplicate), t->declined());
   }
   std::printf("\n");
+}
 
+// The causes of full-frame misses of whole markers, and the first of them one by one.
+void print_miss_causes(const Scored& scored) {
   // ------------------------------------------------------------ why whole markers were missed
   {
     int total = 0;
-    for (const auto& [cause, n] : miss_causes) total += n;
+    for (const auto& [cause, n] : scored.miss_causes) total += n;
     std::printf("## Why full-frame search missed whole markers (%d misses)\n\n| cause | misses |\n| --- | ---: |\n",
                 total);
-    for (const auto& [cause, n] : miss_causes) std::printf("| %s | %d |\n", cause.c_str(), n);
-    if (!miss_rows.empty()) {
+    for (const auto& [cause, n] : scored.miss_causes) std::printf("| %s | %d |\n", cause.c_str(), n);
+    if (!scored.miss_rows.empty()) {
       std::printf(
           "\n| scene | frame | ID | diameter px | u | v | cause | detail |\n| ---: | ---: | ---: | ---: | ---: | ---: "
           "| --- | --- |\n");
-      for (const auto& r : miss_rows) std::printf("%s\n", r.c_str());
+      for (const auto& r : scored.miss_rows) std::printf("%s\n", r.c_str());
     }
     std::printf("\n");
   }
+}
 
+// The head of every bucket table.
+constexpr const char* kBucketHead =
+    "| mode | markers | n | recall | centre RMS px | centre max px | heading RMS deg | heading max deg | worst ID "
+    "bias deg |\n"
+    "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+
+// Recall and accuracy by size, blur, occlusion and contact, and floor.
+void print_buckets(const Scored& scored) {
+  const rv::StressTally& full = scored.full;
+  const rv::StressTally& tracked = scored.tracked;
   // ------------------------------------------------------------ by size
   const auto unoccluded = [](const rv::StressOutcome& o) { return o.occluded == 0; };
   const std::vector<Bucket> sizes = {
@@ -618,11 +613,7 @@ int main(int argc, char** argv) {
       {">= 24 px, occluded", [](const rv::StressOutcome& o) { return o.occluded > 0 && o.diameter_px >= 24; }},
       {">= 24 px, all", [](const rv::StressOutcome& o) { return o.diameter_px >= 24; }},
   };
-  const char* head =
-      "| mode | markers | n | recall | centre RMS px | centre max px | heading RMS deg | heading max deg | worst ID "
-      "bias deg |\n"
-      "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
-  std::printf("## By marker size (unoccluded unless said)\n\n%s", head);
+  std::printf("## By marker size (unoccluded unless said)\n\n%s", kBucketHead);
   print_bucket_rows("full-frame", full.outcomes(), sizes);
   print_bucket_rows("tracked", tracked.outcomes(), sizes);
 
@@ -636,7 +627,7 @@ int main(int argc, char** argv) {
       {"blur >= 1.5 px",
        [](const rv::StressOutcome& o) { return o.occluded == 0 && o.diameter_px >= 24 && o.blur_px >= 1.5; }},
   };
-  std::printf("\n## By blur (markers >= 24 px, unoccluded)\n\n%s", head);
+  std::printf("\n## By blur (markers >= 24 px, unoccluded)\n\n%s", kBucketHead);
   print_bucket_rows("full-frame", full.outcomes(), blurs);
   print_bucket_rows("tracked", tracked.outcomes(), blurs);
 
@@ -650,7 +641,7 @@ int main(int argc, char** argv) {
       {"touching another",
        [](const rv::StressOutcome& o) { return o.diameter_px >= 24 && o.occluded == 0 && o.touching; }},
   };
-  std::printf("\n## By occlusion and contact (markers >= 24 px)\n\n%s", head);
+  std::printf("\n## By occlusion and contact (markers >= 24 px)\n\n%s", kBucketHead);
   print_bucket_rows("full-frame", full.outcomes(), cover);
   print_bucket_rows("tracked", tracked.outcomes(), cover);
 
@@ -660,95 +651,103 @@ int main(int argc, char** argv) {
     floors.push_back({rv::floor_name(f), [f](const rv::StressOutcome& o) {
                         return o.floor == f && o.diameter_px >= 24 && o.occluded == 0;
                       }});
-  std::printf("\n## By floor (markers >= 24 px, unoccluded)\n\n%s", head);
+  std::printf("\n## By floor (markers >= 24 px, unoccluded)\n\n%s", kBucketHead);
   print_bucket_rows("full-frame", full.outcomes(), floors);
   print_bucket_rows("tracked", tracked.outcomes(), floors);
+}
 
-  if (is_lab) {
-    // The second generator's own tables: the sizes the targets name, and each difficulty
-    // (scene k is plain, hard, harsh for k % 3 = 0, 1, 2).
-    const auto whole = [](const rv::StressOutcome& o) { return o.occluded == 0 && !o.touching; };
-    const std::vector<Bucket> fine = {
-        {"< 24 px", [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px < 24; }},
-        {"24-28 px", [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px >= 24 && o.diameter_px < 28; }},
-        {"28-32 px", [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px >= 28 && o.diameter_px < 32; }},
-        {"32-40 px", [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px >= 32 && o.diameter_px < 40; }},
-        {">= 40 px", [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px >= 40; }},
-        {"under a cable", [](const rv::StressOutcome& o) { return o.occluded > 0; }},
-    };
-    std::printf("\n## Lab footage by size (whole markers unless said)\n\n%s", head);
-    print_bucket_rows("full-frame", full.outcomes(), fine);
-    print_bucket_rows("tracked", tracked.outcomes(), fine);
-    std::vector<Bucket> kinds;
-    for (int k = 0; k < 3; ++k) {
-      static const char* names[] = {"plain, whole", "hard, whole", "harsh, whole"};
-      kinds.push_back({names[k], [&, k](const rv::StressOutcome& o) { return whole(o) && o.scene % 3 == k; }});
-    }
-    std::printf("\n## Lab footage by difficulty\n\n%s", head);
-    print_bucket_rows("full-frame", full.outcomes(), kinds);
-    print_bucket_rows("tracked", tracked.outcomes(), kinds);
-    // The heading's mean error by ID: a bias by code is what a lab cannot calibrate away.
-    std::printf("\n## Lab footage: mean heading error by ID (whole markers >= 24 px)\n\n| mode |");
-    for (int id = 1; id <= 8; ++id) std::printf(" ID %d |", id);
-    std::printf(" all |\n| --- |%s\n", " ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
-    for (const rv::StressTally* t : {&full, &tracked}) {
-      std::printf("| %s |", t == &full ? "full-frame" : "tracked");
-      double all_sum = 0;
-      int all_n = 0;
-      for (int id = 1; id <= 8; ++id) {
-        double sum = 0;
-        int n = 0;
-        for (const auto& o : t->outcomes()) {
-          if (o.id != id || !o.found || !whole(o) || o.diameter_px < 24) continue;
-          sum += o.heading_error_deg;
-          ++n;
-        }
-        all_sum += sum;
-        all_n += n;
-        std::printf(" %+.3f |", n ? sum / n : 0.0);
-      }
-      std::printf(" %+.3f |\n", all_n ? all_sum / all_n : 0.0);
-    }
-    std::printf("\n## The lab footage's targets\n\n| target | full-frame | tracked |\n| --- | ---: | ---: |\n");
-    auto row = [&](const char* name, const std::function<std::string(const rv::StressTally&)>& value) {
-      std::printf("| %s | %s | %s |\n", name, value(full).c_str(), value(tracked).c_str());
-    };
-    row("0 wrong IDs (cables included)",
-        [](const rv::StressTally& t) { return std::to_string(t.count(rv::StressMistake::Kind::kWrongId)); });
-    row("0 false detections",
-        [](const rv::StressTally& t) { return std::to_string(t.count(rv::StressMistake::Kind::kFalseDetection)); });
-    row("recall >= 0.99, whole, >= 28 px", [&](const rv::StressTally& t) {
-      return pct(rv::summarise(t.outcomes(), [&](const rv::StressOutcome& o) {
-                   return whole(o) && o.diameter_px >= 28;
-                 }).recall());
-    });
-    row("recall >= 0.97, whole, 24-28 px", [&](const rv::StressTally& t) {
-      return pct(rv::summarise(t.outcomes(), [&](const rv::StressOutcome& o) {
-                   return whole(o) && o.diameter_px >= 24 && o.diameter_px < 28;
-                 }).recall());
-    });
-    auto hard = [&](const rv::StressOutcome& o) { return whole(o) && o.scene % 3 == 1 && o.diameter_px >= 24; };
-    row("heading <= 1.0 deg RMS, hard", [&](const rv::StressTally& t) {
-      char b[32];
-      std::snprintf(b, sizeof b, "%.3f", rv::summarise(t.outcomes(), hard).heading_rms_deg);
-      return std::string(b);
-    });
-    row("no ID's mean heading error beyond 0.3 deg, whole, >= 24 px", [&](const rv::StressTally& t) {
-      const auto st =
-          rv::summarise(t.outcomes(), [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px >= 24; });
-      char b[48];
-      std::snprintf(b, sizeof b, "ID %d: %+.3f", st.worst_bias_id, st.worst_bias_deg);
-      return std::string(b);
-    });
-    row("centre <= 0.15 px RMS, whole, >= 24 px", [&](const rv::StressTally& t) {
-      char b[32];
-      std::snprintf(b, sizeof b, "%.3f", rv::summarise(t.outcomes(), [&](const rv::StressOutcome& o) {
-                                           return whole(o) && o.diameter_px >= 24;
-                                         }).centre_rms_px);
-      return std::string(b);
-    });
+// The second generator's own tables: finer sizes, difficulty, heading bias by ID, its targets.
+void print_lab_tables(const Scored& scored) {
+  const rv::StressTally& full = scored.full;
+  const rv::StressTally& tracked = scored.tracked;
+  // The second generator's own tables: the sizes the targets name, and each difficulty
+  // (scene k is plain, hard, harsh for k % 3 = 0, 1, 2).
+  const auto whole = [](const rv::StressOutcome& o) { return o.occluded == 0 && !o.touching; };
+  const std::vector<Bucket> fine = {
+      {"< 24 px", [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px < 24; }},
+      {"24-28 px", [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px >= 24 && o.diameter_px < 28; }},
+      {"28-32 px", [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px >= 28 && o.diameter_px < 32; }},
+      {"32-40 px", [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px >= 32 && o.diameter_px < 40; }},
+      {">= 40 px", [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px >= 40; }},
+      {"under a cable", [](const rv::StressOutcome& o) { return o.occluded > 0; }},
+  };
+  std::printf("\n## Lab footage by size (whole markers unless said)\n\n%s", kBucketHead);
+  print_bucket_rows("full-frame", full.outcomes(), fine);
+  print_bucket_rows("tracked", tracked.outcomes(), fine);
+  std::vector<Bucket> kinds;
+  for (int k = 0; k < 3; ++k) {
+    static const char* names[] = {"plain, whole", "hard, whole", "harsh, whole"};
+    kinds.push_back({names[k], [&, k](const rv::StressOutcome& o) { return whole(o) && o.scene % 3 == k; }});
   }
+  std::printf("\n## Lab footage by difficulty\n\n%s", kBucketHead);
+  print_bucket_rows("full-frame", full.outcomes(), kinds);
+  print_bucket_rows("tracked", tracked.outcomes(), kinds);
+  // The heading's mean error by ID: a bias by code is what a lab cannot calibrate away.
+  std::printf("\n## Lab footage: mean heading error by ID (whole markers >= 24 px)\n\n| mode |");
+  for (int id = 1; id <= 8; ++id) std::printf(" ID %d |", id);
+  std::printf(" all |\n| --- |%s\n", " ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+  for (const rv::StressTally* t : {&full, &tracked}) {
+    std::printf("| %s |", t == &full ? "full-frame" : "tracked");
+    double all_sum = 0;
+    int all_n = 0;
+    for (int id = 1; id <= 8; ++id) {
+      double sum = 0;
+      int n = 0;
+      for (const auto& o : t->outcomes()) {
+        if (o.id != id || !o.found || !whole(o) || o.diameter_px < 24) continue;
+        sum += o.heading_error_deg;
+        ++n;
+      }
+      all_sum += sum;
+      all_n += n;
+      std::printf(" %+.3f |", n ? sum / n : 0.0);
+    }
+    std::printf(" %+.3f |\n", all_n ? all_sum / all_n : 0.0);
+  }
+  std::printf("\n## The lab footage's targets\n\n| target | full-frame | tracked |\n| --- | ---: | ---: |\n");
+  auto row = [&](const char* name, const std::function<std::string(const rv::StressTally&)>& value) {
+    std::printf("| %s | %s | %s |\n", name, value(full).c_str(), value(tracked).c_str());
+  };
+  row("0 wrong IDs (cables included)",
+      [](const rv::StressTally& t) { return std::to_string(t.count(rv::StressMistake::Kind::kWrongId)); });
+  row("0 false detections",
+      [](const rv::StressTally& t) { return std::to_string(t.count(rv::StressMistake::Kind::kFalseDetection)); });
+  row("recall >= 0.99, whole, >= 28 px", [&](const rv::StressTally& t) {
+    return pct(rv::summarise(t.outcomes(), [&](const rv::StressOutcome& o) {
+                 return whole(o) && o.diameter_px >= 28;
+               }).recall());
+  });
+  row("recall >= 0.97, whole, 24-28 px", [&](const rv::StressTally& t) {
+    return pct(rv::summarise(t.outcomes(), [&](const rv::StressOutcome& o) {
+                 return whole(o) && o.diameter_px >= 24 && o.diameter_px < 28;
+               }).recall());
+  });
+  auto hard = [&](const rv::StressOutcome& o) { return whole(o) && o.scene % 3 == 1 && o.diameter_px >= 24; };
+  row("heading <= 1.0 deg RMS, hard", [&](const rv::StressTally& t) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.3f", rv::summarise(t.outcomes(), hard).heading_rms_deg);
+    return std::string(b);
+  });
+  row("no ID's mean heading error beyond 0.3 deg, whole, >= 24 px", [&](const rv::StressTally& t) {
+    const auto st =
+        rv::summarise(t.outcomes(), [&](const rv::StressOutcome& o) { return whole(o) && o.diameter_px >= 24; });
+    char b[48];
+    std::snprintf(b, sizeof b, "ID %d: %+.3f", st.worst_bias_id, st.worst_bias_deg);
+    return std::string(b);
+  });
+  row("centre <= 0.15 px RMS, whole, >= 24 px", [&](const rv::StressTally& t) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.3f", rv::summarise(t.outcomes(), [&](const rv::StressOutcome& o) {
+                                         return whole(o) && o.diameter_px >= 24;
+                                       }).centre_rms_px);
+    return std::string(b);
+  });
+}
 
+// The stress set's targets beside the measurements.
+void print_stress_targets(const Scored& scored) {
+  const rv::StressTally& full = scored.full;
+  const rv::StressTally& tracked = scored.tracked;
   // ------------------------------------------------------------ targets
   std::printf("\n## The stress set's targets\n\n| target | full-frame | tracked |\n| --- | ---: | ---: |\n");
   auto target_row = [&](const char* name, const std::function<std::string(const rv::StressTally&)>& value) {
@@ -788,7 +787,12 @@ int main(int argc, char** argv) {
     std::snprintf(b, sizeof b, "ID %d: %+.3f", s.worst_bias_id, s.worst_bias_deg);
     return std::string(b);
   });
+}
 
+// The first --mistakes mistakes of each mode, to look at.
+void print_first_mistakes(const Scored& scored, const Options& opt) {
+  const rv::StressTally& full = scored.full;
+  const rv::StressTally& tracked = scored.tracked;
   // ------------------------------------------------------------ the first mistakes
   if (opt.mistakes > 0) {
     std::printf("\n## The first mistakes (see them: `rilbed synth --preset stress --seed %llu --frames N`)\n\n",
@@ -806,11 +810,67 @@ int main(int argc, char** argv) {
       }
     }
   }
+}
 
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options opt;
+  CLI::App app{"rilbed on the vision stress set"};
+  app.add_option("--generator", opt.generator, "stress (the tuning set) or lab (the second, independent generator)")
+      ->check(CLI::IsMember({"stress", "lab"}));
+  app.add_option("--scenes", opt.scenes, "Scenes (each --frames-per-scene frames)")->check(CLI::PositiveNumber);
+  app.add_option("--seed", opt.seed, "The set's seed (default: drawn, and printed)")->each([&](const std::string&) {
+    opt.seed_given = true;
+  });
+  app.add_option("--frames-per-scene", opt.frames_per_scene, "Frames per scene (the tracked clip)")
+      ->check(CLI::Range(1, 64));
+  app.add_option("--threads", opt.threads, "Threads rendering scenes (detection always runs on one)")
+      ->check(CLI::Range(1, 64));
+  app.add_option("--timing-frames", opt.timing_frames, "Frames timed per floor class (plain, textured)")
+      ->check(CLI::Range(0, 1000));
+  app.add_option("--mistakes", opt.mistakes, "Mistakes listed")->check(CLI::Range(0, 100000));
+  app.add_option("--explain", opt.explain, "Whole markers missed by full-frame search listed with their cause")
+      ->check(CLI::Range(0, 100000));
+  app.add_flag("!--no-peers", opt.peers, "Leave out AprilTag and ArUco");
+  app.add_option(
+      "--without", opt.without,
+      std::string("Turn a check off, to measure what it costs in recall and saves in mistakes (repeatable): ") +
+          kChecks);
+  CLI11_PARSE(app, argc, argv);
+  rv::TrackerConfig config;
+  try {
+    config = tracker_config(opt.without);
+  } catch (const CLI::Error& e) {
+    return app.exit(e);
+  }
+  if (!opt.seed_given) opt.seed = std::random_device{}() | (static_cast<std::uint64_t>(std::random_device{}()) << 32);
+  cv::setNumThreads(0);
+  cv::ocl::setUseOpenCL(false);
+  const auto timer = rilbed::bench::measure_timer_overhead();
+  const auto start = Clock::now();
+
+  rv::StressOptions stress;
+  stress.frames_per_scene = opt.frames_per_scene;
+  rv::LabFootageOptions lab;
+  lab.frames_per_scene = opt.frames_per_scene;
+  const bool is_lab = opt.generator == "lab";
+  print_header(opt, is_lab, stress);
+
+  const rv::MarkerFamily family = rv::MarkerFamily::six_ucp();
+  const Scored scored = score_scenes(opt, is_lab, stress, lab, family, config);
+  const double render_score_s = ms_since(start) / 1000;
+
+  print_mistakes(scored);
+  print_miss_causes(scored);
+  print_buckets(scored);
+  if (is_lab) print_lab_tables(scored);
+  print_stress_targets(scored);
+  print_first_mistakes(scored, opt);
   // ------------------------------------------------------------ speed
   SpeedRun speed(family, config, opt.peers, timer.cpu_ms);
-  speed.print_method(plain_kept, textured_kept, opt.frames_per_scene);
-  speed.time(timed);
+  speed.print_method(scored.plain_kept, scored.textured_kept, opt.frames_per_scene);
+  speed.time(scored.timed);
   speed.print_table();
   speed.print_targets(is_lab);
   std::printf("\nRendering and scoring took %.0f s, timing %.0f s (%zu timing calls kept out of the sink: %zu).\n",
