@@ -7,6 +7,8 @@
 // seed, and --explain says why each missed marker was missed).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <future>
 
@@ -61,12 +63,27 @@ TEST(LabFootage, GeneratorIsDeterministicAndItsTruthLiesOnTheMarkers) {
   ASSERT_EQ(a.frames.size(), 1u);
   EXPECT_EQ(cv::norm(a.frames[0], b.frames[0], cv::NORM_INF), 0.0);
   ASSERT_EQ(a.truth[0].size(), 8u);
+  // The mean green level on a circle of `fraction` of a marker's outer radius around its
+  // truth's centre.
+  auto ring_level = [&](const StressTruth& t, double fraction) {
+    double sum = 0;
+    constexpr int kReads = 48;
+    for (int k = 0; k < kReads; ++k) {
+      const double angle = 2 * 3.141592653589793 * k / kReads, r = fraction * 0.5 * t.diameter_px;
+      const int x = static_cast<int>(std::lround(t.u + r * std::cos(angle)));
+      const int y = static_cast<int>(std::lround(t.v + r * std::sin(angle)));
+      sum +=
+          a.frames[0].at<cv::Vec3b>(std::clamp(y, 0, a.frames[0].rows - 1), std::clamp(x, 0, a.frames[0].cols - 1))[1];
+    }
+    return sum / kReads;
+  };
   for (const StressTruth& t : a.truth[0]) {
     EXPECT_GT(t.diameter_px, 15.0);
-    // The marker's hole is black: the truth's centre is darker than the white ring.
-    const cv::Vec3b centre =
-        a.frames[0].at<cv::Vec3b>(static_cast<int>(std::lround(t.v)), static_cast<int>(std::lround(t.u)));
-    EXPECT_LT(centre[1], 128) << "ID " << t.id;
+    // The truth lies on its marker: the black ring's middle (0.67 of the outer radius)
+    // reads darker than the white ring's (0.89) all round. (Not the hole alone: on a small
+    // marker under motion blur the hole, 4 px across, is smeared with the white slices
+    // around it; seed 11049315908254191147's scene 1 has one, its centre at grey 183.)
+    EXPECT_LT(ring_level(t, 0.67) + 20, ring_level(t, 0.89)) << "ID " << t.id;
   }
 }
 
