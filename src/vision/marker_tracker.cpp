@@ -335,15 +335,15 @@ void MarkerTracker::assign_nested(const cv::Mat& grey, bool use_tracks, std::vec
         rays_crossing_bright(grey, b, kNestedRays, kNestedRaysFrom, kNestedRaysTo) < config_.nested_min_bright_rays) {
       continue;
     }
-    // Its outline's box, searched with exact fills (detect_inside): the enclosing blob is
-    // found again (and dropped below) and what it encloses with it.
+    // Its outline's box, searched with exact fills (detect_inside) for the discs it
+    // encloses (the enclosing blob itself, when a seed lies on it, is dropped below).
     const double half_u = std::hypot(b.shape(0, 0), b.shape(0, 1)) + 2;
     const double half_v = std::hypot(b.shape(1, 0), b.shape(1, 1)) + 2;
     const cv::Rect box(static_cast<int>(std::floor(b.u - half_u)), static_cast<int>(std::floor(b.v - half_v)),
                        static_cast<int>(std::ceil(2 * half_u)) + 1, static_cast<int>(std::ceil(2 * half_v)) + 1);
     // Seeds only in its middle (nested_seed_fraction of its half extents): a marker on a
-    // top lies there, and its hole and black slices seed it; the top's rim, further out,
-    // is then not filled (a third of the search's cost) unless the marker sits off-centre.
+    // top lies there, and its hole and black slices seed it; most of the top's rim,
+    // further out, is then not filled.
     const cv::Rect seeds(static_cast<int>(std::floor(b.u - config_.nested_seed_fraction * half_u)),
                          static_cast<int>(std::floor(b.v - config_.nested_seed_fraction * half_v)),
                          static_cast<int>(std::ceil(2 * config_.nested_seed_fraction * half_u)) + 1,

@@ -132,12 +132,17 @@ struct TrackerConfig {
   /// lower searches more blobs for nothing, higher risks a marker whose white ring a
   /// cable or blur breaks. 0 searches inside every unread blob.
   int nested_min_bright_rays = 6;
-  /// The inside search seeds fills only within this fraction of the enclosing blob's half
-  /// extents around its centre. A marker's dark disc on a top 1.5-1.9 times as wide has
-  /// its edge at 0.53-0.67 of the top's radius and the top's rim begins beyond its white
-  /// ring: 0.4 seeds the marker's hole and black slices, not the rim, for a marker up to a
-  /// quarter of the top's radius off its centre (one further off is still found, with the
-  /// rim filled as well, when its disc reaches into the seed box). 1 seeds everywhere.
+  /// The inside search seeds its fills only within this fraction of the enclosing blob's
+  /// half extents around its centre, where a robot carries its marker: its hole and black
+  /// slices seed it there, and most of the top's rim further out is left unfilled (a third
+  /// of the inside search's cost on the lab footage). A marker whose disc reaches no seed
+  /// row inside that box is not found by this search. A blob is searched only when 6 of
+  /// 16 rays from its centre cross something bright (nested_min_bright_rays); if that is
+  /// the marker's white ring, the marker's centre lies within 1.2 of its outer radius R
+  /// of the blob's centre, so its disc comes within 0.42 R of it: inside the box, whose
+  /// half width (0.4 of the top's radius) is 0.42 R or more for any top of radius 1.05 R
+  /// or more. Only a sliver of the disc may lie there when the marker is far off a top
+  /// barely wider than itself. 1 seeds the whole box.
   double nested_seed_fraction = 0.4;
   /// The least bright share of a disc's outline in that search (BlobDetectorConfig::
   /// min_bright_outline elsewhere): between the black ring and a dark top the white ring is
