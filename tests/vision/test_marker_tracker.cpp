@@ -371,11 +371,9 @@ TEST(MarkerTracker, TheShapeFollowsAStretchingMarker) {
 }
 
 // A marker on a robot's dark top 1.6 times as wide as the marker (twice its dark disc's
-// width), as the lab footage's robots carry theirs: the sweep takes the
-// top whole, and the search inside it (seeded only in its middle) finds the marker, with
-// its ID, at every ID, centred on the top and off its centre by a quarter of the top's
-// radius (where the seed box still holds the marker's hole), in a full search and when
-// tracked.
+// width) is found with its ID, at every ID, centred on the top and a quarter of the top's
+// radius off its centre, in a full search and when tracked. Centred, the sweep takes the
+// top whole and only the search inside it (seeded in its middle) finds the marker.
 TEST(MarkerTracker, MarkersOnDarkTopsAreFoundInside) {
   const auto f = MarkerFamily::six_ucp();
   constexpr int kSize = 34;
@@ -397,13 +395,18 @@ TEST(MarkerTracker, MarkersOnDarkTopsAreFoundInside) {
       cv::GaussianBlur(grey, grey, cv::Size(), 0.8);
       const double u = x0 + kSize / 2.0 - 0.5, v = y0 + kSize / 2.0 - 0.5;
       const std::string what = "id " + std::to_string(id) + " off centre " + std::to_string(off_centre);
-      MarkerTracker tracker(f, {1, 2, 3, 4, 5, 6, 7, 8});
+      MarkerTracker tracker(f, {id});  // only its ID: the inside search runs only if it is missed
       const auto full = tracker.detect_full_frame(grey);
       ASSERT_EQ(full.size(), 1u) << what;
       EXPECT_EQ(full[0].id, id) << what;
       EXPECT_NEAR(full[0].u, u, 0.3) << what;
       EXPECT_NEAR(full[0].v, v, 0.3) << what;
-      EXPECT_GT(tracker.last_stats().nested_searches, 0) << what << ": the sweep no longer takes the top whole";
+      // Centred, the marker's hole is the top's centre, and the sweep takes the top whole:
+      // only the search inside finds the marker. (A quarter off, the top's centre may lie
+      // on a white slice, and the exact fill that follows finds the marker at once.)
+      if (off_centre == 0.0) {
+        EXPECT_GT(tracker.last_stats().nested_searches, 0) << what << ": the sweep no longer takes the top whole";
+      }
       for (int frame = 0; frame < 3; ++frame) {
         const auto tracked = tracker.process(grey);
         ASSERT_EQ(tracked.size(), 1u) << what << " frame " << frame;
