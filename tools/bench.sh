@@ -43,6 +43,12 @@ export GLIBC_TUNABLES=glibc.malloc.mmap_threshold=67108864:glibc.malloc.trim_thr
 # AprilTag and ArUco. Its seed is printed; pass it back to see the same frames.
 echo
 "$BUILD_DIR/bench_stress" --scenes 500
+# The second generator's lab footage, which no threshold was tuned on (light traced from
+# the lamp through a lens onto robots' tops and paper stickers, rolling shutter, shot
+# noise, JPEG): 60 scenes (240 frames) from a fresh seed, its targets, and the full and
+# tracked search's cost on its frames beside AprilTag and ArUco.
+echo
+"$BUILD_DIR/bench_stress" --generator lab --scenes 60
 unset GLIBC_TUNABLES
 
 # The simulation: sim-bench's table, then the convoy batch in both modes
