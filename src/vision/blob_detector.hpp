@@ -148,11 +148,11 @@ class BlobDetector {
   /// Like detect(grey, roi), but every region is filled exactly, so that what a dark
   /// region encloses is searched as well: a marker's disc within the dark top of the robot
   /// that carries it (the top, itself a dark disc, is among the blobs returned when a
-  /// seed lies on it). The
-  /// quick sweep that detect() tries first takes in an enclosing region's inside whole
-  /// and clears it; this costs an exact fill per region instead. A disc there is held to
-  /// `min_bright_outline` in place of the config's: a marker's thin white ring between
-  /// its black ring and a dark top, blurred, dips below the local threshold in places.
+  /// seed lies on it). The quick sweep that detect() tries first takes in an enclosing
+  /// region's inside whole and clears it; this costs an exact fill per region instead. A
+  /// disc there is held to `min_bright_outline` in place of the config's: a marker's thin
+  /// white ring between its black ring and a dark top, blurred, dips below the local
+  /// threshold in places.
   /// With `seeds`, fills start only from the seed rows' well-dark pixels within it (each
   /// fill may still extend over all of roi): the middle of a robot's top, where its
   /// marker lies, so that the top's own dark rim around the marker is not filled for

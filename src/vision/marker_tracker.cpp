@@ -339,15 +339,16 @@ void MarkerTracker::assign_nested(const cv::Mat& grey, bool use_tracks, std::vec
     // encloses (the enclosing blob itself, when a seed lies on it, is dropped below).
     const double half_u = std::hypot(b.shape(0, 0), b.shape(0, 1)) + 2;
     const double half_v = std::hypot(b.shape(1, 0), b.shape(1, 1)) + 2;
-    const cv::Rect box(static_cast<int>(std::floor(b.u - half_u)), static_cast<int>(std::floor(b.v - half_v)),
-                       static_cast<int>(std::ceil(2 * half_u)) + 1, static_cast<int>(std::ceil(2 * half_v)) + 1);
     // Seeds only in its middle (nested_seed_fraction of its half extents): a marker on a
     // top lies there, and its hole and black slices seed it; most of the top's rim,
     // further out, is then not filled.
-    const cv::Rect seeds(static_cast<int>(std::floor(b.u - config_.nested_seed_fraction * half_u)),
-                         static_cast<int>(std::floor(b.v - config_.nested_seed_fraction * half_v)),
-                         static_cast<int>(std::ceil(2 * config_.nested_seed_fraction * half_u)) + 1,
-                         static_cast<int>(std::ceil(2 * config_.nested_seed_fraction * half_v)) + 1);
+    auto box_of = [&](double fraction) {
+      return cv::Rect(static_cast<int>(std::floor(b.u - fraction * half_u)),
+                      static_cast<int>(std::floor(b.v - fraction * half_v)),
+                      static_cast<int>(std::ceil(2 * fraction * half_u)) + 1,
+                      static_cast<int>(std::ceil(2 * fraction * half_v)) + 1);
+    };
+    const cv::Rect box = box_of(1.0), seeds = box_of(config_.nested_seed_fraction);
     ++stats_.nested_searches;
     std::vector<Blob> here = detector_.detect_inside(grey, box, config_.nested_min_bright_outline, seeds);
     std::erase_if(here, [&](const Blob& h) { return h.disc_diameter_px() > 0.9 * b.disc_diameter_px(); });
