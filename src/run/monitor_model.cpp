@@ -115,12 +115,19 @@ void MonitorModel::close_second() {
   fps_frames_ = frames;
 }
 
+void MonitorModel::report_world(TimeUs t) {
+  RunObserver* const o = s_.options->observer;
+  if (!o) return;
+  o->on_world(t, s_.world_report);
+  next_world_us_ = (t / 1'000'000 + 1) * 1'000'000;
+}
+
 void MonitorModel::sample(TimeUs t) {
   RunResult& r = *s_.result;
   RunObserver* const o = s_.options->observer;
   const bool new_second = t >= next_report_us_;
   // The world first, so that a viewer can draw whatever follows.
-  if (o && new_second) o->on_world(t, s_.world_report);
+  if (o && t >= next_world_us_) report_world(t);
   for (const auto& e : s_.world_model->drain()) {
     ++r.collisions;
     if (e.second.kind == environment::BodyKind::kRobot) ++r.robot_collisions;

@@ -63,6 +63,11 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   void set_central(bool central) { central_ = central; }
   std::optional<TimeUs> formation_time_us() const { return formation_.formation_time_us(); }
 
+  /// Tells the observer the run's world (field, bodies, camera), as each second's first
+  /// sample does. The run calls it before its first instant, so that a run the console
+  /// ends before any step still announces itself to a recording or a viewer.
+  void report_world(TimeUs t);
+
   /// The run's status now (`state`: "running" or "ended").
   StatusReport status(TimeUs t, const char* state) const;
 
@@ -125,6 +130,7 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   agents::FormationMonitor formation_;
   TimeUs t_us_ = 0;
   TimeUs next_report_us_ = 0;
+  TimeUs next_world_us_ = 0;  // the world is told once a second, with the second's first status
   TimeUs next_overlap_check_us_ = 0;
   std::vector<std::optional<TrajectorySample>> read_samples_;  // read_agents, when listed_: per agent
   std::uint64_t step_digest_ = 0;                              // read_agents: the sum of this step's sample digests

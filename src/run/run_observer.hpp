@@ -149,7 +149,7 @@ struct StatusReport {
 };
 
 /// Receives what a run reports. Every member has an empty default. A run reports each
-/// control step in this order: on_world (on a new second), on_poses, on_wheels,
+/// control step in this order: on_world (before the first instant and on a new second), on_poses, on_wheels,
 /// on_sensors, on_status (on a new second); events and camera frames as they happen.
 class RunObserver {
  public:
@@ -157,7 +157,8 @@ class RunObserver {
   /// Whether anything comes of the step reports (on_poses, on_wheels, on_sensors) now: a
   /// run builds them only when it does (10,000 robots' reports every step cost ~2 ms).
   virtual bool wants_steps() const { return true; }
-  /// At the start, then once per simulated second.
+  /// Before the run's first instant (even one the console ends at once), then once per
+  /// simulated second.
   virtual void on_world(TimeUs /*t_us*/, const WorldReport& /*world*/) {}
   /// After every control step: every robot with a known pose.
   virtual void on_poses(TimeUs /*t_us*/, std::span<const PoseReport> /*poses*/) {}

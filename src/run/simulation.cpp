@@ -318,6 +318,8 @@ void Run::loop() {
   std::atomic<bool> interrupted_paused{false};
   {
     const std::jthread watcher = interrupt_watcher(interrupted_paused);
+    // Before the console's first order can end the run (it may come before the first step).
+    monitor_->report_world(coordinator_->now_us());
     try {
       coordinator_->run_until(end_us_);
     } catch (const std::exception& e) {

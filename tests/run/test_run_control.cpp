@@ -4,6 +4,7 @@
 // a reset, and the refusals.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <filesystem>
@@ -172,6 +173,37 @@ TEST(RunControl, ResetEndsTheRunToStartItOver) {
   EXPECT_LT(r.simulated_s, 2.0);
   EXPECT_TRUE(script.has_event("reset by test: the run starts over"));
   EXPECT_EQ(script.statuses.back().ended_by, "reset");
+}
+
+// A recording or a viewer learns what the run is from its world: a run the console ends
+// before its first step (an exit that came while the run was being built, as after a
+// reset) still reports it first. Without that a replay took the previous run's folder.
+TEST(RunControl, ARunEndedBeforeItsFirstStepStillReportsItsWorldFirst) {
+  struct Order final : RunObserver {
+    std::vector<std::string> calls;
+    void on_world(TimeUs t, const WorldReport&) override { calls.push_back("world " + std::to_string(t)); }
+    void on_poses(TimeUs, std::span<const PoseReport>) override { calls.push_back("poses"); }
+    void on_event(const RunEvent& e) override { calls.push_back("event " + e.detail); }
+    void on_summary(TimeUs, const nlohmann::json&) override { calls.push_back("summary"); }
+  };
+  RunControl control;
+  Order order;
+  RunOptions o;
+  o.seed = 2;
+  o.duration_s = 5.0;
+  o.observer = &order;
+  o.control = &control;
+  const Scenario scenario = shipped("convoy_sim");
+  run::Run run(scenario, o);
+  EXPECT_EQ(control.act(action(ControlAction::Kind::kExit)), std::nullopt);
+  run.loop();
+  const RunResult r = run.end();
+  EXPECT_LT(r.simulated_s, 0.05);
+  ASSERT_FALSE(order.calls.empty());
+  EXPECT_EQ(order.calls.front(), "world 0");
+  EXPECT_EQ(order.calls.back(), "summary");
+  EXPECT_EQ(std::count(order.calls.begin(), order.calls.end(), "world 0"), 1);
+  EXPECT_NE(std::find(order.calls.begin(), order.calls.end(), "event ended by test"), order.calls.end());
 }
 
 }  // namespace
