@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -325,12 +326,20 @@ class Shader {
   Rgb shade(const Ray& ray, double t_s, int* surface = nullptr) const {
     int ignored = 0;
     int& met = surface ? *surface : ignored;
+    // The nearest cable. A cable lies on the floor beyond its own robot, so it may pass
+    // under another robot: there the robot hides it (as the truth's cable_covers has it).
+    std::optional<Rgb> cable;
+    double cable_m = std::numeric_limits<double>::infinity();
+    int cable_index = -1;
     for (std::size_t k = 0; k < s_.cables.size(); ++k) {
-      if (const auto c = cable_hit(s_.cables[k], ray)) {
-        met = kCable + static_cast<int>(k);
-        return *c;
+      double distance_m = 0;
+      if (const auto c = cable_hit(s_.cables[k], ray, &distance_m); c && distance_m < cable_m) {
+        cable = c;
+        cable_m = distance_m;
+        cable_index = static_cast<int>(k);
       }
     }
+    const auto cable_in_front = [&](const cv::Vec3d& p) { return cable && cable_m < cv::norm(p - ray.origin); };
     // The robots' tops, then their sides, then the floor.
     const cv::Vec3d floor_p = ray.at_height(0.0);
     double best_lambda = 2;
@@ -345,6 +354,7 @@ class Shader {
       const cv::Vec3d pose = r.at(t_s);
       const double dx = top_p[0] - pose[0], dy = top_p[1] - pose[1];
       if (dx * dx + dy * dy < r.body_radius_m * r.body_radius_m) {
+        if (cable_in_front(top_p)) break;
         const bool on_marker = dx * dx + dy * dy < r.marker_radius_m * r.marker_radius_m;
         met = (on_marker ? kMarker : kTop) + static_cast<int>(i);
         return top_of(r, pose, top_p);
@@ -362,6 +372,10 @@ class Shader {
         side_robot = static_cast<int>(i);
         side_p = top_p + (floor_p - top_p) * lambda;
       }
+    }
+    if (cable && (side_robot < 0 || cable_in_front(side_p))) {
+      met = kCable + cable_index;
+      return *cable;
     }
     if (side_robot >= 0) {
       met = kSide + side_robot;
@@ -398,9 +412,10 @@ class Shader {
     return across;
   }
 
-  std::optional<Rgb> cable_hit(const Cable& c, const Ray& ray) const {
+  // The cable's radiance where the ray meets it (`distance_m` gets how far), or nothing.
+  std::optional<Rgb> cable_hit(const Cable& c, const Ray& ray, double* distance_m) const {
     {
-      const auto across = cable_point(c, ray, nullptr);
+      const auto across = cable_point(c, ray, distance_m);
       if (!across) return std::nullopt;
       // A cylinder lit from above: brighter along its crest, a narrow highlight.
       const double crest = std::sqrt(1 - *across * *across);

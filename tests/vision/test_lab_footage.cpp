@@ -87,6 +87,37 @@ TEST(LabFootage, GeneratorIsDeterministicAndItsTruthLiesOnTheMarkers) {
   }
 }
 
+// A cable lies on the floor beyond its own robot and may run under another: that robot's
+// top hides it, as the truth (which counts only what lies between camera and marker) has
+// it. Drawn over the top instead, it crossed marker 2 of this scene, which the truth calls
+// whole, and turned its black ring white where it passed (grey 229 against the white
+// ring's 142).
+TEST(LabFootage, ACableOnTheFloorRunsUnderOtherRobots) {
+  LabFootageOptions options;
+  options.frames_per_scene = 4;
+  const StressScene scene = make_lab_scene(5238905471622739143ull, 11, options);
+  ASSERT_EQ(scene.frames.size(), 4u);
+  const cv::Mat& frame = scene.frames[1];
+  const auto it = std::find_if(scene.truth[1].begin(), scene.truth[1].end(),
+                               [](const StressTruth& t) { return t.id == 2; });
+  ASSERT_NE(it, scene.truth[1].end());
+  EXPECT_EQ(it->occluded, 0.0);
+  // Green levels on a circle of `fraction` of the marker's outer radius.
+  auto ring = [&](double fraction) {
+    std::vector<int> levels;
+    for (int k = 0; k < 48; ++k) {
+      const double angle = 2 * 3.141592653589793 * k / 48, r = fraction * 0.5 * it->diameter_px;
+      const int x = static_cast<int>(std::lround(it->u + r * std::cos(angle)));
+      const int y = static_cast<int>(std::lround(it->v + r * std::sin(angle)));
+      levels.push_back(frame.at<cv::Vec3b>(y, x)[1]);
+    }
+    std::sort(levels.begin(), levels.end());
+    return levels;
+  };
+  const std::vector<int> black = ring(0.67), white = ring(0.89);
+  EXPECT_LT(black.back(), white[white.size() / 2]) << "black ring's brightest " << black.back();
+}
+
 TEST(LabFootage, FullFrameAndTrackedFindEveryWholeMarkerWithoutMistakes) {
   for (const bool tracked : {false, true}) {
     SCOPED_TRACE(tracked ? "tracked" : "full-frame");
