@@ -98,8 +98,8 @@ TEST(LabFootage, ACableOnTheFloorRunsUnderOtherRobots) {
   const StressScene scene = make_lab_scene(5238905471622739143ull, 11, options);
   ASSERT_EQ(scene.frames.size(), 4u);
   const cv::Mat& frame = scene.frames[1];
-  const auto it = std::find_if(scene.truth[1].begin(), scene.truth[1].end(),
-                               [](const StressTruth& t) { return t.id == 2; });
+  const auto it =
+      std::find_if(scene.truth[1].begin(), scene.truth[1].end(), [](const StressTruth& t) { return t.id == 2; });
   ASSERT_NE(it, scene.truth[1].end());
   EXPECT_EQ(it->occluded, 0.0);
   // Green levels on a circle of `fraction` of the marker's outer radius.
