@@ -17,6 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 
 const fs::path kPython = fs::path(RILBED_SOURCE_DIR) / "examples" / "python";
+const fs::path kFaulty = fs::path(RILBED_SOURCE_DIR) / "tests" / "python" / "controllers" / "faulty.py";
 
 // What a shell command must set for /usr/bin/python3 to load rilbed's module when this
 // test runs under the sanitizers (`./run asan`): the interpreter is not instrumented, so
@@ -36,7 +37,6 @@ std::string sanitizer_preload() {
   if (asan.empty()) return "";
   return "LD_PRELOAD='" + asan + (ubsan.empty() ? "" : ":" + ubsan) + "' ASAN_OPTIONS=detect_leaks=0 ";
 }
-const fs::path kFaulty = fs::path(RILBED_SOURCE_DIR) / "tests" / "python" / "controllers" / "faulty.py";
 
 std::string quoted(const fs::path& p) {
   std::string q = "'";  // piece by piece: GCC 12's false -Wrestrict (PR 105329)

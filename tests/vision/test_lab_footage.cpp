@@ -11,6 +11,8 @@
 #include <cmath>
 #include <cstdio>
 #include <future>
+#include <numeric>
+#include <vector>
 
 #include "sanitized.hpp"
 #include "vision/lab_footage.hpp"
@@ -56,6 +58,21 @@ const Tallies& tallies() {
 
 bool whole(const StressOutcome& o) { return o.occluded == 0 && !o.touching; }
 
+// The green levels, sorted, read at 48 points of a circle of `fraction` of the marker's
+// outer radius around its truth's centre (each point clamped into the frame).
+std::vector<int> ring_levels(const cv::Mat& frame, const StressTruth& t, double fraction) {
+  constexpr int kReads = 48;
+  std::vector<int> levels;
+  for (int k = 0; k < kReads; ++k) {
+    const double angle = 2 * 3.141592653589793 * k / kReads, r = fraction * 0.5 * t.diameter_px;
+    const int x = std::clamp(static_cast<int>(std::lround(t.u + r * std::cos(angle))), 0, frame.cols - 1);
+    const int y = std::clamp(static_cast<int>(std::lround(t.v + r * std::sin(angle))), 0, frame.rows - 1);
+    levels.push_back(frame.at<cv::Vec3b>(y, x)[1]);
+  }
+  std::sort(levels.begin(), levels.end());
+  return levels;
+}
+
 TEST(LabFootage, GeneratorIsDeterministicAndItsTruthLiesOnTheMarkers) {
   LabFootageOptions options;
   options.frames_per_scene = 1;
@@ -63,19 +80,9 @@ TEST(LabFootage, GeneratorIsDeterministicAndItsTruthLiesOnTheMarkers) {
   ASSERT_EQ(a.frames.size(), 1u);
   EXPECT_EQ(cv::norm(a.frames[0], b.frames[0], cv::NORM_INF), 0.0);
   ASSERT_EQ(a.truth[0].size(), 8u);
-  // The mean green level on a circle of `fraction` of a marker's outer radius around its
-  // truth's centre.
   auto ring_level = [&](const StressTruth& t, double fraction) {
-    double sum = 0;
-    constexpr int kReads = 48;
-    for (int k = 0; k < kReads; ++k) {
-      const double angle = 2 * 3.141592653589793 * k / kReads, r = fraction * 0.5 * t.diameter_px;
-      const int x = static_cast<int>(std::lround(t.u + r * std::cos(angle)));
-      const int y = static_cast<int>(std::lround(t.v + r * std::sin(angle)));
-      sum +=
-          a.frames[0].at<cv::Vec3b>(std::clamp(y, 0, a.frames[0].rows - 1), std::clamp(x, 0, a.frames[0].cols - 1))[1];
-    }
-    return sum / kReads;
+    const std::vector<int> levels = ring_levels(a.frames[0], t, fraction);
+    return std::accumulate(levels.begin(), levels.end(), 0.0) / static_cast<double>(levels.size());
   };
   for (const StressTruth& t : a.truth[0]) {
     EXPECT_GT(t.diameter_px, 15.0);
@@ -102,19 +109,7 @@ TEST(LabFootage, ACableOnTheFloorRunsUnderOtherRobots) {
       std::find_if(scene.truth[1].begin(), scene.truth[1].end(), [](const StressTruth& t) { return t.id == 2; });
   ASSERT_NE(it, scene.truth[1].end());
   EXPECT_EQ(it->occluded, 0.0);
-  // Green levels on a circle of `fraction` of the marker's outer radius.
-  auto ring = [&](double fraction) {
-    std::vector<int> levels;
-    for (int k = 0; k < 48; ++k) {
-      const double angle = 2 * 3.141592653589793 * k / 48, r = fraction * 0.5 * it->diameter_px;
-      const int x = static_cast<int>(std::lround(it->u + r * std::cos(angle)));
-      const int y = static_cast<int>(std::lround(it->v + r * std::sin(angle)));
-      levels.push_back(frame.at<cv::Vec3b>(y, x)[1]);
-    }
-    std::sort(levels.begin(), levels.end());
-    return levels;
-  };
-  const std::vector<int> black = ring(0.67), white = ring(0.89);
+  const std::vector<int> black = ring_levels(frame, *it, 0.67), white = ring_levels(frame, *it, 0.89);
   EXPECT_LT(black.back(), white[white.size() / 2]) << "black ring's brightest " << black.back();
 }
 
