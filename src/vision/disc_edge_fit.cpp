@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <optional>
+#include <utility>
 
 #include <opencv2/core/hal/intrin.hpp>
 
@@ -361,6 +363,68 @@ std::optional<DiscEdgeFit> fit_centre_and_size(const Blob& predicted, double thr
   return fit;
 }
 
+// An ellipse (p - c)^T m (p - c) = 1 in the crossings' frame.
+struct Ellipse {
+  double x0, y0, m00, m01, m11;
+};
+
+// The ellipse closest (algebraically) to the first `count` crossings, or nothing when
+// they pin down no ellipse.
+std::optional<Ellipse> fit_ellipse(const double* px, const double* py, int count) {
+  // The normal equations need only the moments of the points up to the fourth order;
+  // summed in named accumulators (a loop over a small phi array made the compiler store
+  // and reload it through memory, which stalled on every point). Two points per step,
+  // one in each lane, then the odd one out: the same sums for both (PointMoments).
+  PointMoments<v_float64x2> pairs(cv::v_setzero_f64());
+  int first_single = 0;
+  for (; first_single + 1 < count; first_single += 2)
+    pairs.add(cv::v_load(px + first_single), cv::v_load(py + first_single));
+  PointMoments<double> m = pairs.map([](const v_float64x2& v) { return cv::v_reduce_sum(v); });
+  for (int i = first_single; i < count; ++i) m.add(px[i], py[i]);
+  const double sx = m.x, sy = m.y, sxx = m.xx, sxy = m.xy, syy = m.yy, sxxx = m.xxx, sxxy = m.xxy, sxyy = m.xyy,
+               syyy = m.yyy, sxxxx = m.xxxx, sxxxy = m.xxxy, sxxyy = m.xxyy, sxyyy = m.xyyy, syyyy = m.yyyy;
+  // Rows and columns in the order x², xy, y², x, y.
+  const double normal_values[25] = {sxxxx, sxxxy, sxxyy, sxxx, sxxy,  //
+                                    sxxxy, sxxyy, sxyyy, sxxy, sxyy,  //
+                                    sxxyy, sxyyy, syyyy, sxyy, syyy,  //
+                                    sxxx,  sxxy,  sxyy,  sxx,  sxy,   //
+                                    sxxy,  sxyy,  syyy,  sxy,  syy};
+  const double rhs_values[5] = {sxx, sxy, syy, sx, sy};
+  double conic[5];
+  if (!solve_spd5(normal_values, rhs_values, conic)) return std::nullopt;
+  // The conic A x² + B xy + C y² + D x + E y = 1 as (x - x0)^T m (x - x0) = 1.
+  const double m00 = conic[0], m01 = 0.5 * conic[1], m11 = conic[2];
+  const double det_m = m00 * m11 - m01 * m01;
+  if (!(m00 > 0.0 && det_m > 0.0)) return std::nullopt;  // not an ellipse
+  const double inv_det_m = 1.0 / det_m;
+  const double hx = -0.5 * conic[3], hy = -0.5 * conic[4];
+  const double x0 = (m11 * hx - m01 * hy) * inv_det_m, y0 = (m00 * hy - m01 * hx) * inv_det_m;
+  const double level = 1.0 + x0 * hx + y0 * hy;  // 1 + x0^T m x0, as m x0 = h
+  if (!(level > 0.0)) return std::nullopt;
+  const double inv_level = 1.0 / level;
+  return Ellipse{x0, y0, m00 * inv_level, m01 * inv_level, m11 * inv_level};
+}
+
+// A crossing's radial distance from the ellipse, as a fraction of its radius there.
+double radial_residual(double px, double py, const Ellipse& e) {
+  const double dx = px - e.x0, dy = py - e.y0;
+  return std::sqrt(std::max(0.0, e.m00 * dx * dx + 2.0 * e.m01 * dx * dy + e.m11 * dy * dy)) - 1.0;
+}
+
+// The index of the first `count` crossings' farthest inside the ellipse.
+int deepest_crossing(const double* px, const double* py, int count, const Ellipse& e) {
+  int worst = 0;
+  double worst_rho = 1.0;
+  for (int i = 0; i < count; ++i) {
+    const double rho = radial_residual(px[i], py[i], e);
+    if (rho < worst_rho) {
+      worst_rho = rho;
+      worst = i;
+    }
+  }
+  return worst;
+}
+
 // One fit from `predicted`. When too few crossings are found but enough to say where
 // the disc lies, `shift_px` (if given) receives the prediction's error, estimated from
 // those found.
@@ -484,50 +548,37 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
                                py, found, black, white, levels);
   }
 
-  // The normal equations need only the moments of the points up to the fourth order;
-  // summed in named accumulators (a loop over a small phi array made the compiler store
-  // and reload it through memory, which stalled on every point). Two points per step,
-  // one in each lane, then the odd one out: the same sums for both (PointMoments).
-  PointMoments<v_float64x2> pairs(cv::v_setzero_f64());
-  int first_single = 0;
-  for (; first_single + 1 < found; first_single += 2)
-    pairs.add(cv::v_load(px + first_single), cv::v_load(py + first_single));
-  PointMoments<double> m = pairs.map([](const v_float64x2& v) { return cv::v_reduce_sum(v); });
-  for (int i = first_single; i < found; ++i) m.add(px[i], py[i]);
-  const double sx = m.x, sy = m.y, sxx = m.xx, sxy = m.xy, syy = m.yy, sxxx = m.xxx, sxxy = m.xxy, sxyy = m.xyy,
-               syyy = m.yyy, sxxxx = m.xxxx, sxxxy = m.xxxy, sxxyy = m.xxyy, sxyyy = m.xyyy, syyyy = m.yyyy;
-  // Rows and columns in the order x², xy, y², x, y.
-  const double normal_values[25] = {sxxxx, sxxxy, sxxyy, sxxx, sxxy,  //
-                                    sxxxy, sxxyy, sxyyy, sxxy, sxyy,  //
-                                    sxxyy, sxyyy, syyyy, sxyy, syyy,  //
-                                    sxxx,  sxxy,  sxyy,  sxx,  sxy,   //
-                                    sxxy,  sxyy,  syyy,  sxy,  syy};
-  const double rhs_values[5] = {sxx, sxy, syy, sx, sy};
-  double conic[5];
-  if (!solve_spd5(normal_values, rhs_values, conic)) return std::nullopt;
-  // The conic A x² + B xy + C y² + D x + E y = 1 as (x - x0)^T m (x - x0) = 1.
-  double m00 = conic[0], m01 = 0.5 * conic[1], m11 = conic[2];
+  // The general ellipse through the crossings; then, while the crossing farthest from it
+  // lies beyond outlier_residual and fewer than max_outliers have gone, that crossing is
+  // dropped and the ellipse fitted again to the rest (something lying across the rim).
+  std::optional<Ellipse> e = fit_ellipse(px, py, found);
+  if (!e) return std::nullopt;
+  int kept = found, outliers = 0;
+  double residual2 = residual_rms2(px, py, kept, e->x0, e->y0, e->m00, e->m01, e->m11);
+  // (No crossing lies beyond outlier_residual while the squares' sum stays below its square.)
+  while (outliers < config.max_outliers && residual2 * kept > config.outlier_residual * config.outlier_residual) {
+    const int worst = deepest_crossing(px, py, kept, *e);
+    if (radial_residual(px[worst], py[worst], *e) >= -config.outlier_residual) break;
+    --kept;
+    std::swap(px[worst], px[kept]);
+    std::swap(py[worst], py[kept]);
+    ++outliers;
+    auto refit = fit_ellipse(px, py, kept);
+    if (!refit) return std::nullopt;
+    e = refit;
+    residual2 = residual_rms2(px, py, kept, e->x0, e->y0, e->m00, e->m01, e->m11);
+  }
+  const double x0 = e->x0, y0 = e->y0, m00 = e->m00, m01 = e->m01, m11 = e->m11;
   const double det_m = m00 * m11 - m01 * m01;
-  if (!(m00 > 0.0 && det_m > 0.0)) return std::nullopt;  // not an ellipse
-  const double inv_det_m = 1.0 / det_m;
-  const double hx = -0.5 * conic[3], hy = -0.5 * conic[4];
-  const double x0 = (m11 * hx - m01 * hy) * inv_det_m, y0 = (m00 * hy - m01 * hx) * inv_det_m;
-  const double level = 1.0 + x0 * hx + y0 * hy;  // 1 + x0^T m x0, as m x0 = h
-  if (!(level > 0.0)) return std::nullopt;
-  const double inv_level = 1.0 / level;
-  m00 *= inv_level;
-  m01 *= inv_level;
-  m11 *= inv_level;
 
   // RMS of each crossing's distance from the ellipse, radially, as a fraction of the
   // ellipse's radius there (the same in every linearly related frame).
-  const double residual2 = residual_rms2(px, py, found, x0, y0, m00, m01, m11);
   if (residual2 > config.max_residual * config.max_residual) [[unlikely]]
     return std::nullopt;  // as above
 
   // Back to pixels: the outline is centre + radius (x0 + m^-1/2 u), so the shape's
   // square is radius² m^-1.
-  const double cov_scale = radius_px * radius_px / (det_m * inv_level * inv_level);
+  const double cov_scale = radius_px * radius_px / det_m;
   const cv::Matx22d cov(m11 * cov_scale, -m01 * cov_scale, -m01 * cov_scale, m00 * cov_scale);
   const double det_c = cov(0, 0) * cov(1, 1) - cov(0, 1) * cov(1, 0);
   if (!(det_c > 0.0)) return std::nullopt;
@@ -545,6 +596,7 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
   fit.blob.threshold = threshold_grey;
   fit.blob.filled_area_px = area;
   fit.residual = std::sqrt(residual2);
+  fit.outliers = outliers;
   set_levels(fit, black, white, levels);
   return fit;
 }

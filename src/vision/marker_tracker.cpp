@@ -172,6 +172,7 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
   if (matches_.size() < blobs.size()) matches_.resize(blobs.size());
   thresholds_.clear();
   passed_.assign(blobs.size(), false);
+  named_discs_.assign(blobs.begin(), blobs.end());
   stats_.blobs += static_cast<int>(blobs.size());
   for (std::size_t b = 0; b < blobs.size(); ++b) {
     const Blob& blob = blobs[b];
@@ -214,6 +215,10 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
       log_verdict(blob, CandidateFate::kOccluded, &matches[own], runner_up);
       continue;  // not unread: it was read, and what lies across it is no robot's top
     }
+    if (auto reread = reread_covered_rim(grey, blob, matches[own], thresholds_.back())) {
+      named_discs_[b] = reread->first;
+      matches[own] = reread->second;
+    }
     passed_[b] = true;
     double* row = &similarity_[b * columns];
     for (std::size_t c = 0; c < columns; ++c) {
@@ -241,7 +246,7 @@ std::vector<MarkerDetection> MarkerTracker::assign(const cv::Mat& grey, const st
       log_verdict(blobs[r], chosen[r] >= 0 ? CandidateFate::kNamed : CandidateFate::kNotChosen, &*own);
     }
     if (chosen[r] < 0) continue;
-    out.push_back(make_detection(blobs[r], matches_[r][decoder_index_[chosen[r]]], false, thresholds_[r]));
+    out.push_back(make_detection(named_discs_[r], matches_[r][decoder_index_[chosen[r]]], false, thresholds_[r]));
   }
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
   return out;
@@ -393,7 +398,24 @@ std::optional<MarkerDetection> MarkerTracker::confirm(const cv::Mat& grey, const
   if (m.score < config_.min_assign_score || m.score < track.score - config_.confirm_drop) return std::nullopt;
   if (!decoder_.levels_agree(grey, blob, signal_, m)) return std::nullopt;
   if (!templates_.matches(grey, blob, m.id, m.key_angle_rad)) return std::nullopt;
-  return make_detection(blob, m, true, 0.5 * (signal_.black_level + signal_.white_level));
+  const double threshold = 0.5 * (signal_.black_level + signal_.white_level);
+  if (auto reread = reread_covered_rim(grey, blob, m, threshold))
+    return make_detection(reread->first, reread->second, true, threshold);
+  return make_detection(blob, m, true, threshold);
+}
+
+std::optional<std::pair<Blob, CodeMatch>> MarkerTracker::reread_covered_rim(const cv::Mat& grey, const Blob& blob,
+                                                                            const CodeMatch& match,
+                                                                            double threshold_grey) {
+  if (config_.rim_refit.max_outliers <= 0) return std::nullopt;
+  const auto fit = fit_disc_edges(grey, blob, threshold_grey, config_.rim_refit);
+  if (!fit || fit->outliers == 0) return std::nullopt;
+  if (std::hypot(fit->blob.u - blob.u, fit->blob.v - blob.v) < config_.rim_refit_min_shift_px) return std::nullopt;
+  decoder_.sample(grey, fit->blob, reread_signal_);
+  if (!reread_signal_.usable) return std::nullopt;
+  const CodeMatch m = decoder_.match_one(reread_signal_, fit->blob, match.id, match.heading_deg);
+  if (m.score < config_.min_assign_score) return std::nullopt;
+  return std::pair{fit->blob, m};
 }
 
 Blob MarkerTracker::Track::predicted_disc() const {

@@ -3,6 +3,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
+#include <vector>
 
 #include "vision/blob_detector.hpp"
 #include "vision/disc_edge_fit.hpp"
@@ -177,4 +178,49 @@ TEST(DiscEdgeFit, KeepingTheShapeFitsCentreAndSize) {
   const auto whole = fit_disc_edges(img, disc_at(c, 12.2), 115.0);
   ASSERT_TRUE(whole.has_value());
   EXPECT_LT(whole->residual, 0.02);
+}
+
+// A light band (a cable) lying diagonally over the lower left of the black ring's edge
+// moves the crossings under it inwards: an ellipse through all of them is refused or its
+// centre is pulled more than 0.3 px away from the band. Dropping the crossings that lie
+// deep inside the ellipse (max_outliers) fits the rest and finds the centre within
+// 0.2 px; a clean disc drops none and fits as before. (A band straight along a row or
+// column of crossings would cut off a cap that an ellipse squeezed to that side fits as
+// well as the disc: no crossing then lies far from it, and none is dropped.)
+TEST(DiscEdgeFit, DropsTheCrossingsALightBandCovers) {
+  DiscEdgeFitConfig all;
+  all.lines = 8;
+  DiscEdgeFitConfig trimmed = all;
+  trimmed.max_outliers = 8;
+  const double radius = 0.78 * 16.0;
+  for (double offset : {0.0, 0.375}) {
+    cv::Point2d truth;
+    cv::Mat img = marker_image(offset, 70.0, truth);
+    const auto clean_all = fit_disc_edges(img, disc_at(truth + cv::Point2d(0.5, 0), radius), 110.0, all);
+    const auto clean_trimmed = fit_disc_edges(img, disc_at(truth + cv::Point2d(0.5, 0), radius), 110.0, trimmed);
+    ASSERT_TRUE(clean_all && clean_trimmed);
+    EXPECT_EQ(clean_trimmed->outliers, 0);
+    EXPECT_EQ(clean_trimmed->blob.u, clean_all->blob.u);
+    EXPECT_EQ(clean_trimmed->blob.v, clean_all->blob.v);
+
+    // The band: 5 px wide, at 45 degrees, its inner edge 3 px inside the disc's
+    // outline towards the lower left, across the white ring and the floor beyond.
+    const cv::Point2d normal(-std::sqrt(0.5), std::sqrt(0.5)), along(std::sqrt(0.5), std::sqrt(0.5));
+    auto at = [&](double out, double length) { return truth + normal * out + along * length; };
+    std::vector<cv::Point> band;
+    for (const cv::Point2d& p :
+         {at(radius - 3.0, -60), at(radius - 3.0, 60), at(radius + 2.0, 60), at(radius + 2.0, -60)})
+      band.emplace_back(static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)));
+    cv::fillConvexPoly(img, band, cv::Scalar(235), cv::LINE_AA);
+    // Predicted where a fill of what is left would put it: away from the band.
+    const Blob bitten = disc_at(truth - normal * 0.8, radius - 0.8);
+    const auto through_all = fit_disc_edges(img, bitten, 110.0, all);
+    if (through_all) EXPECT_GT(std::hypot(through_all->blob.u - truth.x, through_all->blob.v - truth.y), 0.3);
+    const auto fit = fit_disc_edges(img, bitten, 110.0, trimmed);
+    ASSERT_TRUE(fit.has_value()) << "offset " << offset;
+    EXPECT_GT(fit->outliers, 0);
+    EXPECT_NEAR(fit->blob.u, truth.x, 0.2) << "offset " << offset;
+    EXPECT_NEAR(fit->blob.v, truth.y, 0.2) << "offset " << offset;
+    EXPECT_NEAR(std::sqrt(cv::determinant(fit->blob.shape)), radius, 0.4);
+  }
 }
