@@ -194,7 +194,7 @@ std::vector<TrackConfig> loop_layout(Draw& draw, const FieldBox& box, double wid
 std::vector<TrackConfig> make_track_layout(std::uint64_t seed, TrackLayoutKind kind,
                                            const TrackLayoutOptions& options) {
   const FieldBox box{options.margin_m, options.margin_m, options.field_width_m - options.margin_m,
-                options.field_height_m - options.margin_m};
+                     options.field_height_m - options.margin_m};
   if (!(box.x1 - box.x0 >= 0.6 && box.y1 - box.y0 >= 0.6))
     throw std::invalid_argument("track layout: the field less its margins must be at least 0.6 m each way");
   Draw draw(mix64(seed ^ (static_cast<std::uint64_t>(kind) + 1) * 0x9e3779b97f4a7c15ULL));
