@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "environment/random.hpp"
+#include "environment/shapes.hpp"
 
 namespace rilbed::environment {
 
@@ -42,27 +43,11 @@ TrackConfig segment(Vec2 a, Vec2 b, double width_m) {
   return t;
 }
 
-// Distance from p to segment ab.
-double point_segment_distance(Vec2 p, Vec2 a, Vec2 b) {
-  const Vec2 d = b - a;
-  const double len2 = d.dot(d);
-  const double t = len2 > 0.0 ? std::clamp((p - a).dot(d) / len2, 0.0, 1.0) : 0.0;
-  return (a + d * t - p).norm();
-}
-
-bool segments_cross(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
-  const Vec2 r = b - a, s = d - c;
-  const double denom = r.cross(s);
-  if (std::abs(denom) < 1e-15) return false;
-  const double t = (c - a).cross(s) / denom, u = (c - a).cross(r) / denom;
-  return t > 0.0 && t < 1.0 && u > 0.0 && u < 1.0;
-}
-
 // Whether segments ab and cd cross or come closer than `clearance`.
 bool too_close(Vec2 a, Vec2 b, Vec2 c, Vec2 d, double clearance) {
-  if (segments_cross(a, b, c, d)) return true;
-  return std::min({point_segment_distance(a, c, d), point_segment_distance(b, c, d), point_segment_distance(c, a, b),
-                   point_segment_distance(d, a, b)}) < clearance;
+  if (segment_blocks_sight(a, b, c, d)) return true;
+  return std::min({distance_sq_to_segment(a, c, d), distance_sq_to_segment(b, c, d), distance_sq_to_segment(c, a, b),
+                   distance_sq_to_segment(d, a, b)}) < clearance * clearance;
 }
 
 struct FieldBox {

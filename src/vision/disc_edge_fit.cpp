@@ -548,9 +548,9 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
                                py, found, black, white, levels);
   }
 
-  // The general ellipse through the crossings; then, while the crossing farthest from it
-  // lies beyond outlier_residual and fewer than max_outliers have gone, that crossing is
-  // dropped and the ellipse fitted again to the rest (something lying across the rim).
+  // The general ellipse through the crossings; then, while the crossing deepest inside it
+  // lies deeper than outlier_residual and fewer than max_outliers have gone, that crossing
+  // is dropped and the ellipse fitted again to the rest (something lying across the rim).
   std::optional<Ellipse> e = fit_ellipse(px, py, found);
   if (!e) return std::nullopt;
   int kept = found, outliers = 0;
@@ -571,8 +571,9 @@ std::optional<DiscEdgeFit> fit_from(const cv::Mat& grey, const Blob& predicted, 
   const double x0 = e->x0, y0 = e->y0, m00 = e->m00, m01 = e->m01, m11 = e->m11;
   const double det_m = m00 * m11 - m01 * m01;
 
-  // RMS of each crossing's distance from the ellipse, radially, as a fraction of the
-  // ellipse's radius there (the same in every linearly related frame).
+  // residual2: the mean square of each kept crossing's distance from the ellipse,
+  // radially, as a fraction of the ellipse's radius there (the same in every linearly
+  // related frame).
   if (residual2 > config.max_residual * config.max_residual) [[unlikely]]
     return std::nullopt;  // as above
 
