@@ -97,6 +97,13 @@ fi
 echo
 "$BUILD_DIR/rilbed" loop-bench --real 8 --virtual 100 --frames 300
 
+# track_explore on random tape networks (layouts drawn after its last change), five and
+# three track elements, then under wheel slip the odometer does not count.
+echo
+"$BUILD_DIR/bench_track_explore" --kinds grid,tree,loop --layouts 101-103 --starts 20 --start-seed 7
+"$BUILD_DIR/bench_track_explore" --kinds grid,tree,loop --layouts 101-103 --starts 20 --start-seed 7 --elements 3 --spacing-mm 15
+"$BUILD_DIR/bench_track_explore" --kinds grid,tree,loop --layouts 101-103 --starts 20 --start-seed 7 --slip 0.02
+
 # The web panel: viewers of a 100-robot run (frames and bytes each gets, their effect on the
 # run's loop latency), then the page's drawing rate in headless Chromium.
 echo

@@ -31,7 +31,7 @@ def run(scenario, seed=1, duration_s=None, out=None, overrides=None, **options):
     out: a run folder to write (as ``rilbed run --out`` writes it); None: none.
     overrides: ``{"convoy.standoff_m": 0.1, "robots.0.params.speed_mps": 0.1, ...}``,
         changes to the scenario by path before it is read.
-    options: ``fast`` (default True), ``realtime``, ``rt_factor``, ``stop_when_formed``,
+    options: ``fast`` (default True), ``realtime``, ``rt_factor``, ``stop_when_formed``, ``stop_when_done``,
         ``threads``, ``mode`` ('central' or 'distributed'), ``on_controller_error``
         ('end-run' or 'stop-robot'), ``all_virtual``, ``lcm_url``, ``record``.
 

@@ -6,6 +6,7 @@
 #include "agents/basic_controllers.hpp"
 #include "agents/convoy.hpp"
 #include "agents/library_controllers.hpp"
+#include "agents/track_explore.hpp"
 
 namespace rilbed::agents {
 
@@ -63,6 +64,47 @@ ControllerEntry track_follow_entry() {
     if (!c.sensors.track_sensors.empty()) config.max_value = c.sensors.track_sensors.front().max_value;
     if (c.params.given("max_value")) config.max_value = static_cast<int>(c.params.get("max_value"));
     return std::make_unique<TrackFollowController>(config);
+  };
+  return e;
+}
+
+ControllerEntry track_explore_entry() {
+  ControllerEntry e;
+  e.name = "track_explore";
+  e.summary =
+      "finds a floor tape from anywhere and visits every edge of the tape network with its track sensors and wheel "
+      "counters only (paper 000 section 9), turning once on the spot at each node to tell its kind; records each "
+      "node (track_node) and edge (track_edge) and is done when no way is left untaken; the run folder gets "
+      "track_map.json";
+  const TrackExploreConfig d;
+  e.params = {speed(d.speed_mps, "speed along the tape"),
+              {"tape_width_m", "m", d.reading.tape_width_m, false, 0.003, 0.1, false,
+               "the tape's width: decides which track sensors can see a side arm"},
+              {"scan_turn_radps", "rad/s", d.scan_turn_radps, false, 0.2, 6.0, false,
+               "turn rate of the look round at a node (slower resolves ways better)"},
+              {"match_radius_m", "m", d.match_radius_m, false, 0.01, 0.5, false,
+               "a node found within this of a known one is that node"},
+              {"time_limit_s", "s", 0.0, false, 0.0, 1e6, false, "done after this long, with what it has; 0: never"},
+              {"correct_odometry", "", 0.0, false, 0.0, 1.0, true,
+               "1: correct the odometry from the map it builds (experimental: not yet better under wheel slip); "
+               "0: the map is dead reckoning alone"},
+              {"max_value", "", std::nullopt, false, 1.0, 1e6, true,
+               "the track sensors' full scale; default: the robot's first track sensor's max_value"}};
+  e.sensors = {"track", "odometer", "proximity", "pose"};
+  e.required_sensors = {"track", "odometer"};
+  e.make = [](const ControllerContext& c) {
+    TrackExploreConfig config;
+    config.speed_mps = c.params.get("speed_mps");
+    config.reading.tape_width_m = c.params.get("tape_width_m");
+    config.scan_turn_radps = c.params.get("scan_turn_radps");
+    config.match_radius_m = c.params.get("match_radius_m");
+    config.time_limit_s = c.params.get("time_limit_s");
+    config.correct_odometry = c.params.get("correct_odometry") != 0.0;
+    if (!c.sensors.track_sensors.empty()) config.reading.max_value = c.sensors.track_sensors.front().max_value;
+    if (c.params.given("max_value")) config.reading.max_value = static_cast<int>(c.params.get("max_value"));
+    if (c.sensors.track_sensors.size() < 3)
+      throw std::invalid_argument("track_explore needs at least three track sensors across the robot's front");
+    return std::make_unique<TrackExploreController>(TrackArray::of(c.sensors.track_sensors), config);
   };
   return e;
 }
@@ -156,6 +198,7 @@ ControllerRegistry builtin_controllers() {
   r.add(convoy_entry());
   r.add(wander_entry());
   r.add(track_follow_entry());
+  r.add(track_explore_entry());
   r.add(beacon_homing_entry());
   r.add(goto_entry());
   r.add(braitenberg_entry());

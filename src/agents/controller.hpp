@@ -9,6 +9,7 @@
 #include <optional>
 #include <span>
 #include <stdexcept>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -74,6 +75,15 @@ struct ControlOutput {
   std::string_view behaviour = "idle";
 };
 
+/// Something a controller reports as it learns (a node of the track network it explores):
+/// it becomes an event of the run (events.csv, the bus, the panel, a replay), with the
+/// robot's ID, at the control instant after the step that made it.
+struct ControllerEvent {
+  std::string kind;    ///< what happened, lower case with underscores ("track_node")
+  int other = 0;       ///< a number the kind gives meaning to (a node's ID)
+  std::string detail;  ///< the rest, free text (JSON for the track events)
+};
+
 /// A controller failed at a step: its own code raised an error, or it answered what rilbed
 /// cannot use. The message names the controller, where it comes from and the robot, and
 /// holds the cause (a Python traceback, for one). The run then stops the robot (or every
@@ -100,6 +110,12 @@ class Controller {
   /// Whether it has reached its goal (a controller with a goal, e.g. going to a pose);
   /// a run with RunOptions::stop_when_done ends once every controller is done.
   virtual bool done() const { return false; }
+  /// Whether it reports events (take_events); asked once, so that a swarm's run does not
+  /// ask 100,000 controllers every step.
+  virtual bool reports_events() const { return false; }
+  /// Moves the events made since the last call to the end of `out`. Called on the run's
+  /// thread after each step of a controller that reports_events().
+  virtual void take_events(std::vector<ControllerEvent>& out) { (void)out; }
   /// Whether its step may run at the same time as other robots' controllers' steps (a
   /// run on `--threads N`): it shares no mutable state with them. Asked once. Default
   /// true; a controller that keeps state shared between robots must say false.

@@ -77,6 +77,8 @@ void add_run_command(CLI::App& app) {
                   "Simulated seconds to run (default: the scenario's duration_s)")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--stop-when-formed", args->session.stop_when_formed, "End 5 s after the convoy formed");
+  cmd->add_flag("--stop-when-done", args->session.stop_when_done,
+                "End once every robot's controller is done (track_explore: every edge seen; go_to: at its pose)");
   cmd->add_option("--seed", args->session.seed, "Seed of the initial poses and the noise (first seed of a batch)")
       ->default_val(1);
   cmd->add_option("--seeds", args->session.seeds, "Run a batch of N seeds (seed, seed+1, ...) and print its table")

@@ -28,6 +28,8 @@ void read_session_options(const nlohmann::json& o, session::SessionOptions& s) {
       s.rt_factor = value.get<double>();
     } else if (key == "stop_when_formed") {
       s.stop_when_formed = value.get<bool>();
+    } else if (key == "stop_when_done") {
+      s.stop_when_done = value.get<bool>();
     } else if (key == "threads") {
       s.threads = value.get<int>();
     } else if (key == "quiet") {
@@ -50,9 +52,10 @@ void read_session_options(const nlohmann::json& o, session::SessionOptions& s) {
       s.on_controller_error =
           action == "stop-robot" ? run::ControllerErrorAction::kStopRobot : run::ControllerErrorAction::kEndRun;
     } else {
-      throw py::type_error("run() got an unexpected option '" + key +
-                           "' (it takes fast, realtime, rt_factor, stop_when_formed, threads, quiet, all_virtual, "
-                           "lcm_url, record, mode, on_controller_error)");
+      throw py::type_error(
+          "run() got an unexpected option '" + key +
+          "' (it takes fast, realtime, rt_factor, stop_when_formed, stop_when_done, threads, quiet, all_virtual, "
+          "lcm_url, record, mode, on_controller_error)");
     }
   }
 }

@@ -34,6 +34,8 @@ MonitorModel::MonitorModel(Setup setup)
   listed_ = s_.recorder || s_.options->keep_in_memory || !s_.convoy_ids.empty();
   all_concurrent_ =
       std::all_of(s_.agents.begin(), s_.agents.end(), [](const AgentModel* a) { return a->transitions_concurrent(); });
+  for (AgentModel* a : s_.agents)
+    if (a->reports_events()) reporting_.push_back(a);
   world_bodies_ = std::all_of(s_.agents.begin(), s_.agents.end(), [](const AgentModel* a) {
     return dynamic_cast<const VirtualBody*>(&a->body()) != nullptr;
   });
@@ -141,6 +143,12 @@ void MonitorModel::sample(TimeUs t) {
   }
   read_agents(t);
   r.trajectory_digest += step_digest_;
+  for (AgentModel* a : reporting_) {
+    controller_events_.clear();
+    a->take_events(controller_events_);
+    for (agents::ControllerEvent& e : controller_events_)
+      record({t, std::move(e.kind), a->body().id(), e.other, std::move(e.detail)});
+  }
   // Changes of health and behaviour, in agent order.
   for (const AgentChange& change : changed_) {
     if (change.health != change.old_health) {

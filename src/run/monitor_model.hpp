@@ -80,6 +80,7 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   // An event for the run folder and for the run's observer.
   void record(const RunEvent& event) {
     if (s_.recorder) s_.recorder->add_event(event);
+    if (s_.options->keep_in_memory) s_.result->events.push_back(event);
     if (s_.options->observer) s_.options->observer->on_event(event);
   }
 
@@ -94,6 +95,9 @@ class MonitorModel final : public sim::AtomicModel<TimeUs> {  // state: time to 
   void close_second();
 
   void sample(TimeUs t);
+
+  std::vector<AgentModel*> reporting_;  // agents whose controllers report events
+  std::vector<agents::ControllerEvent> controller_events_;
 
   // An agent whose health or behaviour changed, as read_agents read it (static strings),
   // and what they were before.

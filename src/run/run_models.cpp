@@ -21,6 +21,7 @@ AgentModel::AgentModel(agents::Body& body, std::unique_ptr<agents::Controller> c
     throw std::invalid_argument("agent " + std::to_string(body.id()) + ": control period must be > 0");
   state_.commanded = commanded;
   state_.sigma_us = controller_ && !commanded ? first_step_us : sim::kInfinity;
+  reports_events_ = controller_ && !remote_ && controller_->reports_events();
 }
 
 TimeUs AgentModel::time_advance() const { return state_.sigma_us; }

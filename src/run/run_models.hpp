@@ -105,6 +105,13 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   bool done() const {
     return !controller_ || state_.commanded || failed_ || (remote_ ? remote_done_ : controller_->done());
   }
+  /// Whether its controller reports events (agents::Controller::reports_events; asked
+  /// once, at construction).
+  bool reports_events() const { return reports_events_; }
+  /// Moves its controller's events since the last call to the end of `out`.
+  void take_events(std::vector<agents::ControllerEvent>& out) {
+    if (reports_events_) controller_->take_events(out);
+  }
   /// Whether its controller runs elsewhere (see the constructor).
   bool is_remote() const { return remote_ != nullptr; }
   /// A remote controller's answer: drives the body with it, as step() would have (ignored
@@ -172,7 +179,8 @@ class AgentModel final : public sim::AtomicModel<AgentState> {
   bool profiled_ = false;
   bool remote_done_ = false;  // the remote controller's done() at its last answer
   bool keep_sensors_ = true;
-  bool failed_ = false;  // its controller failed; the robot stands (ControllerWatch)
+  bool failed_ = false;          // its controller failed; the robot stands (ControllerWatch)
+  bool reports_events_ = false;  // its controller's reports_events(), asked once
   int overruns_ = 0;
   const ControllerWatch* watch_ = nullptr;
   sim::Port<TeamBroadcast>& team_in_;

@@ -106,6 +106,7 @@ struct RunResult {
   std::string ended_by;                      ///< "duration", "formed", "done" or "interrupt"
   std::vector<int> not_done;                 ///< with stop_when_done: the robots whose agent was not done at the end
   std::vector<TrajectorySample> trajectory;  ///< with keep_in_memory only
+  std::vector<RunEvent> events;  ///< the monitor's events (not the console's notes), with keep_in_memory only
   /// A real-time run with an observer: how far behind the wall clock each control step
   /// finished, its reports handed to the observer, ms (what a viewer's cost adds to).
   std::vector<float> loop_latency_ms;

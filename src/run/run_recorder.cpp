@@ -93,6 +93,52 @@ void RunRecorder::add_event(const RunEvent& e) {
   events_ << format("%.3f", us_to_seconds(e.t_us)) << ',' << csv_field(e.kind) << ',' << e.id << ',' << e.other << ','
           << csv_field(e.detail) << '\n';
   events_.flush();
+  if (e.kind == "track_node" || e.kind == "track_edge") keep_track_event(e);
+}
+
+void RunRecorder::keep_track_event(const RunEvent& e) {
+  // Each robot's map, from its own events; the detail is JSON (an explorer's, or any
+  // program's on the bus: what does not parse is left out of the map, not thrown).
+  const nlohmann::json detail = nlohmann::json::parse(e.detail, nullptr, false);
+  if (!detail.is_object()) return;
+  TrackMap& map = track_maps_[e.id];
+  if (e.kind == "track_node") {
+    const auto kind = detail.find("kind");
+    const auto x = detail.find("x_m");
+    const auto y = detail.find("y_m");
+    if (kind == detail.end() || !kind->is_string() || x == detail.end() || !x->is_number() || y == detail.end() ||
+        !y->is_number())
+      return;
+    map.nodes[e.other] = {{"id", e.other}, {"kind", *kind}, {"x_m", *x}, {"y_m", *y}};
+  } else {
+    const auto from = detail.find("from");
+    const auto to = detail.find("to");
+    const auto length = detail.find("length_m");
+    if (from == detail.end() || !from->is_number_integer() || to == detail.end() || !to->is_number_integer() ||
+        length == detail.end() || !length->is_number())
+      return;
+    map.edges[e.other] = {{"from", *from}, {"to", *to}, {"length_m", *length}};
+  }
+}
+
+void RunRecorder::write_track_map() const {
+  if (track_maps_.empty()) return;
+  // One robot's map: the one that learned the most edges (then nodes; then the lowest ID).
+  const TrackMap* best = nullptr;
+  int best_id = 0;
+  for (const auto& [id, map] : track_maps_) {
+    if (!best || map.edges.size() > best->edges.size() ||
+        (map.edges.size() == best->edges.size() && map.nodes.size() > best->nodes.size())) {
+      best = &map;
+      best_id = id;
+    }
+  }
+  nlohmann::json out = {{"robot", best_id}, {"nodes", nlohmann::json::array()}, {"edges", nlohmann::json::array()}};
+  for (const auto& [id, node] : best->nodes) out["nodes"].push_back(node);
+  for (const auto& [id, edge] : best->edges) out["edges"].push_back(edge);
+  std::ofstream file(dir_ / "track_map.json");
+  file << out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
+  if (!file) throw std::runtime_error("cannot write " + (dir_ / "track_map.json").string());
 }
 
 void RunRecorder::finish(const nlohmann::json& summary) {
@@ -107,6 +153,7 @@ void RunRecorder::finish(const nlohmann::json& summary) {
   // Names from a scenario file may not be UTF-8: replaced, not thrown at the run's end.
   json << summary.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
   if (!json) throw std::runtime_error("cannot write " + (dir_ / "summary.json").string());
+  write_track_map();
   write_svg();
 }
 

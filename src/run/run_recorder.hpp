@@ -67,9 +67,12 @@ class RunRecorder {
   /// Appends rows to trajectories.csv (header t_s,id,x_m,y_m,theta_deg,behaviour;
   /// theta in degrees CCW from +x, [0, 360)) and keeps every 5th sample per robot for the picture.
   void add_samples(const std::vector<TrajectorySample>& samples);
-  /// Appends a row to events.csv (header t_s,kind,id,other,detail).
+  /// Appends a row to events.csv (header t_s,kind,id,other,detail). The track explorers'
+  /// `track_node` and `track_edge` events are also kept for track_map.json.
   void add_event(const RunEvent& event);
-  /// Writes summary.json (the given object, pretty-printed) and trajectories.svg; flushes
+  /// Writes summary.json (the given object, pretty-printed), track_map.json when a robot
+  /// reported track nodes or edges (that robot's map; the one with the most edges when
+  /// several did) and trajectories.svg; flushes
   /// and closes the CSV files. Call once at the end.
   void finish(const nlohmann::json& summary);
   const std::filesystem::path& dir() const { return dir_; }
@@ -79,6 +82,14 @@ class RunRecorder {
 
  private:
   void write_svg() const;
+  // A robot's map of the track network, from its track_node and track_edge events (the
+  // latest of each ID).
+  struct TrackMap {
+    std::map<int, nlohmann::json> nodes, edges;
+  };
+  void keep_track_event(const RunEvent& e);
+  void write_track_map() const;
+  std::map<int, TrackMap> track_maps_;  // by robot
   std::filesystem::path dir_;
   FieldDrawing field_;
   std::ofstream trajectories_, events_;

@@ -18,6 +18,7 @@
 #include "core/id_list.hpp"
 #include "environment/body_shape.hpp"
 #include "environment/shapes.hpp"
+#include "environment/track_layouts.hpp"
 #include "python/python_controllers.hpp"
 #include "run/robot_description.hpp"
 #include "run/sensor_parameters.hpp"
@@ -608,6 +609,34 @@ void read_map_lists(const Reader& top, const std::string& source, Scenario& s) {
     c.name = t.text("name", "");
     s.map.tracks.push_back(c);
   });
+  if (top.has("track_layout")) {
+    // A random tape network drawn from a seed (grid, tree or loop with spurs), added to
+    // the listed tracks: networks nobody designed the controller for.
+    const Reader l = top.child("track_layout");
+    l.allow({"kind", "seed", "tape_width_m", "margin_m"});
+    const std::string kind = l.text("kind", "grid");
+    environment::TrackLayoutKind k = environment::TrackLayoutKind::kGrid;
+    if (kind == "tree") {
+      k = environment::TrackLayoutKind::kTree;
+    } else if (kind == "loop") {
+      k = environment::TrackLayoutKind::kLoopWithSpurs;
+    } else if (kind != "grid") {
+      l.fail_key("kind", "must be grid, tree or loop");
+    }
+    environment::TrackLayoutOptions options;
+    options.field_width_m = s.map.field.width_m;
+    options.field_height_m = s.map.field.height_m;
+    options.tape_width_m = l.positive("tape_width_m", options.tape_width_m);
+    options.margin_m = l.non_negative("margin_m", options.margin_m);
+    const int seed = l.integer("seed", 1);
+    if (seed < 0) l.fail_key("seed", "must be 0 or more");
+    try {
+      for (auto& t : environment::make_track_layout(static_cast<std::uint64_t>(seed), k, options))
+        s.map.tracks.push_back(std::move(t));
+    } catch (const std::invalid_argument& e) {
+      l.fail_key("margin_m", e.what());
+    }
+  }
   each("beacons", [&](const Reader& b) {
     b.allow({"id", "position", "facing_deg", "aperture_deg", "range_m"});
     environment::BeaconConfig c;
@@ -727,8 +756,8 @@ AgentsSpec read_agents(const Reader& top, const std::vector<RobotSpec>& robots) 
 Scenario read_scenario(const YAML::Node& root, const std::string& source, ScenarioControllers& controllers) {
   Scenario s;
   const Reader top(root, source, "");
-  top.allow({"name", "description", "mode", "field", "timing", "duration_s", "convoy", "obstacles", "tracks", "beacons",
-             "moving_obstacles", "robots", "camera", "safety", "agents"});
+  top.allow({"name", "description", "mode", "field", "timing", "duration_s", "convoy", "obstacles", "tracks",
+             "track_layout", "beacons", "moving_obstacles", "robots", "camera", "safety", "agents"});
   s.name = top.text("name", std::filesystem::path(source).stem().string());
   read_mode_field_and_timing(top, s);
   s.duration_s = top.positive("duration_s", s.duration_s);

@@ -179,6 +179,7 @@ class SessionSetup {
     b.duration_s = o_.duration_s;
     b.on_controller_error = o_.on_controller_error;
     b.stop_when_formed = o_.stop_when_formed;
+    b.stop_when_done = o_.stop_when_done;
     b.seed = o_.seed;
     b.threads = o_.threads;
     b.interrupt = o_.interrupt;

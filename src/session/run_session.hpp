@@ -38,6 +38,7 @@ struct SessionOptions {
   double rt_factor = 1.0;               ///< simulated seconds per wall second, when realtime
   std::optional<double> duration_s;     ///< simulated seconds; default: the scenario's
   bool stop_when_formed = false;        ///< end 5 s after the convoy formed
+  bool stop_when_done = false;          ///< end once every controller is done
   std::uint64_t seed = 1;               ///< the seed (the first of a batch)
   int seeds = 0;                        ///< > 0: a batch of this many seeds
   std::string out;                      ///< the run folder (a batch: one folder per seed and batch.json); empty: none

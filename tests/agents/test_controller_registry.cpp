@@ -36,7 +36,11 @@ TEST(ControllerRegistry, EveryBuiltInEntrySaysWhatItsControllersDo) {
   ASSERT_NE(registry->find("c:braitenberg"), nullptr);
   ASSERT_NE(registry->find("none"), nullptr);
   environment::SensorSuiteConfig sensors;
-  sensors.track_sensors.emplace_back();
+  for (const double y_m : {0.012, 0.0, -0.012}) {  // a row across the front, as track_explore needs
+    environment::TrackSensorConfig element;
+    element.mount_y_m = y_m;
+    sensors.track_sensors.push_back(element);
+  }
   sensors.beacon_finder = environment::BeaconFinderConfig{};
   const ConvoyConfig convoy;
   for (const ControllerEntry& e : registry->entries()) {

@@ -33,6 +33,34 @@ TEST(RunCli, OneRunWritesItsFolder) {
   fs::remove_all(dir);
 }
 
+// The shipped exploring scenario to its end (--stop-when-done), its map in the run folder,
+// and the same map again from a replay of its recording.
+TEST(RunCli, AnExplorerEndsWhenDoneAndItsMapReplays) {
+  const fs::path dir = scratch_dir("run_explore");
+  const std::string log = (dir / "run.lcm").string();
+  CommandResult r = run_rilbed("run " + shipped_scenario_arg("track_explore") + " --fast --stop-when-done --record '" +
+                               log + "' --out '" + (dir / "run").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("(ended by done)"), std::string::npos) << r.out;
+  const auto summary = nlohmann::json::parse(read_file(dir / "run" / "summary.json"));
+  EXPECT_EQ(summary["ended_by"], "done");
+  const std::string map_text = read_file(dir / "run" / "track_map.json");
+  const auto map = nlohmann::json::parse(map_text);
+  EXPECT_GE(map["nodes"].size(), 6u);
+  EXPECT_GE(map["edges"].size(), map["nodes"].size() - 1);  // a connected network
+  for (const auto& n : map["nodes"]) {
+    const std::string kind = n["kind"];
+    EXPECT_TRUE(kind == "end" || kind == "corner" || kind == "tee" || kind == "cross") << kind;
+  }
+  const std::string events = read_file(dir / "run" / "events.csv");
+  EXPECT_NE(events.find(",track_node,1,"), std::string::npos);
+  EXPECT_NE(events.find(",track_edge,1,"), std::string::npos);
+  r = run_rilbed("replay '" + log + "' --out '" + (dir / "replayed").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(read_file(dir / "replayed" / "track_map.json"), map_text);
+  fs::remove_all(dir);
+}
+
 TEST(RunCli, ABatchWritesOneFolderPerSeedAndATable) {
   const fs::path dir = scratch_dir("run_batch");
   const CommandResult r = run_rilbed("run " + shipped_scenario_arg("convoy_sim") +
