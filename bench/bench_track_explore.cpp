@@ -25,7 +25,7 @@ using namespace rilbed;
 namespace {
 
 struct Tally {
-  int runs = 0, all_visited = 0, done = 0, maps_within = 0;
+  int runs = 0, all_visited = 0, done = 0, maps_within = 0, edges = 0, edges_visited = 0;
   int nodes = 0, nodes_found = 0, kinds_right = 0, false_nodes = 0, bends = 0;
   double tape_m = 0.0, worst_error_m = 0.0;
   std::vector<double> times_s;
@@ -58,8 +58,12 @@ int main(int argc, char** argv) {
   app.add_option("--bias", setup.wheel_bias, "Left wheel's systematic error");
   app.add_flag("--correct-odometry", setup.correct_odometry, "track_explore's correct_odometry 1 (experimental)");
   app.add_flag("--explain", explain, "A line per run that missed something");
-  std::string dump;
+  std::string dump, csv_path;
   app.add_option("--dump", dump, "Write each run's folder (and scenario) under this folder");
+  app.add_option("--csv", csv_path,
+                 "Also write a row per run here (tape_mm,kind,layout,start,edges,edges_visited,all_visited_s,nodes,"
+                 "nodes_found,kinds_right,false_nodes,tape_m,worst_node_error_m,ended_by); tools/plot_tape_width.py "
+                 "plots it");
   CLI11_PARSE(app, argc, argv);
   setup.spacing_m = spacing_mm * 1e-3;
   const IdListResult layouts = parse_id_list(layouts_text, 0, 1 << 30, "--layouts");
@@ -87,7 +91,19 @@ int main(int argc, char** argv) {
   std::printf("%-6s %-5s %5s %5s %5s %6s %9s %8s %8s %9s %8s %9s %6s %7s\n", "tape", "kind", "lay", "edges", "nodes",
               "runs", "visited", "done", "map3cm", "t50_s", "tmax_s", "found", "kinds", "false/10m");
   const auto wall = std::chrono::steady_clock::now();
+  std::ofstream csv;
+  if (!csv_path.empty()) {
+    csv.open(csv_path);
+    if (!csv) {
+      std::fprintf(stderr, "cannot write %s\n", csv_path.c_str());
+      return 1;
+    }
+    csv << "tape_mm,kind,layout,start,edges,edges_visited,all_visited_s,nodes,nodes_found,kinds_right,false_nodes,"
+           "tape_m,worst_node_error_m,ended_by\n";
+  }
+  std::vector<std::pair<double, Tally>> per_width;
   for (double width_mm : widths_mm) {
+    Tally width_tally;
     for (environment::TrackLayoutKind kind : kinds) {
       for (int layout : layouts.ids) {
         Tally t;
@@ -117,6 +133,15 @@ int main(int argc, char** argv) {
                                                     run::reported_track_nodes(r.events, 1), 1);
           edges = score.edges;
           nodes = score.nodes;
+          if (csv.is_open()) {
+            csv << width_mm << ',' << environment::track_layout_kind_name(kind) << ',' << layout << ',' << s << ','
+                << score.edges << ',' << score.edges_visited << ','
+                << (score.all_visited_s ? std::to_string(*score.all_visited_s) : "") << ',' << score.nodes << ','
+                << score.nodes_found << ',' << score.kinds_right << ',' << score.false_nodes << ',' << score.tape_m
+                << ',' << score.worst_node_error_m << ',' << r.ended_by << '\n';
+          }
+          t.edges += score.edges;
+          t.edges_visited += score.edges_visited;
           ++t.runs;
           t.tape_m += network.total_length_m();
           t.all_visited += score.all_visited_s.has_value();
@@ -152,9 +177,26 @@ int main(int argc, char** argv) {
                     t.nodes_found ? 100.0 * t.kinds_right / t.nodes_found : 0.0,
                     t.tape_m > 0 ? 10.0 * t.false_nodes / t.tape_m : 0.0);
         std::fflush(stdout);
+        width_tally.runs += t.runs;
+        width_tally.edges += t.edges;
+        width_tally.edges_visited += t.edges_visited;
+        width_tally.all_visited += t.all_visited;
+        width_tally.nodes += t.nodes;
+        width_tally.nodes_found += t.nodes_found;
+        width_tally.false_nodes += t.false_nodes;
+        width_tally.tape_m += t.tape_m;
       }
     }
+    per_width.emplace_back(width_mm, width_tally);
   }
+  // Per tape width, every layout and start pooled: paper 000's question, how narrow a tape
+  // is still reliable.
+  std::printf("\n| tape mm | runs | edges found | runs with every edge | nodes found | false nodes per 10 m |\n");
+  std::printf("| --- | --- | --- | --- | --- | --- |\n");
+  for (const auto& [width_mm, w] : per_width)
+    std::printf("| %.0f | %d | %.1f %% | %.0f %% | %.1f %% | %.2f |\n", width_mm, w.runs,
+                w.edges ? 100.0 * w.edges_visited / w.edges : 0.0, w.runs ? 100.0 * w.all_visited / w.runs : 0.0,
+                w.nodes ? 100.0 * w.nodes_found / w.nodes : 0.0, w.tape_m > 0 ? 10.0 * w.false_nodes / w.tape_m : 0.0);
   std::printf("# %.1f s wall\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - wall).count());
   return 0;
 }

@@ -41,6 +41,18 @@ MAX_WHEEL_UNITS = _api.MAX_WHEEL_UNITS
 WHEEL_BASE_M = _api.WHEEL_BASE_M
 PROXIMITY_COUNT = _api.PROXIMITY_COUNT
 PROXIMITY_MAX = _api.PROXIMITY_MAX
+# What a robot knows of a tape network on board (docs/track-networks.md).
+TrackSensorConfig = _api.TrackSensorConfig
+TrackArray = _api.TrackArray
+TrackReadingConfig = _api.TrackReadingConfig
+TrackArrayReading = _api.TrackArrayReading
+arm_sides = _api.arm_sides
+read_track_array = _api.read_track_array
+TrackFeatureKind = _api.TrackFeatureKind
+track_feature_name = _api.track_feature_name
+BranchScanConfig = _api.BranchScanConfig
+BranchScan = _api.BranchScan
+ScanResult = _api.ScanResult
 
 from ._controller import Controller  # noqa: E402
 from ._runs import RunError, read_run, run  # noqa: E402
@@ -63,4 +75,15 @@ __all__ = [
     "WHEEL_BASE_M",
     "PROXIMITY_COUNT",
     "PROXIMITY_MAX",
+    "TrackSensorConfig",
+    "TrackArray",
+    "TrackReadingConfig",
+    "TrackArrayReading",
+    "arm_sides",
+    "read_track_array",
+    "TrackFeatureKind",
+    "track_feature_name",
+    "BranchScanConfig",
+    "BranchScan",
+    "ScanResult",
 ]

@@ -63,9 +63,12 @@ const rilbed_host& plugin_host() {
   return host;
 }
 
-CControllerAdapter::CControllerAdapter(const rilbed_c_controller& controller, std::shared_ptr<const void> library)
-    : library_(std::move(library)), controller_(controller) {
+CControllerAdapter::CControllerAdapter(const rilbed_c_controller& controller, std::shared_ptr<const void> library,
+                                       std::span<const environment::TrackSensorConfig> track_sensors)
+    : library_(std::move(library)), controller_(controller), track_array_(TrackArray::of(track_sensors)) {
   if (!controller.step) throw std::invalid_argument("C controller has no step function");
+  if (!track_sensors.empty()) track_reading_.max_value = track_sensors.front().max_value;
+  arm_sides_ = arm_sides(track_array_, track_reading_);
 }
 
 CControllerAdapter::~CControllerAdapter() { finish(); }
@@ -90,6 +93,11 @@ void CControllerAdapter::load_inputs(const ControlInput& input) {
   const int tracks = static_cast<int>(std::min<std::size_t>(s.track.size(), 16));
   r.set(RILBED_REG_TRACK_COUNT, tracks);
   for (int i = 0; i < tracks; ++i) r.set(RILBED_REG_TRACK_0 + i, s.track[i]);
+  // The reading track_explore steers by, for controllers in C (track_features.hpp).
+  const TrackArrayReading track = read_track_array(track_array_, s.track, track_reading_, arm_sides_);
+  r.set(RILBED_REG_TRACK_ON, track.on_track ? 1 : 0);
+  r.set(RILBED_REG_TRACK_OFFSET_UM, saturate(track.offset_m * 1e6));
+  r.set(RILBED_REG_TRACK_ARMS, (track.arm_left ? 1 : 0) | (track.arm_right ? 2 : 0));
   const int beacons = static_cast<int>(std::min<std::size_t>(s.beacons.size(), 8));
   r.set(RILBED_REG_BEACON_COUNT, beacons);
   for (int i = 0; i < beacons; ++i) {

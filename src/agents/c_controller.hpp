@@ -9,11 +9,13 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "agents/controller.hpp"
+#include "agents/track_features.hpp"
 #include "rilbed/rilbed_controller.h"
 
 namespace rilbed::agents {
@@ -47,9 +49,11 @@ const rilbed_host& plugin_host();
 class CControllerAdapter final : public Controller {
  public:
   /// `controller` must stay valid while `library` lives (what keeps the library it comes
-  /// from loaded; null for one that lives as long as the program). Throws
-  /// std::invalid_argument if it has no step function.
-  explicit CControllerAdapter(const rilbed_c_controller& controller, std::shared_ptr<const void> library = {});
+  /// from loaded; null for one that lives as long as the program). `track_sensors`: the
+  /// robot's track sensors, for the track reading's registers (RILBED_REG_TRACK_ON, ...).
+  /// Throws std::invalid_argument if it has no step function.
+  explicit CControllerAdapter(const rilbed_c_controller& controller, std::shared_ptr<const void> library = {},
+                              std::span<const environment::TrackSensorConfig> track_sensors = {});
   ~CControllerAdapter() override;
   ControlOutput step(const ControlInput& input) override;
   /// Calls cleanup once (also done by the destructor if the run did not).
@@ -64,6 +68,9 @@ class CControllerAdapter final : public Controller {
   std::shared_ptr<const void> library_;
   const rilbed_c_controller& controller_;
   RegisterMap registers_;
+  TrackArray track_array_;
+  TrackReadingConfig track_reading_;
+  std::vector<int> arm_sides_;
   bool initialised_ = false;
   bool finished_ = false;
   std::optional<TimeUs> last_t_us_;

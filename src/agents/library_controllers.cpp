@@ -277,8 +277,8 @@ core::Result<ControllerEntry> c_controller_entry(const rilbed_c_controller& cont
   e.concurrent = false;
   e.origin = origin;
   if (library) e.library = library->path().string();
-  e.make = [library, &controller](const ControllerContext&) {
-    return std::make_unique<CControllerAdapter>(controller, library);
+  e.make = [library, &controller](const ControllerContext& c) {
+    return std::make_unique<CControllerAdapter>(controller, library, c.sensors.track_sensors);
   };
   return checked(std::move(e));
 }

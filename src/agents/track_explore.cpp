@@ -277,6 +277,7 @@ ControlOutput TrackExploreController::approach(const TrackArrayReading&) {
 
 void TrackExploreController::start_scan() {
   approach_started_ = false;
+  scanner_start_m_ = odometry_.pose().position_m;
   scanner_.start(odometry_.pose(), approach_heading_rad_);
   mode_ = Mode::kScan;
 }
@@ -291,6 +292,20 @@ ControlOutput TrackExploreController::scan(const ControlInput& input) {
 }
 
 void TrackExploreController::after_scan(const ScanResult& result) {
+  if (verifying_node_ >= 0) {
+    // The look from the node's centre: the ways it adds are the node's.
+    const int node = verifying_node_;
+    verifying_node_ = -1;
+    auto& n = map_.nodes[static_cast<std::size_t>(node)];
+    n.looked_from_centre = true;
+    const Arrival look{result.kind,  n.position_m, result.ways_rad, result.way_points_m,
+                       n.position_m, 0.0,          std::nullopt};
+    merge_ways(node, look, n.position_m, 0.0);
+    on_leg_ = false;
+    route_.clear();
+    leave(node);
+    return;
+  }
   if (result.ways_rad.empty()) {
     on_leg_ = false;
     mode_ = Mode::kSearch;
@@ -331,8 +346,13 @@ void TrackExploreController::after_scan(const ScanResult& result) {
       return;
     }
   }
-  Arrival arrival{result.kind,         result.node_m,         result.ways_rad,
-                  result.way_points_m, approach_heading_rad_, on_leg_ ? arrival_line() : std::nullopt};
+  const Arrival arrival{result.kind,
+                        result.node_m,
+                        result.ways_rad,
+                        result.way_points_m,
+                        scanner_start_m_,
+                        approach_heading_rad_,
+                        on_leg_ ? arrival_line() : std::nullopt};
   rescans_ = 0;
   const int node = arrive(arrival, length);
   leave(node);
@@ -482,6 +502,8 @@ void TrackExploreController::merge_ways(int node, const Arrival& arrival, Vec2 a
   // A way this turn saw that the node lacks (a turn off its centre missed it, or took two
   // ways for one) is added, untaken; the kind follows the number of ways.
   auto& n = map_.nodes[static_cast<std::size_t>(node)];
+  // Only a turn on the node's centre: off it, one tape's crossings point elsewhere.
+  if (!arrival.scanned_from_m || (*arrival.scanned_from_m - at).norm() > 0.01) return;
   bool changed = false;
   for (const Vec2& q : arrival.way_points_m) {
     const Vec2 d = q - at;
@@ -547,6 +569,7 @@ int TrackExploreController::arrive(const Arrival& arrival, double length_m) {
     added.kind = arrival.kind;
     added.position_m = arrival.node_m;
     for (double w : arrival.ways_rad) added.ways.push_back({w, -1, false, {}});
+    added.looked_from_centre = arrival.scanned_from_m && (*arrival.scanned_from_m - arrival.node_m).norm() < 0.008;
     map_.nodes.push_back(added);
     node = added.id;
     emit_node(added);
@@ -617,6 +640,13 @@ void TrackExploreController::leave_by(int node, int way) {
   // Leave from the node's centre: off it, the way's tape is not where its direction says.
   centre_at_m_ = map_.nodes[static_cast<std::size_t>(node)].position_m;
   mode_ = (centre_at_m_ - odometry_.pose().position_m).norm() > 0.006 ? Mode::kCentre : Mode::kTurn;
+  if (!map_.nodes[static_cast<std::size_t>(node)].looked_from_centre) {
+    // Its ways were read off its centre (or from a bend): look again from there first.
+    verifying_node_ = node;
+    scan_after_centre_ = true;
+    approach_heading_rad_ = odometry_.pose().heading_rad;
+    if (mode_ == Mode::kTurn) start_scan();
+  }
 }
 
 ControlOutput TrackExploreController::centre() {
@@ -736,9 +766,20 @@ ControlOutput TrackExploreController::follow(const ControlInput&, const TrackArr
     const bool turned = std::abs(wrap_rad_pi(pose.heading_rad - arm_heading_rad_)) >= deg_to_rad(15.0);
     // Straight on past the arm (a junction), or turned without a corner showing in the
     // path by now: back to where the arm crossed, and look round there.
-    if (arm_pending_ && travel > arm_at + (turned ? 0.12 : 0.03)) {
+    if (arm_pending_ && travel > arm_at + (turned ? 0.08 : 0.03)) {
       arm_pending_ = false;
       centre_at_m_ = arm_node_m_;
+      if (turned) {
+        // Where the tape it came in along meets the tape it turned onto: an oblique arm's
+        // node is short of where a square one's would be.
+        const auto in = fitted_line(cue_travel_m_ - 0.15, cue_travel_m_ - 0.01);
+        const auto out = fitted_line(travel - 0.05, travel);
+        if (in && out) {
+          const Vec2 at = meet_of_lines(std::vector<Vec2>{in->point_m, out->point_m},
+                                        std::vector<double>{in->heading_rad, out->heading_rad}, arm_node_m_);
+          if ((at - arm_node_m_).norm() < 0.08) centre_at_m_ = at;
+        }
+      }
       scan_after_centre_ = true;
       approach_heading_rad_ = arm_heading_rad_;
       cue_travel_m_ = arm_at - sensor_ahead_m_;
@@ -766,8 +807,8 @@ ControlOutput TrackExploreController::follow(const ControlInput&, const TrackArr
       const TrackFeatureKind kind =
           in_dir.cross(out_dir) > 0 ? TrackFeatureKind::kCornerLeft : TrackFeatureKind::kCornerRight;
       const double past = travel - vertex.travel_m;
-      const Arrival arrival{kind, vertex.sensor_m, {wrap_rad_pi(in_heading + kPi), out_heading},
-                            {},   in_heading,      TapeLine{vertex.sensor_m, in_heading}};
+      const Arrival arrival{kind,         vertex.sensor_m, {wrap_rad_pi(in_heading + kPi), out_heading}, {},
+                            std::nullopt, in_heading,      TapeLine{vertex.sensor_m, in_heading}};
       const int node = arrive(arrival, vertex.travel_m - leg_.start_travel_m);
       const int out = map_.nearest_way(node, out_heading);
       set_followed(node, out, {vertex.sensor_m, out_heading});

@@ -81,6 +81,9 @@ struct ExploredTrackMap {
     TrackFeatureKind kind = TrackFeatureKind::kEnd;
     Vec2 position_m;
     std::vector<Way> ways;
+    /// Whether a turn on the spot has read its ways from (within 8 mm of) its centre; if
+    /// not, the robot turns there once more the first time it leaves it.
+    bool looked_from_centre = false;
   };
   struct Edge {
     int from = 0, from_way = 0;
@@ -141,6 +144,7 @@ class TrackExploreController final : public Controller {
     Vec2 node_m;                   // where it thinks the node is (odometry)
     std::vector<double> ways_rad;  // the ways it saw
     std::vector<Vec2> way_points_m;
+    std::optional<Vec2> scanned_from_m;   // where it turned (none for a bend)
     double heading_rad = 0.0;             // the heading it came in with
     std::optional<TapeLine> followed_in;  // the tape it followed in, when it followed enough
   };
@@ -217,6 +221,8 @@ class TrackExploreController final : public Controller {
   Vec2 centre_at_m_;                   // the node it drives to before leaving it (or turning again)
   bool scan_after_centre_ = false;     // centring to turn on a new node again
   int rescans_ = 0;                    // turns again on the node being arrived at
+  int verifying_node_ = -1;            // the node it turns on again, from its centre, before leaving it
+  Vec2 scanner_start_m_;               // where the current turn on the spot began
   double arrival_length_m_ = 0.0;      // the leg's length when it first stopped at the node
   double approach_until_m_ = 0.0;      // odometer at which the approach stops
   double approach_heading_rad_ = 0.0;  // heading the approach holds (and the arrival's)

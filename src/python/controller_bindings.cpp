@@ -213,6 +213,7 @@ void bind_controller_api(py::module_& m) {
   bind_step_input(m);
   bind_swarm_input(m);
   bind_output(m);
+  bind_track_features(m);
   m.def(
       "wheels_from_twist",
       [](double speed_mps, double turn_rate_radps) {

@@ -43,5 +43,9 @@ std::string traceback_text(pybind11::error_already_set& e);
 /// Adds the controller API (Controller's inputs and outputs, the constants) to `m`, as
 /// both the embedded module and the extension module hold it.
 void bind_controller_api(pybind11::module_& m);
+/// Adds what a robot knows of a tape network on board (agents/track_features.hpp) to `m`:
+/// TrackSensorConfig, TrackArray, read_track_array, BranchScan, ... Called by
+/// bind_controller_api.
+void bind_track_features(pybind11::module_& m);
 
 }  // namespace rilbed::python

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <vector>
 
+#include "agents/c_controller.hpp"
 #include "agents/dead_reckoning.hpp"
 #include "agents/track_explore.hpp"
 #include "agents/track_features.hpp"
@@ -119,6 +120,37 @@ TEST(TrackArrayReading, FollowsTheRunNearestTheTapeItFollows) {
   const auto sides = arm_sides(array, config);
   EXPECT_NEAR(read_track_array(array, values, config, sides, 0.02).run_offset_m, 0.024, 1e-9);
   EXPECT_NEAR(read_track_array(array, values, config, sides, -0.02).run_offset_m, -0.024, 1e-9);
+}
+
+namespace {
+void no_step() {}
+}  // namespace
+
+TEST(TrackArrayReading, CControllersReadItInRegisters) {
+  const auto elements = array_block(5, 0.012);
+  const rilbed_c_controller controller{"test", nullptr, no_step, nullptr};
+  CControllerAdapter adapter(controller, {}, elements);
+  ControlInput input;
+  input.robot_id = 1;
+  // A tape 6 mm to the left with a side arm leaving to the right.
+  input.sensors.track =
+      read_at({tape({0.2, 0.506}, {0.8, 0.506}), tape({0.42, 0.506}, {0.42, 0.3})}, {{0.4, 0.5}, 0.0}, elements);
+  adapter.step(input);
+  const TrackArrayReading expected = read_track_array(TrackArray::of(elements), input.sensors.track,
+                                                      TrackReadingConfig{}, arm_sides(TrackArray::of(elements), {}));
+  EXPECT_EQ(adapter.registers().peek(RILBED_REG_TRACK_ON), 1);
+  EXPECT_EQ(adapter.registers().peek(RILBED_REG_TRACK_OFFSET_UM), std::lround(expected.offset_m * 1e6));
+  EXPECT_EQ(adapter.registers().peek(RILBED_REG_TRACK_ARMS), 2);  // right
+  // The tape alone, 6 mm to the left: a positive offset, no arms.
+  input.sensors.track = read_at({tape({0.2, 0.506}, {0.8, 0.506})}, {{0.4, 0.5}, 0.0}, elements);
+  adapter.step(input);
+  EXPECT_GT(adapter.registers().peek(RILBED_REG_TRACK_OFFSET_UM), 0);
+  EXPECT_EQ(adapter.registers().peek(RILBED_REG_TRACK_ARMS), 0);
+  input.sensors.track = read_at({tape({0.2, 0.8}, {0.8, 0.8})}, {{0.4, 0.5}, 0.0}, elements);
+  adapter.step(input);
+  EXPECT_EQ(adapter.registers().peek(RILBED_REG_TRACK_ON), 0);
+  EXPECT_EQ(adapter.registers().peek(RILBED_REG_TRACK_OFFSET_UM), 0);
+  EXPECT_EQ(adapter.registers().peek(RILBED_REG_TRACK_ARMS), 0);
 }
 
 TEST(BranchScan, TellsEveryKindOfNodeFromItsCentre) {

@@ -133,3 +133,56 @@ class ControllerApi(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TrackFeaturesFromPython(unittest.TestCase):
+    """The track sensor row's reading and the turn on a node, as track_explore uses them."""
+
+    def row(self, count=5, spacing_m=0.012):
+        return [rilbed.TrackSensorConfig(mount_x_m=0.02, mount_y_m=(0.5 * (count - 1) - k) * spacing_m, inclination_deg=0)
+                for k in range(count)]
+
+    def test_the_row_reads_as_in_cpp(self):
+        array = rilbed.TrackArray.of(self.row())
+        self.assertEqual(len(array.points_m), 5)
+        self.assertAlmostEqual(array.points_m[0][1], 0.024, places=6)
+        self.assertEqual(array.centre_element(), 2)
+        config = rilbed.TrackReadingConfig(tape_width_m=0.02)
+        sides = rilbed.arm_sides(array, config)
+        self.assertEqual(sides, [1, 0, 0, 0, -1])
+        # The tape under the two left-middle elements, and an arm on the far right.
+        r = rilbed.read_track_array(array, [0, 255, 255, 0, 255], config, sides)
+        self.assertTrue(r.on_track)
+        self.assertEqual(r.elements_on, 3)
+        self.assertTrue(r.arm_right)
+        self.assertFalse(r.arm_left)
+        self.assertAlmostEqual(r.run_offset_m, 0.006, places=6)
+        self.assertFalse(rilbed.read_track_array(array, [0] * 5, config, sides).on_track)
+
+    def test_a_cone_that_misses_the_floor_is_refused(self):
+        with self.assertRaises(ValueError):
+            rilbed.TrackArray.of([rilbed.TrackSensorConfig(inclination_deg=85, cone_angle_deg=30)])
+
+    def test_a_turn_on_an_end_tells_an_end(self):
+        # Readings as an end of tape behind the robot gives them: the elements see it while
+        # they point backwards (their directions within 20 degrees of straight behind).
+        import math
+        array = rilbed.TrackArray.of(self.row())
+        scan = rilbed.BranchScan(array, rilbed.TrackReadingConfig())
+        scan.start(rilbed.Pose(0.5, 0.5, 0.0), 0.0)
+        step = 0
+        while not scan.complete():
+            heading = math.radians(4.0 * step)
+            pose = rilbed.Pose(0.5, 0.5, math.atan2(math.sin(heading), math.cos(heading)))
+            track = []
+            for x, y in array.points_m:
+                bearing = heading + math.atan2(y, x)
+                behind = abs(math.atan2(math.sin(bearing - math.pi), math.cos(bearing - math.pi)))
+                track.append(255 if behind < math.radians(20) else 0)
+            scan.add(pose, track)
+            step += 1
+        result = scan.result()
+        self.assertEqual(result.kind, rilbed.TrackFeatureKind.END)
+        self.assertEqual(rilbed.track_feature_name(result.kind), "end")
+        self.assertEqual(len(result.ways_rad), 1)
+        self.assertAlmostEqual(abs(result.ways_rad[0]), math.pi, delta=math.radians(3))

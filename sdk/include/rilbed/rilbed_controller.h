@@ -31,21 +31,26 @@ extern "C" {
 
 /* Register addresses. R: read only, W: written by the controller, RW: both. */
 enum rilbed_register {
-  RILBED_REG_ID = 0x00,           /* R: the robot's ID */
-  RILBED_REG_TIME_MS = 0x01,      /* R: simulated time, milliseconds (wraps at 2^31) */
-  RILBED_REG_PERIOD_MS = 0x02,    /* R: control period, milliseconds */
-  RILBED_REG_PROX_0 = 0x10,       /* R: proximity sensors 0..7 at 0x10..0x17, 0..1023 (-1: none) */
-  RILBED_REG_ODO_LEFT = 0x20,     /* R: left wheel counter, pulses of 0.08 mm (low 32 bits) */
-  RILBED_REG_ODO_RIGHT = 0x21,    /* R: right wheel counter */
-  RILBED_REG_RANGE_COUNT = 0x28,  /* R: number of range finders (up to 8) */
-  RILBED_REG_RANGE_0 = 0x30,      /* R: range finder i at 0x30+i, millimetres; -1: nothing in range */
-  RILBED_REG_TRACK_COUNT = 0x38,  /* R: number of track sensors (up to 16) */
-  RILBED_REG_TRACK_0 = 0x40,      /* R: track sensor i at 0x40+i, 0..its Max Value */
-  RILBED_REG_BEACON_COUNT = 0x50, /* R: number of beacons in view (up to 8) */
-  RILBED_REG_BEACON_0 = 0x60,     /* R: beacon i: ID at 0x60+2i, bearing at 0x61+2i in millidegrees CCW from ahead */
-  RILBED_REG_POSE_VALID = 0x70,   /* R: 1 if the pose registers hold the robot's pose */
-  RILBED_REG_POSE_X_MM = 0x71,    /* R: field x, millimetres */
-  RILBED_REG_POSE_Y_MM = 0x72,    /* R: field y, millimetres */
+  RILBED_REG_ID = 0x00,              /* R: the robot's ID */
+  RILBED_REG_TIME_MS = 0x01,         /* R: simulated time, milliseconds (wraps at 2^31) */
+  RILBED_REG_PERIOD_MS = 0x02,       /* R: control period, milliseconds */
+  RILBED_REG_PROX_0 = 0x10,          /* R: proximity sensors 0..7 at 0x10..0x17, 0..1023 (-1: none) */
+  RILBED_REG_ODO_LEFT = 0x20,        /* R: left wheel counter, pulses of 0.08 mm (low 32 bits) */
+  RILBED_REG_ODO_RIGHT = 0x21,       /* R: right wheel counter */
+  RILBED_REG_RANGE_COUNT = 0x28,     /* R: number of range finders (up to 8) */
+  RILBED_REG_RANGE_0 = 0x30,         /* R: range finder i at 0x30+i, millimetres; -1: nothing in range */
+  RILBED_REG_TRACK_COUNT = 0x38,     /* R: number of track sensors (up to 16) */
+  RILBED_REG_TRACK_ON = 0x39,        /* R: 1 when a track sensor reads at least half its Max Value, else 0 */
+  RILBED_REG_TRACK_OFFSET_UM = 0x3A, /* R: where the tape lies across the sensors, micrometres left of the
+                                        robot's axis (the mean of those that see it); 0 when off */
+  RILBED_REG_TRACK_ARMS = 0x3B,      /* R: side arms: bit 0 left, bit 1 right (a sensor farther out than a 20 mm
+                                        tape's edge sees tape while one in the middle does: a junction or a corner) */
+  RILBED_REG_TRACK_0 = 0x40,         /* R: track sensor i at 0x40+i, 0..its Max Value */
+  RILBED_REG_BEACON_COUNT = 0x50,    /* R: number of beacons in view (up to 8) */
+  RILBED_REG_BEACON_0 = 0x60,        /* R: beacon i: ID at 0x60+2i, bearing at 0x61+2i in millidegrees CCW from ahead */
+  RILBED_REG_POSE_VALID = 0x70,      /* R: 1 if the pose registers hold the robot's pose */
+  RILBED_REG_POSE_X_MM = 0x71,       /* R: field x, millimetres */
+  RILBED_REG_POSE_Y_MM = 0x72,       /* R: field y, millimetres */
   RILBED_REG_POSE_HEADING_MDEG = 0x73, /* R: heading, millidegrees CCW from +x, [0, 360000) */
   RILBED_REG_MOTOR_LEFT = 0x80,        /* RW: left wheel speed, Khepera units (pulses/10 ms, clamped to +-127) */
   RILBED_REG_MOTOR_RIGHT = 0x81,       /* RW: right wheel speed */
