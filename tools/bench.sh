@@ -100,11 +100,11 @@ echo
 # track_explore on random tape networks (layouts drawn after its last change), five and
 # three track elements, then under wheel slip the odometer does not count.
 echo
-"$BUILD_DIR/bench_track_explore" --kinds grid,tree,loop --layouts 201-203 --starts 20 --start-seed 11
-"$BUILD_DIR/bench_track_explore" --kinds grid,tree,loop --layouts 201-203 --starts 20 --start-seed 11 --elements 3 --spacing-mm 15
-"$BUILD_DIR/bench_track_explore" --kinds grid,tree,loop --layouts 201-203 --starts 20 --start-seed 11 --slip 0.02
+"$BUILD_DIR/bench_track_explore" --kinds grid,tree,loop --layouts 301-303 --starts 20 --start-seed 13
+"$BUILD_DIR/bench_track_explore" --kinds grid,tree,loop --layouts 301-303 --starts 20 --start-seed 13 --elements 3 --spacing-mm 15
+"$BUILD_DIR/bench_track_explore" --kinds grid,tree,loop --layouts 301-303 --starts 20 --start-seed 13 --slip 0.02
 # Paper 000's tape-width experiment (tools/plot_tape_width.py plots the CSV).
-"$BUILD_DIR/bench_track_explore" --kinds grid,tree,loop --layouts 201-203 --starts 10 --start-seed 11 \
+"$BUILD_DIR/bench_track_explore" --kinds grid,tree,loop --layouts 301-303 --starts 10 --start-seed 13 \
   --tape-mm 5,10,15,20,25,30 --csv "$BUILD_DIR/tape_width.csv"
 
 # The web panel: viewers of a 100-robot run (frames and bytes each gets, their effect on the

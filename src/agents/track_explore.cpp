@@ -500,7 +500,8 @@ void TrackExploreController::set_followed(int node, int way, const TapeLine& lin
 
 void TrackExploreController::merge_ways(int node, const Arrival& arrival, Vec2 at, double turn_rad) {
   // A way this turn saw that the node lacks (a turn off its centre missed it, or took two
-  // ways for one) is added, untaken; the kind follows the number of ways.
+  // ways for one) is added, untaken; the kind follows the number of ways. Ways it has
+  // take this turn's directions unless followed.
   auto& n = map_.nodes[static_cast<std::size_t>(node)];
   // Only a turn on the node's centre: off it, one tape's crossings point elsewhere.
   if (!arrival.scanned_from_m || (*arrival.scanned_from_m - at).norm() > 0.01) return;
@@ -508,10 +509,15 @@ void TrackExploreController::merge_ways(int node, const Arrival& arrival, Vec2 a
   for (const Vec2& q : arrival.way_points_m) {
     const Vec2 d = q - at;
     const double direction = wrap_rad_pi(std::atan2(d.y, d.x) + turn_rad);
-    const bool known = std::any_of(n.ways.begin(), n.ways.end(), [&](const auto& w) {
-      return angle_off(w.direction_rad, direction) < deg_to_rad(config_.scan.merge_deg + 5.0);
-    });
-    if (known) continue;
+    const int k = map_.nearest_way(node, direction);
+    if (k >= 0 && angle_off(n.ways[static_cast<std::size_t>(k)].direction_rad, direction) <
+                      deg_to_rad(config_.scan.merge_deg + 5.0)) {
+      // A way it knows. Unless its tape was followed (a line, the better measure), it takes
+      // this turn's direction: the robot leaves from where it turned, along what it saw.
+      auto& w = n.ways[static_cast<std::size_t>(k)];
+      if (!w.followed) w.direction_rad = direction;
+      continue;
+    }
     n.ways.push_back({direction, ExploredTrackMap::kUntaken, false, {}});
     changed = true;
   }

@@ -1,5 +1,5 @@
 // track_explore on tape networks nobody designed it for: random layouts from seeds that
-// were drawn after its last change (layout seeds 201-203, start seed 11; its tuning used
+// were drawn after its last change (layout seeds 301-303, start seed 13; its tuning used
 // layout seeds 1-4 and start seed 1), each explored from 20 random starts through real
 // runs, scored against the network.
 #include <gtest/gtest.h>
@@ -47,8 +47,8 @@ Pose2 random_start(environment::NoiseRng& rng) {
 TEST(TrackExplore, ExploresRandomGridsFromAnywhere) {
   int false_nodes = 0;
   double tape_m = 0.0;
-  for (int layout : {201, 202, 203}) {
-    environment::NoiseRng starts(environment::mix64(11 * 1000003 + static_cast<std::uint64_t>(layout)));
+  for (int layout : {301, 302, 303}) {
+    environment::NoiseRng starts(environment::mix64(13 * 1000003 + static_cast<std::uint64_t>(layout)));
     for (int s = 0; s < 20; ++s) {
       const Pose2 start = random_start(starts);
       const Explored e = explore(environment::TrackLayoutKind::kGrid, layout, start);
@@ -68,7 +68,7 @@ TEST(TrackExplore, ExploresRandomGridsFromAnywhere) {
 TEST(TrackExplore, WritesTheMapItReportedToTheRunFolder) {
   const auto dir = std::filesystem::temp_directory_path() / "rilbed_track_explore_map";
   std::filesystem::remove_all(dir);
-  const Explored e = explore(environment::TrackLayoutKind::kGrid, 203, {{0.5, 0.5}, 0.3}, dir);
+  const Explored e = explore(environment::TrackLayoutKind::kGrid, 303, {{0.5, 0.5}, 0.3}, dir);
   EXPECT_EQ(e.result.ended_by, "done");
   std::ifstream in(dir / "track_map.json");
   ASSERT_TRUE(in) << "no track_map.json";
