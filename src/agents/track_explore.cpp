@@ -57,13 +57,17 @@ int ExploredTrackMap::nearest_way(int node, double direction_rad) const {
   int best = -1;
   double best_off = std::numeric_limits<double>::infinity();
   const auto& ways = nodes[static_cast<std::size_t>(node)].ways;
-  for (int w = 0; w < static_cast<int>(ways.size()); ++w) {
-    if (ways[static_cast<std::size_t>(w)].edge == kNoTape) continue;
-    const double off = std::abs(wrap_rad_pi(ways[static_cast<std::size_t>(w)].direction_rad - direction_rad));
-    if (off < best_off) {
-      best_off = off;
-      best = w;
+  // Ways with tape first; a node whose ways were all struck off still answers one.
+  for (const bool struck : {false, true}) {
+    for (int w = 0; w < static_cast<int>(ways.size()); ++w) {
+      if ((ways[static_cast<std::size_t>(w)].edge == kNoTape) != struck) continue;
+      const double off = std::abs(wrap_rad_pi(ways[static_cast<std::size_t>(w)].direction_rad - direction_rad));
+      if (off < best_off) {
+        best_off = off;
+        best = w;
+      }
     }
+    if (best >= 0) return best;
   }
   return best;
 }
@@ -138,7 +142,8 @@ TrackExploreController::TrackExploreController(TrackArray array, TrackExploreCon
       centre_element_(array_.centre_element()),
       odometry_(config_.wheel_base_m),
       scanner_(array_, config_.reading, config_.scan) {
-  if (array_.points_m.empty()) throw std::invalid_argument("track_explore needs track sensors");
+  if (std::none_of(array_.points_m.begin(), array_.points_m.end(), [](Vec2 p) { return p.norm() >= 0.008; }))
+    throw std::invalid_argument("track_explore needs track sensors 8 mm or more from the robot's centre");
   double ahead = 0.0;
   for (const Vec2& p : array_.points_m) ahead += p.x;
   sensor_ahead_m_ = ahead / static_cast<double>(array_.points_m.size());
@@ -307,6 +312,7 @@ void TrackExploreController::after_scan(const ScanResult& result) {
     return;
   }
   if (result.ways_rad.empty()) {
+    rescans_ = 0;
     on_leg_ = false;
     mode_ = Mode::kSearch;
     return;
@@ -326,6 +332,7 @@ void TrackExploreController::after_scan(const ScanResult& result) {
           std::abs(wrap_rad_pi(result.ways_rad[static_cast<std::size_t>(best)] - approach_heading_rad_)))
         best = k;
     target_heading_rad_ = result.ways_rad[static_cast<std::size_t>(best)];
+    rescans_ = 0;
     if (!on_leg_) leg_ = {-1, -1, odometry_.travelled_m()};
     on_leg_ = true;
     mode_ = Mode::kTurn;
@@ -638,6 +645,7 @@ void TrackExploreController::leave(int node) {
 }
 
 void TrackExploreController::leave_by(int node, int way) {
+  scan_after_centre_ = false;
   target_heading_rad_ = map_.nodes[static_cast<std::size_t>(node)].ways[static_cast<std::size_t>(way)].direction_rad;
   leg_ = {node, way, odometry_.travelled_m()};
   leg_way_fitted_ = false;

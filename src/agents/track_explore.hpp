@@ -10,6 +10,7 @@
 // position to the node's, heading by the ways' directions, so that drift does not grow
 // from node to node. Gentle corners that the follower takes without losing the tape are
 // found from the path the sensor row drew (two straight stretches meeting at an angle).
+// (The odometry corrections apply with correct_odometry only, off by default.)
 // It then leaves by a way it has not taken, or drives the known graph to the nearest
 // node that has one; when no way is left untaken it is done. Each node becomes a
 // `track_node` event, each edge a `track_edge` event; the run folder's track_map.json is
@@ -114,7 +115,9 @@ std::string_view track_node_kind_of(TrackFeatureKind kind);
 /// "approach", "avoid", "done".
 class TrackExploreController final : public Controller {
  public:
-  /// `array`: the robot's track elements, in the order of its readings.
+  /// `array`: the robot's track elements, in the order of its readings. Throws
+  /// std::invalid_argument for an array with no element 8 mm or more off the robot's
+  /// centre (a turn on the spot would see nothing).
   TrackExploreController(TrackArray array, TrackExploreConfig config = {});
   ControlOutput step(const ControlInput& input) override;
   bool done() const override { return mode_ == Mode::kDone; }

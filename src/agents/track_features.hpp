@@ -105,7 +105,7 @@ struct BranchScanConfig {
 
 /// What a turn on the spot found.
 struct ScanResult {
-  /// Directions of the ways leaving the node, odometry frame, radians in [-pi, pi),
+  /// Directions of the ways leaving the node, odometry frame, radians in (-pi, pi],
   /// counter-clockwise order from the first.
   std::vector<double> ways_rad;
   /// Per way, a point on its centre line (where the outer elements crossed it), odometry

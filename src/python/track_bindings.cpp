@@ -28,10 +28,14 @@ void bind_sensor_config(py::module_& m) {
                                 "One track sensor element as a scenario's `sensors: track:` entry gives it (paper 000 "
                                 "section 8.1): where it sits on the robot and its cone.")
       .def(py::init([](double mount_x_m, double mount_y_m, double height_mm, double inclination_deg,
-                       double cone_angle_deg, int precision, double coverage_percent, int max_value) {
+                       double cone_angle_deg, int precision, double coverage_percent, int max_value,
+                       double mount_yaw_deg, double error_level_percent, bool graded) {
              TrackSensorConfig c;
              c.mount_x_m = mount_x_m;
              c.mount_y_m = mount_y_m;
+             c.mount_yaw_deg = mount_yaw_deg;
+             c.error_level_percent = error_level_percent;
+             c.graded = graded;
              c.height_mm = height_mm;
              c.inclination_deg = inclination_deg;
              c.cone_angle_deg = cone_angle_deg;
@@ -42,7 +46,11 @@ void bind_sensor_config(py::module_& m) {
            }),
            py::arg("mount_x_m") = 0.0, py::arg("mount_y_m") = 0.0, py::arg("height_mm") = 8.0,
            py::arg("inclination_deg") = 45.0, py::arg("cone_angle_deg") = 30.0, py::arg("precision") = 16,
-           py::arg("coverage_percent") = 15.0, py::arg("max_value") = 255)
+           py::arg("coverage_percent") = 15.0, py::arg("max_value") = 255, py::arg("mount_yaw_deg") = 0.0,
+           py::arg("error_level_percent") = 5.0, py::arg("graded") = false)
+      .def_readwrite("mount_yaw_deg", &TrackSensorConfig::mount_yaw_deg)
+      .def_readwrite("error_level_percent", &TrackSensorConfig::error_level_percent)
+      .def_readwrite("graded", &TrackSensorConfig::graded)
       .def_readwrite("mount_x_m", &TrackSensorConfig::mount_x_m)
       .def_readwrite("mount_y_m", &TrackSensorConfig::mount_y_m)
       .def_readwrite("height_mm", &TrackSensorConfig::height_mm)
