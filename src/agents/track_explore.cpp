@@ -159,7 +159,6 @@ ControlOutput TrackExploreController::drive(double speed_mps, double turn_radps,
 }
 
 ControlOutput TrackExploreController::step(const ControlInput& input) {
-  t_us_ = input.t_us;
   if (!input.sensors.odometry) throw ControllerError("track_explore needs the wheel counters (sensors: odometer)");
   odometry_.update(*input.sensors.odometry);
   if (!anchored_) {
@@ -173,12 +172,12 @@ ControlOutput TrackExploreController::step(const ControlInput& input) {
   switch (mode_) {
     case Mode::kSearch: return search(input, reading);
     case Mode::kAcquire: return acquire();
-    case Mode::kApproach: return approach(reading);
+    case Mode::kApproach: return approach();
     case Mode::kScan: return scan(input);
     case Mode::kCentre: return centre();
-    case Mode::kTurn: return turn(input, reading);
+    case Mode::kTurn: return turn(reading);
     case Mode::kFind: return find(reading);
-    case Mode::kFollow: return follow(input, reading);
+    case Mode::kFollow: return follow(reading);
     case Mode::kDone: break;
   }
   return drive(0, 0, "done");
@@ -258,7 +257,7 @@ ControlOutput TrackExploreController::acquire() {
   return drive(std::min(config_.speed_mps, std::max(0.02, 3.0 * distance)), 3.0 * error, "acquire");
 }
 
-ControlOutput TrackExploreController::approach(const TrackArrayReading&) {
+ControlOutput TrackExploreController::approach() {
   const Pose2 pose = odometry_.pose();
   if (!approach_started_) {
     approach_started_ = true;
@@ -608,7 +607,6 @@ int TrackExploreController::arrive(const Arrival& arrival, double length_m) {
     }
   }
   on_leg_ = false;
-  at_node_ = node;
   if (chain_.empty()) chain_start_m_ = odometry_.travelled_m();
   return node;
 }
@@ -687,7 +685,7 @@ ControlOutput TrackExploreController::centre() {
   return drive(std::min(config_.speed_mps, std::max(0.02, 3.0 * distance)), 3.0 * error, "centre");
 }
 
-ControlOutput TrackExploreController::turn(const ControlInput&, const TrackArrayReading& reading) {
+ControlOutput TrackExploreController::turn(const TrackArrayReading& reading) {
   const double error = wrap_rad_pi(target_heading_rad_ - odometry_.pose().heading_rad);
   if (std::abs(error) < deg_to_rad(4.0)) {
     mode_ = Mode::kFind;
@@ -734,7 +732,7 @@ ControlOutput TrackExploreController::find(const TrackArrayReading& reading) {
   return drive(0, error > 0 ? 1.0 : -1.0, "find");
 }
 
-ControlOutput TrackExploreController::follow(const ControlInput&, const TrackArrayReading& reading) {
+ControlOutput TrackExploreController::follow(const TrackArrayReading& reading) {
   const Pose2 pose = odometry_.pose();
   const double travel = odometry_.travelled_m();
   if (!reading.on_track) {
@@ -747,9 +745,8 @@ ControlOutput TrackExploreController::follow(const ControlInput&, const TrackArr
       // The array loses the tape half its width past the centre line's end (the far edge
       // of a tape leaving square, or a tape's round end): the robot's centre goes there.
       approach_until_m_ = off_since_m_ + sensor_ahead_m_ - 0.5 * config_.reading.tape_width_m;
-      lost_cue_ = true;
       approach_heading_rad_ = pose.heading_rad;
-      return approach(reading);
+      return approach();
     }
     return drive(config_.speed_mps * 0.5, 0, "follow");
   }

@@ -159,11 +159,11 @@ class TrackExploreController final : public Controller {
   // Where across the array the tape it follows should lie (TrackArrayReading::run_offset_m).
   double followed_tape_offset() const;
   ControlOutput search(const ControlInput& input, const TrackArrayReading& reading);
-  ControlOutput follow(const ControlInput& input, const TrackArrayReading& reading);
+  ControlOutput follow(const TrackArrayReading& reading);
   ControlOutput acquire();
   ControlOutput centre();
-  ControlOutput approach(const TrackArrayReading& reading);
-  ControlOutput turn(const ControlInput& input, const TrackArrayReading& reading);
+  ControlOutput approach();
+  ControlOutput turn(const TrackArrayReading& reading);
   ControlOutput find(const TrackArrayReading& reading);
   ControlOutput scan(const ControlInput& input);
   void start_scan();
@@ -214,7 +214,6 @@ class TrackExploreController final : public Controller {
   Mode mode_ = Mode::kSearch;
   Leg leg_;
   bool on_leg_ = false;
-  int at_node_ = -1;
   std::vector<std::pair<int, int>> route_;
   double target_heading_rad_ = 0.0;
   Vec2 acquire_at_m_;                // where the array first saw a tape
@@ -231,7 +230,6 @@ class TrackExploreController final : public Controller {
   double approach_heading_rad_ = 0.0;  // heading the approach holds (and the arrival's)
   double off_since_m_ = -1.0;          // odometer when the tape was last lost, -1 while on it
   double cue_travel_m_ = 0.0;          // odometer when the cue that stopped the following came
-  bool lost_cue_ = false;              // the cue was the loss of the tape (not a side arm)
   bool arm_pending_ = false;           // a side arm seen; junction or corner not yet told
   double arm_heading_rad_ = 0.0;       // the heading when the arm was seen
   Vec2 arm_node_m_;                    // where the node would be for an arm square to the tape
@@ -246,7 +244,6 @@ class TrackExploreController final : public Controller {
   int find_round_ = 0;
   std::deque<PathPoint> path_;
   double last_bend_deg_ = 0.0;
-  TimeUs t_us_ = 0;
   // Nodes found since it last stood on a known one, with the odometer then.
   struct ChainNode {
     int node;

@@ -96,6 +96,18 @@ void RunRecorder::add_event(const RunEvent& e) {
   if (e.kind == "track_node" || e.kind == "track_edge") keep_track_event(e);
 }
 
+std::optional<ReportedTrackNode> reported_track_node(const RunEvent& e) {
+  if (e.kind != "track_node") return std::nullopt;
+  const nlohmann::json d = nlohmann::json::parse(e.detail, nullptr, false);
+  if (!d.is_object()) return std::nullopt;
+  const auto kind = d.find("kind");
+  const auto x = d.find("x_m");
+  const auto y = d.find("y_m");
+  if (kind == d.end() || !kind->is_string() || x == d.end() || !x->is_number() || y == d.end() || !y->is_number())
+    return std::nullopt;
+  return ReportedTrackNode{e.other, kind->get<std::string>(), {x->get<double>(), y->get<double>()}, e.t_us};
+}
+
 void RunRecorder::keep_track_event(const RunEvent& e) {
   // Each robot's map, from its own events; the detail is JSON (an explorer's, or any
   // program's on the bus: what does not parse is left out of the map, not thrown).
@@ -103,13 +115,9 @@ void RunRecorder::keep_track_event(const RunEvent& e) {
   if (!detail.is_object()) return;
   TrackMap& map = track_maps_[e.id];
   if (e.kind == "track_node") {
-    const auto kind = detail.find("kind");
-    const auto x = detail.find("x_m");
-    const auto y = detail.find("y_m");
-    if (kind == detail.end() || !kind->is_string() || x == detail.end() || !x->is_number() || y == detail.end() ||
-        !y->is_number())
-      return;
-    map.nodes[e.other] = {{"id", e.other}, {"kind", *kind}, {"x_m", *x}, {"y_m", *y}};
+    if (const auto node = reported_track_node(e))
+      map.nodes[e.other] = {
+          {"id", e.other}, {"kind", node->kind}, {"x_m", node->position_m.x}, {"y_m", node->position_m.y}};
   } else {
     const auto from = detail.find("from");
     const auto to = detail.find("to");

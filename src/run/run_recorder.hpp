@@ -40,6 +40,19 @@ struct RunEvent {
   std::string detail;
 };
 
+/// A node of a tape network a robot reported: a `track_node` event (track_explore's).
+struct ReportedTrackNode {
+  int id = 0;        ///< the event's `other`
+  std::string kind;  ///< "end", "corner", "tee", "cross"
+  Vec2 position_m;   ///< field frame
+  TimeUs t_us = 0;   ///< when it was reported
+};
+
+/// The node a `track_node` event reports; nullopt when its detail is not a JSON object
+/// with `kind` (a string), `x_m` and `y_m` (numbers). Events may come from any program on
+/// the bus: what does not parse is no node, never an exception.
+std::optional<ReportedTrackNode> reported_track_node(const RunEvent& event);
+
 /// What the SVG shows besides the trajectories (field frame, metres).
 struct FieldDrawing {
   double width_m = 1.5;

@@ -5,25 +5,19 @@
 #include <cstdio>
 #include <limits>
 
-#include <nlohmann/json.hpp>
-
 namespace rilbed::run {
 
 std::vector<ReportedTrackNode> reported_track_nodes(const std::vector<RunEvent>& events, int robot_id) {
   std::vector<ReportedTrackNode> nodes;
   for (const RunEvent& e : events) {
-    if (e.kind != "track_node" || e.id != robot_id) continue;
-    const nlohmann::json d = nlohmann::json::parse(e.detail, nullptr, false);
-    if (!d.is_object() || !d.contains("kind") || !d["kind"].is_string() || !d.contains("x_m") ||
-        !d["x_m"].is_number() || !d.contains("y_m") || !d["y_m"].is_number())
-      continue;
-    ReportedTrackNode node{
-        e.other, d["kind"].get<std::string>(), {d["x_m"].get<double>(), d["y_m"].get<double>()}, e.t_us};
-    const auto same = std::find_if(nodes.begin(), nodes.end(), [&](const auto& n) { return n.id == e.other; });
+    if (e.id != robot_id) continue;
+    const auto node = reported_track_node(e);
+    if (!node) continue;
+    const auto same = std::find_if(nodes.begin(), nodes.end(), [&](const auto& n) { return n.id == node->id; });
     if (same != nodes.end())
-      *same = node;
+      *same = *node;
     else
-      nodes.push_back(node);
+      nodes.push_back(*node);
   }
   return nodes;
 }

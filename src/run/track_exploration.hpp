@@ -15,14 +15,6 @@
 
 namespace rilbed::run {
 
-/// A node a robot reported (a `track_node` event's detail).
-struct ReportedTrackNode {
-  int id = 0;
-  std::string kind;  ///< "end", "corner", "tee", "cross"
-  Vec2 position_m;
-  TimeUs t_us = 0;  ///< when it was reported
-};
-
 /// The nodes robot `robot_id` reported, latest per ID, from a run's events. Details that
 /// do not parse are skipped.
 std::vector<ReportedTrackNode> reported_track_nodes(const std::vector<RunEvent>& events, int robot_id);
